@@ -1,0 +1,33 @@
+//! `ricci` — the command-line tool. Argument parsing, progress, JSON reports and error
+//! messages for people; no math lives here (DESIGN.md §2, §4).
+//!
+//! Exit codes: 0 success, 1 bad input (the library refused the data), 2 bad arguments.
+
+mod cmd;
+mod util;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "ricci", version, about = "Discrete surface Ricci flow, surface structures and manifold splines")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Validate a mesh and report its topology and triangle quality.
+    Info(cmd::info::Args),
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Info(a) => cmd::info::run(a),
+    };
+    if let Err(e) = result {
+        eprintln!("error: {}", util::sentence(&e));
+        std::process::exit(util::exit_code(&e));
+    }
+}

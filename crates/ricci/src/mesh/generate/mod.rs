@@ -1,0 +1,1 @@
+//! Procedural surfaces of good triangle quality (test and demo inputs).

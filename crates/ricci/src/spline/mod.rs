@@ -1,0 +1,1 @@
+//! Triangular B-splines (DMS) and manifold splines (paper 000 §5).
