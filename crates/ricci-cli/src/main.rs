@@ -9,7 +9,11 @@ mod util;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "ricci", version, about = "Discrete surface Ricci flow, surface structures and manifold splines")]
+#[command(
+    name = "ricci",
+    version,
+    about = "Discrete surface Ricci flow, surface structures and manifold splines"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

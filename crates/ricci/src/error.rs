@@ -19,7 +19,11 @@ pub struct Location {
 
 impl Location {
     pub fn file(file: impl Into<String>) -> Self {
-        Location { file: Some(file.into()), line: None, byte: None }
+        Location {
+            file: Some(file.into()),
+            line: None,
+            byte: None,
+        }
     }
     pub fn with_line(mut self, line: usize) -> Self {
         self.line = Some(line);
@@ -62,7 +66,10 @@ pub enum Error {
     Parse { location: Location, message: String },
     /// The mesh is not a valid oriented 2-manifold triangle mesh (non-manifold, non-orientable, …).
     #[error("{}{message}", prefix(.file))]
-    InvalidMesh { file: Option<String>, message: String },
+    InvalidMesh {
+        file: Option<String>,
+        message: String,
+    },
     /// The mesh is valid but has the wrong topology for the requested operation.
     #[error("{message}")]
     Topology { message: String },
@@ -83,30 +90,52 @@ fn prefix(file: &Option<String>) -> String {
 
 impl Error {
     pub fn io(path: impl Into<String>, source: std::io::Error) -> Self {
-        Error::Io { path: path.into(), source }
+        Error::Io {
+            path: path.into(),
+            source,
+        }
     }
     pub fn parse(location: Location, message: impl Into<String>) -> Self {
-        Error::Parse { location, message: message.into() }
+        Error::Parse {
+            location,
+            message: message.into(),
+        }
     }
     pub fn invalid_mesh(message: impl Into<String>) -> Self {
-        Error::InvalidMesh { file: None, message: message.into() }
+        Error::InvalidMesh {
+            file: None,
+            message: message.into(),
+        }
     }
     pub fn topology(message: impl Into<String>) -> Self {
-        Error::Topology { message: message.into() }
+        Error::Topology {
+            message: message.into(),
+        }
     }
     pub fn input(message: impl Into<String>) -> Self {
-        Error::InvalidInput { message: message.into() }
+        Error::InvalidInput {
+            message: message.into(),
+        }
     }
     pub fn numerical(message: impl Into<String>) -> Self {
-        Error::Numerical { message: message.into() }
+        Error::Numerical {
+            message: message.into(),
+        }
     }
     /// Attach a file name to an error that does not carry one yet.
     pub fn in_file(self, file: &str) -> Self {
         match self {
-            Error::InvalidMesh { file: None, message } => {
-                Error::InvalidMesh { file: Some(file.to_string()), message }
-            }
-            Error::Parse { mut location, message } if location.file.is_none() => {
+            Error::InvalidMesh {
+                file: None,
+                message,
+            } => Error::InvalidMesh {
+                file: Some(file.to_string()),
+                message,
+            },
+            Error::Parse {
+                mut location,
+                message,
+            } if location.file.is_none() => {
                 location.file = Some(file.to_string());
                 Error::Parse { location, message }
             }

@@ -27,6 +27,7 @@ pub mod flow;
 pub mod layout;
 pub mod mesh;
 pub mod metric;
+pub mod progress;
 pub mod spline;
 
 pub use error::{Error, Result};

@@ -19,7 +19,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let m = &surface.mesh;
     let t = topology(m);
     let q = angle_stats(&surface);
-    let genus = if t.components.len() == 1 { json!(t.components[0].genus) } else { json!(t.genus()) };
+    let genus = if t.components.len() == 1 {
+        json!(t.components[0].genus)
+    } else {
+        json!(t.genus())
+    };
     let v = json!({
         "file": a.mesh.display().to_string(),
         "vertices": m.n_vertices(),
@@ -57,7 +61,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 c.vertices, c.edges, c.faces, c.boundary_loops, c.euler_characteristic, c.genus
             );
         }
-        println!("  angles: min {:.3}°, max {:.3}°", q.min_angle_deg, q.max_angle_deg);
+        println!(
+            "  angles: min {:.3}°, max {:.3}°",
+            q.min_angle_deg, q.max_angle_deg
+        );
         for n in &report.notes {
             println!("  note: {n}");
         }

@@ -121,7 +121,10 @@ pub fn build_surface(soup: PolygonSoup) -> Result<(Surface, BuildReport)> {
         keys.sort_unstable();
         for w in keys.windows(2) {
             if w[0].0 == w[1].0 {
-                let (a, b) = (tri_src[w[0].1 as usize] as usize, tri_src[w[1].1 as usize] as usize);
+                let (a, b) = (
+                    tri_src[w[0].1 as usize] as usize,
+                    tri_src[w[1].1 as usize] as usize,
+                );
                 return Err(Error::invalid_mesh(format!(
                     "faces {a}{} and {b}{} are duplicates (both use vertices {}, {}, {})",
                     at_line(&soup.polygon_lines, a),
@@ -138,12 +141,22 @@ pub fn build_surface(soup: PolygonSoup) -> Result<(Surface, BuildReport)> {
     for (f, t) in tris.iter().enumerate() {
         for i in 0..3 {
             let (a, b) = (t[i], t[(i + 1) % 3]);
-            edge_faces.entry((a.min(b), a.max(b))).or_default().push(f as u32);
+            edge_faces
+                .entry((a.min(b), a.max(b)))
+                .or_default()
+                .push(f as u32);
         }
     }
     // Report the non-manifold edge with the smallest vertex ids (deterministic).
-    if let Some(((a, b), fs)) = edge_faces.iter().filter(|(_, fs)| fs.len() > 2).min_by_key(|(k, _)| **k) {
-        let list: Vec<String> = fs.iter().map(|&f| tri_src[f as usize].to_string()).collect();
+    if let Some(((a, b), fs)) = edge_faces
+        .iter()
+        .filter(|(_, fs)| fs.len() > 2)
+        .min_by_key(|(k, _)| **k)
+    {
+        let list: Vec<String> = fs
+            .iter()
+            .map(|&f| tri_src[f as usize].to_string())
+            .collect();
         return Err(Error::invalid_mesh(format!(
             "non-manifold edge between vertices {a} and {b}: it is shared by {} faces ({})",
             fs.len(),
@@ -222,17 +235,36 @@ pub fn build_surface(soup: PolygonSoup) -> Result<(Surface, BuildReport)> {
         }
     }
     if !report.dropped_vertices.is_empty() {
-        let first: Vec<String> = report.dropped_vertices.iter().take(5).map(|v| v.to_string()).collect();
+        let first: Vec<String> = report
+            .dropped_vertices
+            .iter()
+            .take(5)
+            .map(|v| v.to_string())
+            .collect();
         report.notes.push(format!(
             "{} vertices no face refers to were dropped (first: {})",
             report.dropped_vertices.len(),
             first.join(", ")
         ));
     }
-    let positions: Vec<[f64; 3]> = vertex_origin.iter().map(|&v| soup.positions[v as usize]).collect();
-    let uvs = soup.uvs.as_ref().map(|uv| vertex_origin.iter().map(|&v| uv[v as usize]).collect());
-    let faces: Vec<[u32; 3]> =
-        tris.iter().map(|t| [new_id[t[0] as usize], new_id[t[1] as usize], new_id[t[2] as usize]]).collect();
+    let positions: Vec<[f64; 3]> = vertex_origin
+        .iter()
+        .map(|&v| soup.positions[v as usize])
+        .collect();
+    let uvs = soup
+        .uvs
+        .as_ref()
+        .map(|uv| vertex_origin.iter().map(|&v| uv[v as usize]).collect());
+    let faces: Vec<[u32; 3]> = tris
+        .iter()
+        .map(|t| {
+            [
+                new_id[t[0] as usize],
+                new_id[t[1] as usize],
+                new_id[t[2] as usize],
+            ]
+        })
+        .collect();
     let mesh = Mesh::from_triangles(positions.len(), faces).map_err(|e| match e {
         // Translate ids back to the input numbering in the message.
         Error::InvalidMesh { file, message } => Error::InvalidMesh {
@@ -246,16 +278,25 @@ pub fn build_surface(soup: PolygonSoup) -> Result<(Surface, BuildReport)> {
         let [a, b, c] = t.map(|v| positions[v as usize]);
         let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
         let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        let n = [u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]];
+        let n = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
         let area2 = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        let scale = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).max(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+        let scale =
+            (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).max(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
         if area2 <= 1e-14 * scale || scale == 0.0 {
             report.zero_area_faces.push(f as u32);
         }
     }
     if !report.zero_area_faces.is_empty() {
-        let first: Vec<String> =
-            report.zero_area_faces.iter().take(5).map(|&f| tri_src[f as usize].to_string()).collect();
+        let first: Vec<String> = report
+            .zero_area_faces
+            .iter()
+            .take(5)
+            .map(|&f| tri_src[f as usize].to_string())
+            .collect();
         report.notes.push(format!(
             "{} faces have zero area (first: {})",
             report.zero_area_faces.len(),
@@ -264,7 +305,14 @@ pub fn build_surface(soup: PolygonSoup) -> Result<(Surface, BuildReport)> {
     }
     report.vertex_origin = vertex_origin;
     report.face_origin = tri_src;
-    Ok((Surface { mesh, positions, uvs }, report))
+    Ok((
+        Surface {
+            mesh,
+            positions,
+            uvs,
+        },
+        report,
+    ))
 }
 
 /// Rewrite "vertex N" in a message from output ids to input ids (and add the line).
@@ -291,7 +339,11 @@ mod tests {
     use super::*;
 
     fn soup(positions: Vec<[f64; 3]>, polygons: Vec<Vec<u32>>) -> PolygonSoup {
-        PolygonSoup { positions, polygons, ..Default::default() }
+        PolygonSoup {
+            positions,
+            polygons,
+            ..Default::default()
+        }
     }
 
     fn square_grid(n: usize) -> PolygonSoup {
@@ -344,7 +396,12 @@ mod tests {
         }
         let mut q = Vec::new();
         for i in 0..n - 1 {
-            q.push(vec![2 * i as u32, 2 * i as u32 + 2, 2 * i as u32 + 3, 2 * i as u32 + 1]);
+            q.push(vec![
+                2 * i as u32,
+                2 * i as u32 + 2,
+                2 * i as u32 + 3,
+                2 * i as u32 + 1,
+            ]);
         }
         let l = 2 * (n - 1) as u32;
         q.push(vec![l, 1, 0, l + 1]); // twisted closure
@@ -354,15 +411,24 @@ mod tests {
 
     #[test]
     fn errors_name_the_culprit() {
-        let e = build_surface(soup(vec![[0.0; 3]; 3], vec![vec![0, 1, 3]])).unwrap_err().to_string();
-        assert!(e.contains("face 0") && e.contains("vertex 3"), "{e}");
-        let e = build_surface(soup(vec![[0.0, f64::NAN, 0.0], [1.0; 3], [2.0; 3]], vec![vec![0, 1, 2]]))
+        let e = build_surface(soup(vec![[0.0; 3]; 3], vec![vec![0, 1, 3]]))
             .unwrap_err()
             .to_string();
+        assert!(e.contains("face 0") && e.contains("vertex 3"), "{e}");
+        let e = build_surface(soup(
+            vec![[0.0, f64::NAN, 0.0], [1.0; 3], [2.0; 3]],
+            vec![vec![0, 1, 2]],
+        ))
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("vertex 0") && e.contains("non-finite"), "{e}");
-        let e = build_surface(soup(vec![[0.0; 3]; 3], vec![vec![0, 1, 1]])).unwrap_err().to_string();
+        let e = build_surface(soup(vec![[0.0; 3]; 3], vec![vec![0, 1, 1]]))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("face 0"), "{e}");
-        let e = build_surface(soup(vec![[0.0; 3]; 3], vec![vec![0, 1, 2], vec![2, 1, 0]])).unwrap_err().to_string();
+        let e = build_surface(soup(vec![[0.0; 3]; 3], vec![vec![0, 1, 2], vec![2, 1, 0]]))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("duplicates"), "{e}");
         let e = build_surface(soup(vec![], vec![])).unwrap_err().to_string();
         assert!(e.contains("no faces"), "{e}");
@@ -371,8 +437,17 @@ mod tests {
     #[test]
     fn pinched_vertex_is_named_in_input_numbering() {
         // Vertex 0 is unreferenced; two triangles touch at input vertex 1 only.
-        let p = vec![[0.0; 3], [0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]];
-        let e = build_surface(soup(p, vec![vec![1, 2, 3], vec![1, 4, 5]])).unwrap_err().to_string();
+        let p = vec![
+            [0.0; 3],
+            [0.0; 3],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, -1.0, 0.0],
+        ];
+        let e = build_surface(soup(p, vec![vec![1, 2, 3], vec![1, 4, 5]]))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("non-manifold vertex 1"), "{e}");
     }
 }

@@ -60,7 +60,11 @@ impl Mesh {
             if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
                 return Err(Error::invalid_mesh(format!(
                     "face {f} uses vertex {} twice",
-                    if t[0] == t[1] || t[0] == t[2] { t[0] } else { t[1] }
+                    if t[0] == t[1] || t[0] == t[2] {
+                        t[0]
+                    } else {
+                        t[1]
+                    }
                 )));
             }
         }
@@ -68,7 +72,10 @@ impl Mesh {
         let nh_int = 3 * nf;
         let mut keyed: Vec<(u64, u32)> = (0..nh_int as u32)
             .map(|h| {
-                let (a, b) = (faces[h as usize / 3][h as usize % 3], faces[h as usize / 3][(h as usize % 3 + 1) % 3]);
+                let (a, b) = (
+                    faces[h as usize / 3][h as usize % 3],
+                    faces[h as usize / 3][(h as usize % 3 + 1) % 3],
+                );
                 let (lo, hi) = if a < b { (a, b) } else { (b, a) };
                 (((lo as u64) << 32) | hi as u64, h)
             })
@@ -111,7 +118,8 @@ impl Mesh {
                     edge_he.push(h0);
                 }
                 n => {
-                    let fs: Vec<String> = keyed[i..j].iter().map(|x| (x.1 / 3).to_string()).collect();
+                    let fs: Vec<String> =
+                        keyed[i..j].iter().map(|x| (x.1 / 3).to_string()).collect();
                     return Err(Error::invalid_mesh(format!(
                         "non-manifold edge ({lo}, {hi}) is shared by {n} faces ({})",
                         fs.join(", ")
@@ -160,7 +168,16 @@ impl Mesh {
             // h = u→w interior with boundary twin: it is the first outgoing half-edge of u.
             vertex_he[origin(h) as usize] = h;
         }
-        let mesh = Mesh { n_vertices, faces, twin, boundary_next, boundary_origin, he_edge, edge_he, vertex_he };
+        let mesh = Mesh {
+            n_vertices,
+            faces,
+            twin,
+            boundary_next,
+            boundary_origin,
+            he_edge,
+            edge_he,
+            vertex_he,
+        };
         mesh.check_vertex_fans()?;
         Ok(mesh)
     }
@@ -177,7 +194,10 @@ impl Mesh {
             if self.vertex_he[v] == NONE {
                 continue;
             }
-            let fan = self.vertex_faces(v as u32).take(count[v] as usize + 1).count();
+            let fan = self
+                .vertex_faces(v as u32)
+                .take(count[v] as usize + 1)
+                .count();
             if fan != count[v] as usize {
                 return Err(Error::invalid_mesh(format!(
                     "non-manifold vertex {v}: its {} faces form more than one fan (the surface is pinched there)",
@@ -222,7 +242,11 @@ impl Mesh {
     }
     /// The three edges of face `f`, edge `i` opposite to vertex `i`.
     pub fn face_edges_opposite(&self, f: u32) -> [u32; 3] {
-        [self.he_edge[(3 * f + 1) as usize], self.he_edge[(3 * f + 2) as usize], self.he_edge[(3 * f) as usize]]
+        [
+            self.he_edge[(3 * f + 1) as usize],
+            self.he_edge[(3 * f + 2) as usize],
+            self.he_edge[(3 * f) as usize],
+        ]
     }
 
     // ----- half-edges -----
@@ -335,7 +359,12 @@ impl Mesh {
     /// half-edge, so the tips enumerate all neighbours exactly once.
     pub fn outgoing(&self, v: u32) -> Outgoing<'_> {
         let start = self.vertex_he[v as usize];
-        Outgoing { mesh: self, start, cur: start, done: start == NONE }
+        Outgoing {
+            mesh: self,
+            start,
+            cur: start,
+            done: start == NONE,
+        }
     }
     /// Neighbouring vertices in counter-clockwise order.
     pub fn vertex_neighbors(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
@@ -343,11 +372,14 @@ impl Mesh {
     }
     /// Faces around `v` in counter-clockwise order.
     pub fn vertex_faces(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
-        self.outgoing(v).filter(move |&h| !self.is_boundary_halfedge(h)).map(|h| h / 3)
+        self.outgoing(v)
+            .filter(move |&h| !self.is_boundary_halfedge(h))
+            .map(|h| h / 3)
     }
     /// Corners at `v` (interior outgoing half-edges = corners at their origin), counter-clockwise.
     pub fn vertex_corners(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
-        self.outgoing(v).filter(move |&h| !self.is_boundary_halfedge(h))
+        self.outgoing(v)
+            .filter(move |&h| !self.is_boundary_halfedge(h))
     }
     /// Number of edges at `v`.
     pub fn valence(&self, v: u32) -> usize {

@@ -28,7 +28,11 @@ impl Surface {
     /// Build from triangles, validating connectivity (see [`build_surface`] for soups).
     pub fn new(positions: Vec<[f64; 3]>, faces: Vec<[u32; 3]>) -> crate::Result<Surface> {
         let mesh = Mesh::from_triangles(positions.len(), faces)?;
-        Ok(Surface { mesh, positions, uvs: None })
+        Ok(Surface {
+            mesh,
+            positions,
+            uvs: None,
+        })
     }
 
     /// Euclidean length of every edge, indexed by edge id.

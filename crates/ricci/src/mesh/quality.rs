@@ -20,7 +20,11 @@ pub fn face_angles(s: &Surface, f: u32) -> [f64; 3] {
         let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
         let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
         let dot = u[0] * w[0] + u[1] * w[1] + u[2] * w[2];
-        let cr = [u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]];
+        let cr = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
         let crn = (cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]).sqrt();
         out[i] = crn.atan2(dot);
     }
@@ -37,5 +41,8 @@ pub fn angle_stats(s: &Surface) -> AngleStats {
             hi = hi.max(a);
         }
     }
-    AngleStats { min_angle_deg: lo.to_degrees(), max_angle_deg: hi.to_degrees() }
+    AngleStats {
+        min_angle_deg: lo.to_degrees(),
+        max_angle_deg: hi.to_degrees(),
+    }
 }

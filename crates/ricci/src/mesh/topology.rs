@@ -95,7 +95,10 @@ pub fn topology(mesh: &Mesh) -> Topology {
         c.euler_characteristic = c.vertices as i64 - c.edges as i64 + c.faces as i64;
         c.genus = (2 - c.euler_characteristic - c.boundary_loops as i64) / 2;
     }
-    Topology { face_component: comp, components }
+    Topology {
+        face_component: comp,
+        components,
+    }
 }
 
 #[cfg(test)]

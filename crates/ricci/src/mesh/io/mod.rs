@@ -10,6 +10,8 @@ use std::path::Path;
 /// Read and validate a mesh file; the format is chosen by extension.
 pub fn read_surface(path: &Path) -> Result<(Surface, BuildReport)> {
     let name = path.display().to_string();
-    Err(Error::input(format!("{name}: no mesh readers are implemented yet")))
-        .and_then(|s| build_surface(s).map_err(|e: Error| e.in_file(&name)))
+    Err(Error::input(format!(
+        "{name}: no mesh readers are implemented yet"
+    )))
+    .and_then(|s| build_surface(s).map_err(|e: Error| e.in_file(&name)))
 }

@@ -1,0 +1,270 @@
+//! The three background geometries of discrete Ricci flow (paper 001 §IV): Euclidean E²
+//! (curvature 0), hyperbolic H² (−1) and spherical S² (+1).
+//!
+//! Code that differs per geometry (cosine laws, areas, later their derivatives and layouts) is
+//! written once against the [`Background`] trait; the runtime [`Geometry`] enum picks the
+//! implementation once at the top (`match g { Geometry::Euclidean => f::<Euclidean>(), … }`).
+//!
+//! Notation (DESIGN.md §3): `s(x), c(x)` are `x, 1` (E²), `sinh x, cosh x` (H²),
+//! `sin x, cos x` (S²).
+
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+use std::fmt;
+use std::str::FromStr;
+
+/// Background geometry chosen at run time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Geometry {
+    Euclidean,
+    Hyperbolic,
+    Spherical,
+}
+
+impl Geometry {
+    /// Gaussian curvature λ of the background (0, −1, +1), as in Gauss–Bonnet
+    /// `Σ K_i + λ·Area = 2πχ`.
+    pub fn curvature(self) -> f64 {
+        match self {
+            Geometry::Euclidean => 0.0,
+            Geometry::Hyperbolic => -1.0,
+            Geometry::Spherical => 1.0,
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            Geometry::Euclidean => "euclidean",
+            Geometry::Hyperbolic => "hyperbolic",
+            Geometry::Spherical => "spherical",
+        }
+    }
+    /// Corner angle opposite side `a` (see [`Background::angle`]).
+    pub fn angle(self, a: f64, b: f64, c: f64) -> f64 {
+        match self {
+            Geometry::Euclidean => Euclidean::angle(a, b, c),
+            Geometry::Hyperbolic => Hyperbolic::angle(a, b, c),
+            Geometry::Spherical => Spherical::angle(a, b, c),
+        }
+    }
+    /// Side opposite the angle `theta` enclosed by sides `b` and `c`.
+    pub fn side(self, b: f64, c: f64, theta: f64) -> f64 {
+        match self {
+            Geometry::Euclidean => Euclidean::side(b, c, theta),
+            Geometry::Hyperbolic => Hyperbolic::side(b, c, theta),
+            Geometry::Spherical => Spherical::side(b, c, theta),
+        }
+    }
+    /// Area of the triangle with sides `a, b, c`.
+    pub fn area(self, a: f64, b: f64, c: f64) -> f64 {
+        match self {
+            Geometry::Euclidean => Euclidean::area(a, b, c),
+            Geometry::Hyperbolic => Hyperbolic::area(a, b, c),
+            Geometry::Spherical => Spherical::area(a, b, c),
+        }
+    }
+}
+
+impl fmt::Display for Geometry {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Geometry {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "euclidean" | "e2" | "flat" => Ok(Geometry::Euclidean),
+            "hyperbolic" | "h2" => Ok(Geometry::Hyperbolic),
+            "spherical" | "s2" => Ok(Geometry::Spherical),
+            _ => Err(format!(
+                "unknown geometry '{s}' (expected euclidean, hyperbolic or spherical)"
+            )),
+        }
+    }
+}
+
+/// A background geometry at compile time.
+pub trait Background: Copy + Send + Sync + 'static {
+    const KIND: Geometry;
+    /// `x`, `sinh x`, `sin x`.
+    fn s(x: f64) -> f64;
+    /// `1`, `cosh x`, `cos x`.
+    fn c(x: f64) -> f64;
+
+    /// Corner angle opposite side `a` in the triangle with sides `a, b, c`, by the half-angle
+    /// form of the cosine law, `tan²(θ/2) = s(σ−b)s(σ−c) / (s(σ)s(σ−a))` with σ the
+    /// semi-perimeter, which is accurate for small and large angles alike. Degenerate
+    /// triangles get the continuous extension: θ = π if `a ≥ b + c`, θ = 0 if `b ≥ a + c` or
+    /// `c ≥ a + b`.
+    #[inline]
+    fn angle(a: f64, b: f64, c: f64) -> f64 {
+        let sig = 0.5 * (a + b + c);
+        let (sa, sb, sc) = (sig - a, sig - b, sig - c);
+        if sa <= 0.0 {
+            return PI;
+        }
+        if sb <= 0.0 || sc <= 0.0 {
+            return 0.0;
+        }
+        let den = Self::s(sig) * Self::s(sa);
+        if den <= 0.0 {
+            // Spherical triangles with perimeter ≥ 2π: fall back to the cosine law.
+            return Self::angle_cosine_law(a, b, c);
+        }
+        2.0 * ((Self::s(sb) * Self::s(sc) / den).max(0.0)).sqrt().atan()
+    }
+
+    /// Corner angle by the plain cosine law (clamped), for reference and fallbacks.
+    fn angle_cosine_law(a: f64, b: f64, c: f64) -> f64;
+
+    /// Side opposite the angle `theta` enclosed by sides `b` and `c`.
+    fn side(b: f64, c: f64, theta: f64) -> f64;
+
+    /// Area of the triangle with sides `a, b, c` (Heron; angle defect / excess).
+    fn area(a: f64, b: f64, c: f64) -> f64;
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Euclidean;
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Hyperbolic;
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Spherical;
+
+impl Background for Euclidean {
+    const KIND: Geometry = Geometry::Euclidean;
+    #[inline]
+    fn s(x: f64) -> f64 {
+        x
+    }
+    #[inline]
+    fn c(_: f64) -> f64 {
+        1.0
+    }
+    fn angle_cosine_law(a: f64, b: f64, c: f64) -> f64 {
+        ((b * b + c * c - a * a) / (2.0 * b * c))
+            .clamp(-1.0, 1.0)
+            .acos()
+    }
+    fn side(b: f64, c: f64, theta: f64) -> f64 {
+        // a² = (b − c)² + 4bc sin²(θ/2): no cancellation for small θ.
+        let h = (0.5 * theta).sin();
+        ((b - c) * (b - c) + 4.0 * b * c * h * h).max(0.0).sqrt()
+    }
+    fn area(a: f64, b: f64, c: f64) -> f64 {
+        // Kahan's stable Heron formula (sides sorted a ≥ b ≥ c).
+        let mut s = [a, b, c];
+        s.sort_by(|x, y| y.total_cmp(x));
+        let [a, b, c] = s;
+        let p = (a + (b + c)) * (c - (a - b)) * (c + (a - b)) * (a + (b - c));
+        0.25 * p.max(0.0).sqrt()
+    }
+}
+
+impl Background for Hyperbolic {
+    const KIND: Geometry = Geometry::Hyperbolic;
+    #[inline]
+    fn s(x: f64) -> f64 {
+        x.sinh()
+    }
+    #[inline]
+    fn c(x: f64) -> f64 {
+        x.cosh()
+    }
+    fn angle_cosine_law(a: f64, b: f64, c: f64) -> f64 {
+        ((b.cosh() * c.cosh() - a.cosh()) / (b.sinh() * c.sinh()))
+            .clamp(-1.0, 1.0)
+            .acos()
+    }
+    fn side(b: f64, c: f64, theta: f64) -> f64 {
+        // cosh a = cosh(b − c) + 2 sinh b sinh c sin²(θ/2).
+        let h = (0.5 * theta).sin();
+        let ch = (b - c).cosh() + 2.0 * b.sinh() * c.sinh() * h * h;
+        ch.max(1.0).acosh()
+    }
+    fn area(a: f64, b: f64, c: f64) -> f64 {
+        (PI - Self::angle(a, b, c) - Self::angle(b, c, a) - Self::angle(c, a, b)).max(0.0)
+    }
+}
+
+impl Background for Spherical {
+    const KIND: Geometry = Geometry::Spherical;
+    #[inline]
+    fn s(x: f64) -> f64 {
+        x.sin()
+    }
+    #[inline]
+    fn c(x: f64) -> f64 {
+        x.cos()
+    }
+    fn angle_cosine_law(a: f64, b: f64, c: f64) -> f64 {
+        ((a.cos() - b.cos() * c.cos()) / (b.sin() * c.sin()))
+            .clamp(-1.0, 1.0)
+            .acos()
+    }
+    fn side(b: f64, c: f64, theta: f64) -> f64 {
+        // cos a = cos(b − c) − 2 sin b sin c sin²(θ/2).
+        let h = (0.5 * theta).sin();
+        let ca = (b - c).cos() - 2.0 * b.sin() * c.sin() * h * h;
+        ca.clamp(-1.0, 1.0).acos()
+    }
+    fn area(a: f64, b: f64, c: f64) -> f64 {
+        (Self::angle(a, b, c) + Self::angle(b, c, a) + Self::angle(c, a, b) - PI).max(0.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check<B: Background>(a: f64, b: f64, c: f64) {
+        let t = B::angle(a, b, c);
+        let t2 = B::angle_cosine_law(a, b, c);
+        assert!((t - t2).abs() < 1e-9, "{:?}: {t} vs {t2}", B::KIND);
+        let a2 = B::side(b, c, t);
+        assert!(
+            (a - a2).abs() < 1e-12 * (1.0 + a),
+            "{:?}: side {a} vs {a2}",
+            B::KIND
+        );
+    }
+
+    #[test]
+    fn half_angle_agrees_with_cosine_law_and_side_inverts_angle() {
+        for &(a, b, c) in &[
+            (0.3, 0.4, 0.5),
+            (0.1, 0.2, 0.25),
+            (0.5, 0.5, 0.5),
+            (0.05, 0.9, 0.93),
+        ] {
+            check::<Euclidean>(a, b, c);
+            check::<Hyperbolic>(a, b, c);
+            check::<Spherical>(a, b, c);
+        }
+    }
+
+    #[test]
+    fn angle_sums_match_curvature_of_background() {
+        // Equilateral triangles: E² sum π; H² less; S² more; area = |π − sum|.
+        let l = 0.7;
+        let e = 3.0 * Euclidean::angle(l, l, l);
+        let h = 3.0 * Hyperbolic::angle(l, l, l);
+        let s = 3.0 * Spherical::angle(l, l, l);
+        assert!((e - PI).abs() < 1e-14);
+        assert!(h < PI && s > PI);
+        // Octant of the unit sphere: sides π/2, angles π/2, area π/2.
+        let q = PI / 2.0;
+        assert!((Spherical::angle(q, q, q) - q).abs() < 1e-12);
+        assert!((Spherical::area(q, q, q) - q).abs() < 1e-12);
+        assert!((Euclidean::area(3.0, 4.0, 5.0) - 6.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn degenerate_triangles_get_the_continuous_extension() {
+        assert_eq!(Euclidean::angle(2.0, 1.0, 1.0), PI);
+        assert_eq!(Euclidean::angle(1.0, 2.5, 1.0), 0.0);
+        assert_eq!(Hyperbolic::angle(3.0, 1.0, 1.0), PI);
+    }
+}
