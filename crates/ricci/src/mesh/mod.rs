@@ -9,6 +9,7 @@ pub mod connectivity;
 pub mod generate;
 pub mod io;
 pub mod quality;
+pub mod refine;
 pub mod topology;
 
 pub use build::{build_surface, BuildReport, PolygonSoup};
