@@ -226,10 +226,31 @@ impl ConformalStructure {
         lengths: &mut [f64],
         derivatives: &mut [[f64; 2]],
     ) {
-        use super::scheme::{CirclePacking, VertexScaling};
         let edges: Vec<[u32; 2]> = (0..mesh.n_edges() as u32)
             .map(|e| mesh.edge_vertices(e))
             .collect();
+        self.lengths_of_edges(&edges, u, lengths, derivatives);
+    }
+
+    /// As [`ConformalStructure::lengths_and_derivatives`], with the connectivity cache.
+    pub fn lengths_from_data(
+        &self,
+        data: &super::MeshData,
+        u: &[f64],
+        lengths: &mut [f64],
+        derivatives: &mut [[f64; 2]],
+    ) {
+        self.lengths_of_edges(&data.edges, u, lengths, derivatives);
+    }
+
+    fn lengths_of_edges(
+        &self,
+        edges: &[[u32; 2]],
+        u: &[f64],
+        lengths: &mut [f64],
+        derivatives: &mut [[f64; 2]],
+    ) {
+        use super::scheme::{CirclePacking, VertexScaling};
         let mut vd = vec![[0.0; 3]; u.len()];
         macro_rules! go {
             ($b:ty, $l:ty) => {
