@@ -12,6 +12,11 @@ use super::{Mesh, Surface};
 use crate::error::{Error, Result};
 use std::collections::HashMap;
 
+/// A face counts as zero-area when its area is at most this times the squared diagonal of
+/// the bounding box (sides around 10⁻⁶ of the model's size: below the precision of typical
+/// ascii files).
+pub const ZERO_AREA_RELATIVE: f64 = 1e-12;
+
 /// What a mesh file holds before validation.
 #[derive(Debug, Clone, Default)]
 pub struct PolygonSoup {
@@ -24,6 +29,8 @@ pub struct PolygonSoup {
     pub polygon_lines: Option<Vec<usize>>,
     /// Texture coordinates per vertex, if the file carried them in a per-vertex way.
     pub uvs: Option<Vec<[f64; 2]>>,
+    /// What the reader ignored or changed, one sentence each (copied into the report).
+    pub notes: Vec<String>,
 }
 
 /// What the builder changed or noticed while accepting the input.
@@ -54,7 +61,10 @@ fn at_line(lines: &Option<Vec<usize>>, i: usize) -> String {
 
 /// Validate a polygon soup and build the surface. See the module docs for what is checked.
 pub fn build_surface(soup: PolygonSoup) -> Result<(Surface, BuildReport)> {
-    let mut report = BuildReport::default();
+    let mut report = BuildReport {
+        notes: soup.notes.clone(),
+        ..Default::default()
+    };
     let nv_in = soup.positions.len();
     if soup.polygons.is_empty() {
         return Err(Error::invalid_mesh("the file contains no faces"));
@@ -273,7 +283,19 @@ pub fn build_surface(soup: PolygonSoup) -> Result<(Surface, BuildReport)> {
         },
         other => other,
     })?;
-    // Zero-area faces.
+    // Zero-area faces: area at most ZERO_AREA_RELATIVE × (bounding-box diagonal)², or
+    // collinear corners to rounding (cross product ≤ 1e-14 × longest side²).
+    let diag2 = {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in &positions {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>()
+    };
     for (f, t) in mesh.faces().iter().enumerate() {
         let [a, b, c] = t.map(|v| positions[v as usize]);
         let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
@@ -286,7 +308,7 @@ pub fn build_surface(soup: PolygonSoup) -> Result<(Surface, BuildReport)> {
         let area2 = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
         let scale =
             (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).max(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-        if area2 <= 1e-14 * scale || scale == 0.0 {
+        if area2 <= 1e-14 * scale || 0.5 * area2 <= ZERO_AREA_RELATIVE * diag2 {
             report.zero_area_faces.push(f as u32);
         }
     }
