@@ -13,10 +13,14 @@
 
 mod obj;
 mod off;
+mod ply;
+mod stl;
 pub(crate) mod text;
 
 pub use obj::{parse_obj, write_obj};
 pub use off::{parse_off, write_off};
+pub use ply::{parse_ply, write_ply};
+pub use stl::{parse_stl, write_stl};
 
 use super::{build_surface, BuildReport, PolygonSoup, Surface};
 use crate::error::{Error, Result};
@@ -87,8 +91,8 @@ pub fn parse(data: &[u8], format: Format) -> Result<PolygonSoup> {
     match format {
         Format::Obj => parse_obj(data),
         Format::Off => parse_off(data),
-        Format::Ply => Err(text::whole("PLY reading is not implemented yet")),
-        Format::Stl => Err(text::whole("STL reading is not implemented yet")),
+        Format::Ply => parse_ply(data),
+        Format::Stl => parse_stl(data),
     }
 }
 
@@ -115,14 +119,12 @@ pub fn write_to<W: std::io::Write>(
     format: Format,
     encoding: Encoding,
 ) -> Result<()> {
-    let _ = encoding;
+    let binary = encoding == Encoding::Binary;
     match format {
         Format::Obj => write_obj(w, s),
         Format::Off => write_off(w, s),
-        Format::Ply | Format::Stl => Err(Error::input(format!(
-            "writing {} is not implemented yet",
-            format.name()
-        ))),
+        Format::Ply => write_ply(w, s, binary),
+        Format::Stl => write_stl(w, s, binary),
     }
 }
 

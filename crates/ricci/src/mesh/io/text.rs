@@ -21,10 +21,6 @@ impl<'a> Lines<'a> {
             line: 0,
         }
     }
-    /// Byte offset of the start of the next line.
-    pub(crate) fn offset(&self) -> usize {
-        self.pos
-    }
     /// The bytes not consumed yet.
     pub(crate) fn rest(&self) -> &'a [u8] {
         &self.data[self.pos..]
