@@ -39,6 +39,8 @@ use crate::mesh::Surface;
 use crate::progress::{NoProgress, Progress};
 use std::f64::consts::PI;
 
+pub use implicit::ToriChain;
+pub use remesh::Implicit;
 pub use sphere::icosphere;
 pub use torus::{torus, torus_grid};
 

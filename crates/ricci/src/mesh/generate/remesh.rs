@@ -27,13 +27,13 @@ use crate::error::{Error, Result};
 const NONE: u32 = u32::MAX;
 
 /// A smooth implicit surface `f = 0`, `f < 0` inside, `∇f` pointing out.
-pub(crate) trait Implicit {
-    fn value(&self, p: P3) -> f64;
-    fn gradient(&self, p: P3) -> P3;
+pub trait Implicit {
+    fn value(&self, p: [f64; 3]) -> f64;
+    fn gradient(&self, p: [f64; 3]) -> [f64; 3];
 
     /// Newton projection along the gradient onto `f = 0` (stops at `|f| ≤ 1e-12` or after 30
     /// steps; each step is limited to `max_step` so a bad start cannot jump to another sheet).
-    fn project(&self, mut p: P3, max_step: f64) -> P3 {
+    fn project(&self, mut p: [f64; 3], max_step: f64) -> [f64; 3] {
         for _ in 0..30 {
             let f = self.value(p);
             if f.abs() <= 1e-12 {
@@ -55,7 +55,7 @@ pub(crate) trait Implicit {
     }
 
     /// Unit outward normal at `p`.
-    fn normal(&self, p: P3) -> P3 {
+    fn normal(&self, p: [f64; 3]) -> [f64; 3] {
         let g = self.gradient(p);
         let n = norm(g);
         if n > 0.0 {
