@@ -218,14 +218,50 @@ pub enum GeneratorKind {
 
 /// Optional parameters; `None` takes the kind's default. A parameter that a kind does not
 /// use is refused by [`generate`].
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct GeneratorParams {
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub resolution: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub subdivisions: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub major: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub minor: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub inner: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub outer: Option<f64>,
+}
+
+impl GeneratorParams {
+    /// The parameters [`generate`] uses for `kind`: the given ones, with the defaults filled
+    /// in for the unset parameters that apply to the kind (for reports).
+    pub fn with_defaults(&self, kind: GeneratorKind) -> GeneratorParams {
+        let mut p = self.clone();
+        match kind {
+            GeneratorKind::Sphere => {
+                p.subdivisions = p
+                    .subdivisions
+                    .or(p.resolution)
+                    .or(Some(DEFAULT_SUBDIVISIONS));
+                p.resolution = None;
+            }
+            GeneratorKind::Torus => {
+                p.major = p.major.or(Some(DEFAULT_MAJOR));
+                p.minor = p.minor.or(Some(DEFAULT_MINOR));
+            }
+            GeneratorKind::Annulus => {
+                p.inner = p.inner.or(Some(DEFAULT_INNER));
+                p.outer = p.outer.or(Some(DEFAULT_OUTER));
+            }
+            _ => {}
+        }
+        if kind != GeneratorKind::Sphere {
+            p.resolution = p.resolution.or(Some(default_resolution(&kind)));
+        }
+        p
+    }
 }
 
 impl GeneratorKind {
