@@ -191,7 +191,7 @@ pub fn genus_with_progress(
     }
     // Grid fine enough to resolve the tubes, the holes and the blends.
     let r = field.minor;
-    let spacing = l.clamp(r / 10.0, r / 5.0);
+    let spacing = (2.0 * l).clamp(r / 20.0, r / 5.0);
     progress.report("marching", None, "polygonising the implicit surface");
     let (pos, tris) = implicit::marching_tetrahedra(&field, field.bounds(2.0 * spacing), spacing);
     let mut mesh = remesh::TriMesh::new(pos, tris)?;

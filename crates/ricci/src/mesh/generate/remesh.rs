@@ -387,6 +387,16 @@ impl TriMesh {
         out
     }
 
+    /// Whether some face around `v` folds over (normal outside the cone of half-angle
+    /// acos(`cos_limit`) around `up`) when `v` is at `p`.
+    fn star_folds(&self, p: P3, up: P3, cos_limit: f64, ring: &[u32]) -> bool {
+        ring.iter().any(|&g| {
+            let n = tri_normal(p, self.p(self.dst(g)), self.p(self.org(prev(g))));
+            let nn = norm(n) * norm(up);
+            nn == 0.0 || dot(n, up) <= cos_limit * nn
+        })
+    }
+
     /// Smallest angle among the faces around `v` when `v` is at `p` (`-1` if one folds over,
     /// i.e. its normal leaves the cone of half-angle acos(`cos_limit`) around `up`).
     fn star_quality(&self, p: P3, up: P3, cos_limit: f64, ring: &[u32]) -> f64 {
@@ -591,7 +601,7 @@ fn tangential_relaxation<F: Implicit>(m: &mut TriMesh, field: &F, max_step: f64)
         m.ring(v, &mut ring);
         let p = target[v as usize];
         let up = field.normal(p);
-        if m.star_quality(p, up, COS_FOLD, &ring) > 0.0 {
+        if !m.star_folds(p, up, COS_FOLD, &ring) {
             m.pos[v as usize] = p;
         }
     }
