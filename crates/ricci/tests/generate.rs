@@ -196,6 +196,31 @@ fn torus_grid_follows_the_conformal_modulus() {
     }
 }
 
+#[test]
+fn extreme_radii_scale_instead_of_overflowing() {
+    // Same shape at any scale: the mesh is the unit one, scaled.
+    let (a, b) = (
+        torus(1.0, 0.5, 24).unwrap(),
+        torus(1e300, 0.5e300, 24).unwrap(),
+    );
+    assert_eq!(a.mesh.faces(), b.mesh.faces());
+    for (p, q) in a.positions.iter().zip(&b.positions) {
+        for k in 0..3 {
+            assert!(
+                (p[k] * 1e300 - q[k]).abs() <= 1e-12 * 1e300,
+                "{p:?} vs {q:?}"
+            );
+        }
+    }
+    let (a, b) = (
+        annulus(0.25, 1.0, 32).unwrap(),
+        annulus(0.5e300, 2e300, 32).unwrap(),
+    );
+    assert_eq!(a.mesh.faces(), b.mesh.faces());
+    assert!(b.positions.iter().all(|p| p.iter().all(|x| x.is_finite())));
+    assert_planar_cover(&a, polygon_area(32, 1.0) - polygon_area(8, 0.25), "annulus");
+}
+
 // ---------------------------------------------------------------- planar
 
 #[test]
@@ -553,6 +578,8 @@ fn bad_parameters_are_refused_with_a_sentence() {
     input_error(icosphere(11), "subdivisions");
     input_error(annulus(1.0, 0.5, 32), "0 < inner < outer");
     input_error(annulus(0.0, 1.0, 32), "inner");
+    input_error(annulus(1e-9, 1.0, 32), "too small");
+    input_error(annulus(1.0, f64::INFINITY, 32), "outer");
     input_error(disk(3), "resolution");
     input_error(disk(1_000_000), "limit");
     input_error(pair_of_pants(8), "resolution");

@@ -100,29 +100,39 @@ pub fn disk(resolution: u32) -> Result<Surface> {
     )
 }
 
+/// Smallest accepted ratio `r_in / r_out` of the annulus.
+pub const MIN_ANNULUS_RATIO: f64 = 1e-3;
+
 /// Annulus `r_in < |p| < r_out` with `resolution` segments on the outer circle (the inner
-/// circle gets the same spacing, at least 8 segments).
+/// circle gets the same spacing, at least 8 segments). Meshed at `r_out = 1` and scaled, so
+/// only the ratio `r_in / r_out` (at least [`MIN_ANNULUS_RATIO`]) matters.
 pub fn annulus(r_in: f64, r_out: f64, resolution: u32) -> Result<Surface> {
     if !(r_in.is_finite() && r_out.is_finite()) || r_in <= 0.0 || r_out <= r_in {
         return Err(Error::input(format!(
             "annulus: the radii must satisfy 0 < inner < outer (got inner = {r_in}, outer = {r_out})"
         )));
     }
+    let ratio = r_in / r_out;
+    if ratio < MIN_ANNULUS_RATIO {
+        return Err(Error::input(format!(
+            "annulus: inner / outer = {ratio:e} is too small (at least {MIN_ANNULUS_RATIO})"
+        )));
+    }
     check_resolution("annulus", resolution, 8)?;
-    check_planar_size(
-        "annulus",
-        PI * (r_out * r_out - r_in * r_in),
-        r_out,
-        resolution,
-    )?;
-    planar::mesh_domain(
+    check_planar_size("annulus", PI * (1.0 - ratio * ratio), 1.0, resolution)?;
+    let mut s = planar::mesh_domain(
         "annulus",
         &planar::Domain {
-            outer: r_out,
-            holes: vec![([0.0, 0.0], r_in)],
+            outer: 1.0,
+            holes: vec![([0.0, 0.0], ratio)],
         },
         resolution,
-    )
+    )?;
+    for p in &mut s.positions {
+        p[0] *= r_out;
+        p[1] *= r_out;
+    }
+    Ok(s)
 }
 
 /// Radius and centres of the two holes of [`pair_of_pants`].
