@@ -281,7 +281,11 @@ mod tests {
         for i in 0..20 {
             for j in 0..20 {
                 let (t, p) = (i as f64 * 0.33, j as f64 * 0.29);
-                pts.push([1.0 + t.sin() * p.cos(), 2.0 + t.sin() * p.sin(), 3.0 + t.cos()]);
+                pts.push([
+                    1.0 + t.sin() * p.cos(),
+                    2.0 + t.sin() * p.sin(),
+                    3.0 + t.cos(),
+                ]);
             }
         }
         let (c, r) = bounding_sphere(&pts);
@@ -291,14 +295,28 @@ mod tests {
 
     #[test]
     fn orthographic_front_camera_maps_square_to_centred_square() {
-        let sq = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 2.0, 0.0], [0.0, 2.0, 0.0]];
-        let view = View { margin: 1.25, ..View::front() };
+        let sq = [
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 2.0, 0.0],
+            [0.0, 2.0, 0.0],
+        ];
+        let view = View {
+            margin: 1.25,
+            ..View::front()
+        };
         let cam = Camera::frame(&sq, &view, [0.0, 0.0, 100.0, 100.0]).unwrap();
         // The square spans 100/1.25 = 80 pixels, centred: from 10 to 90; y flipped.
         let p = cam.project([0.0, 0.0, 0.0]);
         let q = cam.project([2.0, 2.0, 0.0]);
-        assert!((p.x - 10.0).abs() < 1e-9 && (p.y - 90.0).abs() < 1e-9, "{p:?}");
-        assert!((q.x - 90.0).abs() < 1e-9 && (q.y - 10.0).abs() < 1e-9, "{q:?}");
+        assert!(
+            (p.x - 10.0).abs() < 1e-9 && (p.y - 90.0).abs() < 1e-9,
+            "{p:?}"
+        );
+        assert!(
+            (q.x - 90.0).abs() < 1e-9 && (q.y - 10.0).abs() < 1e-9,
+            "{q:?}"
+        );
         assert!(p.depth > 0.0);
     }
 
@@ -320,7 +338,10 @@ mod tests {
         for p in &pts {
             let s = cam.project(*p);
             assert!(s.depth > 0.0);
-            assert!(s.x > 0.0 && s.x < 200.0 && s.y > 0.0 && s.y < 100.0, "{s:?}");
+            assert!(
+                s.x > 0.0 && s.x < 200.0 && s.y > 0.0 && s.y < 100.0,
+                "{s:?}"
+            );
             touched |= s.x < 15.0 || s.x > 185.0 || s.y < 8.0 || s.y > 92.0;
         }
         assert!(touched, "the framing is far from tight");

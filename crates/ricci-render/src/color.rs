@@ -38,7 +38,11 @@ pub fn linear_to_srgb(c: f32) -> f32 {
 /// An sRGB colour converted to linear light.
 #[inline]
 pub fn to_linear(c: Rgb) -> Rgb {
-    [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2])]
+    [
+        srgb_to_linear(c[0]),
+        srgb_to_linear(c[1]),
+        srgb_to_linear(c[2]),
+    ]
 }
 
 /// Parse `#rrggbb` (or `rrggbb`) into an sRGB colour.
@@ -47,7 +51,11 @@ pub fn parse_hex(s: &str) -> Option<Rgb> {
     if s.len() != 6 || !s.is_ascii() {
         return None;
     }
-    let c = |i: usize| u8::from_str_radix(&s[i..i + 2], 16).ok().map(|v| v as f32 / 255.0);
+    let c = |i: usize| {
+        u8::from_str_radix(&s[i..i + 2], 16)
+            .ok()
+            .map(|v| v as f32 / 255.0)
+    };
     Some([c(0)?, c(2)?, c(4)?])
 }
 
@@ -145,7 +153,9 @@ impl ScalarRange {
         }
         let (lo, hi) = v
             .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                (a.min(x), b.max(x))
+            });
         Some(match self {
             ScalarRange::MinMax | ScalarRange::Fixed(..) => (lo, hi),
             ScalarRange::Symmetric => {
@@ -156,7 +166,8 @@ impl ScalarRange {
                 let p = p.clamp(0.0, 0.5);
                 if symmetric {
                     let mut a: Vec<f64> = v.iter().map(|x| x.abs()).collect();
-                    let k = (((1.0 - 2.0 * p) * (a.len() - 1) as f64).round() as usize).min(a.len() - 1);
+                    let k = (((1.0 - 2.0 * p) * (a.len() - 1) as f64).round() as usize)
+                        .min(a.len() - 1);
                     let (_, m, _) = a.select_nth_unstable_by(k, f64::total_cmp);
                     (-*m, *m)
                 } else {
@@ -199,7 +210,11 @@ pub fn categorical(i: usize) -> Rgb {
         [238, 102, 119], // rose
     ];
     let c = P[i % P.len()];
-    [c[0] as f32 / 255.0, c[1] as f32 / 255.0, c[2] as f32 / 255.0]
+    [
+        c[0] as f32 / 255.0,
+        c[1] as f32 / 255.0,
+        c[2] as f32 / 255.0,
+    ]
 }
 
 /// A light, low-saturation version of a colour (mix with white), for fills.
@@ -228,7 +243,11 @@ fn srgb_to_lab(c: [f64; 3]) -> [f64; 3] {
             7.787 * t + 16.0 / 116.0
         }
     };
-    let (fx, fy, fz) = (f(x / WHITE_D65[0]), f(y / WHITE_D65[1]), f(z / WHITE_D65[2]));
+    let (fx, fy, fz) = (
+        f(x / WHITE_D65[0]),
+        f(y / WHITE_D65[1]),
+        f(z / WHITE_D65[2]),
+    );
     [116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)]
 }
 
@@ -256,7 +275,11 @@ fn lab_to_srgb(lab: [f64; 3]) -> [f64; 3] {
 
 fn lab_to_msh(l: [f64; 3]) -> [f64; 3] {
     let m = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
-    let s = if m > 0.0 { (l[0] / m).clamp(-1.0, 1.0).acos() } else { 0.0 };
+    let s = if m > 0.0 {
+        (l[0] / m).clamp(-1.0, 1.0).acos()
+    } else {
+        0.0
+    };
     [m, s, l[2].atan2(l[1])]
 }
 
@@ -289,7 +312,10 @@ fn diverging(c1: [f64; 3], c2: [f64; 3], t: f64) -> [f64; 3] {
     let mut b = lab_to_msh(srgb_to_lab(c2));
     let mut t = t;
     let dh = (a[2] - b[2]).abs();
-    if a[1] > 0.05 && b[1] > 0.05 && dh.min(2.0 * std::f64::consts::PI - dh) > std::f64::consts::FRAC_PI_3 {
+    if a[1] > 0.05
+        && b[1] > 0.05
+        && dh.min(2.0 * std::f64::consts::PI - dh) > std::f64::consts::FRAC_PI_3
+    {
         let mid = a[0].max(b[0]).max(88.0);
         if t < 0.5 {
             b = [mid, 0.0, 0.0];
@@ -612,7 +638,10 @@ mod tests {
         for (i, hex) in expected.iter().enumerate() {
             let want = to8(parse_hex(hex).unwrap());
             let got = to8(Colormap::Viridis.eval(i as f64 / 9.0));
-            assert!(close8(got, want, 2), "viridis({i}/9) = {got:?}, R says {want:?}");
+            assert!(
+                close8(got, want, 2),
+                "viridis({i}/9) = {got:?}, R says {want:?}"
+            );
         }
     }
 
@@ -637,7 +666,10 @@ mod tests {
         ];
         for (t, want) in checks {
             let got = to8(Colormap::CoolWarm.eval(t));
-            assert!(close8(got, want, 2), "coolwarm({t}) = {got:?}, Moreland says {want:?}");
+            assert!(
+                close8(got, want, 2),
+                "coolwarm({t}) = {got:?}, Moreland says {want:?}"
+            );
         }
     }
 
@@ -664,9 +696,12 @@ mod tests {
         assert_eq!(ScalarRange::Symmetric.resolve(&v), Some((-3.0, 3.0)));
         assert_eq!(ScalarRange::MinMax.resolve(&[f64::NAN]), None);
         let w: Vec<f64> = (0..=100).map(|i| i as f64).collect();
-        let (lo, hi) = ScalarRange::Percentile { p: 0.05, symmetric: false }
-            .resolve(&w)
-            .unwrap();
+        let (lo, hi) = ScalarRange::Percentile {
+            p: 0.05,
+            symmetric: false,
+        }
+        .resolve(&w)
+        .unwrap();
         assert_eq!((lo, hi), (5.0, 95.0));
         assert_eq!(normalize(7.0, 7.0, 7.0), 0.5);
     }

@@ -6,7 +6,11 @@ use crate::{color::Rgb, image::Image};
 /// Glyph rows (top to bottom; bit 0 is the leftmost pixel) for an ASCII character; other
 /// characters draw as '?'.
 fn glyph(c: char) -> [u8; 8] {
-    let i = if c.is_ascii() { c as usize } else { '?' as usize };
+    let i = if c.is_ascii() {
+        c as usize
+    } else {
+        '?' as usize
+    };
     font8x8::legacy::BASIC_LEGACY[i]
 }
 
@@ -41,7 +45,15 @@ pub fn draw_text(img: &mut Image, x: i64, y: i64, scale: u32, text: &str, color:
 }
 
 /// Draw `text` over a soft halo of `halo` colour so it stays readable on any background.
-pub fn draw_text_halo(img: &mut Image, x: i64, y: i64, scale: u32, text: &str, color: Rgb, halo: Rgb) {
+pub fn draw_text_halo(
+    img: &mut Image,
+    x: i64,
+    y: i64,
+    scale: u32,
+    text: &str,
+    color: Rgb,
+    halo: Rgb,
+) {
     let s = scale as i64;
     for (dx, dy) in [(-1, 0), (1, 0), (0, -1), (0, 1)] {
         draw_text(img, x + dx * s.max(1), y + dy * s.max(1), scale, text, halo);

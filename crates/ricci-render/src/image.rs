@@ -82,7 +82,8 @@ impl Image {
             enc.set_depth(png::BitDepth::Eight);
             enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
             enc.set_compression(png::Compression::Fast);
-            let enc_err = |e: png::EncodingError| Error::Encode(format!("PNG encoding failed: {e}"));
+            let enc_err =
+                |e: png::EncodingError| Error::Encode(format!("PNG encoding failed: {e}"));
             if opaque {
                 enc.set_color(png::ColorType::Rgb);
                 let rgb: Vec<u8> = self

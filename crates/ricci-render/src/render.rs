@@ -50,7 +50,10 @@ impl Uvs<'_> {
                 uv.len()
             ));
         }
-        if let Some(i) = uv.iter().position(|p| !p[0].is_finite() || !p[1].is_finite()) {
+        if let Some(i) = uv
+            .iter()
+            .position(|p| !p[0].is_finite() || !p[1].is_finite())
+        {
             return input_err(format!("texture coordinate of {what} {i} is not finite"));
         }
         Ok(())
@@ -320,7 +323,11 @@ pub fn render(
     let (nv, nf) = (positions.len(), triangles.len());
     let scalar_range = check_paint(&style.paint, nv, nf)?;
     for (k, pl) in style.polylines.iter().enumerate() {
-        if let Some(i) = pl.points.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
+        if let Some(i) = pl
+            .points
+            .iter()
+            .position(|p| !p.iter().all(|x| x.is_finite()))
+        {
             return input_err(format!("point {i} of polyline {k} is not finite"));
         }
     }
@@ -373,7 +380,18 @@ pub fn render(
         .collect();
 
     // 2. Visibility.
-    let (ids, depth) = rasterize(&verts, triangles, sw, sh);
+    let setups: Vec<Option<Setup>> = triangles
+        .par_iter()
+        .map(|t| {
+            let v = t.map(|i| &verts[i as usize]);
+            if v[0].valid && v[1].valid && v[2].valid {
+                Setup::new(v)
+            } else {
+                None
+            }
+        })
+        .collect();
+    let (ids, depth) = rasterize(&verts, triangles, &setups, sw, sh);
 
     // 3. Polylines.
     let lines = if style.polylines.is_empty() {
@@ -392,8 +410,19 @@ pub fn render(
         ))
     };
 
-    // 4. Shading and resolve.
-    let shader = Shader::new(style, opts, &verts, triangles, perspective, scalar_range, ss);
+    // 4. Shading and resolve. Each pixel shades every distinct face among its samples once,
+    // at the centroid of that face's samples (centroid sampling), and weights it by the
+    // number of samples; textures and lines are filtered analytically over the pixel.
+    let shader = Shader::new(
+        style,
+        opts,
+        &verts,
+        triangles,
+        &setups,
+        perspective,
+        scalar_range,
+        ss,
+    );
     let bg = match opts.background {
         Background::White => ([1.0f32, 1.0, 1.0], 1.0f32),
         Background::Transparent => ([0.0, 0.0, 0.0], 0.0),
@@ -407,39 +436,96 @@ pub fn render(
         .enumerate()
         .map(|(py, row)| {
             let mut covered = 0usize;
-            let inv_n = 1.0 / (ss * ss) as f32;
+            let n = ss * ss;
+            let inv_n = 1.0 / n as f32;
+            let mut faces = [0u32; 64];
+            let mut count = [0u32; 64];
+            let mut sum = [[0.0f32; 2]; 64];
+            let mut group = [0u8; 64];
+            let mut colors = [[0.0f32; 3]; 64];
             for px in 0..w {
-                let mut acc = [0.0f32; 4];
+                let mut nd = 0usize;
+                let mut k = 0usize;
                 for sy in py * ss..(py + 1) * ss {
                     for sx in px * ss..(px + 1) * ss {
-                        let i = sy * sw + sx;
-                        let f = ids[i];
-                        let (mut c, mut a) = if f == NO_FACE {
-                            (bg.0, bg.1)
-                        } else {
-                            covered += 1;
-                            (shader.shade(f, sx as f32 + 0.5, sy as f32 + 0.5), 1.0)
+                        let f = ids[sy * sw + sx];
+                        let j = match faces[..nd].iter().position(|&g| g == f) {
+                            Some(j) => j,
+                            None => {
+                                faces[nd] = f;
+                                count[nd] = 0;
+                                sum[nd] = [0.0; 2];
+                                nd += 1;
+                                nd - 1
+                            }
                         };
-                        if let Some(l) = &lines {
-                            let cov = l.coverage[i];
-                            if cov > 0.0 {
-                                let lc = l.colors[l.color_index[i] as usize];
-                                for k in 0..3 {
-                                    c[k] += cov * (lc[k] - c[k]);
+                        count[j] += 1;
+                        sum[j][0] += sx as f32 + 0.5;
+                        sum[j][1] += sy as f32 + 0.5;
+                        group[k] = j as u8;
+                        k += 1;
+                    }
+                }
+                let mut acc = [0.0f32; 4];
+                for j in 0..nd {
+                    let c = count[j] as f32;
+                    if faces[j] == NO_FACE {
+                        colors[j] = bg.0;
+                        for q in 0..3 {
+                            acc[q] += bg.0[q] * bg.1 * c;
+                        }
+                        acc[3] += bg.1 * c;
+                    } else {
+                        covered += count[j] as usize;
+                        let col = shader.shade(faces[j], sum[j][0] / c, sum[j][1] / c);
+                        colors[j] = col;
+                        for q in 0..3 {
+                            acc[q] += col[q] * c;
+                        }
+                        acc[3] += c;
+                    }
+                }
+                if let Some(l) = &lines {
+                    // Redo the pixel per sample where a line covers it.
+                    let mut k = 0usize;
+                    let mut any = false;
+                    for sy in py * ss..(py + 1) * ss {
+                        for sx in px * ss..(px + 1) * ss {
+                            any |= l.coverage[sy * sw + sx] > 0.0;
+                        }
+                    }
+                    if any {
+                        acc = [0.0; 4];
+                        for sy in py * ss..(py + 1) * ss {
+                            for sx in px * ss..(px + 1) * ss {
+                                let i = sy * sw + sx;
+                                let j = group[k] as usize;
+                                k += 1;
+                                let mut c = colors[j];
+                                let mut a = if faces[j] == NO_FACE { bg.1 } else { 1.0 };
+                                let cov = l.coverage[i];
+                                if cov > 0.0 {
+                                    let lc = l.colors[l.color_index[i] as usize];
+                                    for q in 0..3 {
+                                        c[q] = c[q] * a + cov * (lc[q] - c[q] * a);
+                                    }
+                                    a += cov * (1.0 - a);
+                                    if a > 0.0 {
+                                        c = c.map(|x| x / a);
+                                    }
                                 }
-                                a += cov * (1.0 - a);
+                                for q in 0..3 {
+                                    acc[q] += c[q] * a;
+                                }
+                                acc[3] += a;
                             }
                         }
-                        for k in 0..3 {
-                            acc[k] += c[k] * a;
-                        }
-                        acc[3] += a;
                     }
                 }
                 let o = &mut row[4 * px..4 * px + 4];
                 if acc[3] > 0.0 {
-                    for k in 0..3 {
-                        o[k] = lut.encode(acc[k] / acc[3]);
+                    for q in 0..3 {
+                        o[q] = lut.encode(acc[q] / acc[3]);
                     }
                 }
                 o[3] = (acc[3] * inv_n * 255.0).round() as u8;
@@ -595,15 +681,21 @@ impl Setup {
     }
 }
 
-fn rasterize(verts: &[ScreenVertex], tris: &[[u32; 3]], sw: usize, sh: usize) -> (Vec<u32>, Vec<f32>) {
+fn rasterize(
+    verts: &[ScreenVertex],
+    tris: &[[u32; 3]],
+    setups: &[Option<Setup>],
+    sw: usize,
+    sh: usize,
+) -> (Vec<u32>, Vec<f32>) {
     let nbands = sh.div_ceil(BAND);
     // Bin triangles by the bands their vertical extent overlaps.
     let mut bins: Vec<Vec<u32>> = vec![Vec::new(); nbands];
     for (f, t) in tris.iter().enumerate() {
-        let v = t.map(|i| &verts[i as usize]);
-        if !(v[0].valid && v[1].valid && v[2].valid) {
+        if setups[f].is_none() {
             continue;
         }
+        let v = t.map(|i| &verts[i as usize]);
         let ymin = v[0].y.min(v[1].y).min(v[2].y);
         let ymax = v[0].y.max(v[1].y).max(v[2].y);
         if !(ymax >= 0.0 && ymin <= sh as f32) {
@@ -628,7 +720,9 @@ fn rasterize(verts: &[ScreenVertex], tris: &[[u32; 3]], sw: usize, sh: usize) ->
             for &f in bin {
                 let t = tris[f as usize];
                 let v = t.map(|i| &verts[i as usize]);
-                let Some(s) = Setup::new(v) else { continue };
+                let Some(s) = setups[f as usize] else {
+                    continue;
+                };
                 let ymin = v[0].y.min(v[1].y).min(v[2].y);
                 let ymax = v[0].y.max(v[1].y).max(v[2].y);
                 let xmin = v[0].x.min(v[1].x).min(v[2].x);
@@ -723,9 +817,15 @@ fn draw_polylines(
             })
             .collect();
         let n = pts.len();
-        let nseg = if pl.closed && n > 2 { n } else { n.saturating_sub(1) };
+        let nseg = if pl.closed && n > 2 {
+            n
+        } else {
+            n.saturating_sub(1)
+        };
         for i in 0..nseg {
-            let (Some(a), Some(b)) = (pts[i], pts[(i + 1) % n]) else { continue };
+            let (Some(a), Some(b)) = (pts[i], pts[(i + 1) % n]) else {
+                continue;
+            };
             let x0 = ((a.0.min(b.0) - hw - 1.0).floor().max(0.0)) as usize;
             let x1 = ((a.0.max(b.0) + hw + 1.0).ceil().min(sw as f32 - 1.0)).max(0.0) as usize;
             let y0 = ((a.1.min(b.1) - hw - 1.0).floor().max(0.0)) as usize;
@@ -813,6 +913,7 @@ struct Shader<'a> {
     wire_color: Rgb,
     verts: &'a [ScreenVertex],
     tris: &'a [[u32; 3]],
+    setups: &'a [Option<Setup>],
     perspective: bool,
     lit: bool,
     ss: f32,
@@ -831,6 +932,7 @@ impl<'a> Shader<'a> {
         opts: &RenderOptions,
         verts: &'a [ScreenVertex],
         tris: &'a [[u32; 3]],
+        setups: &'a [Option<Setup>],
         perspective: bool,
         range: Option<(f64, f64)>,
         ss: usize,
@@ -853,9 +955,12 @@ impl<'a> Shader<'a> {
         Shader {
             paint: &style.paint,
             wire: style.wireframe,
-            wire_color: style.wireframe.map_or([0.0; 3], |w| color::to_linear(w.color)),
+            wire_color: style
+                .wireframe
+                .map_or([0.0; 3], |w| color::to_linear(w.color)),
             verts,
             tris,
+            setups,
             perspective,
             lit: opts.lighting == Lighting::Studio,
             ss: ss as f32,
@@ -873,7 +978,7 @@ impl<'a> Shader<'a> {
         let fi = f as usize;
         let t = self.tris[fi];
         let v = t.map(|i| &self.verts[i as usize]);
-        let Some(s) = Setup::new(v) else {
+        let Some(s) = self.setups[fi] else {
             return [0.5; 3];
         };
         let l = s.bary(x, y);
@@ -910,7 +1015,13 @@ impl<'a> Shader<'a> {
             [0.0, 0.0, 1.0]
         };
         let mut ndv = n[0] * view[0] + n[1] * view[1] + n[2] * view[2];
-        let back = ndv < 0.0 && face_normal(v).iter().zip(view).map(|(a, b)| a * b).sum::<f32>() < 0.0;
+        let back = ndv < 0.0
+            && face_normal(v)
+                .iter()
+                .zip(view)
+                .map(|(a, b)| a * b)
+                .sum::<f32>()
+                < 0.0;
         if ndv < 0.0 {
             n = n.map(|c| -c);
             ndv = -ndv;
@@ -945,7 +1056,10 @@ impl<'a> Shader<'a> {
                 } else {
                     let tt = normalize(value as f64, self.range.0, self.range.1) as f32;
                     let mut c = self.map.as_ref().map_or([0.5; 3], |m| m.eval(tt));
-                    if sc.isolines > 0 && sc.location == ScalarLocation::Vertex && self.range.1 > self.range.0 {
+                    if sc.isolines > 0
+                        && sc.location == ScalarLocation::Vertex
+                        && self.range.1 > self.range.0
+                    {
                         let vals = t.map(|i| {
                             normalize(sc.values[i as usize], self.range.0, self.range.1) as f32
                                 * sc.isolines as f32
@@ -953,7 +1067,7 @@ impl<'a> Shader<'a> {
                         let g = screen_gradient(&s, vals);
                         let z = tt * sc.isolines as f32;
                         let dist = (z - z.round()).abs() / g.max(1e-9); // in samples
-                        let cov = (0.6 * self.ss - dist + 0.5).clamp(0.0, 1.0) * 0.7;
+                        let cov = ((0.6 * self.ss - dist) / self.ss + 0.5).clamp(0.0, 1.0) * 0.7;
                         c = mix(c, [0.0; 3], cov);
                     }
                     (c, false)
@@ -1009,7 +1123,7 @@ impl<'a> Shader<'a> {
                     d = d.min(l[i] / g);
                 }
             }
-            let cov = (0.5 * w.width * self.ss - d + 0.5).clamp(0.0, 1.0) * w.opacity;
+            let cov = ((0.5 * w.width * self.ss - d) / self.ss + 0.5).clamp(0.0, 1.0) * w.opacity;
             c = mix(c, self.wire_color, cov);
         }
         c
@@ -1018,7 +1132,14 @@ impl<'a> Shader<'a> {
     /// UV (scaled by the frequency) at the sample and the size of the sample's footprint in
     /// those units along u and v.
     #[inline]
-    fn uv_and_footprint(&self, uvs: &Uvs, f: usize, s: &Setup, lp: [f32; 3], freq: f64) -> ([f32; 2], [f32; 2]) {
+    fn uv_and_footprint(
+        &self,
+        uvs: &Uvs,
+        f: usize,
+        s: &Setup,
+        lp: [f32; 3],
+        freq: f64,
+    ) -> ([f32; 2], [f32; 2]) {
         let c = [0, 1, 2].map(|i| uvs.corner(self.tris, f, i));
         let fr = freq as f32;
         let u = [0, 1, 2].map(|i| c[i][0] as f32 * fr);
@@ -1036,7 +1157,15 @@ impl<'a> Shader<'a> {
             s.a[0] * v[0] + s.a[1] * v[1] + s.a[2] * v[2],
             s.b[0] * v[0] + s.b[1] * v[1] + s.b[2] * v[2],
         ];
-        (uv, [du[0].abs() + du[1].abs(), dv[0].abs() + dv[1].abs()])
+        // One pixel is `ss` samples wide.
+        let px = self.ss;
+        (
+            uv,
+            [
+                px * (du[0].abs() + du[1].abs()),
+                px * (dv[0].abs() + dv[1].abs()),
+            ],
+        )
     }
 }
 
@@ -1070,8 +1199,16 @@ fn screen_gradient(s: &Setup, vals: [f32; 3]) -> f32 {
 
 #[inline]
 fn face_normal(v: [&ScreenVertex; 3]) -> [f32; 3] {
-    let a = [v[1].p[0] - v[0].p[0], v[1].p[1] - v[0].p[1], v[1].p[2] - v[0].p[2]];
-    let b = [v[2].p[0] - v[0].p[0], v[2].p[1] - v[0].p[1], v[2].p[2] - v[0].p[2]];
+    let a = [
+        v[1].p[0] - v[0].p[0],
+        v[1].p[1] - v[0].p[1],
+        v[1].p[2] - v[0].p[2],
+    ];
+    let b = [
+        v[2].p[0] - v[0].p[0],
+        v[2].p[1] - v[0].p[1],
+        v[2].p[2] - v[0].p[2],
+    ];
     let n = [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -1165,7 +1302,15 @@ impl Legend {
             let t = normalize(*value, self.range.0, self.range.1);
             let y = bot - ((bot - top) as f64 * t).round() as i64;
             img.fill_rect(x0 + bar_w, y, 4 * sc, 1.max(sc / 2), frame, 1.0);
-            font::draw_text_halo(img, x0 + bar_w + 6 * sc, y - th / 2, self.scale, label, text, halo);
+            font::draw_text_halo(
+                img,
+                x0 + bar_w + 6 * sc,
+                y - th / 2,
+                self.scale,
+                label,
+                text,
+                halo,
+            );
         }
         if !s.label.is_empty() {
             let tw = font::text_width(&s.label, self.scale);

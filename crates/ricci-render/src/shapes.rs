@@ -42,7 +42,8 @@ pub fn torus(big: f64, small: f64, n: usize, m: usize) -> Shape {
         for j in 0..m {
             let v = 2.0 * PI * j as f64 / m as f64;
             let r = big + small * v.cos();
-            s.positions.push([r * u.cos(), r * u.sin(), small * v.sin()]);
+            s.positions
+                .push([r * u.cos(), r * u.sin(), small * v.sin()]);
         }
     }
     let id = |i: usize, j: usize| ((i % n) * m + (j % m)) as u32;
