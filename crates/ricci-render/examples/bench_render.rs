@@ -22,7 +22,11 @@ fn cpu_seconds() -> f64 {
     // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
     let rest = stat.rsplit_once(')').map_or("", |r| r.1);
     let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |i: usize| f.get(i).and_then(|s| s.parse::<f64>().ok()).unwrap_or(f64::NAN);
+    let ticks = |i: usize| {
+        f.get(i)
+            .and_then(|s| s.parse::<f64>().ok())
+            .unwrap_or(f64::NAN)
+    };
     (ticks(11) + ticks(12)) / 100.0
 }
 
@@ -41,7 +45,7 @@ fn time<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, f64, T) {
 }
 
 /// Minimal OFF reader for the optional real-mesh case (triangles only).
-fn read_off(path: &std::path::Path) -> Option<(Vec<[f64; 3]>, Vec<[u32; 3]>)> {
+fn read_off(path: &std::path::Path) -> Option<shapes::Shape> {
     let text = std::fs::read_to_string(path).ok()?;
     let mut tok = text
         .lines()
@@ -67,7 +71,10 @@ fn read_off(path: &std::path::Path) -> Option<(Vec<[f64; 3]>, Vec<[u32; 3]>)> {
             f.push([idx[0], idx[j], idx[j + 1]]);
         }
     }
-    Some((p, f))
+    Some(shapes::Shape {
+        positions: p,
+        triangles: f,
+    })
 }
 
 fn bench_mesh(name: &str, p: &[[f64; 3]], t: &[[u32; 3]], uv: Option<&[[f64; 2]]>) {
@@ -140,7 +147,7 @@ fn main() {
     if let Some(dir) = std::env::var_os("RICCI_MESHES") {
         let path = std::path::Path::new(&dir).join("seahorse2_100K.off");
         match read_off(&path) {
-            Some((p, f)) => bench_mesh("seahorse2_100K.off", &p, &f, None),
+            Some(s) => bench_mesh("seahorse2_100K.off", &s.positions, &s.triangles, None),
             None => eprintln!("note: could not read {}", path.display()),
         }
     }

@@ -92,25 +92,71 @@ fn plots(out: &std::path::Path) {
             uv.push([rr * a.cos(), rr * a.sin()]);
         }
     }
-    let id = |r: usize, k: usize| if r == 0 { 0 } else { (1 + (r - 1) * n + k % n) as u32 };
-    for k in 0..n { tri.push([0, id(1, k), id(1, k + 1)]); }
-    for r in 1..6 { for k in 0..n { tri.push([id(r, k), id(r + 1, k), id(r + 1, k + 1)]); tri.push([id(r, k), id(r + 1, k + 1), id(r, k + 1)]); } }
+    let id = |r: usize, k: usize| {
+        if r == 0 {
+            0
+        } else {
+            (1 + (r - 1) * n + k % n) as u32
+        }
+    };
+    for k in 0..n {
+        tri.push([0, id(1, k), id(1, k + 1)]);
+    }
+    for r in 1..6 {
+        for k in 0..n {
+            tri.push([id(r, k), id(r + 1, k), id(r + 1, k + 1)]);
+            tri.push([id(r, k), id(r + 1, k + 1), id(r, k + 1)]);
+        }
+    }
     let mut plot = LayoutPlot::new(LayoutCopy::new(&uv, &tri));
     plot.disk = true;
     plot.title = "fundamental domain (genus 2)".into();
     for (i, (name, g)) in canonical_side_names(2).into_iter().enumerate() {
         let pts = (0..=6).map(|j| uv[id(6, 6 * i + j) as usize]).collect();
-        plot.sides.push(Side { points: pts, color: color::categorical(g), label: name });
+        plot.sides.push(Side {
+            points: pts,
+            color: color::categorical(g),
+            label: name,
+        });
     }
-    let uv2: Vec<[f64;2]> = uv.iter().map(|p| [p[0]*0.3+0.6, p[1]*0.3]).collect();
+    let uv2: Vec<[f64; 2]> = uv.iter().map(|p| [p[0] * 0.3 + 0.6, p[1] * 0.3]).collect();
     plot.copies.push(LayoutCopy::tinted(&uv2, &tri, 1));
     let fig = layout_figure(&plot).unwrap();
     std::fs::write(out.join("disk.svg"), fig.to_svg()).unwrap();
     std::fs::write(out.join("disk.png"), fig.to_png(1.0).unwrap()).unwrap();
-    let v: Vec<f64> = (0..5000).map(|i| 1.0 + 0.05 * ((i as f64 * 0.7).sin() + (i as f64 * 1.3).cos()) * (i % 7) as f64 / 7.0).collect();
-    let fig = histogram_figure(&v, &Histogram { title: "angle ratio".into(), x_label: "ratio".into(), reference: Some(1.0), ..Default::default() }).unwrap();
+    let v: Vec<f64> = (0..5000)
+        .map(|i| {
+            1.0 + 0.05 * ((i as f64 * 0.7).sin() + (i as f64 * 1.3).cos()) * (i % 7) as f64 / 7.0
+        })
+        .collect();
+    let fig = histogram_figure(
+        &v,
+        &Histogram {
+            title: "angle ratio".into(),
+            x_label: "ratio".into(),
+            reference: Some(1.0),
+            ..Default::default()
+        },
+    )
+    .unwrap();
     std::fs::write(out.join("hist.png"), fig.to_png(1.0).unwrap()).unwrap();
-    let pts: Vec<[f64; 2]> = (0..12).map(|k| [k as f64, 10f64.powf(-(k * k) as f64 / 8.0)]).collect();
-    let fig = line_plot_figure(&[Series { name: "max |K - K*|".into(), points: pts, color: color::categorical(1) }], &LinePlot { log_y: true, title: "Newton".into(), x_label: "iteration".into(), y_label: "residual".into(), ..Default::default() }).unwrap();
+    let pts: Vec<[f64; 2]> = (0..12)
+        .map(|k| [k as f64, 10f64.powf(-(k * k) as f64 / 8.0)])
+        .collect();
+    let fig = line_plot_figure(
+        &[Series {
+            name: "max |K - K*|".into(),
+            points: pts,
+            color: color::categorical(1),
+        }],
+        &LinePlot {
+            log_y: true,
+            title: "Newton".into(),
+            x_label: "iteration".into(),
+            y_label: "residual".into(),
+            ..Default::default()
+        },
+    )
+    .unwrap();
     std::fs::write(out.join("line.png"), fig.to_png(1.0).unwrap()).unwrap();
 }

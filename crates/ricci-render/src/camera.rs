@@ -140,17 +140,41 @@ impl Camera {
                 }
                 let ty = (0.5 * fov_y_deg.to_radians()).tan();
                 let tx = ty * aspect;
-                let mut dist = 0.0f64;
-                let mut zmax = f64::MIN;
-                for p in positions {
-                    let d = sub(*p, target);
-                    let (x, y, z) = (dot(d, right), dot(d, up0), dot(d, back));
-                    dist = dist
-                        .max(z + view.margin * x.abs() / tx)
-                        .max(z + view.margin * y.abs() / ty);
-                    zmax = zmax.max(z);
+                // Distance that fits every vertex for a given target, then re-centre the
+                // target on the perspective image of the mesh; a few rounds make it tight.
+                let fit = |target: [f64; 3]| {
+                    let mut dist = 0.0f64;
+                    let mut zmax = f64::MIN;
+                    for p in positions {
+                        let d = sub(*p, target);
+                        let (x, y, z) = (dot(d, right), dot(d, up0), dot(d, back));
+                        dist = dist
+                            .max(z + view.margin * x.abs() / tx)
+                            .max(z + view.margin * y.abs() / ty);
+                        zmax = zmax.max(z);
+                    }
+                    dist.max(zmax + 0.05 * radius)
+                };
+                let mut target = target;
+                for _ in 0..4 {
+                    let dist = fit(target);
+                    let (mut a0, mut a1, mut b0, mut b1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+                    for p in positions {
+                        let d = sub(*p, target);
+                        let (x, y, z) = (dot(d, right), dot(d, up0), dot(d, back));
+                        let depth = (dist - z).max(1e-12 * radius);
+                        a0 = a0.min(x / depth);
+                        a1 = a1.max(x / depth);
+                        b0 = b0.min(y / depth);
+                        b1 = b1.max(y / depth);
+                    }
+                    let shift = add(
+                        scale(right, 0.5 * (a0 + a1) * dist),
+                        scale(up0, 0.5 * (b0 + b1) * dist),
+                    );
+                    target = add(target, shift);
                 }
-                let dist = dist.max(zmax + 0.05 * radius);
+                let dist = fit(target);
                 (ty, add(target, scale(back, dist)))
             }
         };

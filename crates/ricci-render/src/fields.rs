@@ -122,7 +122,13 @@ pub fn gaussian_curvature(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Res
     let a = mixed_areas(positions, triangles)?;
     let bd = boundary_vertices(positions.len(), triangles);
     Ok((0..k.len())
-        .map(|v| if bd[v] || a[v] <= 0.0 { f64::NAN } else { k[v] / a[v] })
+        .map(|v| {
+            if bd[v] || a[v] <= 0.0 {
+                f64::NAN
+            } else {
+                k[v] / a[v]
+            }
+        })
         .collect())
 }
 
@@ -187,7 +193,8 @@ pub fn area_distortion(
         s3.push(0.5 * norm(cross(sub(p[1], p[0]), sub(p[2], p[0]))));
         let q = t.map(|i| uvs[i as usize]);
         let a = 0.5
-            * ((q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]))
+            * ((q[1][0] - q[0][0]) * (q[2][1] - q[0][1])
+                - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]))
                 .abs();
         s2.push(a);
     }
@@ -240,10 +247,16 @@ mod tests {
     #[test]
     fn angle_defect_satisfies_gauss_bonnet() {
         let s = shapes::icosphere(2);
-        let k: f64 = angle_defect(&s.positions, &s.triangles).unwrap().iter().sum();
+        let k: f64 = angle_defect(&s.positions, &s.triangles)
+            .unwrap()
+            .iter()
+            .sum();
         assert!((k - 4.0 * PI).abs() < 1e-9, "sphere: {k}");
         let t = shapes::torus(2.0, 0.7, 30, 17);
-        let k: f64 = angle_defect(&t.positions, &t.triangles).unwrap().iter().sum();
+        let k: f64 = angle_defect(&t.positions, &t.triangles)
+            .unwrap()
+            .iter()
+            .sum();
         assert!(k.abs() < 1e-9, "torus: {k}");
         let g = shapes::grid(7, 1.0);
         let k = angle_defect(&g.positions, &g.triangles).unwrap();
@@ -272,7 +285,10 @@ mod tests {
             assert!((v - 0.5).abs() < 0.01, "sphere H = {v}");
         }
         // Mixed areas sum to the surface area (4π r² up to discretisation).
-        let a: f64 = mixed_areas(&s.positions, &s.triangles).unwrap().iter().sum();
+        let a: f64 = mixed_areas(&s.positions, &s.triangles)
+            .unwrap()
+            .iter()
+            .sum();
         assert!((a / (16.0 * PI) - 1.0).abs() < 0.01);
         // Torus (R, r) = (2, 0.8): outer equator H = (1/r + 1/(R+r))/2, inner
         // (1/r − 1/(R−r))/2; vertex i*m + j sits at angles (2πi/n, 2πj/m).
@@ -282,7 +298,11 @@ mod tests {
         let outer = 0.5 * (1.0 / 0.8 + 1.0 / 2.8);
         let inner = 0.5 * (1.0 / 0.8 - 1.0 / 1.2);
         assert!((h[0] - outer).abs() < 0.01 * outer, "{} vs {outer}", h[0]);
-        assert!((h[m / 2] - inner).abs() < 0.02 * inner, "{} vs {inner}", h[m / 2]);
+        assert!(
+            (h[m / 2] - inner).abs() < 0.02 * inner,
+            "{} vs {inner}",
+            h[m / 2]
+        );
         // Gaussian curvature at the outer equator: 1/(r (R + r)).
         let k = gaussian_curvature(&t.positions, &t.triangles).unwrap();
         let want = 1.0 / (0.8 * 2.8);

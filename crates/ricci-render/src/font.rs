@@ -103,7 +103,7 @@ mod tests {
     #[test]
     fn numbers_are_short() {
         assert_eq!(format_number(0.0), "0");
-        assert_eq!(format_number(3.14159), "3.14");
+        assert_eq!(format_number(4.56789), "4.57");
         assert_eq!(format_number(-0.012345), "-0.0123");
         assert_eq!(format_number(1234.7), "1235");
         assert_eq!(format_number(2.0), "2");

@@ -48,9 +48,15 @@ pub fn glb(positions: &[[f64; 3]], triangles: &[[u32; 3]], opts: &GlbOptions) ->
     let n = positions.len();
     if let Some(uv) = opts.uvs {
         if uv.len() != n {
-            return input_err(format!("there are {} texture coordinates for {n} vertices", uv.len()));
+            return input_err(format!(
+                "there are {} texture coordinates for {n} vertices",
+                uv.len()
+            ));
         }
-        if let Some(i) = uv.iter().position(|p| !(p[0].is_finite() && p[1].is_finite())) {
+        if let Some(i) = uv
+            .iter()
+            .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+        {
             return input_err(format!("texture coordinate of vertex {i} is not finite"));
         }
     }
@@ -64,8 +70,12 @@ pub fn glb(positions: &[[f64; 3]], triangles: &[[u32; 3]], opts: &GlbOptions) ->
     let mut bin: Vec<u8> = Vec::new();
     let mut root = json::Root::default();
     let buffer_index = json::Index::<json::Buffer>::new(0);
-    let mut view = |root: &mut json::Root, bin: &mut Vec<u8>, bytes: &[u8], target: Option<json::buffer::Target>, stride: Option<usize>| {
-        while bin.len() % 4 != 0 {
+    let view = |root: &mut json::Root,
+                bin: &mut Vec<u8>,
+                bytes: &[u8],
+                target: Option<json::buffer::Target>,
+                stride: Option<usize>| {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         let offset = bin.len();
@@ -118,7 +128,13 @@ pub fn glb(positions: &[[f64; 3]], triangles: &[[u32; 3]], opts: &GlbOptions) ->
             bytes.extend_from_slice(&v.to_le_bytes());
         }
     }
-    let v = view(&mut root, &mut bin, &bytes, Some(Target::ArrayBuffer), Some(12));
+    let v = view(
+        &mut root,
+        &mut bin,
+        &bytes,
+        Some(Target::ArrayBuffer),
+        Some(12),
+    );
     let pos = accessor(
         &mut root,
         v,
@@ -134,12 +150,22 @@ pub fn glb(positions: &[[f64; 3]], triangles: &[[u32; 3]], opts: &GlbOptions) ->
     // Normals (unit length; isolated vertices get +z).
     let mut bytes = Vec::with_capacity(12 * n);
     for nrm in &normals {
-        let nrm = if nrm == &[0.0; 3] { [0.0, 0.0, 1.0] } else { *nrm };
+        let nrm = if nrm == &[0.0; 3] {
+            [0.0, 0.0, 1.0]
+        } else {
+            *nrm
+        };
         for c in nrm {
             bytes.extend_from_slice(&(c as f32).to_le_bytes());
         }
     }
-    let v = view(&mut root, &mut bin, &bytes, Some(Target::ArrayBuffer), Some(12));
+    let v = view(
+        &mut root,
+        &mut bin,
+        &bytes,
+        Some(Target::ArrayBuffer),
+        Some(12),
+    );
     let nacc = accessor(&mut root, v, n, C::F32, T::Vec3, None, None);
     attributes.insert(Valid(json::mesh::Semantic::Normals), nacc);
 
@@ -150,7 +176,13 @@ pub fn glb(positions: &[[f64; 3]], triangles: &[[u32; 3]], opts: &GlbOptions) ->
             bytes.extend_from_slice(&(p[0] as f32).to_le_bytes());
             bytes.extend_from_slice(&((1.0 - p[1]) as f32).to_le_bytes());
         }
-        let v = view(&mut root, &mut bin, &bytes, Some(Target::ArrayBuffer), Some(8));
+        let v = view(
+            &mut root,
+            &mut bin,
+            &bytes,
+            Some(Target::ArrayBuffer),
+            Some(8),
+        );
         let a = accessor(&mut root, v, n, C::F32, T::Vec2, None, None);
         attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), a);
     }
@@ -162,7 +194,13 @@ pub fn glb(positions: &[[f64; 3]], triangles: &[[u32; 3]], opts: &GlbOptions) ->
                 bytes.extend_from_slice(&x.clamp(0.0, 1.0).to_le_bytes());
             }
         }
-        let v = view(&mut root, &mut bin, &bytes, Some(Target::ArrayBuffer), Some(12));
+        let v = view(
+            &mut root,
+            &mut bin,
+            &bytes,
+            Some(Target::ArrayBuffer),
+            Some(12),
+        );
         let a = accessor(&mut root, v, n, C::F32, T::Vec3, None, None);
         attributes.insert(Valid(json::mesh::Semantic::Colors(0)), a);
     }
@@ -173,8 +211,22 @@ pub fn glb(positions: &[[f64; 3]], triangles: &[[u32; 3]], opts: &GlbOptions) ->
             bytes.extend_from_slice(&i.to_le_bytes());
         }
     }
-    let v = view(&mut root, &mut bin, &bytes, Some(Target::ElementArrayBuffer), None);
-    let indices = accessor(&mut root, v, 3 * triangles.len(), C::U32, T::Scalar, None, None);
+    let v = view(
+        &mut root,
+        &mut bin,
+        &bytes,
+        Some(Target::ElementArrayBuffer),
+        None,
+    );
+    let indices = accessor(
+        &mut root,
+        v,
+        3 * triangles.len(),
+        C::U32,
+        T::Scalar,
+        None,
+        None,
+    );
 
     // Material, with the checker texture when there are UVs.
     let mut pbr = json::material::PbrMetallicRoughness {
@@ -253,7 +305,7 @@ pub fn glb(positions: &[[f64; 3]], triangles: &[[u32; 3]], opts: &GlbOptions) ->
         nodes: vec![node],
     });
     root.scene = Some(scene);
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     root.push(json::Buffer {
@@ -265,12 +317,14 @@ pub fn glb(positions: &[[f64; 3]], triangles: &[[u32; 3]], opts: &GlbOptions) ->
     });
     root.asset.generator = Some(format!("ricci-render {}", env!("CARGO_PKG_VERSION")));
 
-    let mut js = json::serialize::to_vec(&root).map_err(|e| Error::Encode(format!("glTF JSON: {e}")))?;
-    while js.len() % 4 != 0 {
+    let mut js =
+        json::serialize::to_vec(&root).map_err(|e| Error::Encode(format!("glTF JSON: {e}")))?;
+    while !js.len().is_multiple_of(4) {
         js.push(b' ');
     }
     let total = 12 + 8 + js.len() + 8 + bin.len();
-    let total32 = u32::try_from(total).map_err(|_| Error::Encode("the glTF file would exceed 4 GiB".into()))?;
+    let total32 = u32::try_from(total)
+        .map_err(|_| Error::Encode("the glTF file would exceed 4 GiB".into()))?;
     let mut out = Vec::with_capacity(total);
     out.extend_from_slice(b"glTF");
     out.extend_from_slice(&2u32.to_le_bytes());
@@ -293,8 +347,17 @@ mod tests {
     fn glb_parses_back_with_counts_and_uv_range() {
         let t = shapes::torus(2.0, 0.5, 24, 12);
         let n = t.positions.len();
-        let uv: Vec<[f64; 2]> = (0..n).map(|k| [-1.0 + 3.0 * (k / 12) as f64 / 23.0, 0.25 + 0.5 * (k % 12) as f64 / 11.0]).collect();
-        let colors: Vec<Rgb> = (0..n).map(|k| color::Colormap::Viridis.eval(k as f64 / n as f64)).collect();
+        let uv: Vec<[f64; 2]> = (0..n)
+            .map(|k| {
+                [
+                    -1.0 + 3.0 * (k / 12) as f64 / 23.0,
+                    0.25 + 0.5 * (k % 12) as f64 / 11.0,
+                ]
+            })
+            .collect();
+        let colors: Vec<Rgb> = (0..n)
+            .map(|k| color::Colormap::Viridis.eval(k as f64 / n as f64))
+            .collect();
         let bytes = glb(
             &t.positions,
             &t.triangles,
@@ -318,17 +381,31 @@ mod tests {
         assert_eq!(idx.len(), 3 * t.triangles.len());
         assert_eq!(&idx[..3], &t.triangles[0]);
         let tc: Vec<[f32; 2]> = reader.read_tex_coords(0).unwrap().into_f32().collect();
-        let (umin, umax) = tc.iter().fold((f32::MAX, f32::MIN), |a, p| (a.0.min(p[0]), a.1.max(p[0])));
-        let (vmin, vmax) = tc.iter().fold((f32::MAX, f32::MIN), |a, p| (a.0.min(p[1]), a.1.max(p[1])));
-        assert!((umin + 1.0).abs() < 1e-6 && (umax - 2.0).abs() < 1e-6, "u in [{umin}, {umax}]");
+        let (umin, umax) = tc
+            .iter()
+            .fold((f32::MAX, f32::MIN), |a, p| (a.0.min(p[0]), a.1.max(p[0])));
+        let (vmin, vmax) = tc
+            .iter()
+            .fold((f32::MAX, f32::MIN), |a, p| (a.0.min(p[1]), a.1.max(p[1])));
+        assert!(
+            (umin + 1.0).abs() < 1e-6 && (umax - 2.0).abs() < 1e-6,
+            "u in [{umin}, {umax}]"
+        );
         // v is flipped: [0.25, 0.75] -> [0.25, 0.75] (symmetric about 1/2).
-        assert!((vmin - 0.25).abs() < 1e-6 && (vmax - 0.75).abs() < 1e-6, "v in [{vmin}, {vmax}]");
+        assert!(
+            (vmin - 0.25).abs() < 1e-6 && (vmax - 0.75).abs() < 1e-6,
+            "v in [{vmin}, {vmax}]"
+        );
         assert_eq!(reader.read_colors(0).unwrap().into_rgb_f32().count(), n);
         // Bounds recorded in the accessor match the data.
         let b = prim.bounding_box();
         assert!((b.max[0] - 2.5).abs() < 1e-5 && (b.min[2] + 0.5).abs() < 1e-5);
         // The texture is an embedded PNG of 6 x 6 checks.
-        let tex = prim.material().pbr_metallic_roughness().base_color_texture().unwrap();
+        let tex = prim
+            .material()
+            .pbr_metallic_roughness()
+            .base_color_texture()
+            .unwrap();
         let img = match tex.texture().source().source() {
             ::gltf::image::Source::View { view, mime_type } => {
                 assert_eq!(mime_type, "image/png");
@@ -349,8 +426,20 @@ mod tests {
         let bytes = glb(&s.positions, &s.triangles, &GlbOptions::default()).unwrap();
         let g = ::gltf::Gltf::from_slice(&bytes).unwrap();
         let prim = g.meshes().next().unwrap().primitives().next().unwrap();
-        assert!(prim.material().pbr_metallic_roughness().base_color_texture().is_none());
+        assert!(prim
+            .material()
+            .pbr_metallic_roughness()
+            .base_color_texture()
+            .is_none());
         assert_eq!(g.textures().count(), 0);
-        assert!(glb(&s.positions, &s.triangles, &GlbOptions { uvs: Some(&[[0.0; 2]]), ..Default::default() }).is_err());
+        assert!(glb(
+            &s.positions,
+            &s.triangles,
+            &GlbOptions {
+                uvs: Some(&[[0.0; 2]]),
+                ..Default::default()
+            }
+        )
+        .is_err());
     }
 }

@@ -21,6 +21,8 @@
 //! Every function returns [`Error`] on bad data (index out of range, NaN position, wrong
 //! length) and never panics on user data.
 
+#![allow(clippy::needless_range_loop)] // index loops over xyz read best in numeric code
+
 pub mod camera;
 pub mod color;
 pub mod fields;

@@ -89,7 +89,14 @@ impl Figure {
             .sum()
     }
 
-    fn text(&mut self, at: [f64; 2], text: impl Into<String>, size: f64, color: Rgb, anchor: Anchor) {
+    fn text(
+        &mut self,
+        at: [f64; 2],
+        text: impl Into<String>,
+        size: f64,
+        color: Rgb,
+        anchor: Anchor,
+    ) {
         self.items.push(Item::Text {
             at,
             text: text.into(),
@@ -141,7 +148,13 @@ impl Figure {
                     let mut d = String::with_capacity(polygons.len() * 40);
                     for poly in polygons {
                         for (k, p) in poly.iter().enumerate() {
-                            let _ = write!(d, "{}{} {}", if k == 0 { "M" } else { "L" }, num(p[0]), num(p[1]));
+                            let _ = write!(
+                                d,
+                                "{}{} {}",
+                                if k == 0 { "M" } else { "L" },
+                                num(p[0]),
+                                num(p[1])
+                            );
                         }
                         d.push('Z');
                     }
@@ -161,8 +174,13 @@ impl Figure {
                     closed,
                     class,
                 } => {
-                    let pts: Vec<String> = points.iter().map(|p| format!("{},{}", num(p[0]), num(p[1]))).collect();
-                    let dash = dash.map_or(String::new(), |d| format!(r#" stroke-dasharray="{} {}""#, num(d), num(d)));
+                    let pts: Vec<String> = points
+                        .iter()
+                        .map(|p| format!("{},{}", num(p[0]), num(p[1])))
+                        .collect();
+                    let dash = dash.map_or(String::new(), |d| {
+                        format!(r#" stroke-dasharray="{} {}""#, num(d), num(d))
+                    });
                     let _ = writeln!(
                         s,
                         r#"<{tag} class="{class}" points="{}" fill="none" stroke="{}" stroke-width="{}" stroke-linejoin="round" stroke-linecap="round"{dash}/>"#,
@@ -230,11 +248,16 @@ impl Figure {
 
     /// The figure rasterized as an [`Image`].
     pub fn to_image(&self, scale: f64) -> Result<Image> {
-        use tiny_skia::{FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Stroke, StrokeDash, Transform};
+        use tiny_skia::{
+            FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Stroke, StrokeDash, Transform,
+        };
         if !(scale > 0.0 && scale <= 16.0) {
             return input_err(format!("the PNG scale {scale} must be in (0, 16]"));
         }
-        let (w, h) = ((self.width * scale).round() as u32, (self.height * scale).round() as u32);
+        let (w, h) = (
+            (self.width * scale).round() as u32,
+            (self.height * scale).round() as u32,
+        );
         let mut pm = Pixmap::new(w.max(1), h.max(1))
             .ok_or_else(|| Error::Input(format!("cannot allocate a {w}x{h} picture")))?;
         if let Some(bg) = self.background {
@@ -323,7 +346,11 @@ impl Figure {
                     stroke_width,
                     ..
                 } => {
-                    let Some(path) = PathBuilder::from_circle(center[0] as f32, center[1] as f32, *radius as f32) else {
+                    let Some(path) = PathBuilder::from_circle(
+                        center[0] as f32,
+                        center[1] as f32,
+                        *radius as f32,
+                    ) else {
                         continue;
                     };
                     if let Some(f) = fill {
@@ -555,9 +582,15 @@ pub fn layout_figure(plot: &LayoutPlot) -> Result<Figure> {
     let pad = 36.0; // room for labels
     let size = plot.size.max(64.0);
     let (w, h) = if ext[0] >= ext[1] {
-        (size, (size - 2.0 * pad) * ext[1] / ext[0] + 2.0 * pad + title_h)
+        (
+            size,
+            (size - 2.0 * pad) * ext[1] / ext[0] + 2.0 * pad + title_h,
+        )
     } else {
-        ((size - 2.0 * pad - title_h) * ext[0] / ext[1] + 2.0 * pad, size)
+        (
+            (size - 2.0 * pad - title_h) * ext[0] / ext[1] + 2.0 * pad,
+            size,
+        )
     };
     let scale = ((w - 2.0 * pad) / ext[0]).min((h - 2.0 * pad - title_h) / ext[1]);
     let cx = 0.5 * (lo[0] + hi[0]);
@@ -579,9 +612,14 @@ pub fn layout_figure(plot: &LayoutPlot) -> Result<Figure> {
             id: None,
         });
     }
-    let edge_width = (0.6f64).min(0.25 + 40.0 / (1.0 + (plot.copies[0].triangles.len() as f64).sqrt()));
+    let edge_width =
+        (0.6f64).min(0.25 + 40.0 / (1.0 + (plot.copies[0].triangles.len() as f64).sqrt()));
     for c in &plot.copies {
-        let tri = |t: &[u32; 3]| t.iter().map(|&i| frame.map(c.uvs[i as usize])).collect::<Vec<_>>();
+        let tri = |t: &[u32; 3]| {
+            t.iter()
+                .map(|&i| frame.map(c.uvs[i as usize]))
+                .collect::<Vec<_>>()
+        };
         match &c.face_colors {
             None => fig.items.push(Item::Polygons {
                 polygons: c.triangles.iter().map(tri).collect(),
@@ -592,9 +630,13 @@ pub fn layout_figure(plot: &LayoutPlot) -> Result<Figure> {
             }),
             Some(fc) => {
                 // Group faces by colour to keep the SVG small.
-                let mut groups: std::collections::BTreeMap<[u8; 3], Vec<Vec<[f64; 2]>>> = Default::default();
+                let mut groups: std::collections::BTreeMap<[u8; 3], Vec<Vec<[f64; 2]>>> =
+                    Default::default();
                 for (f, t) in c.triangles.iter().enumerate() {
-                    groups.entry(crate::image::to8(fc[f])).or_default().push(tri(t));
+                    groups
+                        .entry(crate::image::to8(fc[f]))
+                        .or_default()
+                        .push(tri(t));
                 }
                 for (col, polys) in groups {
                     fig.items.push(Item::Polygons {
@@ -663,7 +705,13 @@ pub fn layout_figure(plot: &LayoutPlot) -> Result<Figure> {
         });
     }
     if !plot.title.is_empty() {
-        fig.text([0.5 * w, 20.0], plot.title.clone(), 16.0, [0.1; 3], Anchor::Middle);
+        fig.text(
+            [0.5 * w, 20.0],
+            plot.title.clone(),
+            16.0,
+            [0.1; 3],
+            Anchor::Middle,
+        );
     }
     Ok(fig)
 }
@@ -676,7 +724,10 @@ fn polyline_midpoint(p: &[[f64; 2]]) -> [f64; 2] {
         let l = seg(i);
         if acc + l >= 0.5 * total && l > 0.0 {
             let t = (0.5 * total - acc) / l;
-            return [p[i][0] + t * (p[i + 1][0] - p[i][0]), p[i][1] + t * (p[i + 1][1] - p[i][1])];
+            return [
+                p[i][0] + t * (p[i + 1][0] - p[i][0]),
+                p[i][1] + t * (p[i + 1][1] - p[i][1]),
+            ];
         }
         acc += l;
     }
@@ -742,9 +793,15 @@ impl Axes {
         let grid = [0.9; 3];
         let xt = nice_ticks(self.xr.0, self.xr.1, 6);
         let yt: Vec<f64> = if self.log_y {
-            let (a, b) = (self.yr.0.log10().ceil() as i32, self.yr.1.log10().floor() as i32);
+            let (a, b) = (
+                self.yr.0.log10().ceil() as i32,
+                self.yr.1.log10().floor() as i32,
+            );
             let every = ((b - a) / 8 + 1).max(1);
-            (a..=b).filter(|k| (k - a) % every == 0).map(|k| 10f64.powi(k)).collect()
+            (a..=b)
+                .filter(|k| (k - a) % every == 0)
+                .map(|k| 10f64.powi(k))
+                .collect()
         } else {
             nice_ticks(self.yr.0, self.yr.1, 5)
         };
@@ -761,7 +818,13 @@ impl Axes {
         for &x in &xt {
             let p = self.px(x);
             fig.line(vec![[p, self.y1], [p, self.y1 + 5.0]], ink, 1.0, "tick");
-            fig.text([p, self.y1 + 14.0], font::format_number(x), 12.0, ink, Anchor::Middle);
+            fig.text(
+                [p, self.y1 + 14.0],
+                font::format_number(x),
+                12.0,
+                ink,
+                Anchor::Middle,
+            );
         }
         fig.items.push(Item::Polyline {
             points: vec![[self.x0, self.y0], [self.x0, self.y1], [self.x1, self.y1]],
@@ -772,10 +835,22 @@ impl Axes {
             class: "axes",
         });
         if !title.is_empty() {
-            fig.text([0.5 * (self.x0 + self.x1), 18.0], title, 15.0, [0.05; 3], Anchor::Middle);
+            fig.text(
+                [0.5 * (self.x0 + self.x1), 18.0],
+                title,
+                15.0,
+                [0.05; 3],
+                Anchor::Middle,
+            );
         }
         if !xlabel.is_empty() {
-            fig.text([0.5 * (self.x0 + self.x1), self.y1 + 34.0], xlabel, 13.0, ink, Anchor::Middle);
+            fig.text(
+                [0.5 * (self.x0 + self.x1), self.y1 + 34.0],
+                xlabel,
+                13.0,
+                ink,
+                Anchor::Middle,
+            );
         }
         if !ylabel.is_empty() {
             fig.text([self.x0, self.y0 - 12.0], ylabel, 13.0, ink, Anchor::Middle);
@@ -857,7 +932,11 @@ pub fn histogram_figure(values: &[f64], h: &Histogram) -> Result<Figure> {
     let counts = bin_counts(&finite, h.bins, lo, hi);
     let cmax = counts.iter().copied().max().unwrap_or(1).max(1);
     let mut fig = Figure::new(h.width, h.height);
-    let ytop = nice_ticks(0.0, cmax as f64 * 1.05, 5).last().copied().unwrap_or(1.0).max(cmax as f64);
+    let ytop = nice_ticks(0.0, cmax as f64 * 1.05, 5)
+        .last()
+        .copied()
+        .unwrap_or(1.0)
+        .max(cmax as f64);
     let ax = Axes {
         x0: 64.0,
         x1: h.width - 20.0,
@@ -943,7 +1022,10 @@ impl Default for LinePlot {
 /// Draw line plots; with `log_y`, points with y ≤ 0 are left out.
 pub fn line_plot_figure(series: &[Series], lp: &LinePlot) -> Result<Figure> {
     let usable = |p: &[f64; 2]| p[0].is_finite() && p[1].is_finite() && (!lp.log_y || p[1] > 0.0);
-    let (mut xr, mut yr) = ((f64::INFINITY, f64::NEG_INFINITY), (f64::INFINITY, f64::NEG_INFINITY));
+    let (mut xr, mut yr) = (
+        (f64::INFINITY, f64::NEG_INFINITY),
+        (f64::INFINITY, f64::NEG_INFINITY),
+    );
     for s in series {
         for p in s.points.iter().filter(|p| usable(p)) {
             xr = (xr.0.min(p[0]), xr.1.max(p[0]));
@@ -967,7 +1049,10 @@ pub fn line_plot_figure(series: &[Series], lp: &LinePlot) -> Result<Figure> {
         }
         let t = nice_ticks(yr.0, yr.1, 5);
         let step = if t.len() > 1 { t[1] - t[0] } else { 0.0 };
-        yr = (yr.0.min(t[0]), yr.1.max(t.last().copied().unwrap_or(yr.1) + 0.0 * step));
+        yr = (
+            yr.0.min(t[0]),
+            yr.1.max(t.last().copied().unwrap_or(yr.1) + 0.0 * step),
+        );
     }
     let mut fig = Figure::new(lp.width, lp.height);
     let ax = Axes {
@@ -981,7 +1066,12 @@ pub fn line_plot_figure(series: &[Series], lp: &LinePlot) -> Result<Figure> {
     };
     ax.draw(&mut fig, &lp.title, &lp.x_label, &lp.y_label);
     for s in series {
-        let pts: Vec<[f64; 2]> = s.points.iter().filter(|p| usable(p)).map(|p| [ax.px(p[0]), ax.py(p[1])]).collect();
+        let pts: Vec<[f64; 2]> = s
+            .points
+            .iter()
+            .filter(|p| usable(p))
+            .map(|p| [ax.px(p[0]), ax.py(p[1])])
+            .collect();
         if pts.is_empty() {
             continue;
         }
@@ -1003,10 +1093,20 @@ pub fn line_plot_figure(series: &[Series], lp: &LinePlot) -> Result<Figure> {
     let named: Vec<&Series> = series.iter().filter(|s| !s.name.is_empty()).collect();
     for (k, s) in named.iter().enumerate() {
         let y = ax.y0 + 12.0 + 18.0 * k as f64;
-        let longest = named.iter().map(|s| s.name.chars().count()).max().unwrap_or(0) as f64;
+        let longest = named
+            .iter()
+            .map(|s| s.name.chars().count())
+            .max()
+            .unwrap_or(0) as f64;
         let x = ax.x1 - 36.0 - 7.5 * longest;
         fig.line(vec![[x, y], [x + 22.0, y]], s.color, 2.5, "legend");
-        fig.text([x + 28.0, y], s.name.clone(), 12.0, [0.15; 3], Anchor::Start);
+        fig.text(
+            [x + 28.0, y],
+            s.name.clone(),
+            12.0,
+            [0.15; 3],
+            Anchor::Start,
+        );
     }
     Ok(fig)
 }
@@ -1024,7 +1124,11 @@ mod tests {
     fn nice_ticks_are_round_and_cover() {
         assert_eq!(nice_ticks(0.0, 1.0, 5), vec![0.0, 0.2, 0.4, 0.6, 0.8, 1.0]);
         let t = nice_ticks(-3.7, 12.2, 6);
-        assert!(t.iter().all(|x| (x / 2.0 - (x / 2.0).round()).abs() < 1e-12), "{t:?}");
+        assert!(
+            t.iter()
+                .all(|x| (x / 2.0 - (x / 2.0).round()).abs() < 1e-12),
+            "{t:?}"
+        );
         assert!(t[0] >= -3.7 && *t.last().unwrap() <= 12.2 && t.len() >= 5);
     }
 
@@ -1044,7 +1148,11 @@ mod tests {
         plot.title = "Poincaré disk <test>".into();
         for (i, (name, g)) in canonical_side_names(2).into_iter().enumerate() {
             let pts = (0..=3).map(|j| uv[1 + (3 * i + j) % n]).collect();
-            plot.sides.push(Side { points: pts, color: color::categorical(g), label: name });
+            plot.sides.push(Side {
+                points: pts,
+                color: color::categorical(g),
+                label: name,
+            });
         }
         let fig = layout_figure(&plot).unwrap();
         let svg = fig.to_svg();
@@ -1058,20 +1166,34 @@ mod tests {
         let r: f64 = circle.attribute("r").unwrap().parse().unwrap();
         let cx: f64 = circle.attribute("cx").unwrap().parse().unwrap();
         let cy: f64 = circle.attribute("cy").unwrap().parse().unwrap();
-        let path = doc.descendants().find(|e| e.attribute("class") == Some("faces")).unwrap();
+        let path = doc
+            .descendants()
+            .find(|e| e.attribute("class") == Some("faces"))
+            .unwrap();
         let d = path.attribute("d").unwrap();
         let first = d[1..].split('L').nth(1).unwrap(); // second vertex of the first triangle
-        let xy: Vec<f64> = first.split(' ').map(|s| s.trim_end_matches('Z').parse().unwrap()).collect();
+        let xy: Vec<f64> = first
+            .split(' ')
+            .map(|s| s.trim_end_matches('Z').parse().unwrap())
+            .collect();
         let dist = ((xy[0] - cx).powi(2) + (xy[1] - cy).powi(2)).sqrt();
         assert!((dist / r - 0.9).abs() < 0.01, "rim at {dist} of radius {r}");
         assert_eq!(d.matches('M').count(), n);
-        let labels: Vec<&str> = doc.descendants().filter(|e| e.has_tag_name("text")).filter_map(|e| e.text()).collect();
-        assert!(labels.contains(&"a1") && labels.contains(&"b2^-1"), "{labels:?}");
+        let labels: Vec<&str> = doc
+            .descendants()
+            .filter(|e| e.has_tag_name("text"))
+            .filter_map(|e| e.text())
+            .collect();
+        assert!(
+            labels.contains(&"a1") && labels.contains(&"b2^-1"),
+            "{labels:?}"
+        );
         assert!(labels.iter().any(|l| l.contains("<test>")));
         // The PNG version draws the circle: pixels on it are dark.
         let img = fig.to_image(1.0).unwrap();
         let (x, y) = ((cx + r) as u32, cy as u32);
-        let dark = (x.saturating_sub(1)..=x + 1).any(|xx| img.pixel(xx.min(img.width - 1), y)[0] < 100);
+        let dark =
+            (x.saturating_sub(1)..=x + 1).any(|xx| img.pixel(xx.min(img.width - 1), y)[0] < 100);
         assert!(dark, "no unit circle at ({x}, {y}) in the PNG");
     }
 
@@ -1120,9 +1242,14 @@ mod tests {
         .unwrap();
         let svg = fig.to_svg();
         let doc = parse(&svg);
-        let bars = doc.descendants().find(|e| e.attribute("class") == Some("bars")).unwrap();
+        let bars = doc
+            .descendants()
+            .find(|e| e.attribute("class") == Some("bars"))
+            .unwrap();
         assert_eq!(bars.attribute("d").unwrap().matches('M').count(), 10);
-        assert!(doc.descendants().any(|e| e.attribute("class") == Some("reference")));
+        assert!(doc
+            .descendants()
+            .any(|e| e.attribute("class") == Some("reference")));
         assert!(histogram_figure(&[f64::NAN], &Histogram::default()).is_err());
         assert!(fig.to_png(1.0).unwrap().starts_with(b"\x89PNG"));
     }
@@ -1131,8 +1258,16 @@ mod tests {
     fn log_line_plot_places_decades_evenly() {
         let pts: Vec<[f64; 2]> = (0..8).map(|k| [k as f64, 10f64.powi(-2 * k)]).collect();
         let fig = line_plot_figure(
-            &[Series { name: "residual".into(), points: pts, color: color::categorical(0) }],
-            &LinePlot { log_y: true, title: "Newton".into(), ..Default::default() },
+            &[Series {
+                name: "residual".into(),
+                points: pts,
+                color: color::categorical(0),
+            }],
+            &LinePlot {
+                log_y: true,
+                title: "Newton".into(),
+                ..Default::default()
+            },
         )
         .unwrap();
         // The markers of a geometric sequence are equally spaced vertically.

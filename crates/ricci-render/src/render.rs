@@ -652,7 +652,7 @@ impl Setup {
     #[inline]
     fn new(v: [&ScreenVertex; 3]) -> Option<Setup> {
         let area2 = (v[1].x - v[0].x) * (v[2].y - v[0].y) - (v[1].y - v[0].y) * (v[2].x - v[0].x);
-        if !(area2.abs() > 1e-12) {
+        if area2.is_nan() || area2.abs() <= 1e-12 {
             return None;
         }
         let inv = 1.0 / area2;
@@ -927,6 +927,7 @@ struct Shader<'a> {
 const NAN_COLOR: Rgb = [0.25, 0.25, 0.25];
 
 impl<'a> Shader<'a> {
+    #[allow(clippy::too_many_arguments)]
     fn new(
         style: &'a Style<'a>,
         opts: &RenderOptions,
@@ -1089,7 +1090,7 @@ impl<'a> Shader<'a> {
                 (mix(self.two_colors[1], self.two_colors[0], m), false)
             }
         };
-        if back {
+        if back && self.lit {
             albedo = [albedo[0] * 0.8, albedo[1] * 0.78, albedo[2] * 0.72];
         }
         let mut c = if self.lit {
