@@ -9,15 +9,19 @@
 
 use crate::color::{self, Rgb};
 use crate::image::Image;
+use crate::render::Uvs;
 use crate::{check_mesh, input_err, Error, Result};
+use std::collections::HashMap;
 use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
 
 /// What to put in the file besides positions, normals and triangles.
 #[derive(Debug, Clone, Default)]
 pub struct GlbOptions<'a> {
-    /// One UV per vertex.
-    pub uvs: Option<&'a [[f64; 2]]>,
+    /// Texture coordinates, per vertex or per corner (vertices are split where corners of
+    /// one vertex have different UVs, e.g. along a cut; normals stay those of the welded
+    /// mesh so shading is smooth across seams).
+    pub uvs: Option<Uvs<'a>>,
     /// Checks per UV unit of the embedded checker texture (used with `uvs`; default 8).
     pub checker_frequency: Option<f64>,
     /// One sRGB colour per vertex (COLOR_0).
@@ -46,27 +50,81 @@ pub fn checker_texture(checks: u32, px: u32) -> Image {
 pub fn glb(positions: &[[f64; 3]], triangles: &[[u32; 3]], opts: &GlbOptions) -> Result<Vec<u8>> {
     check_mesh(positions, triangles)?;
     let n = positions.len();
-    if let Some(uv) = opts.uvs {
-        if uv.len() != n {
-            return input_err(format!(
-                "there are {} texture coordinates for {n} vertices",
-                uv.len()
-            ));
-        }
-        if let Some(i) = uv
-            .iter()
-            .position(|p| !(p[0].is_finite() && p[1].is_finite()))
-        {
-            return input_err(format!("texture coordinate of vertex {i} is not finite"));
-        }
-    }
     if let Some(c) = opts.colors {
         if c.len() != n {
             return input_err(format!("there are {} colours for {n} vertices", c.len()));
         }
     }
-    let normals = crate::render::vertex_normals(positions, triangles);
+    match opts.uvs {
+        None => glb_welded(positions, triangles, None, opts),
+        Some(Uvs::PerVertex(uv)) => glb_welded(positions, triangles, Some(uv), opts),
+        Some(Uvs::PerCorner(uv)) => {
+            if uv.len() != 3 * triangles.len() {
+                return input_err(format!(
+                    "there are {} corner texture coordinates for {} corners",
+                    uv.len(),
+                    3 * triangles.len()
+                ));
+            }
+            // Split vertices by (vertex, uv) and carry positions, normals and colours along.
+            let normals = crate::render::vertex_normals(positions, triangles);
+            let mut index: HashMap<(u32, u64, u64), u32> = HashMap::new();
+            let (mut p2, mut n2, mut uv2, mut c2) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            let mut t2 = Vec::with_capacity(triangles.len());
+            for (f, t) in triangles.iter().enumerate() {
+                let mut nt = [0u32; 3];
+                for i in 0..3 {
+                    let v = t[i];
+                    let q = uv[3 * f + i];
+                    let key = (v, q[0].to_bits(), q[1].to_bits());
+                    nt[i] = *index.entry(key).or_insert_with(|| {
+                        p2.push(positions[v as usize]);
+                        n2.push(normals[v as usize]);
+                        uv2.push(q);
+                        if let Some(c) = opts.colors {
+                            c2.push(c[v as usize]);
+                        }
+                        (p2.len() - 1) as u32
+                    });
+                }
+                t2.push(nt);
+            }
+            let o2 = GlbOptions {
+                uvs: None,
+                colors: opts.colors.map(|_| c2.as_slice()),
+                ..opts.clone()
+            };
+            glb_build(&p2, &t2, &n2, Some(&uv2), &o2)
+        }
+    }
+}
 
+fn glb_welded(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    uvs: Option<&[[f64; 2]]>,
+    opts: &GlbOptions,
+) -> Result<Vec<u8>> {
+    let normals = crate::render::vertex_normals(positions, triangles);
+    glb_build(positions, triangles, &normals, uvs, opts)
+}
+
+fn glb_build(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    normals: &[[f64; 3]],
+    uvs: Option<&[[f64; 2]]>,
+    opts: &GlbOptions,
+) -> Result<Vec<u8>> {
+    let n = positions.len();
+    if let Some(uv) = uvs {
+        if uv.len() != n {
+            return input_err(format!("there are {} texture coordinates for {n} vertices", uv.len()));
+        }
+        if let Some(i) = uv.iter().position(|p| !(p[0].is_finite() && p[1].is_finite())) {
+            return input_err(format!("texture coordinate of vertex {i} is not finite"));
+        }
+    }
     let mut bin: Vec<u8> = Vec::new();
     let mut root = json::Root::default();
     let buffer_index = json::Index::<json::Buffer>::new(0);
@@ -149,7 +207,7 @@ pub fn glb(positions: &[[f64; 3]], triangles: &[[u32; 3]], opts: &GlbOptions) ->
 
     // Normals (unit length; isolated vertices get +z).
     let mut bytes = Vec::with_capacity(12 * n);
-    for nrm in &normals {
+    for nrm in normals {
         let nrm = if nrm == &[0.0; 3] {
             [0.0, 0.0, 1.0]
         } else {
@@ -170,7 +228,7 @@ pub fn glb(positions: &[[f64; 3]], triangles: &[[u32; 3]], opts: &GlbOptions) ->
     attributes.insert(Valid(json::mesh::Semantic::Normals), nacc);
 
     // UVs.
-    if let Some(uv) = opts.uvs {
+    if let Some(uv) = uvs {
         let mut bytes = Vec::with_capacity(8 * n);
         for p in uv {
             bytes.extend_from_slice(&(p[0] as f32).to_le_bytes());
@@ -234,7 +292,7 @@ pub fn glb(positions: &[[f64; 3]], triangles: &[[u32; 3]], opts: &GlbOptions) ->
         roughness_factor: json::material::StrengthFactor(0.75),
         ..Default::default()
     };
-    if opts.uvs.is_some() {
+    if uvs.is_some() {
         let f = opts.checker_frequency.unwrap_or(8.0);
         if !(f.is_finite() && f > 0.0) {
             return input_err(format!("the checker frequency {f} must be positive"));
@@ -362,7 +420,7 @@ mod tests {
             &t.positions,
             &t.triangles,
             &GlbOptions {
-                uvs: Some(&uv),
+                uvs: Some(Uvs::PerVertex(&uv)),
                 checker_frequency: Some(6.0),
                 colors: Some(&colors),
                 name: Some("torus".into()),
@@ -436,10 +494,46 @@ mod tests {
             &s.positions,
             &s.triangles,
             &GlbOptions {
-                uvs: Some(&[[0.0; 2]]),
+                uvs: Some(Uvs::PerVertex(&[[0.0; 2]])),
                 ..Default::default()
             }
         )
         .is_err());
+    }
+
+    #[test]
+    fn per_corner_uvs_split_vertices_only_at_seams() {
+        // A torus with wrapping per-corner UVs: vertices on the two seam circles are split,
+        // so the file has (n + 1)(m + 1) vertices instead of n m.
+        let (n, m) = (10usize, 6usize);
+        let t = shapes::torus(2.0, 0.5, n, m);
+        let mut corner = Vec::new();
+        for f in 0..t.triangles.len() {
+            let (i, j) = ((f / 2) / m, (f / 2) % m);
+            let uv = |di: usize, dj: usize| [(i + di) as f64 / n as f64, (j + dj) as f64 / m as f64];
+            if f % 2 == 0 {
+                corner.extend([uv(0, 0), uv(1, 0), uv(1, 1)]);
+            } else {
+                corner.extend([uv(0, 0), uv(1, 1), uv(0, 1)]);
+            }
+        }
+        let bytes = glb(
+            &t.positions,
+            &t.triangles,
+            &GlbOptions {
+                uvs: Some(Uvs::PerCorner(&corner)),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let g = ::gltf::Gltf::from_slice(&bytes).unwrap();
+        let blob = g.blob.as_deref().unwrap();
+        let prim = g.meshes().next().unwrap().primitives().next().unwrap();
+        let reader = prim.reader(|_| Some(blob));
+        assert_eq!(reader.read_positions().unwrap().count(), (n + 1) * (m + 1));
+        assert_eq!(reader.read_indices().unwrap().into_u32().count(), 3 * t.triangles.len());
+        let tc: Vec<[f32; 2]> = reader.read_tex_coords(0).unwrap().into_f32().collect();
+        let umax = tc.iter().map(|p| p[0]).fold(0.0f32, f32::max);
+        assert!((umax - 1.0).abs() < 1e-6);
     }
 }
