@@ -277,9 +277,12 @@ pub fn ricci_flow(
     let mut notes = Vec::new();
     if ev.structure.clamped_edges > 0 {
         notes.push(format!(
-            "{} edge(s) had their Thurston intersection angle clamped into [0, π/2]; the initial \
-             metric differs from the input there",
-            ev.structure.clamped_edges
+            "{} of {} edges had their Thurston intersection angle clamped into [0, π/2] \
+             (circles that did not meet were made tangent); the initial metric differs from the \
+             input there (initial length error up to {:.1}%)",
+            ev.structure.clamped_edges,
+            mesh.n_edges(),
+            100.0 * ev.structure.initial_length_error
         ));
     }
     let outcome = match options.solver {

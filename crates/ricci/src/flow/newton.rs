@@ -191,9 +191,22 @@ pub fn newton(
             chord_steps += 1;
             frozen.copy_from_slice(&target.curvature);
         }
-        // Right-hand side r = K̄ − K on the free vertices.
+        // Right-hand side r = K̄ − K on the free vertices. With a scale pin (E²), Gauss–Bonnet
+        // makes Σ r vanish over the prescribed vertices up to rounding; the rounding would
+        // accumulate at the pinned vertex (≈ 1e-10 on a million faces), so its mean is
+        // removed and spread evenly instead.
+        let shift = if settings.pinned.is_empty() {
+            0.0
+        } else {
+            let (sum, count) = (0..n)
+                .filter(|&i| !target.fixed[i])
+                .fold((0.0, 0usize), |(s, c), i| {
+                    (s + target.curvature[i] - ev.ws.curvature[i], c + 1)
+                });
+            sum / count.max(1) as f64
+        };
         for (c, &v) in pattern.free_vertex.iter().enumerate() {
-            rhs[c] = target.curvature[v as usize] - ev.ws.curvature[v as usize];
+            rhs[c] = target.curvature[v as usize] - ev.ws.curvature[v as usize] - shift;
         }
         let r0 = rhs.clone();
         // Round boundaries, exact steps: J = H − Σ_loops [(T/L)∇²L − (T/L²) w wᵀ]; the sparse
@@ -300,7 +313,10 @@ pub fn newton(
         let use_frozen = dynamic && !exact;
         let g0: f64 = -r0.iter().zip(&rhs).map(|(r, d)| r * d).sum::<f64>(); // ∇E·δ < 0
         let res0: f64 = r0.iter().map(|r| r * r).sum();
-        let mut t = 1.0;
+        // S² and exact round-boundary steps (indefinite systems): a trust region of 2 in u
+        // (radii change by at most e²), against wild steps from a nearly singular system.
+        let dmax = delta.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+        let mut t: f64 = if indefinite && dmax > 2.0 { 2.0 / dmax } else { 1.0 };
         let mut accepted = false;
         for _ in 0..40 {
             for i in 0..n {
