@@ -162,7 +162,7 @@ fn convergence_list_of_issue_3() {
             TargetSpec::Cones(c) => format!("{} cones −2π", c.len()),
             other => other.to_string(),
         };
-        let mut report = |sc: Scheme, r: &ricci::Result<FlowResult>| match r {
+        let report = |sc: Scheme, r: &ricci::Result<FlowResult>| match r {
             Ok(r) => eprintln!(
                 "{file:27} {:6} {g:11} {label:18} {sc:10} {:5}  {:.2e}  {:.1e}  {:.3}   {}",
                 s.mesh.n_faces(),
