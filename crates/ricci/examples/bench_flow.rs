@@ -53,15 +53,35 @@ fn cases() -> Vec<Case> {
         case("botijo H2", "botijo.off", Hyperbolic, "uniform"),
         case("botijo E2 8 cones", "botijo.off", Euclidean, "cones"),
         case("seahorse H2", "seahorse2_100K.off", Hyperbolic, "uniform"),
-        case("camelhead E2 round", "camelhead.off", Euclidean, "round-boundary"),
+        case(
+            "camelhead E2 round",
+            "camelhead.off",
+            Euclidean,
+            "round-boundary",
+        ),
         case("maxplanck S2", "maxplanck.nf25k.off", Spherical, "uniform"),
         case("horse S2", "horse.ply", Spherical, "uniform"),
         case("torus 1M E2", "gen:torus", Euclidean, "uniform"),
     ];
     for (name, mesh, g, scheme) in [
-        ("kitten E2 yamabe", "kitten.nf20k.off", Euclidean, Scheme::Yamabe),
-        ("kitten E2 inversive", "kitten.nf20k.off", Euclidean, Scheme::Inversive),
-        ("seahorse H2 tangential", "seahorse2_100K.off", Hyperbolic, Scheme::Tangential),
+        (
+            "kitten E2 yamabe",
+            "kitten.nf20k.off",
+            Euclidean,
+            Scheme::Yamabe,
+        ),
+        (
+            "kitten E2 inversive",
+            "kitten.nf20k.off",
+            Euclidean,
+            Scheme::Inversive,
+        ),
+        (
+            "seahorse H2 tangential",
+            "seahorse2_100K.off",
+            Hyperbolic,
+            Scheme::Tangential,
+        ),
         ("horse S2 yamabe", "horse.ply", Spherical, Scheme::Yamabe),
     ] {
         v.push(Case {
@@ -90,7 +110,11 @@ fn cpu_seconds() -> f64 {
     // /proc/self/schedstat: time spent on the CPU in nanoseconds.
     std::fs::read_to_string("/proc/self/schedstat")
         .ok()
-        .and_then(|s| s.split_whitespace().next().and_then(|x| x.parse::<f64>().ok()))
+        .and_then(|s| {
+            s.split_whitespace()
+                .next()
+                .and_then(|x| x.parse::<f64>().ok())
+        })
         .map(|ns| ns * 1e-9)
         .unwrap_or(f64::NAN)
 }
@@ -99,9 +123,11 @@ fn peak_mib() -> f64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
         .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1).and_then(|x| x.parse::<f64>().ok()))
+            s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| {
+                l.split_whitespace()
+                    .nth(1)
+                    .and_then(|x| x.parse::<f64>().ok())
+            })
         })
         .map(|kb| kb / 1024.0)
         .unwrap_or(f64::NAN)
@@ -178,7 +204,16 @@ fn main() {
     }
     println!(
         "{:22} {:>8} {:10} {:10} {:>6} {:>9} {:>8} {:>8} {:>7} {:>8} route",
-        "case", "faces", "scheme", "solver", "steps", "max|K-K̄|", "flow s", "cpu s", "read s", "peak MiB"
+        "case",
+        "faces",
+        "scheme",
+        "solver",
+        "steps",
+        "max|K-K̄|",
+        "flow s",
+        "cpu s",
+        "read s",
+        "peak MiB"
     );
     let exe = std::env::current_exe().expect("own executable");
     for c in cases().iter().filter(|c| c.name.contains(&filter)) {
@@ -188,7 +223,11 @@ fn main() {
             .expect("run case");
         print!("{}", String::from_utf8_lossy(&out.stdout));
         if !out.status.success() {
-            println!("{:22} failed: {}", c.name, String::from_utf8_lossy(&out.stderr).trim());
+            println!(
+                "{:22} failed: {}",
+                c.name,
+                String::from_utf8_lossy(&out.stderr).trim()
+            );
         }
     }
 }

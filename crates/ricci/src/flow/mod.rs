@@ -230,13 +230,7 @@ pub fn ricci_flow(
         ));
     }
     if target.is_dynamic() {
-        target::set_round_totals(
-            mesh,
-            &mut target,
-            &ev.ws.lengths,
-            &ev.ws.dlengths,
-            &ev.data.edges,
-        );
+        target::set_round_totals(&mut target, &ev.ws.lengths, &ev.ws.dlengths, &ev.data.edges);
     }
     target::check_gauss_bonnet(mesh, geometry, &target)?;
     let phi = ev

@@ -37,7 +37,7 @@ use super::linear::SymmetricSolver;
 use super::target::Target;
 use super::IterationRecord;
 use crate::error::Result;
-use crate::metric::{Evaluator, Geometry, HessianPattern};
+use crate::metric::{Evaluator, HessianPattern};
 use crate::progress::Progress;
 use std::time::Instant;
 
@@ -316,7 +316,11 @@ pub fn newton(
         // S² and exact round-boundary steps (indefinite systems): a trust region of 2 in u
         // (radii change by at most e²), against wild steps from a nearly singular system.
         let dmax = delta.iter().fold(0.0f64, |m, d| m.max(d.abs()));
-        let mut t: f64 = if indefinite && dmax > 2.0 { 2.0 / dmax } else { 1.0 };
+        let mut t: f64 = if indefinite && dmax > 2.0 {
+            2.0 / dmax
+        } else {
+            1.0
+        };
         let mut accepted = false;
         for _ in 0..40 {
             for i in 0..n {
@@ -619,7 +623,6 @@ pub fn gradient_flow(
     if eps < settings.step {
         notes.push(format!("step length reduced to ε = {eps:.3e}"));
     }
-    let _ = Geometry::Euclidean;
     Ok(SolveOutcome {
         u,
         iterations: it,

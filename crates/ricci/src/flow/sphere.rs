@@ -1,19 +1,26 @@
-//! The robust route from a closed genus-0 mesh to the sphere (used when spherical Newton does
-//! not converge from the initial metric; paper 001 §V, paper 002 §7.1 discuss spherical flow,
-//! this route follows the classical puncture-and-project construction):
+//! The robust route from a closed genus-0 mesh to the sphere, used when spherical Newton does
+//! not converge from the initial metric (paper 001 §V and paper 002 §7.1 treat the spherical
+//! flow; this is the classical puncture-and-project construction, made exact for vertex
+//! scaling):
 //!
-//! 1. remove the star of one vertex `v` (the interior vertex of largest valence): a disk;
-//! 2. flatten the disk by Euclidean Ricci flow with a round boundary (the user's scheme, else
-//!    tangential packing, else vertex scaling);
-//! 3. lay it out in the plane (breadth-first placement by circle intersection), move the
-//!    boundary circle (least-squares fit) to the unit circle;
+//! 1. remove the star of one vertex `v` (the largest Euclidean angle deficit among vertices of
+//!    valence ≥ 5): a disk;
+//! 2. flatten the disk by Euclidean vertex-scaling flow with the link of `v` held at
+//!    `w_j = −2 log l_vj` and `K̄ = 0` inside. This is exact: stereographic projection from
+//!    the north pole `N` scales chords by `|σ(x) − σ(y)| = 2|x − y| / (|x − N||y − N|)`, so the
+//!    planar image of a vertex-scaled unit sphere with `v` at `N` is a vertex-scaled flat disk
+//!    whose link values are `−2 log l_vj` up to a constant (the inversion of the star about
+//!    `v`). (DESIGN.md suggests a round boundary here; the Dirichlet condition is the one that
+//!    reproduces the discrete conformal class exactly, and it is a convex problem.);
+//! 3. lay the disk out in the plane (breadth-first placement by circle intersection) and move
+//!    the least-squares circle through its boundary to the unit circle;
 //! 4. stereographic projection to the unit sphere, `v` at the north pole;
-//! 5. Möbius normalization: centroid of the vertices at the origin (iterated `x ↦ T_c(x)`,
-//!    `T_a(x) = (1 − |a|²)(x − a)/|x − a|² − a`);
+//! 5. Möbius normalization: the centroid of the vertices moves to the origin (iterated
+//!    `x ↦ T_a(x) = (1 − |a|²)(x − a)/|x − a|² − a` with `a` a damped centroid);
 //! 6. spherical edge lengths from the embedded points, `d = 2 asin(|x_i − x_j|/2)`;
-//! 7. the scheme's variables `u` fitted to these lengths (Gauss–Newton on `Σ (l_e(u) − d_e)²`),
-//!    then spherical Newton from there — the start is close to the solution set with the
-//!    Möbius freedom already centred, so Newton converges quickly.
+//! 7. the scheme's variables `u` fitted to these lengths (Gauss–Newton on `Σ (l_e(u) − d_e)²`;
+//!    exact for vertex scaling when the embedding is valid), then spherical Newton from there:
+//!    the start is close to the solution set with its Möbius freedom already centred.
 
 use super::linear::SymmetricSolver;
 use super::newton::{self, NewtonSettings, SolveOutcome};

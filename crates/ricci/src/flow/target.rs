@@ -355,10 +355,7 @@ pub fn resolve(mesh: &Mesh, geometry: Geometry, spec: &TargetSpec) -> Result<Tar
             }
             let genus = topo.components[0].genus;
             let b = loops.len();
-            let lens: Vec<f64> = loops.iter().map(|l| l.len() as f64).collect();
-            let _ = lens;
-            // Loop lengths by the input metric are measured later; order by edge count here
-            // and by length in `set_round_totals`.
+            // Genus 0: totals are set from the loop lengths in `set_round_totals`.
             for l in &loops {
                 let vertices: Vec<u32> = l.iter().map(|&h| mesh.he_origin(h)).collect();
                 let edges: Vec<u32> = l.iter().map(|&h| mesh.he_edge(h)).collect();
@@ -392,7 +389,6 @@ pub fn resolve(mesh: &Mesh, geometry: Geometry, spec: &TargetSpec) -> Result<Tar
 /// Round boundaries of genus-0 surfaces: the longest loop (by `lengths`) gets +2π, the
 /// others −2π. Then targets are set from the metric.
 pub fn set_round_totals(
-    mesh: &Mesh,
     target: &mut Target,
     lengths: &[f64],
     dlengths: &[[f64; 2]],
@@ -411,7 +407,6 @@ pub fn set_round_totals(
             l.total = if k == longest { 2.0 * PI } else { -2.0 * PI };
         }
     }
-    let _ = mesh;
     target.update_round(lengths, dlengths, edge_vertices);
 }
 
