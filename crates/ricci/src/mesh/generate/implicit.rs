@@ -246,3 +246,78 @@ pub(crate) fn marching_tetrahedra<F: Implicit>(
     }
     (positions, faces)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{topology, Surface};
+
+    struct Sphere(f64);
+    impl Implicit for Sphere {
+        fn value(&self, p: [f64; 3]) -> f64 {
+            norm(p) - self.0
+        }
+        fn gradient(&self, p: [f64; 3]) -> [f64; 3] {
+            scale(p, 1.0 / norm(p))
+        }
+    }
+
+    fn volume(s: &Surface) -> f64 {
+        s.mesh
+            .faces()
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| s.positions[v as usize]);
+                dot(a, cross(b, c)) / 6.0
+            })
+            .sum()
+    }
+
+    #[test]
+    fn marching_tetrahedra_gives_a_closed_outward_sphere() {
+        let h = 0.1;
+        let (pos, faces) = marching_tetrahedra(&Sphere(1.0), ([-1.3; 3], [1.3; 3]), h);
+        let s = Surface::new(pos, faces).unwrap();
+        let t = topology(&s.mesh);
+        assert_eq!(t.components.len(), 1);
+        assert_eq!(t.components[0].genus, 0);
+        assert!(!s.mesh.has_boundary());
+        // Vertices on grid edges within one cell of the sphere; volume outward ≈ 4π/3.
+        for p in &s.positions {
+            assert!((norm(*p) - 1.0).abs() < h * 3f64.sqrt());
+        }
+        let v = volume(&s);
+        assert!((v - 4.0 * std::f64::consts::PI / 3.0).abs() < 0.05, "{v}");
+    }
+
+    #[test]
+    fn the_chain_field_has_genus_g_and_an_exact_gradient() {
+        for g in [1u32, 2, 3] {
+            let f = ToriChain::new(g);
+            let (pos, faces) = marching_tetrahedra(&f, f.bounds(0.2), 0.08);
+            let s = Surface::new(pos, faces).unwrap();
+            let t = topology(&s.mesh);
+            assert_eq!(t.components.len(), 1);
+            assert_eq!(t.components[0].genus, g as i64);
+            assert!(volume(&s) > 0.0);
+        }
+        // Gradient against central differences, also inside the blends.
+        let f = ToriChain::new(3);
+        let eps = 1e-6;
+        for p in [
+            [0.1, 0.9, 0.2],
+            [-1.0, 1.3, 0.1],
+            [0.05, -0.95, -0.3],
+            [2.3, 0.2, 0.35],
+        ] {
+            let g = f.gradient(p);
+            for k in 0..3 {
+                let (mut a, mut b) = (p, p);
+                a[k] += eps;
+                b[k] -= eps;
+                let fd = (f.value(a) - f.value(b)) / (2.0 * eps);
+                assert!((fd - g[k]).abs() < 1e-7, "{p:?} axis {k}: {fd} vs {}", g[k]);
+            }
+        }
+    }
+}
