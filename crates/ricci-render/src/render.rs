@@ -1288,8 +1288,14 @@ impl Legend {
         };
         let halo = if text[0] > 0.5 { [0.0; 3] } else { [1.0; 3] };
         let cmap = s.colormap;
+        let constant = self.range.1 <= self.range.0;
         for y in top..=bot {
-            let t = (bot - y) as f64 / (bot - top).max(1) as f64;
+            // A constant field has one colour (the centre of the map) and one label.
+            let t = if constant {
+                0.5
+            } else {
+                (bot - y) as f64 / (bot - top).max(1) as f64
+            };
             img.fill_rect(x0, y, bar_w, 1, cmap.eval(t), 1.0);
         }
         // Frame.
