@@ -22,8 +22,8 @@ use super::geom::*;
 use super::remesh::Implicit;
 use std::collections::HashMap;
 
-/// Genus-g "chain of tori" implicit surface.
-pub(crate) struct ToriChain {
+/// The genus-g "chain of tori" implicit surface of [`genus`](super::genus) (see the module docs).
+pub struct ToriChain {
     pub centers: Vec<f64>,
     pub major: f64,
     pub minor: f64,
@@ -44,7 +44,7 @@ impl ToriChain {
     }
 
     /// Bounding box of the surface with a margin.
-    pub fn bounds(&self, margin: f64) -> (P3, P3) {
+    pub fn bounds(&self, margin: f64) -> ([f64; 3], [f64; 3]) {
         let ext = self.major + self.minor + self.blend + margin;
         let zext = self.minor + self.blend + margin;
         let x0 = self.centers.first().copied().unwrap_or(0.0);
@@ -95,10 +95,10 @@ impl ToriChain {
 }
 
 impl Implicit for ToriChain {
-    fn value(&self, p: P3) -> f64 {
+    fn value(&self, p: [f64; 3]) -> f64 {
         self.eval(p).0
     }
-    fn gradient(&self, p: P3) -> P3 {
+    fn gradient(&self, p: [f64; 3]) -> [f64; 3] {
         self.eval(p).1
     }
 }

@@ -27,13 +27,13 @@ use crate::error::{Error, Result};
 const NONE: u32 = u32::MAX;
 
 /// A smooth implicit surface `f = 0`, `f < 0` inside, `∇f` pointing out.
-pub(crate) trait Implicit {
-    fn value(&self, p: P3) -> f64;
-    fn gradient(&self, p: P3) -> P3;
+pub trait Implicit {
+    fn value(&self, p: [f64; 3]) -> f64;
+    fn gradient(&self, p: [f64; 3]) -> [f64; 3];
 
     /// Newton projection along the gradient onto `f = 0` (stops at `|f| ≤ 1e-12` or after 30
     /// steps; each step is limited to `max_step` so a bad start cannot jump to another sheet).
-    fn project(&self, mut p: P3, max_step: f64) -> P3 {
+    fn project(&self, mut p: [f64; 3], max_step: f64) -> [f64; 3] {
         for _ in 0..30 {
             let f = self.value(p);
             if f.abs() <= 1e-12 {
@@ -55,7 +55,7 @@ pub(crate) trait Implicit {
     }
 
     /// Unit outward normal at `p`.
-    fn normal(&self, p: P3) -> P3 {
+    fn normal(&self, p: [f64; 3]) -> [f64; 3] {
         let g = self.gradient(p);
         let n = norm(g);
         if n > 0.0 {
@@ -387,6 +387,16 @@ impl TriMesh {
         out
     }
 
+    /// Whether some face around `v` folds over (normal outside the cone of half-angle
+    /// acos(`cos_limit`) around `up`) when `v` is at `p`.
+    fn star_folds(&self, p: P3, up: P3, cos_limit: f64, ring: &[u32]) -> bool {
+        ring.iter().any(|&g| {
+            let n = tri_normal(p, self.p(self.dst(g)), self.p(self.org(prev(g))));
+            let nn = norm(n) * norm(up);
+            nn == 0.0 || dot(n, up) <= cos_limit * nn
+        })
+    }
+
     /// Smallest angle among the faces around `v` when `v` is at `p` (`-1` if one folds over,
     /// i.e. its normal leaves the cone of half-angle acos(`cos_limit`) around `up`).
     fn star_quality(&self, p: P3, up: P3, cos_limit: f64, ring: &[u32]) -> f64 {
@@ -591,7 +601,7 @@ fn tangential_relaxation<F: Implicit>(m: &mut TriMesh, field: &F, max_step: f64)
         m.ring(v, &mut ring);
         let p = target[v as usize];
         let up = field.normal(p);
-        if m.star_quality(p, up, COS_FOLD, &ring) > 0.0 {
+        if !m.star_folds(p, up, COS_FOLD, &ring) {
             m.pos[v as usize] = p;
         }
     }
