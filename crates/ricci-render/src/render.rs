@@ -182,6 +182,9 @@ pub enum Paint<'a> {
     Circles(Circles<'a>),
     Scalar(Scalar<'a>),
     Zebra(Zebra),
+    /// One sRGB colour per face (atlas charts, patches, spline pieces; see
+    /// [`crate::color::categorical`]).
+    FaceColors(&'a [Rgb]),
 }
 
 impl Default for Paint<'_> {
@@ -298,7 +301,19 @@ impl Rendered {
 }
 
 const NO_FACE: u32 = u32::MAX;
+/// Upper bound on supersampled pixels (8 bytes each in the visibility buffers: 2 GiB).
+const MAX_SAMPLES: u64 = 1 << 28;
 const BAND: usize = 32;
+
+/// Render a triangle mesh and encode it as PNG bytes (see [`render`]).
+pub fn render_png(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    style: &Style,
+    opts: &RenderOptions,
+) -> Result<Vec<u8>> {
+    render(positions, triangles, style, opts)?.png()
+}
 
 /// Render a triangle mesh.
 pub fn render(
@@ -318,6 +333,14 @@ pub fn render(
         return input_err(format!(
             "supersampling {} must be between 1 and 8",
             opts.supersample
+        ));
+    }
+    let samples = (opts.width as u64 * opts.supersample as u64)
+        * (opts.height as u64 * opts.supersample as u64);
+    if samples > MAX_SAMPLES {
+        return input_err(format!(
+            "{}x{} pixels with {}x{} supersampling need {samples} samples, more than the {MAX_SAMPLES} this renderer allows; lower the size or the supersampling",
+            opts.width, opts.height, opts.supersample, opts.supersample
         ));
     }
     let (nv, nf) = (positions.len(), triangles.len());
@@ -590,6 +613,14 @@ fn check_paint(paint: &Paint, nv: usize, nf: usize) -> Result<Option<(f64, f64)>
         }
         Paint::Zebra(z) => freq_ok(z.stripes)?,
         Paint::Solid(_) => {}
+        Paint::FaceColors(c) => {
+            if c.len() != nf {
+                return input_err(format!(
+                    "there are {} face colours, but the mesh has {nf} faces",
+                    c.len()
+                ));
+            }
+        }
     }
     Ok(None)
 }
@@ -943,6 +974,7 @@ impl<'a> Shader<'a> {
             Paint::Circles(c) => [c.ink, c.paper],
             Paint::Zebra(z) => [z.dark, z.light],
             Paint::Solid(c) => [*c, *c],
+            Paint::FaceColors(_) => [[0.0; 3], [0.0; 3]],
             Paint::Scalar(_) => [[0.0; 3], [0.0; 3]],
         };
         let map = match &style.paint {
@@ -1030,6 +1062,7 @@ impl<'a> Shader<'a> {
 
         let (mut albedo, shiny) = match self.paint {
             Paint::Solid(_) => (self.two_colors[0], true),
+            Paint::FaceColors(c) => (color::to_linear(c[fi]), true),
             Paint::Checker(c) => {
                 let (uv, fw) = self.uv_and_footprint(&c.uvs, fi, &s, lp, c.frequency);
                 let a = checker(uv[0], fw[0]) * checker(uv[1], fw[1]);
