@@ -551,7 +551,7 @@ pub fn render(
                         o[q] = lut.encode(acc[q] / acc[3]);
                     }
                 }
-                o[3] = (acc[3] * inv_n * 255.0).round() as u8;
+                o[3] = fround(acc[3] * inv_n * 255.0) as u8;
             }
             covered
         })
@@ -758,14 +758,14 @@ fn rasterize(
                 let ymax = v[0].y.max(v[1].y).max(v[2].y);
                 let xmin = v[0].x.min(v[1].x).min(v[2].x);
                 let xmax = v[0].x.max(v[1].x).max(v[2].x);
-                let ya = ((ymin - 0.5).ceil().max(y0 as f32)) as usize;
-                let yb = ((ymax - 0.5).floor().min(y1 as f32 - 1.0)).max(-1.0);
+                let ya = (fceil(ymin - 0.5).max(y0 as f32)) as usize;
+                let yb = (ffloor(ymax - 0.5).min(y1 as f32 - 1.0)).max(-1.0);
                 if yb < 0.0 || (yb as usize) < ya {
                     continue;
                 }
                 let yb = yb as usize;
-                let xa0 = (xmin - 0.5).ceil().max(0.0);
-                let xb0 = (xmax - 0.5).floor().min(sw as f32 - 1.0);
+                let xa0 = fceil(xmin - 0.5).max(0.0);
+                let xb0 = ffloor(xmax - 0.5).min(sw as f32 - 1.0);
                 if xb0 < xa0 {
                     continue;
                 }
@@ -781,9 +781,9 @@ fn rasterize(
                         let r = s.b[i] * yc + s.c[i];
                         let a = s.a[i];
                         if a > 0.0 {
-                            lo = lo.max(((EPS - r) / a - 0.5).ceil());
+                            lo = lo.max(fceil((EPS - r) / a - 0.5));
                         } else if a < 0.0 {
-                            hi = hi.min(((EPS - r) / a - 0.5).floor());
+                            hi = hi.min(ffloor((EPS - r) / a - 0.5));
                         } else if r < EPS {
                             hi = -1.0;
                         }
@@ -1071,7 +1071,7 @@ impl<'a> Shader<'a> {
             }
             Paint::Circles(c) => {
                 let (uv, fw) = self.uv_and_footprint(&c.uvs, fi, &s, lp, c.frequency);
-                let (fx, fy) = (uv[0] - uv[0].floor() - 0.5, uv[1] - uv[1].floor() - 0.5);
+                let (fx, fy) = (uv[0] - ffloor(uv[0]) - 0.5, uv[1] - ffloor(uv[1]) - 0.5);
                 let d = (fx * fx + fy * fy).sqrt();
                 let w = 0.5 * (fw[0] + fw[1]).max(1e-6);
                 let inside = ((c.radius as f32 - d) / w + 0.5).clamp(0.0, 1.0);
@@ -1100,7 +1100,7 @@ impl<'a> Shader<'a> {
                         });
                         let g = screen_gradient(&s, vals);
                         let z = tt * sc.isolines as f32;
-                        let dist = (z - z.round()).abs() / g.max(1e-9); // in samples
+                        let dist = (z - fround(z)).abs() / g.max(1e-9); // in samples
                         let cov = ((0.6 * self.ss - dist) / self.ss + 0.5).clamp(0.0, 1.0) * 0.7;
                         c = mix(c, [0.0; 3], cov);
                     }
@@ -1117,7 +1117,7 @@ impl<'a> Shader<'a> {
                 ];
                 let phi = r[1].atan2(r[2]) / std::f32::consts::PI; // in (-1, 1]
                 let u = phi * z.stripes as f32;
-                let fr = u - u.floor();
+                let fr = u - ffloor(u);
                 let tri = (fr - 0.5).abs() * 2.0; // 1 at stripe borders, 0 in the middle
                 let m = ((tri - 0.5) / 0.12 + 0.5).clamp(0.0, 1.0);
                 (mix(self.two_colors[1], self.two_colors[0], m), false)
@@ -1208,11 +1208,11 @@ impl<'a> Shader<'a> {
 #[inline]
 fn checker(x: f32, w: f32) -> f32 {
     let tri = |x: f32| {
-        let m = x - 2.0 * (x * 0.5).floor(); // x mod 2
+        let m = x - 2.0 * ffloor(x * 0.5); // x mod 2
         1.0 - (m - 1.0).abs()
     };
     if w < 1e-4 {
-        let m = x - 2.0 * (x * 0.5).floor();
+        let m = x - 2.0 * ffloor(x * 0.5);
         if m < 1.0 {
             1.0
         } else {
@@ -1358,4 +1358,29 @@ impl Legend {
             font::draw_text_halo(img, tx, top - th - 8 * sc, self.scale, &s.label, text, halo);
         }
     }
+}
+
+// f32 floor/ceil/round without a libm call (the default x86-64 target has no SSE4.1 `roundss`);
+// exact for |x| < 2^31.
+#[inline(always)]
+fn ffloor(x: f32) -> f32 {
+    let t = x as i32 as f32;
+    if t > x {
+        t - 1.0
+    } else {
+        t
+    }
+}
+#[inline(always)]
+fn fceil(x: f32) -> f32 {
+    let t = x as i32 as f32;
+    if t < x {
+        t + 1.0
+    } else {
+        t
+    }
+}
+#[inline(always)]
+fn fround(x: f32) -> f32 {
+    ffloor(x + 0.5)
 }
