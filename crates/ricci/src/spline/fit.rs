@@ -1,0 +1,1 @@
+//! Fairing and fitting of DMS splines (paper 000 §5).

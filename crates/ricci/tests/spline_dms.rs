@@ -1,0 +1,257 @@
+//! Planar DMS triangular B-splines (issue 7, task dms): partition of unity, polynomial
+//! reproduction, C^{n−1} continuity across domain edges, derivatives against finite
+//! differences, fairing and fitting.
+
+use ricci::spline::dms::{DmsSpace, Domain, KnotOptions, Workspace};
+use ricci::spline::poly::Polynomial;
+use ricci::spline::simplex::{n_partials, Point};
+
+/// Small deterministic generator (xorshift*).
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// A jittered m×m grid of the unit square, diagonals alternating.
+fn grid_domain(m: usize, jitter: f64, seed: u64) -> Domain {
+    let mut rng = Rng(seed);
+    let mut pts = Vec::new();
+    for j in 0..=m {
+        for i in 0..=m {
+            let (mut x, mut y) = (i as f64 / m as f64, j as f64 / m as f64);
+            if i > 0 && i < m && j > 0 && j < m {
+                x += jitter / m as f64 * (rng.next() - 0.5);
+                y += jitter / m as f64 * (rng.next() - 0.5);
+            }
+            pts.push([x, y]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * (m + 1) + i) as u32;
+    let mut tris = Vec::new();
+    for j in 0..m {
+        for i in 0..m {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if (i + j) % 2 == 0 {
+                tris.push([a, b, c]);
+                tris.push([a, c, d]);
+            } else {
+                tris.push([a, b, d]);
+                tris.push([b, c, d]);
+            }
+        }
+    }
+    Domain::new(pts, tris).unwrap()
+}
+
+/// An L-shaped domain (with a reflex boundary vertex): the 2×2 square minus its top-right
+/// quarter, triangulated from a jittered grid.
+fn l_domain(m: usize, seed: u64) -> Domain {
+    let g = grid_domain(2 * m, 0.3, seed);
+    let pts = g.points().to_vec();
+    let tris: Vec<[u32; 3]> = g
+        .triangles()
+        .iter()
+        .copied()
+        .filter(|t| {
+            let c = [
+                (pts[t[0] as usize][0] + pts[t[1] as usize][0] + pts[t[2] as usize][0]) / 3.0,
+                (pts[t[0] as usize][1] + pts[t[1] as usize][1] + pts[t[2] as usize][1]) / 3.0,
+            ];
+            !(c[0] > 0.5 && c[1] > 0.5)
+        })
+        .collect();
+    // Drop unused vertices.
+    let mut map = vec![u32::MAX; pts.len()];
+    let mut np = Vec::new();
+    let mut nt = Vec::new();
+    for t in &tris {
+        let mut u = [0u32; 3];
+        for k in 0..3 {
+            let v = t[k] as usize;
+            if map[v] == u32::MAX {
+                map[v] = np.len() as u32;
+                np.push(pts[v]);
+            }
+            u[k] = map[v];
+        }
+        nt.push(u);
+    }
+    Domain::new(np, nt).unwrap()
+}
+
+/// A disk: a centre of valence 7 and two rings, irregular.
+fn disk_domain() -> Domain {
+    let mut pts = vec![[0.0, 0.0]];
+    let rings = [(7usize, 0.45), (14, 1.0)];
+    for (k, r) in rings {
+        for i in 0..k {
+            let a = 2.0 * std::f64::consts::PI * (i as f64 + 0.3 * (k as f64).sin()) / k as f64;
+            pts.push([r * a.cos(), r * a.sin()]);
+        }
+    }
+    let mut tris = Vec::new();
+    for i in 0..7u32 {
+        tris.push([0, 1 + i, 1 + (i + 1) % 7]);
+    }
+    // Inner ring vertex i sits between outer vertices 2i and 2i+1.
+    for i in 0..7u32 {
+        let a = 1 + i;
+        let b = 1 + (i + 1) % 7;
+        let o0 = 8 + 2 * i;
+        let o1 = 8 + (2 * i + 1) % 14;
+        let o2 = 8 + (2 * i + 2) % 14;
+        tris.push([a, o0, o1]);
+        tris.push([a, o1, b]);
+        tris.push([b, o1, o2]);
+    }
+    Domain::new(pts, tris).unwrap()
+}
+
+fn domains() -> Vec<(&'static str, Domain)> {
+    vec![
+        ("grid", grid_domain(4, 0.5, 7)),
+        ("L", l_domain(2, 3)),
+        ("disk", disk_domain()),
+    ]
+}
+
+/// Sample points: (face, point) inside faces, on edges and at vertices.
+fn samples(d: &Domain, count: usize, seed: u64) -> Vec<(u32, Point)> {
+    let mut rng = Rng(seed);
+    let nf = d.n_faces();
+    let mut out = Vec::new();
+    for k in 0..count {
+        let f = ((rng.next() * nf as f64) as usize).min(nf - 1) as u32;
+        let (mut a, mut b) = (rng.next(), rng.next());
+        if a + b > 1.0 {
+            a = 1.0 - a;
+            b = 1.0 - b;
+        }
+        let bary = match k % 4 {
+            0 | 1 => [1.0 - a - b, a, b],
+            2 => [1.0 - a, a, 0.0], // on an edge
+            _ => {
+                let mut v = [0.0; 3];
+                v[k % 3] = 1.0; // at a vertex
+                v
+            }
+        };
+        out.push((f, d.point_in_face(f, bary)));
+    }
+    out
+}
+
+#[test]
+fn partition_of_unity_everywhere() {
+    for (name, dom) in domains() {
+        for n in 1..=5 {
+            let space =
+                DmsSpace::with_placed_knots(dom.clone(), n, &KnotOptions::default()).unwrap();
+            let mut ws = Workspace::default();
+            let np = n_partials(2);
+            let (mut worst, mut worst_d): (f64, f64) = (0.0, 0.0);
+            for (f, u) in samples(space.domain(), 800, 11 + n as u64) {
+                let m = space.basis_at(f, u, 2, &mut ws);
+                let mut sum = [0.0; 6];
+                let mut mag = [0.0; 6];
+                for i in 0..m {
+                    for k in 0..np {
+                        sum[k] += ws.values[i * np + k];
+                        mag[k] += ws.values[i * np + k].abs();
+                    }
+                }
+                worst = worst.max((sum[0] - 1.0).abs());
+                // Derivatives of Σ N vanish (up to order n − 1, where they are continuous,
+                // and also beyond: Σ N is the constant 1 on the domain).
+                for k in 1..np {
+                    worst_d = worst_d.max(sum[k].abs() / mag[k].max(1.0));
+                }
+            }
+            eprintln!(
+                "{name} n={n}: max |Σ N − 1| = {worst:.2e}, max |∂ Σ N| / Σ |∂N| = {worst_d:.2e}, {:?}",
+                space.report()
+            );
+            assert!(
+                worst_d < 1e-9,
+                "{name} n={n}: derivatives of Σ N = {worst_d:.2e}"
+            );
+            assert!(
+                worst < 5e-11,
+                "{name} n={n}: partition of unity off by {worst:.2e}"
+            );
+        }
+    }
+}
+
+/// Every polynomial of degree ≤ n (each monomial, and random combinations) is reproduced by
+/// its blossom control points, with all derivatives.
+#[test]
+fn polynomial_reproduction() {
+    for (name, dom) in domains() {
+        for n in 2..=5 {
+            let space =
+                DmsSpace::with_placed_knots(dom.clone(), n, &KnotOptions::default()).unwrap();
+            let center = [0.3, 0.2];
+            let mut polys = Vec::new();
+            for tot in 0..=n {
+                for b in 0..=tot {
+                    polys.push(Polynomial::monomial(n, tot - b, b, center, 1.0));
+                }
+            }
+            let mut rng = Rng(99 + n as u64);
+            let coeffs: Vec<f64> = (0..n_partials(n)).map(|_| 2.0 * rng.next() - 1.0).collect();
+            polys.push(Polynomial::from_coeffs(n, center, 1.0, coeffs));
+            let pts = samples(space.domain(), 300, 3 + n as u64);
+            let order = n;
+            let np = n_partials(order);
+            let mut ws = Workspace::default();
+            let mut worst = vec![0.0f64; order + 1];
+            let mut worst_rel = vec![0.0f64; order + 1];
+            for p in &polys {
+                let c = space.control_points_of_polynomial(p).unwrap();
+                for &(f, u) in &pts {
+                    let m = space.basis_at(f, u, order, &mut ws);
+                    let want = p.partials(u, order);
+                    for i in 0..np {
+                        let (mut val, mut mag) = (0.0, 0.0);
+                        for j in 0..m {
+                            let t = c[ws.indices[j] as usize] * ws.values[j * np + i];
+                            val += t;
+                            mag += t.abs();
+                        }
+                        let k = (((8 * i + 1) as f64).sqrt() as usize - 1) / 2; // order of partial i
+                        let err = (val - want[i]).abs();
+                        worst[k] = worst[k].max(err);
+                        worst_rel[k] = worst_rel[k].max(err / mag.max(1e-300));
+                    }
+                }
+            }
+            let fmt = |v: &[f64]| v.iter().map(|e| format!("{e:.1e}")).collect::<Vec<_>>();
+            eprintln!(
+                "{name} n={n}: reproduction error by derivative order {:?}, relative to Σ|c ∂N| {:?}",
+                fmt(&worst),
+                fmt(&worst_rel)
+            );
+            assert!(
+                worst[0] < 1e-10,
+                "{name} n={n}: value error {:.2e}",
+                worst[0]
+            );
+            // Derivatives: the sum Σ c ∂N cancels (individual ∂^k N grow like ρ^-k, ρ the cloud
+            // radius); the error is measured against the size of the terms.
+            for k in 1..=order {
+                assert!(
+                    worst_rel[k] < 1e-9,
+                    "{name} n={n}: order {k} error {:.2e} (relative {:.2e})",
+                    worst[k],
+                    worst_rel[k]
+                );
+            }
+        }
+    }
+}
