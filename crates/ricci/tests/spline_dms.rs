@@ -2,6 +2,8 @@
 //! reproduction, C^{n−1} continuity across domain edges, derivatives against finite
 //! differences, fairing and fitting.
 
+#![allow(clippy::needless_range_loop)]
+
 use ricci::spline::dms::{DmsSpace, Domain, KnotOptions, Workspace};
 use ricci::spline::poly::Polynomial;
 use ricci::spline::simplex::{n_partials, Point};
@@ -254,4 +256,269 @@ fn polynomial_reproduction() {
             }
         }
     }
+}
+
+fn random_control(space: &DmsSpace, dim: usize, seed: u64) -> Vec<f64> {
+    let mut rng = Rng(seed);
+    (0..space.n_control_points() * dim)
+        .map(|_| 2.0 * rng.next() - 1.0)
+        .collect()
+}
+
+/// Largest |partial| of each total order over a set of evaluations.
+fn order_of(i: usize) -> usize {
+    (((8 * i + 1) as f64).sqrt() as usize - 1) / 2
+}
+
+/// C^{n−1} across every interior domain edge, with random control points: the partials up to
+/// order n − 1 approached from the two faces agree; the order-n partials do jump (so the
+/// one-sided evaluation is really one-sided).
+#[test]
+fn continuity_across_domain_edges() {
+    for (name, dom) in [("grid", grid_domain(4, 0.5, 21)), ("disk", disk_domain())] {
+        for n in 2..=5 {
+            let space =
+                DmsSpace::with_placed_knots(dom.clone(), n, &KnotOptions::default()).unwrap();
+            let c = random_control(&space, 1, 5 + n as u64);
+            let mesh = space.domain().mesh();
+            let np = n_partials(n);
+            let mut ws = Workspace::default();
+            let (mut a, mut b) = (vec![0.0; np], vec![0.0; np]);
+            let mut rng = Rng(77);
+            let mut jumps = Vec::new(); // (order, |jump|)
+            let mut scale = vec![0.0f64; n + 1];
+            for e in 0..mesh.n_edges() as u32 {
+                if mesh.is_boundary_edge(e) {
+                    continue;
+                }
+                let h = mesh.edge_halfedge(e);
+                let (f, g) = (mesh.he_face(h), mesh.he_face(mesh.he_twin(h)));
+                let [p, q] = mesh
+                    .edge_vertices(e)
+                    .map(|v| space.domain().points()[v as usize]);
+                for s in 0..3 {
+                    let t = if s == 0 { 0.5 } else { rng.next() };
+                    let u = [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])];
+                    space.evaluate(&c, 1, f, u, n, &mut ws, &mut a);
+                    space.evaluate(&c, 1, g, u, n, &mut ws, &mut b);
+                    for i in 0..np {
+                        let k = order_of(i);
+                        scale[k] = scale[k].max(a[i].abs()).max(b[i].abs());
+                        jumps.push((k, (a[i] - b[i]).abs()));
+                    }
+                }
+            }
+            let mut worst = vec![0.0f64; n + 1];
+            for (k, j) in jumps {
+                worst[k] = worst[k].max(j / scale[k]);
+            }
+            eprintln!(
+                "{name} n={n}: relative jumps by order {:?}",
+                worst.iter().map(|e| format!("{e:.1e}")).collect::<Vec<_>>()
+            );
+            for k in 0..n {
+                assert!(
+                    worst[k] <= 1e-8,
+                    "{name} n={n}: order-{k} jump {:.2e}",
+                    worst[k]
+                );
+            }
+            assert!(
+                worst[n] > 1e-3,
+                "{name} n={n}: order-n partials do not jump ({:.2e})",
+                worst[n]
+            );
+        }
+    }
+}
+
+/// Partials of order k against central differences of the partials of order k − 1, for random
+/// control points in R³, k = 1..n−1 (where they are continuous).
+#[test]
+fn derivatives_match_finite_differences() {
+    let dom = grid_domain(3, 0.5, 4);
+    for n in 2..=5 {
+        let space = DmsSpace::with_placed_knots(dom.clone(), n, &KnotOptions::default()).unwrap();
+        let dim = 3;
+        let c = random_control(&space, dim, 40 + n as u64);
+        let order = n - 1;
+        let np = n_partials(order);
+        let mut ws = Workspace::default();
+        let mut out = vec![0.0; np * dim];
+        let (mut op, mut om) = (vec![0.0; np * dim], vec![0.0; np * dim]);
+        let h = 1e-6;
+        let mut worst = 0.0f64;
+        let mut scale = vec![0.0f64; order + 1];
+        let pts: Vec<(u32, Point)> = samples(space.domain(), 200, 8)
+            .into_iter()
+            .enumerate()
+            .filter(|(k, _)| k % 4 < 2)
+            .map(|(_, s)| s)
+            .collect();
+        let mut errs = Vec::new();
+        for &(f, u) in &pts {
+            space.evaluate(&c, dim, f, u, order, &mut ws, &mut out);
+            for i in 0..np {
+                for d in 0..dim {
+                    scale[order_of(i)] = scale[order_of(i)].max(out[i * dim + d].abs());
+                }
+            }
+            for axis in 0..2 {
+                let mut up = u;
+                let mut um = u;
+                up[axis] += h;
+                um[axis] -= h;
+                space.evaluate(&c, dim, f, up, order, &mut ws, &mut op);
+                space.evaluate(&c, dim, f, um, order, &mut ws, &mut om);
+                // d/dx of partial (a, b) is partial (a+1, b); d/dy is (a, b+1).
+                for k in 0..order {
+                    for b in 0..=k {
+                        let a = k - b;
+                        let from = k * (k + 1) / 2 + b;
+                        let (a2, b2) = if axis == 0 { (a + 1, b) } else { (a, b + 1) };
+                        let to = (k + 1) * (k + 2) / 2 + b2;
+                        debug_assert_eq!(a2 + b2, k + 1);
+                        for d in 0..dim {
+                            let fd = (op[from * dim + d] - om[from * dim + d]) / (2.0 * h);
+                            errs.push((k + 1, (fd - out[to * dim + d]).abs()));
+                        }
+                    }
+                }
+            }
+        }
+        for (k, e) in errs {
+            worst = worst.max(e / scale[k]);
+        }
+        eprintln!("n={n}: worst finite-difference mismatch {worst:.1e} (relative to the largest partial of that order)");
+        assert!(
+            worst < 1e-4,
+            "n={n}: derivatives disagree with finite differences ({worst:.2e})"
+        );
+    }
+}
+
+/// The basis of a triangle built from knots in another chart (rigid motion, as between charts
+/// of an affine atlas, and a general affine map) gives the same values at the mapped point,
+/// and derivatives that transform by the chain rule.
+#[test]
+fn triangle_basis_is_chart_independent() {
+    use ricci::spline::dms::{KnotClouds, TriangleBasis};
+    let dom = grid_domain(3, 0.5, 9);
+    for n in [3, 5] {
+        let clouds = KnotClouds::place(&dom, n, &KnotOptions::default()).unwrap();
+        let f = 7u32;
+        let tri = dom.triangles()[f as usize];
+        let base = TriangleBasis::new(n, tri.map(|v| clouds.cloud(v))).unwrap();
+        // x ↦ A x + t
+        let maps = [
+            (
+                [[0.6f64.cos(), -0.6f64.sin()], [0.6f64.sin(), 0.6f64.cos()]],
+                [3.0, -2.0],
+            ),
+            ([[1.3, 0.4], [-0.2, 0.8]], [-1.0, 5.0]),
+        ];
+        for (a, t) in maps {
+            let map = |p: Point| {
+                [
+                    a[0][0] * p[0] + a[0][1] * p[1] + t[0],
+                    a[1][0] * p[0] + a[1][1] * p[1] + t[1],
+                ]
+            };
+            let lin = |p: Point| {
+                [
+                    a[0][0] * p[0] + a[0][1] * p[1],
+                    a[1][0] * p[0] + a[1][1] * p[1],
+                ]
+            };
+            let moved: Vec<Vec<Point>> = tri
+                .iter()
+                .map(|&v| clouds.cloud(v).iter().map(|&p| map(p)).collect())
+                .collect();
+            let other =
+                TriangleBasis::new(n, [&moved[0][..], &moved[1][..], &moved[2][..]]).unwrap();
+            let np = n_partials(1);
+            let (mut x, mut y) = (vec![0.0; base.len() * np], vec![0.0; base.len() * np]);
+            let mut work = Vec::new();
+            let mut worst: f64 = 0.0;
+            for (g, u) in samples(&dom, 200, 31) {
+                if g != f {
+                    continue;
+                }
+                let c = dom.centroid(f);
+                let d = [c[0] - u[0], c[1] - u[1]];
+                base.eval(u, d, 1, &mut work, &mut x);
+                other.eval(map(u), lin(d), 1, &mut work, &mut y);
+                for b in 0..base.len() {
+                    worst = worst.max((x[b * np] - y[b * np]).abs());
+                    // ∇_u N = Aᵀ ∇_x N
+                    let gx = a[0][0] * y[b * np + 1] + a[1][0] * y[b * np + 2];
+                    let gy = a[0][1] * y[b * np + 1] + a[1][1] * y[b * np + 2];
+                    let s = x[b * np + 1].abs() + x[b * np + 2].abs() + 1.0;
+                    worst = worst
+                        .max((gx - x[b * np + 1]).abs() / s)
+                        .max((gy - x[b * np + 2]).abs() / s);
+                }
+            }
+            assert!(worst < 1e-11, "n={n}: chart dependence {worst:.2e}");
+        }
+    }
+}
+
+/// The B-patch blossom weights of a triangle reproduce the blossom of a polynomial from its
+/// control points at arbitrary arguments (what the fairing constraints of Fig. 13 rely on).
+#[test]
+fn blossom_weights_reproduce_polynomial_blossoms() {
+    let dom = disk_domain();
+    for n in 2..=5 {
+        let space = DmsSpace::with_placed_knots(dom.clone(), n, &KnotOptions::default()).unwrap();
+        let mut rng = Rng(3 + n as u64);
+        let coeffs: Vec<f64> = (0..n_partials(n)).map(|_| 2.0 * rng.next() - 1.0).collect();
+        let p = Polynomial::from_coeffs(n, [0.1, -0.1], 1.0, coeffs);
+        let c = space.control_points_of_polynomial(&p).unwrap();
+        let nb = space.per_triangle();
+        let mut w = vec![0.0; nb];
+        for f in [0u32, 5, 11] {
+            let args: Vec<Point> = (0..n)
+                .map(|_| [2.0 * rng.next() - 1.0, 2.0 * rng.next() - 1.0])
+                .collect();
+            space.triangle(f).blossom_weights(&args, &mut w);
+            let via: f64 = (0..nb).map(|b| w[b] * c[f as usize * nb + b]).sum();
+            assert!(
+                (via - p.blossom(&args)).abs() < 1e-11,
+                "n={n} face {f}: {via} vs {}",
+                p.blossom(&args)
+            );
+        }
+    }
+}
+
+/// Bad input is refused with a sentence naming the culprit.
+#[test]
+fn refuses_inadmissible_input() {
+    use ricci::spline::dms::KnotClouds;
+    // A clockwise triangle.
+    let e = Domain::new(vec![[0.0, 0.0], [0.0, 1.0], [1.0, 0.0]], vec![[0, 1, 2]]).unwrap_err();
+    assert!(e.to_string().contains("face 0"), "{e}");
+    // Knots of a boundary vertex inside the domain.
+    let dom = grid_domain(2, 0.0, 1);
+    let n = 2;
+    let mut knots = KnotClouds::place(&dom, n, &KnotOptions::default())
+        .unwrap()
+        .knots()
+        .to_vec();
+    let p0 = dom.points()[0];
+    knots[1] = [p0[0] + 0.05, p0[1] + 0.05]; // into the square
+    let e = DmsSpace::new(dom.clone(), KnotClouds::new(n, knots).unwrap()).unwrap_err();
+    assert!(e.to_string().contains("boundary vertex 0"), "{e}");
+    // Degree out of range, spread out of range.
+    assert!(KnotClouds::place(&dom, 9, &KnotOptions::default()).is_err());
+    assert!(KnotClouds::place(
+        &dom,
+        3,
+        &KnotOptions {
+            spread: 0.9,
+            seed: 1
+        }
+    )
+    .is_err());
 }
