@@ -522,3 +522,163 @@ fn refuses_inadmissible_input() {
     )
     .is_err());
 }
+
+/// Paper 000's fairing: constraints hold after it, the result is the closest feasible point
+/// (c − c̃ is orthogonal to every feasible direction, e.g. towards polynomial control points),
+/// r = 0 keeps the subdivision net (its edge control points are already shared), polynomial
+/// control points are left alone, and larger r gives a fairer (lower thin-plate energy)
+/// surface.
+#[test]
+fn fairing_satisfies_constraints_and_is_optimal() {
+    use ricci::spline::fit::{constraint_residuals, fair, fairness_constraints, thin_plate_energy};
+    let dom = grid_domain(4, 0.4, 12);
+    for n in [3, 5] {
+        let space = DmsSpace::with_placed_knots(dom.clone(), n, &KnotOptions::default()).unwrap();
+        // A bumpy height field sampled at the domain vertices → subdivision control points.
+        let pos: Vec<f64> = space
+            .domain()
+            .points()
+            .iter()
+            .flat_map(|p| [p[0], p[1], 0.2 * (7.0 * p[0]).sin() * (5.0 * p[1]).cos()])
+            .collect();
+        let c = space.subdivision_control_points(&pos, 3).unwrap();
+        let scale = c.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        let (c0, rep0) = fair(&space, &c, 3, 0).unwrap();
+        assert!(rep0.converged, "{rep0:?}");
+        assert!(
+            rep0.rms_change < 1e-12 * scale,
+            "r=0 changed the subdivision net: {rep0:?}"
+        );
+        let mut energies = vec![thin_plate_energy(&space, &c0, 3)];
+        let mut rng = Rng(5);
+        for r in 1..n {
+            let (x, rep) = fair(&space, &c, 3, r).unwrap();
+            assert!(
+                rep.converged && rep.max_constraint_residual < 1e-10,
+                "n={n} r={r}: {rep:?}"
+            );
+            let cons = fairness_constraints(&space, r).unwrap();
+            let res = constraint_residuals(&space, &cons, &x, 3);
+            // Residual relative to the size of each constraint's terms.
+            let mut worst = 0.0f64;
+            for (i, con) in cons.iter().enumerate() {
+                let norm = 1.0 + con.weights.iter().map(|w| w.abs()).sum::<f64>();
+                for d in 0..3 {
+                    worst = worst.max(res[i * 3 + d].abs() / (norm * scale));
+                }
+            }
+            assert!(
+                worst < 1e-10,
+                "n={n} r={r}: constraint residual {worst:.2e}"
+            );
+            // Optimality: ⟨c − x, q − x⟩ = 0 for a feasible q (a polynomial's control points).
+            let coeffs: Vec<f64> = (0..n_partials(n)).map(|_| rng.next() - 0.5).collect();
+            let poly = Polynomial::from_coeffs(n, [0.5, 0.5], 1.0, coeffs);
+            let q1 = space.control_points_of_polynomial(&poly).unwrap();
+            let q: Vec<f64> = q1.iter().flat_map(|&v| [v, 0.5 * v, -v]).collect();
+            let (mut dot, mut na, mut nb) = (0.0, 0.0, 0.0);
+            for k in 0..x.len() {
+                dot += (c[k] - x[k]) * (q[k] - x[k]);
+                na += (c[k] - x[k]).powi(2);
+                nb += (q[k] - x[k]).powi(2);
+            }
+            let cos = dot / (na * nb).sqrt();
+            assert!(
+                cos.abs() < 1e-8,
+                "n={n} r={r}: not the closest feasible point (cos {cos:.2e})"
+            );
+            // Polynomial control points are feasible: the fairing leaves them in place.
+            let (qq, _) = fair(&space, &q, 3, r).unwrap();
+            let moved = qq
+                .iter()
+                .zip(&q)
+                .fold(0.0f64, |a, (u, v)| a.max((u - v).abs()));
+            assert!(moved < 1e-9, "n={n} r={r}: polynomial moved by {moved:.2e}");
+            energies.push(thin_plate_energy(&space, &x, 3));
+            eprintln!("n={n} r={r}: {} constraints, rms change {:.3e}, residual {:.1e}, steps {}, energy {:.4e}", rep.constraints, rep.rms_change, rep.max_constraint_residual, rep.refinement_steps, energies[r]);
+        }
+        assert!(
+            energies[n - 1] < energies[0],
+            "n={n}: fairing did not lower the thin-plate energy {energies:?}"
+        );
+    }
+}
+
+/// The least-squares fit: exact data from a polynomial of degree ≤ n is reproduced when the
+/// smoothing is negligible; with smoothing the objective drops below its initial value, the
+/// normal equations are solved, and more smoothing trades error for energy.
+#[test]
+fn fit_reduces_objective_and_reproduces_polynomials() {
+    use ricci::spline::fit::{fit, DataPoint, FitOptions};
+    let dom = disk_domain();
+    for n in [3, 5] {
+        let space = DmsSpace::with_placed_knots(dom.clone(), n, &KnotOptions::default()).unwrap();
+        let mut rng = Rng(17);
+        let coeffs: Vec<f64> = (0..n_partials(n)).map(|_| rng.next() - 0.5).collect();
+        let poly = Polynomial::from_coeffs(n, [0.0, 0.0], 1.0, coeffs);
+        // Dense data: many points per face.
+        let data: Vec<DataPoint> = samples(space.domain(), 40 * space.domain().n_faces(), 23)
+            .into_iter()
+            .map(|(f, u)| DataPoint {
+                face: f,
+                param: u,
+                target: vec![poly.eval(u)],
+            })
+            .collect();
+        let init = vec![0.0; space.n_control_points()];
+        let (x, rep) = fit(
+            &space,
+            &data,
+            &init,
+            1,
+            &FitOptions {
+                smoothing: 0.0,
+                ridge: 1e-12,
+            },
+        )
+        .unwrap();
+        eprintln!("n={n} exact: {rep:?}");
+        assert!(
+            rep.max_error < 1e-7,
+            "n={n}: polynomial not reproduced by the fit: {rep:?}"
+        );
+        assert!(rep.relative_residual < 1e-8);
+        let _ = x;
+        // Noisy data with smoothing.
+        let noisy: Vec<DataPoint> = data
+            .iter()
+            .map(|d| DataPoint {
+                target: vec![d.target[0] + 0.05 * (rng.next() - 0.5)],
+                ..d.clone()
+            })
+            .collect();
+        let mut last_energy = f64::INFINITY;
+        let mut last_err = 0.0;
+        for s in [1e-4, 1e-2, 1.0] {
+            let (_, rep) = fit(
+                &space,
+                &noisy,
+                &init,
+                1,
+                &FitOptions {
+                    smoothing: s,
+                    ridge: 1e-9,
+                },
+            )
+            .unwrap();
+            eprintln!("n={n} smoothing {s}: {rep:?}");
+            assert!(rep.objective_after < rep.objective_before);
+            assert!(rep.relative_residual < 1e-8);
+            assert!(
+                rep.energy_after <= last_energy * (1.0 + 1e-9),
+                "energy must fall as smoothing grows"
+            );
+            assert!(
+                rep.rms_error >= last_err * (1.0 - 1e-9),
+                "error must grow as smoothing grows"
+            );
+            last_energy = rep.energy_after;
+            last_err = rep.rms_error;
+        }
+    }
+}
