@@ -614,7 +614,7 @@ pub fn fit(
     for k in energy_blocks.index.keys() {
         merged.entry(*k).or_insert(usize::MAX);
     }
-    for (&(a, b), _) in &merged {
+    for &(a, b) in merged.keys() {
         let db = data_blocks
             .index
             .get(&(a, b))
