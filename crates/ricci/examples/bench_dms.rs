@@ -6,7 +6,7 @@
 
 use std::time::Instant;
 
-use ricci::spline::dms::{DmsSpace, Domain, KnotOptions, Workspace};
+use ricci::spline::dms::{DmsSpace, Domain, KnotClouds, KnotOptions, Workspace};
 use ricci::spline::fit::{fair, fit, DataPoint, FitOptions};
 use ricci::spline::simplex::n_partials;
 
@@ -50,7 +50,10 @@ fn main() {
     );
     for n in [3usize, 5] {
         let t0 = Instant::now();
-        let space = DmsSpace::with_placed_knots(dom.clone(), n, &KnotOptions::default()).unwrap();
+        let clouds = KnotClouds::place(&dom, n, &KnotOptions::default()).unwrap();
+        let t_place = t0.elapsed().as_secs_f64();
+        let t0 = Instant::now();
+        let space = DmsSpace::new(dom.clone(), clouds).unwrap();
         let t_build = t0.elapsed().as_secs_f64();
         let rep = space.report();
         let nc = space.n_control_points();
@@ -103,10 +106,11 @@ fn main() {
         let (_, fr) = fit(&space, &data, &c, 3, &FitOptions::default()).unwrap();
         let t_fit = t0.elapsed().as_secs_f64();
         println!(
-            "n={n}: {nc} control points, build {:.3} s (max {} simplex nodes/triangle, general position {:.1e}); \
+            "n={n}: {nc} control points, knot placement {:.3} s, basis build {:.3} s (max {} simplex nodes/triangle, general position {:.1e}); \
              eval {:.2} µs/point (value), {:.2} µs/point (≤ 2nd derivatives); \
              fairing r={r}: {:.3} s ({} constraints, residual {:.1e}, {} CG steps); \
              fit: {:.3} s ({} points, rms {:.2e}, max {:.2e}) [checksum {acc:.3}]",
+            t_place,
             t_build,
             rep.max_nodes,
             rep.min_general_position,

@@ -295,16 +295,29 @@ impl KnotClouds {
             .map(|v| mesh.vertex_faces(v).collect())
             .collect();
         // Quality of vertex v's cloud: worst triple with at least one knot of v.
-        let local_quality = |v: usize, knots: &[Point]| -> f64 {
+        // Stops early once the quality drops to `floor` (the candidate is then rejected).
+        let local_quality = |v: usize, knots: &[Point], floor: f64| -> f64 {
             let mut q = f64::INFINITY;
+            let mut arr = Vec::with_capacity(3 * (n + 1));
             for &f in &faces_of[v] {
                 let t = mesh.face(f);
-                let arr = triangle_knots(knots, n, t);
+                arr.clear();
+                // This vertex's moving knots first.
                 let m = t.iter().position(|&w| w as usize == v).unwrap_or(0);
-                q = q.min(general_position_involving(
-                    &arr,
-                    m * (n + 1)..(m + 1) * (n + 1),
-                ));
+                arr.extend_from_slice(&knots[v * (n + 1) + 1..(v + 1) * (n + 1)]);
+                for (mm, &w) in t.iter().enumerate() {
+                    if mm == m {
+                        arr.push(knots[v * (n + 1)]);
+                    } else {
+                        arr.extend_from_slice(
+                            &knots[w as usize * (n + 1)..(w as usize + 1) * (n + 1)],
+                        );
+                    }
+                }
+                q = q.min(general_position_involving(&arr, n, floor));
+                if q <= floor {
+                    return q;
+                }
             }
             q
         };
@@ -314,19 +327,22 @@ impl KnotClouds {
         let mut counter = 0u64;
         for round in 0..12 {
             // Optimise the clouds of dirty vertices (two sweeps).
-            for _sweep in 0..2 {
+            for sweep in 0..2 {
                 for v in 0..nv {
                     if !dirty[v] {
                         continue;
                     }
                     let range = v * (n + 1)..(v + 1) * (n + 1);
-                    let mut best_q = local_quality(v, &knots);
+                    let mut best_q = local_quality(v, &knots, 0.0);
+                    if sweep > 0 && best_q > 0.05 {
+                        continue; // good enough: only poor clouds get a second sweep
+                    }
                     let mut best = knots[range.clone()].to_vec();
                     for _ in 0..CANDIDATES {
                         counter += 1;
                         candidate(v, radius[v], counter, &mut trial);
                         knots[range.clone()].copy_from_slice(&trial);
-                        let q = local_quality(v, &knots);
+                        let q = local_quality(v, &knots, best_q);
                         if q > best_q {
                             best_q = q;
                             best.copy_from_slice(&trial);
@@ -407,22 +423,43 @@ pub fn triple_quality(a: Point, b: Point, c: Point) -> f64 {
 /// Smallest [`triple_quality`] over all triples of knots: a scale-free measure of how far the
 /// knots are from having three on a line.
 pub fn general_position(knots: &[Point]) -> f64 {
-    general_position_involving(knots, 0..knots.len())
+    general_position_involving(knots, knots.len(), 0.0)
 }
 
 /// Smallest [`triple_quality`] over the triples with at least one knot in `range`.
-fn general_position_involving(knots: &[Point], range: std::ops::Range<usize>) -> f64 {
-    let mut worst = f64::INFINITY;
-    for i in 0..knots.len() {
-        for j in i + 1..knots.len() {
-            for l in j + 1..knots.len() {
-                if range.contains(&i) || range.contains(&j) || range.contains(&l) {
-                    worst = worst.min(triple_quality(knots[i], knots[j], knots[l]));
+/// Smallest [`triple_quality`] over the triples whose first knot is in `0..prefix` (i.e. all
+/// triples with at least one knot there). Stops as soon as the result is known to be
+/// `≤ floor`. Works with squared qualities (no square roots in the loop).
+fn general_position_involving(knots: &[Point], prefix: usize, floor: f64) -> f64 {
+    let floor2 = floor * floor;
+    let mut worst2 = f64::INFINITY;
+    let k = knots.len();
+    for i in 0..prefix.min(k) {
+        for j in i + 1..k {
+            let dij = sub(knots[j], knots[i]);
+            let x2 = dij[0] * dij[0] + dij[1] * dij[1];
+            for l in j + 1..k {
+                let dil = sub(knots[l], knots[i]);
+                let djl = sub(knots[l], knots[j]);
+                let z2 = dil[0] * dil[0] + dil[1] * dil[1];
+                let y2 = djl[0] * djl[0] + djl[1] * djl[1];
+                let det = dij[0] * dil[1] - dij[1] * dil[0];
+                let prod = x2 * y2 * z2;
+                let q2 = if prod == 0.0 {
+                    0.0
+                } else {
+                    (det * det * x2.max(y2).max(z2) / prod).min(1.0)
+                };
+                if q2 < worst2 {
+                    worst2 = q2;
+                    if worst2 <= floor2 {
+                        return worst2.sqrt();
+                    }
                 }
             }
         }
     }
-    worst
+    worst2.sqrt()
 }
 
 /// For the knot array of one triangle (`[m * (n+1) + k] = t_{m,k}`): the smallest relative
@@ -448,6 +485,33 @@ pub fn patch_quality(n: usize, knots: &[Point]) -> (f64, f64) {
         polygon_area(&omega) / (0.5 * det3(t(0, 0), t(1, 0), t(2, 0)))
     };
     (min_orientation, omega_ratio)
+}
+
+/// Convex hull (Andrew's monotone chain), counter-clockwise, without collinear points.
+fn convex_hull(points: &[Point]) -> Vec<Point> {
+    let mut p = points.to_vec();
+    p.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+    p.dedup();
+    if p.len() < 3 {
+        return p;
+    }
+    let mut h: Vec<Point> = Vec::with_capacity(2 * p.len());
+    for pass in 0..2 {
+        let start = h.len();
+        let iter: Box<dyn Iterator<Item = &Point>> = if pass == 0 {
+            Box::new(p.iter())
+        } else {
+            Box::new(p.iter().rev())
+        };
+        for &q in iter {
+            while h.len() >= start + 2 && det3(h[h.len() - 2], h[h.len() - 1], q) <= 0.0 {
+                h.pop();
+            }
+            h.push(q);
+        }
+        h.pop();
+    }
+    h
 }
 
 /// Polygon clipping of a convex polygon by the half-plane on the left of `a → b`.
@@ -490,6 +554,8 @@ pub struct TriangleBasis {
     scale: Vec<f64>,
     /// Bounding box of all knots (contains every support).
     bbox: [Point; 2],
+    /// Convex hull of all knots, counter-clockwise (contains every support).
+    hull: Vec<Point>,
     /// Affine barycentric maps of `Δ_γ`, `|γ| < n`, for the blossom: per γ (ordered by `|γ|`,
     /// then [`multi_indices`]) `[a, bx, by]` for each of the three coordinates.
     patch: Vec<[[f64; 3]; 3]>,
@@ -497,6 +563,8 @@ pub struct TriangleBasis {
     min_orientation: f64,
     /// Area of `Ω_I = ∩ Δ_β` relative to the area of `Δ_0` (the domain triangle).
     omega_ratio: f64,
+    /// [`general_position`] of the knot array.
+    general_position: f64,
 }
 
 impl TriangleBasis {
@@ -574,8 +642,11 @@ impl TriangleBasis {
                 patch.push(maps);
             }
         }
+        let hull = convex_hull(&knots);
         Ok(TriangleBasis {
             degree: n,
+            general_position: gp,
+            hull,
             knots,
             family,
             scale,
@@ -604,13 +675,27 @@ impl TriangleBasis {
     pub fn bbox(&self) -> [Point; 2] {
         self.bbox
     }
-    /// Could `u` be in the support of a basis function (bounding-box test)?
+    /// Could `u` be in the support of a basis function (inside or on the convex hull of the
+    /// knots, with a small tolerance)?
     #[inline]
     pub fn may_contain(&self, u: Point) -> bool {
-        u[0] >= self.bbox[0][0]
+        if !(u[0] >= self.bbox[0][0]
             && u[0] <= self.bbox[1][0]
             && u[1] >= self.bbox[0][1]
-            && u[1] <= self.bbox[1][1]
+            && u[1] <= self.bbox[1][1])
+        {
+            return false;
+        }
+        let k = self.hull.len();
+        let diam = (self.bbox[1][0] - self.bbox[0][0]).max(self.bbox[1][1] - self.bbox[0][1]);
+        for i in 0..k {
+            let (a, b) = (self.hull[i], self.hull[(i + 1) % k]);
+            let len = norm(sub(b, a));
+            if det3(a, b, u) < -1e-9 * len * diam {
+                return false;
+            }
+        }
+        true
     }
     /// Smallest relative signed area of the triangles `Δ_β`, `|β| ≤ n`.
     pub fn min_orientation(&self) -> f64 {
@@ -619,6 +704,10 @@ impl TriangleBasis {
     /// Area of `Ω_I` over the area of the triangle.
     pub fn omega_ratio(&self) -> f64 {
         self.omega_ratio
+    }
+    /// How far the knots are from having three on a line ([`general_position`]).
+    pub fn general_position(&self) -> f64 {
+        self.general_position
     }
     /// Smallest relative determinant of the recurrence triangles.
     pub fn min_relative_det(&self) -> f64 {
@@ -850,22 +939,27 @@ impl DmsSpace {
                 }
             }
         }
-        let mut bases = Vec::with_capacity(mesh.n_faces());
+        use rayon::prelude::*;
+        let bases: Vec<TriangleBasis> = mesh
+            .faces()
+            .par_iter()
+            .enumerate()
+            .map(|(f, t)| {
+                TriangleBasis::new(n, t.map(|v| clouds.cloud(v)))
+                    .map_err(|e| Error::input(format!("face {f}: {e}")))
+            })
+            .collect::<Result<_>>()?;
         let mut report = KnotReport {
             min_orientation: f64::INFINITY,
             min_omega_ratio: f64::INFINITY,
             min_general_position: f64::INFINITY,
             max_nodes: 0,
         };
-        for (f, t) in mesh.faces().iter().enumerate() {
-            let b = TriangleBasis::new(n, t.map(|v| clouds.cloud(v)))
-                .map_err(|e| Error::input(format!("face {f}: {e}")))?;
+        for b in &bases {
             report.min_orientation = report.min_orientation.min(b.min_orientation);
             report.min_omega_ratio = report.min_omega_ratio.min(b.omega_ratio);
-            report.min_general_position =
-                report.min_general_position.min(general_position(&b.knots));
+            report.min_general_position = report.min_general_position.min(b.general_position);
             report.max_nodes = report.max_nodes.max(b.n_nodes());
-            bases.push(b);
         }
         let boxes: Vec<[Point; 2]> = bases.iter().map(|b| b.bbox).collect();
         let grid = Grid::new(&boxes);
