@@ -1,3 +1,5 @@
 //! One module per subcommand; each has `Args` (clap) and `run`.
 
+pub mod generate;
 pub mod info;
+pub mod render;
