@@ -494,12 +494,17 @@ fn fuzz_regression_binary_stl_refuses_coordinates_beyond_f32() {
         stl += "  endloop\n endfacet\n";
     }
     stl += "endsolid t\n";
-    let (s, _) = ricci::mesh::build_surface(io::parse(stl.as_bytes(), Format::Stl).unwrap()).unwrap();
+    let (s, _) =
+        ricci::mesh::build_surface(io::parse(stl.as_bytes(), Format::Stl).unwrap()).unwrap();
     let mut out = Vec::new();
     let e = io::write_stl(&mut out, &s, true).unwrap_err().to_string();
     assert_has(&e, &["32-bit", "ascii STL"]);
     let mut out = Vec::new();
     io::write_stl(&mut out, &s, false).unwrap();
     let (back, _) = ricci::mesh::build_surface(io::parse(&out, Format::Stl).unwrap()).unwrap();
-    assert!(back.positions.iter().flatten().any(|&x| x == 3.333333333333333e110));
+    assert!(back
+        .positions
+        .iter()
+        .flatten()
+        .any(|&x| x == 3.333333333333333e110));
 }
