@@ -55,6 +55,10 @@ pub fn check(data: &[u8], format: Format) {
         let (b, _) = build_surface(back).expect("our own output builds");
         assert_eq!(b.mesh, surface.mesh, "connectivity changed in a round trip");
         let bits = |p: &[[f64; 3]]| p.iter().map(|q| q.map(f64::to_bits)).collect::<Vec<_>>();
-        assert_eq!(bits(&b.positions), bits(&surface.positions), "positions changed");
+        assert_eq!(
+            bits(&b.positions),
+            bits(&surface.positions),
+            "positions changed"
+        );
     }
 }
