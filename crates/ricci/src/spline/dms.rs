@@ -1031,7 +1031,15 @@ impl DmsSpace {
     /// All basis functions that may be non-zero at `u` in face `face` (values and partials up
     /// to `order`, as limits from inside `face`), written to `ws.indices` / `ws.values`.
     /// Returns the number of functions.
-    pub fn basis_at(&self, face: u32, u: Point, order: usize, ws: &mut Workspace) -> usize {
+    pub fn basis_at(&self, face: u32, u: Point, order: usize, ws: &mut Workspace) -> Result<usize> {
+        if face as usize >= self.bases.len() || !u[0].is_finite() || !u[1].is_finite() {
+            return Err(Error::input(format!(
+                "spline evaluation at ({}, {}) in face {face}: the domain has {} faces and the point must be finite",
+                u[0],
+                u[1],
+                self.bases.len()
+            )));
+        }
         let np = n_partials(order);
         let nb = self.per_triangle();
         let c = self.domain.centroid(face);
@@ -1055,7 +1063,7 @@ impl DmsSpace {
             }
             ws.values.extend_from_slice(&ws.local[..nb * np]);
         }
-        ws.indices.len()
+        Ok(ws.indices.len())
     }
 
     /// Evaluate `F = Σ c N` and its partials up to `order` at `u` in `face`:
@@ -1071,11 +1079,19 @@ impl DmsSpace {
         order: usize,
         ws: &mut Workspace,
         out: &mut [f64],
-    ) {
+    ) -> Result<()> {
         let np = n_partials(order);
-        debug_assert_eq!(control.len(), self.n_control_points() * dim);
+        if control.len() != self.n_control_points() * dim || out.len() < np * dim {
+            return Err(Error::input(format!(
+                "spline evaluation: {} control numbers for {} control points of dimension {dim}, output of {} for {} numbers",
+                control.len(),
+                self.n_control_points(),
+                out.len(),
+                np * dim
+            )));
+        }
         out[..np * dim].fill(0.0);
-        let m = self.basis_at(face, u, order, ws);
+        let m = self.basis_at(face, u, order, ws)?;
         for i in 0..m {
             let g = ws.indices[i] as usize;
             let vals = &ws.values[i * np..(i + 1) * np];
@@ -1089,6 +1105,7 @@ impl DmsSpace {
                 }
             }
         }
+        Ok(())
     }
 
     /// Control points (`dim` = 1) of a polynomial of degree `≤ n` by blossoming: the spline
