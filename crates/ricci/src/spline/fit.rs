@@ -9,7 +9,7 @@
 //! shared (the arguments then only involve knots of the edge's vertices); larger `r` ties
 //! more rows of control points to the neighbour's polynomial, `r = n` would make the whole
 //! spline one polynomial. The constraints are homogeneous, `A c̃ = 0`, so `c̃ = c − Aᵀ y` with
-//! `A Aᵀ y = A c`; `A Aᵀ` is singular (both orientations repeat the `β_o = 0` rows), so it is
+//! `A Aᵀ y = A c`; `A Aᵀ` can be singular (constraints around a vertex are dependent), so it is
 //! factored with a tiny diagonal shift (faer sparse Cholesky) and used as the preconditioner
 //! of conjugate gradients on the consistent system until `‖A c̃‖` reaches the tolerance.
 //!
@@ -43,7 +43,8 @@ pub struct Constraint {
     pub weights: Vec<f64>,
 }
 
-/// The constraints of paper 000 eq. 14 for fairness parameter `r` (`0 ≤ r ≤ n − 1`).
+/// The constraints of paper 000 eq. 14 for fairness parameter `r` (`0 ≤ r ≤ n − 1`), for
+/// both orientations of every interior edge (the shared-control-point rows, `β_o = 0`, once).
 pub fn fairness_constraints(space: &DmsSpace, r: usize) -> Result<Vec<Constraint>> {
     let n = space.degree();
     if r >= n {
@@ -66,6 +67,12 @@ pub fn fairness_constraints(space: &DmsSpace, r: usize) -> Result<Vec<Constraint
         let bj = space.triangle(fj);
         for (k, beta) in multi_indices(n).into_iter().enumerate() {
             if beta[o] > r {
+                continue;
+            }
+            // With β_o = 0 the constraint only involves the edge's knots and says that the
+            // two triangles share this control point: the same equation as the opposite
+            // orientation's, so it is imposed once (from the lower face index).
+            if beta[o] == 0 && fi > fj {
                 continue;
             }
             let args = bi.blossom_args(beta);
