@@ -25,6 +25,9 @@ enum Command {
     Info(cmd::info::Args),
     /// Procedural test surfaces: sphere, torus, disk, annulus, pants, genus-g.
     Generate(cmd::generate::Args),
+    /// Render a surface to PNG (checkerboard from UVs, scalar fields, zebra) or export glTF.
+    Render(Box<cmd::render::Args>),
+
     /// Discrete Ricci flow: a flat, hyperbolic or spherical metric with prescribed curvature.
     Flow(cmd::flow::Args),
 }
@@ -34,6 +37,8 @@ fn main() {
     let result = match cli.command {
         Command::Info(a) => cmd::info::run(a),
         Command::Generate(a) => cmd::generate::run(a),
+        Command::Render(a) => cmd::render::run(*a),
+
         Command::Flow(a) => cmd::flow::run(a),
     };
     if let Err(e) = result {

@@ -3,3 +3,4 @@
 pub mod flow;
 pub mod generate;
 pub mod info;
+pub mod render;
