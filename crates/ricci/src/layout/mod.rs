@@ -3,7 +3,18 @@
 //!
 //! * [`isometry`] — rigid motions of the plane, Möbius maps of the Poincaré disk (SU(1,1)),
 //!   rotations of the sphere; composition, inverse, fitting from point pairs; Klein matrices.
+//! * [`place`] — breadth-first isometric placement of a disk (or of a closed genus-0 surface on
+//!   the sphere) with a metric, generic over the background geometry ([`Space`]).
+//! * [`deck`] — fundamental polygons with paired sides, side pairings, deck transformation
+//!   generators and the group relation.
+//! * [`synthetic`] — closed surfaces with exact flat / hyperbolic metrics and known polygons
+//!   (flat tori, regular 4g-gons), the references of the tests.
 
+pub mod deck;
 pub mod isometry;
+pub mod place;
+pub mod synthetic;
 
+pub use deck::{deck_group, DeckGroup, Polygon, Side, SidePairing};
 pub use isometry::{Isometry, Mobius, RigidMotion, Rotation};
+pub use place::{align, layout, Layout, Space};

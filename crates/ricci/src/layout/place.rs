@@ -1,0 +1,457 @@
+//! Isometric placement of a simply connected mesh with a given metric (paper 001 §V Step 4,
+//! "Flatten a seed face" and "Flatten a fundamental domain"; paper 002 §4.3.2 and §6.2.2.2).
+//!
+//! The three model spaces implement [`Space`] (on the background types of
+//! [`crate::metric::geometry`]): the plane (points are complex numbers), the Poincaré disk
+//! (complex numbers of modulus < 1) and the unit sphere (unit vectors of R³).
+//!
+//! Placement of the third vertex `k` of a face `(i, j, k)` (counter-clockwise) whose edge
+//! `i → j` is placed: the isometry that moves `p_i` to a base point and `p_j` onto a reference
+//! direction is applied, the triangle is put in its canonical position there, and the inverse
+//! isometry brings `p_k` back. This is the circle intersection with the orientation check of
+//! the papers, written so that every face is computed at the centre of the model: for H² each
+//! face is moved to the centre of the disk by a Möbius map before placing (paper 001 §VI.b),
+//! which avoids the unstable computations near the unit circle; for S² the frame
+//! `(p_i, t, p_i × t)` solves `p·p_i = cos l_ik`, `p·p_j = cos l_jk`, `|p| = 1`,
+//! `det[p_i, p_j, p] > 0` without cancellation. The angle at `i` comes from the half-angle
+//! form of the cosine law ([`Background::angle`]), accurate for needle triangles; the papers'
+//! sphere seed formula (which takes chord lengths) is not used: lengths are geodesic (DESIGN.md §3).
+//!
+//! [`layout`] places a seed face (by default the face farthest from the boundary, or a
+//! centre of a closed mesh, to keep the breadth-first depth — along which rounding errors
+//! accumulate — small) and then walks the faces breadth first. Each vertex is placed once, by
+//! the first face that reaches it; faces reached when all three vertices are placed are only
+//! checked. The result reports flipped faces (negative orientation), degenerate faces and the
+//! largest disagreement between laid-out distances and the metric, which measures how far the
+//! metric is from being exactly flat / hyperbolic / spherical (curvature error).
+
+use super::isometry::{
+    cross3, det3, disk_distance, dot3, normalize3, sphere_distance, Complex, Isometry, Mobius,
+    RigidMotion, Rotation,
+};
+use crate::error::{Error, Result};
+use crate::mesh::{topology, Mesh, NONE};
+use crate::metric::geometry::{Background, Euclidean, Geometry, Hyperbolic, Spherical};
+use std::collections::VecDeque;
+
+/// A model space to lay out in: points, isometries and the placement of one triangle.
+pub trait Space: Background {
+    type Point: Copy + std::fmt::Debug + Send + Sync + 'static;
+    type Iso: Isometry<Point = Self::Point>;
+    /// The counter-clockwise triangle with side lengths `l01 = |p0 p1|`, `l12`, `l20` in its
+    /// canonical position: `p0` at the base point, `p1` on the reference direction.
+    fn seed(l01: f64, l12: f64, l20: f64) -> [Self::Point; 3] {
+        let p0 = Self::base_point();
+        let p1 = Self::along_reference(l01);
+        let p2 = Self::third(p0, p1, l01, l12, l20);
+        [p0, p1, p2]
+    }
+    /// The base point (origin of the plane / centre of the disk / north pole).
+    fn base_point() -> Self::Point;
+    /// The point at distance `d` from the base point along the reference direction.
+    fn along_reference(d: f64) -> Self::Point;
+    /// The vertex `p_k` of the counter-clockwise triangle `(p_i, p_j, p_k)` with metric side
+    /// lengths `l_ij`, `l_jk`, `l_ki`, placed relative to `p_i` and the direction towards `p_j`.
+    fn third(pi: Self::Point, pj: Self::Point, lij: f64, ljk: f64, lki: f64) -> Self::Point;
+    /// Positive for counter-clockwise triangles, negative for clockwise ones.
+    fn orientation(a: Self::Point, b: Self::Point, c: Self::Point) -> f64;
+    /// Geodesic distance.
+    fn distance(a: Self::Point, b: Self::Point) -> f64;
+}
+
+#[inline]
+fn angle_cs<B: Background>(opposite: f64, b: f64, c: f64) -> (f64, f64) {
+    let t = B::angle(opposite, b, c);
+    let (s, co) = t.sin_cos();
+    (co, s)
+}
+
+impl Space for Euclidean {
+    type Point = Complex;
+    type Iso = RigidMotion;
+    fn base_point() -> Complex {
+        Complex::new(0.0, 0.0)
+    }
+    fn along_reference(d: f64) -> Complex {
+        Complex::new(d, 0.0)
+    }
+    #[inline]
+    fn third(pi: Complex, pj: Complex, lij: f64, ljk: f64, lki: f64) -> Complex {
+        let (c, s) = angle_cs::<Euclidean>(ljk, lij, lki);
+        let d = pj - pi;
+        let n = d.norm();
+        let u = if n > 0.0 {
+            d / n
+        } else {
+            Complex::new(1.0, 0.0)
+        };
+        pi + u * Complex::new(lki * c, lki * s)
+    }
+    #[inline]
+    fn orientation(a: Complex, b: Complex, c: Complex) -> f64 {
+        ((b - a).conj() * (c - a)).im
+    }
+    #[inline]
+    fn distance(a: Complex, b: Complex) -> f64 {
+        (a - b).norm()
+    }
+}
+
+impl Space for Hyperbolic {
+    type Point = Complex;
+    type Iso = Mobius;
+    fn base_point() -> Complex {
+        Complex::new(0.0, 0.0)
+    }
+    fn along_reference(d: f64) -> Complex {
+        Complex::new((0.5 * d).tanh(), 0.0)
+    }
+    #[inline]
+    fn third(pi: Complex, pj: Complex, lij: f64, ljk: f64, lki: f64) -> Complex {
+        // Move p_i to the centre: T(z) = (z − p_i)/(1 − p̄_i z); there the hyperbolic circle
+        // of radius l_ki around 0 is the Euclidean circle of radius tanh(l_ki/2).
+        let (c, s) = angle_cs::<Hyperbolic>(ljk, lij, lki);
+        let one = Complex::new(1.0, 0.0);
+        let wj = (pj - pi) / (one - pi.conj() * pj);
+        let n = wj.norm();
+        let u = if n > 0.0 { wj / n } else { one };
+        let w = u * Complex::new(c, s) * (0.5 * lki).tanh();
+        (w + pi) / (one + pi.conj() * w)
+    }
+    #[inline]
+    fn orientation(a: Complex, b: Complex, c: Complex) -> f64 {
+        // Orientation is Möbius invariant; evaluate it with a at the centre, where geodesics
+        // through a are straight.
+        let one = Complex::new(1.0, 0.0);
+        let wb = (b - a) / (one - a.conj() * b);
+        let wc = (c - a) / (one - a.conj() * c);
+        (wb.conj() * wc).im
+    }
+    #[inline]
+    fn distance(a: Complex, b: Complex) -> f64 {
+        disk_distance(a, b)
+    }
+}
+
+impl Space for Spherical {
+    type Point = [f64; 3];
+    type Iso = Rotation;
+    fn base_point() -> [f64; 3] {
+        [0.0, 0.0, 1.0]
+    }
+    fn along_reference(d: f64) -> [f64; 3] {
+        [d.sin(), 0.0, d.cos()]
+    }
+    #[inline]
+    fn third(pi: [f64; 3], pj: [f64; 3], lij: f64, ljk: f64, lki: f64) -> [f64; 3] {
+        let (c, s) = angle_cs::<Spherical>(ljk, lij, lki);
+        let e1 = normalize3(pi);
+        let d = [pj[0] - e1[0], pj[1] - e1[1], pj[2] - e1[2]];
+        let k = dot3(d, e1);
+        let e2 = normalize3([d[0] - k * e1[0], d[1] - k * e1[1], d[2] - k * e1[2]]);
+        let e3 = cross3(e1, e2);
+        let (sl, cl) = lki.sin_cos();
+        normalize3([
+            cl * e1[0] + sl * (c * e2[0] + s * e3[0]),
+            cl * e1[1] + sl * (c * e2[1] + s * e3[1]),
+            cl * e1[2] + sl * (c * e2[2] + s * e3[2]),
+        ])
+    }
+    #[inline]
+    fn orientation(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+        det3(a, b, c)
+    }
+    #[inline]
+    fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+        sphere_distance(a, b)
+    }
+}
+
+/// The result of [`layout`]: one position per vertex and what was measured.
+#[derive(Debug, Clone)]
+pub struct Layout<P> {
+    pub geometry: Geometry,
+    /// Position of every vertex of the laid-out mesh.
+    pub positions: Vec<P>,
+    pub seed_face: u32,
+    /// Faces with negative orientation in the layout.
+    pub flipped_faces: Vec<u32>,
+    /// Faces whose metric triangle is degenerate (zero area) or whose layout has zero area.
+    pub degenerate_faces: Vec<u32>,
+    /// Largest `|d(p_a, p_b) − l_ab|` over all edges (0 for an exact metric, up to rounding).
+    pub max_length_error: f64,
+    /// Largest breadth-first depth (in faces) from the seed face.
+    pub depth: u32,
+}
+
+/// Check that a metric fits the mesh: one finite positive length per edge (below π on the
+/// sphere).
+pub fn check_lengths(mesh: &Mesh, lengths: &[f64], geometry: Geometry) -> Result<()> {
+    if lengths.len() != mesh.n_edges() {
+        return Err(Error::input(format!(
+            "the metric has {} edge lengths but the mesh has {} edges",
+            lengths.len(),
+            mesh.n_edges()
+        )));
+    }
+    for (e, &l) in lengths.iter().enumerate() {
+        let bad = !(l > 0.0 && l.is_finite())
+            || (geometry == Geometry::Spherical && l >= std::f64::consts::PI);
+        if bad {
+            let [a, b] = mesh.edge_vertices(e as u32);
+            return Err(Error::input(format!(
+                "edge {e} (vertices {a}–{b}) has length {l}, which is not a valid {} length",
+                geometry.name()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Default seed face: on a disk the face farthest (in face-adjacency steps) from the
+/// boundary; on a closed mesh a face of smallest eccentricity estimate (two sweeps).
+pub fn central_face(mesh: &Mesh) -> u32 {
+    let nf = mesh.n_faces();
+    if nf == 0 {
+        return 0;
+    }
+    let bfs = |sources: &[u32]| -> Vec<u32> {
+        let mut d = vec![u32::MAX; nf];
+        let mut q = VecDeque::new();
+        for &s in sources {
+            d[s as usize] = 0;
+            q.push_back(s);
+        }
+        while let Some(f) = q.pop_front() {
+            for h in mesh.face_halfedges(f) {
+                let g = mesh.he_face(mesh.he_twin(h));
+                if g != NONE && d[g as usize] == u32::MAX {
+                    d[g as usize] = d[f as usize] + 1;
+                    q.push_back(g);
+                }
+            }
+        }
+        d
+    };
+    let argmax = |d: &[u32]| -> u32 {
+        let mut best = 0u32;
+        for (f, &x) in d.iter().enumerate() {
+            if x != u32::MAX && x > d[best as usize] {
+                best = f as u32;
+            }
+        }
+        best
+    };
+    let boundary_faces: Vec<u32> = (0..nf as u32)
+        .filter(|&f| {
+            mesh.face_halfedges(f)
+                .iter()
+                .any(|&h| mesh.is_boundary_halfedge(mesh.he_twin(h)))
+        })
+        .collect();
+    if !boundary_faces.is_empty() {
+        return argmax(&bfs(&boundary_faces));
+    }
+    let da = bfs(&[0]);
+    let fa = argmax(&da);
+    let d1 = bfs(&[fa]);
+    let fb = argmax(&d1);
+    let d2 = bfs(&[fb]);
+    (0..nf as u32)
+        .min_by_key(|&f| (d1[f as usize].max(d2[f as usize]), f))
+        .unwrap_or(0)
+}
+
+/// Lay out a simply connected mesh (a disk, e.g. a cut mesh, or a closed genus-0 surface on
+/// the sphere) with edge lengths `lengths` (by edge id) in the model space `S`.
+///
+/// Errors: wrong number of lengths or invalid values (naming the edge), a mesh that is not
+/// connected and simply connected (naming its topology), an out-of-range seed face.
+pub fn layout<S: Space>(
+    mesh: &Mesh,
+    lengths: &[f64],
+    seed_face: Option<u32>,
+) -> Result<Layout<S::Point>> {
+    check_lengths(mesh, lengths, S::KIND)?;
+    let nf = mesh.n_faces();
+    if nf == 0 {
+        return Err(Error::input("cannot lay out a mesh without faces"));
+    }
+    let topo = topology(mesh);
+    if topo.components.len() != 1 {
+        return Err(Error::topology(format!(
+            "a layout needs a connected mesh, this one has {} components",
+            topo.components.len()
+        )));
+    }
+    let c = &topo.components[0];
+    let simply_connected = c.genus == 0 && c.boundary_loops <= 1;
+    if !simply_connected {
+        return Err(Error::topology(format!(
+            "a layout needs a disk or a closed genus-0 surface, this mesh has genus {} and {} \
+             boundary loops (cut it to a disk first)",
+            c.genus, c.boundary_loops
+        )));
+    }
+    if c.boundary_loops == 0 && S::KIND != Geometry::Spherical {
+        return Err(Error::topology(
+            "a closed genus-0 surface can only be laid out on the sphere (use the spherical \
+             geometry), or cut it to a disk first",
+        ));
+    }
+    let seed = match seed_face {
+        Some(f) if (f as usize) < nf => f,
+        Some(f) => {
+            return Err(Error::input(format!(
+                "seed face {f} does not exist (the mesh has {nf} faces)"
+            )))
+        }
+        None => central_face(mesh),
+    };
+    Ok(layout_unchecked::<S>(mesh, lengths, seed))
+}
+
+/// Breadth-first placement from `seed` (inputs already validated).
+pub(crate) fn layout_unchecked<S: Space>(
+    mesh: &Mesh,
+    lengths: &[f64],
+    seed: u32,
+) -> Layout<S::Point> {
+    let nv = mesh.n_vertices();
+    let nf = mesh.n_faces();
+    let len = |h: u32| lengths[mesh.he_edge(h) as usize];
+    let mut pos = vec![S::base_point(); nv];
+    let mut placed = vec![false; nv];
+    let mut face_depth = vec![u32::MAX; nf];
+    // Queue entries: (face, interior half-edge of that face whose ends are placed).
+    let mut queue: VecDeque<(u32, u32)> = VecDeque::with_capacity(nf);
+    let [h0, h1, h2] = mesh.face_halfedges(seed);
+    let tri = S::seed(len(h0), len(h1), len(h2));
+    let fv = mesh.face(seed);
+    for i in 0..3 {
+        pos[fv[i] as usize] = tri[i];
+        placed[fv[i] as usize] = true;
+    }
+    face_depth[seed as usize] = 0;
+    let mut depth = 0;
+    let push_neighbours = |f: u32, queue: &mut VecDeque<(u32, u32)>, face_depth: &mut [u32]| {
+        let d = face_depth[f as usize];
+        for h in mesh.face_halfedges(f) {
+            let t = mesh.he_twin(h);
+            let g = mesh.he_face(t);
+            if g != NONE && face_depth[g as usize] == u32::MAX {
+                face_depth[g as usize] = d + 1;
+                queue.push_back((g, t));
+            }
+        }
+    };
+    push_neighbours(seed, &mut queue, &mut face_depth);
+    while let Some((f, h)) = queue.pop_front() {
+        depth = depth.max(face_depth[f as usize]);
+        let i = mesh.he_origin(h);
+        let j = mesh.he_tip(h);
+        let hn = mesh.he_next(h);
+        let hp = mesh.he_prev(h);
+        let k = mesh.he_tip(hn);
+        if !placed[k as usize] {
+            pos[k as usize] = S::third(pos[i as usize], pos[j as usize], len(h), len(hn), len(hp));
+            placed[k as usize] = true;
+        }
+        push_neighbours(f, &mut queue, &mut face_depth);
+    }
+    // Measurements.
+    let mut flipped = Vec::new();
+    let mut degenerate = Vec::new();
+    for f in 0..nf as u32 {
+        let [a, b, c] = mesh.face(f);
+        let [ha, hb, hc] = mesh.face_halfedges(f);
+        let metric_area = S::area(len(hb), len(hc), len(ha));
+        let o = S::orientation(pos[a as usize], pos[b as usize], pos[c as usize]);
+        if o < 0.0 {
+            flipped.push(f);
+        } else if o == 0.0 || metric_area <= 0.0 {
+            degenerate.push(f);
+        }
+    }
+    let mut max_err = 0.0f64;
+    for e in 0..mesh.n_edges() as u32 {
+        let [a, b] = mesh.edge_vertices(e);
+        let d = S::distance(pos[a as usize], pos[b as usize]);
+        max_err = max_err.max((d - lengths[e as usize]).abs());
+    }
+    Layout {
+        geometry: S::KIND,
+        positions: pos,
+        seed_face: seed,
+        flipped_faces: flipped,
+        degenerate_faces: degenerate,
+        max_length_error: max_err,
+        depth,
+    }
+}
+
+/// The isometry that best maps layout `b` onto layout `a` (least squares over all vertices)
+/// and the largest remaining distance between corresponding vertices after applying it.
+pub fn align<S: Space>(a: &[S::Point], b: &[S::Point]) -> Result<(S::Iso, f64)> {
+    if a.len() != b.len() {
+        return Err(Error::input(
+            "cannot align layouts with different numbers of vertices",
+        ));
+    }
+    let pairs: Vec<(S::Point, S::Point)> = b.iter().copied().zip(a.iter().copied()).collect();
+    let iso = S::Iso::fit(&pairs)?;
+    let dev = pairs
+        .iter()
+        .map(|&(x, y)| S::distance(iso.apply(x), y))
+        .fold(0.0, f64::max);
+    Ok((iso, dev))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn seed_triangles_have_their_side_lengths_and_orientation() {
+        fn check<S: Space>(l: [f64; 3]) {
+            let p = S::seed(l[0], l[1], l[2]);
+            assert!(
+                (S::distance(p[0], p[1]) - l[0]).abs() < 1e-13,
+                "{:?}",
+                S::KIND
+            );
+            assert!(
+                (S::distance(p[1], p[2]) - l[1]).abs() < 1e-13,
+                "{:?}",
+                S::KIND
+            );
+            assert!(
+                (S::distance(p[2], p[0]) - l[2]).abs() < 1e-13,
+                "{:?}",
+                S::KIND
+            );
+            assert!(S::orientation(p[0], p[1], p[2]) > 0.0);
+            // The third vertex on the other side of an edge of a triangle placed elsewhere.
+            let q = S::third(p[1], p[0], l[0], l[2] * 1.1, l[1] * 0.9);
+            assert!(S::orientation(p[1], p[0], q) > 0.0);
+            assert!((S::distance(q, p[1]) - l[1] * 0.9).abs() < 1e-12);
+            assert!((S::distance(q, p[0]) - l[2] * 1.1).abs() < 1e-12);
+        }
+        for l in [[0.3, 0.4, 0.5], [1.0, 1.2, 0.7], [0.01, 0.0105, 0.012]] {
+            check::<Euclidean>(l);
+            check::<Hyperbolic>(l);
+            check::<Spherical>(l);
+        }
+        // Far from the centre of the disk the Möbius recentring keeps the accuracy.
+        let p = Complex::new(0.999, 0.0);
+        let m = Mobius::from_pairs(
+            Complex::new(0.0, 0.0),
+            Complex::new(0.1, 0.0),
+            p,
+            Complex::new(0.999, 0.0001),
+        );
+        let t = Hyperbolic::seed(0.5, 0.6, 0.7).map(|z| m.apply(z));
+        let q = Hyperbolic::third(t[0], t[1], 0.5, 0.6, 0.7);
+        assert!(Hyperbolic::distance(q, t[2]) < 1e-9);
+    }
+}
