@@ -33,11 +33,12 @@ fn check_layouts<S: Space<Point = C>>(s: &SyntheticSurface, tol: f64) -> Layout<
         );
         let (_, dev) = align::<S>(&s.positions, &l.positions).unwrap();
         assert!(dev < tol, "seed {seed:?}: deviation from exact {dev}");
-        if first.is_none() {
-            first = Some(l);
-        } else {
-            let (_, d) = align::<S>(&first.as_ref().unwrap().positions, &l.positions).unwrap();
-            assert!(d < tol, "layouts from different seeds differ by {d}");
+        match &first {
+            None => first = Some(l),
+            Some(f) => {
+                let (_, d) = align::<S>(&f.positions, &l.positions).unwrap();
+                assert!(d < tol, "layouts from different seeds differ by {d}");
+            }
         }
     }
     first.unwrap()

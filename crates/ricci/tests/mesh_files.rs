@@ -17,7 +17,10 @@ fn meshes_dir() -> Option<PathBuf> {
     if dir.join("SOURCES.md").is_file() {
         Some(dir)
     } else {
-        eprintln!("note: RICCI_MESHES={} has no SOURCES.md; skipping", dir.display());
+        eprintln!(
+            "note: RICCI_MESHES={} has no SOURCES.md; skipping",
+            dir.display()
+        );
         None
     }
 }
@@ -194,7 +197,11 @@ fn every_mesh_matches_the_independent_table() {
         return;
     };
     let table = parse_table(&std::fs::read_to_string(dir.join("SOURCES.md")).unwrap());
-    assert!(table.len() >= 20, "only {} rows parsed from SOURCES.md", table.len());
+    assert!(
+        table.len() >= 20,
+        "only {} rows parsed from SOURCES.md",
+        table.len()
+    );
     let listed: BTreeMap<&str, &Row> = table.iter().map(|r| (r.file.as_str(), r)).collect();
     // Every mesh file in the folder is in the table, and every row has its file.
     let mut files: Vec<String> = std::fs::read_dir(&dir)
@@ -235,7 +242,11 @@ fn every_mesh_matches_the_independent_table() {
         let expected_valid = row.orientable && row.nm_vertices == 0 && row.genus.is_some();
         match read_surface(&path) {
             Ok((s, report)) => {
-                check("accepted", expected_valid, "an invalid surface was accepted".into());
+                check(
+                    "accepted",
+                    expected_valid,
+                    "an invalid surface was accepted".into(),
+                );
                 let m = &s.mesh;
                 let t = topology(m);
                 check("V", m.n_vertices() == row.v, format!("{}", m.n_vertices()));
@@ -283,7 +294,11 @@ fn every_mesh_matches_the_independent_table() {
                 check("refused", !expected_valid, msg.clone());
                 check("names the file", msg.contains(&row.file), msg.clone());
                 if !row.orientable {
-                    check("non-orientable", msg.contains("not orientable"), msg.clone());
+                    check(
+                        "non-orientable",
+                        msg.contains("not orientable"),
+                        msg.clone(),
+                    );
                 } else if row.nm_vertices > 0 {
                     // "non-manifold vertex N (line L)": N must really be pinched, and line L
                     // must be where that vertex is defined.
@@ -295,7 +310,11 @@ fn every_mesh_matches_the_independent_table() {
                     check("names a vertex", n.is_some(), msg.clone());
                     if let Some(n) = n {
                         let fans = fans_around(&soup, n);
-                        check("vertex is pinched", fans > 1, format!("vertex {n} has {fans} fan(s)"));
+                        check(
+                            "vertex is pinched",
+                            fans > 1,
+                            format!("vertex {n} has {fans} fan(s)"),
+                        );
                         let line = soup.vertex_lines.as_ref().map(|l| l[n as usize]);
                         if let Some(line) = line {
                             check(

@@ -20,6 +20,9 @@
 //! SU(1,1) on the Hermitian matrices `Q(z) = (z, 1)ᵀ(z̄, 1)/(1 − |z|²)`, whose coordinates
 //! `X₀ = (1 + |z|²)/(1 − |z|²)`, `X₁ + iX₂ = 2z/(1 − |z|²)` are the hyperboloid model.
 
+// `!(x > 0.0)` is used on purpose: it is also true for NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use crate::error::{Error, Result};
 use num_complex::Complex64 as C;
 
@@ -603,7 +606,7 @@ mod tests {
         ((*seed >> 11) as f64) / ((1u64 << 53) as f64)
     }
     fn disk_point(s: &mut u64) -> C {
-        C::from_polar(0.9 * rng(s).sqrt(), 6.283 * rng(s))
+        C::from_polar(0.9 * rng(s).sqrt(), std::f64::consts::TAU * rng(s))
     }
 
     #[test]

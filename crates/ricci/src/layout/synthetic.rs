@@ -17,6 +17,9 @@
 //! are shared with the closed mesh) with its lengths and vertex map, the labelled
 //! [`Polygon`], and the exact positions of the cut-mesh vertices.
 
+// `!(x > 0.0)` is used on purpose: it is also true for NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use super::deck::Polygon;
 use super::isometry::{disk_distance, klein_to_poincare, Complex};
 use crate::error::{Error, Result};
