@@ -140,7 +140,8 @@ fn group_edges(n_vertices: usize, tris: &[[u32; 3]]) -> EdgeGroups {
                     if third(x.1) == third(y.1) {
                         g.n_duplicates += 1;
                         if g.duplicate.is_none() {
-                            g.duplicate = Some(((x.1 & H) / 3, (y.1 & H) / 3));
+                            let (f0, f1) = ((x.1 & H) / 3, (y.1 & H) / 3);
+                            g.duplicate = Some((f0.min(f1), f0.max(f1)));
                         }
                     }
                 }
@@ -242,9 +243,10 @@ pub fn build_surface(soup: PolygonSoup) -> Result<(Surface, BuildReport)> {
         let (a, b) = (src(f), src(g));
         let mut k = tris[f as usize];
         k.sort_unstable();
-        let more = match groups.n_duplicates {
-            1 => String::new(),
-            n => format!("; {} pairs of duplicate faces in all", n),
+        // Two faces with the same vertices meet on all three of their edges.
+        let more = match groups.n_duplicates / 3 {
+            0 | 1 => String::new(),
+            n => format!("; {n} pairs of duplicate faces in all"),
         };
         return Err(Error::invalid_mesh(format!(
             "faces {a}{} and {b}{} are duplicates (both use vertices {}, {}, {}){more}",

@@ -8,7 +8,7 @@
 //! | generator | resolution means | faces | min angle at the default |
 //! |---|---|---|---|
 //! | [`icosphere`]`(s)` | subdivision levels `s` (default 3) | `20·4^s` | 54° |
-//! | [`torus`]`(R, r, n)` | segments around the major circle (default 48) | `2 n n_w` | 56° (R = 1, r = 0.5) |
+//! | [`torus`](fn@torus)`(R, r, n)` | segments around the major circle (default 48) | `2 n n_w` | 56° (R = 1, r = 0.5) |
 //! | [`disk`]`(n)` | boundary segments (default 64) | ≈ `0.18 n²` | 37° |
 //! | [`annulus`]`(r_in, r_out, n)` | segments on the outer circle (default 64) | ≈ `0.18 n² (1 − r_in²/r_out²)` | 37° |
 //! | [`pair_of_pants`]`(n)` | segments on the outer circle (default 64) | ≈ `0.16 n²` | 37° |
@@ -39,6 +39,8 @@ use crate::mesh::Surface;
 use crate::progress::{NoProgress, Progress};
 use std::f64::consts::PI;
 
+pub use implicit::ToriChain;
+pub use remesh::Implicit;
 pub use sphere::icosphere;
 pub use torus::{torus, torus_grid};
 
@@ -98,29 +100,39 @@ pub fn disk(resolution: u32) -> Result<Surface> {
     )
 }
 
+/// Smallest accepted ratio `r_in / r_out` of the annulus.
+pub const MIN_ANNULUS_RATIO: f64 = 1e-3;
+
 /// Annulus `r_in < |p| < r_out` with `resolution` segments on the outer circle (the inner
-/// circle gets the same spacing, at least 8 segments).
+/// circle gets the same spacing, at least 8 segments). Meshed at `r_out = 1` and scaled, so
+/// only the ratio `r_in / r_out` (at least [`MIN_ANNULUS_RATIO`]) matters.
 pub fn annulus(r_in: f64, r_out: f64, resolution: u32) -> Result<Surface> {
     if !(r_in.is_finite() && r_out.is_finite()) || r_in <= 0.0 || r_out <= r_in {
         return Err(Error::input(format!(
             "annulus: the radii must satisfy 0 < inner < outer (got inner = {r_in}, outer = {r_out})"
         )));
     }
+    let ratio = r_in / r_out;
+    if ratio < MIN_ANNULUS_RATIO {
+        return Err(Error::input(format!(
+            "annulus: inner / outer = {ratio:e} is too small (at least {MIN_ANNULUS_RATIO})"
+        )));
+    }
     check_resolution("annulus", resolution, 8)?;
-    check_planar_size(
-        "annulus",
-        PI * (r_out * r_out - r_in * r_in),
-        r_out,
-        resolution,
-    )?;
-    planar::mesh_domain(
+    check_planar_size("annulus", PI * (1.0 - ratio * ratio), 1.0, resolution)?;
+    let mut s = planar::mesh_domain(
         "annulus",
         &planar::Domain {
-            outer: r_out,
-            holes: vec![([0.0, 0.0], r_in)],
+            outer: 1.0,
+            holes: vec![([0.0, 0.0], ratio)],
         },
         resolution,
-    )
+    )?;
+    for p in &mut s.positions {
+        p[0] *= r_out;
+        p[1] *= r_out;
+    }
+    Ok(s)
 }
 
 /// Radius and centres of the two holes of [`pair_of_pants`].
@@ -189,7 +201,7 @@ pub fn genus_with_progress(
     }
     // Grid fine enough to resolve the tubes, the holes and the blends.
     let r = field.minor;
-    let spacing = l.clamp(r / 10.0, r / 5.0);
+    let spacing = (2.0 * l).clamp(r / 20.0, r / 5.0);
     progress.report("marching", None, "polygonising the implicit surface");
     let (pos, tris) = implicit::marching_tetrahedra(&field, field.bounds(2.0 * spacing), spacing);
     let mut mesh = remesh::TriMesh::new(pos, tris)?;
@@ -216,14 +228,50 @@ pub enum GeneratorKind {
 
 /// Optional parameters; `None` takes the kind's default. A parameter that a kind does not
 /// use is refused by [`generate`].
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct GeneratorParams {
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub resolution: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub subdivisions: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub major: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub minor: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub inner: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub outer: Option<f64>,
+}
+
+impl GeneratorParams {
+    /// The parameters [`generate`] uses for `kind`: the given ones, with the defaults filled
+    /// in for the unset parameters that apply to the kind (for reports).
+    pub fn with_defaults(&self, kind: GeneratorKind) -> GeneratorParams {
+        let mut p = self.clone();
+        match kind {
+            GeneratorKind::Sphere => {
+                p.subdivisions = p
+                    .subdivisions
+                    .or(p.resolution)
+                    .or(Some(DEFAULT_SUBDIVISIONS));
+                p.resolution = None;
+            }
+            GeneratorKind::Torus => {
+                p.major = p.major.or(Some(DEFAULT_MAJOR));
+                p.minor = p.minor.or(Some(DEFAULT_MINOR));
+            }
+            GeneratorKind::Annulus => {
+                p.inner = p.inner.or(Some(DEFAULT_INNER));
+                p.outer = p.outer.or(Some(DEFAULT_OUTER));
+            }
+            _ => {}
+        }
+        if kind != GeneratorKind::Sphere {
+            p.resolution = p.resolution.or(Some(default_resolution(&kind)));
+        }
+        p
+    }
 }
 
 impl GeneratorKind {

@@ -36,8 +36,9 @@ pub fn torus_grid(major: f64, minor: f64, resolution: u32) -> Result<(u32, u32, 
              around the major circle)"
         )));
     }
-    let c = (major * major - minor * minor).sqrt();
-    let height = 2.0 * PI * minor / c;
+    // Scale-free: W = 2π q / √(1 − q²), q = r / R (no overflow for huge radii).
+    let q = minor / major;
+    let height = 2.0 * PI * q / ((1.0 - q) * (1.0 + q)).sqrt();
     let a = 2.0 * PI / resolution as f64;
     let rows = height / (a * 3f64.sqrt() / 2.0);
     if !rows.is_finite() || rows > 1e9 {
@@ -56,13 +57,15 @@ pub fn torus_grid(major: f64, minor: f64, resolution: u32) -> Result<(u32, u32, 
 pub fn torus(major: f64, minor: f64, resolution: u32) -> Result<Surface> {
     let (n_u, n_w, height) = torus_grid(major, minor, resolution)?;
     let (rr, r) = (major, minor);
-    let c = (rr * rr - r * r).sqrt();
+    let q = r / rr;
+    // c / r with c = √(R² − r²), computed without squaring the radii.
+    let c_over_r = ((1.0 - q) * (1.0 + q)).sqrt() / q;
     let k = ((rr - r) / (rr + r)).sqrt();
     let (nu, nw) = (n_u as usize, n_w as usize);
     let mut positions = Vec::with_capacity(nu * nw);
     for j in 0..nw {
         let w = height * j as f64 / nw as f64;
-        let phi = c * w / (2.0 * r);
+        let phi = c_over_r * w / 2.0;
         let v = 2.0 * phi.sin().atan2(k * phi.cos());
         let lambda = rr + r * v.cos();
         let z = r * v.sin();
