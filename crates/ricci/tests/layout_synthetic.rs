@@ -262,3 +262,26 @@ fn errors_name_the_problem() {
     let e = layout::<Euclidean>(&s.cut, &s.cut_lengths, Some(10_000)).unwrap_err();
     assert!(e.to_string().contains("seed face 10000"), "{e}");
 }
+
+#[test]
+fn universal_cover_tiles_carry_words_that_evaluate_to_their_maps() {
+    use ricci::layout::cover::{tiles_by_radius, tiles_by_words};
+    let s = regular_polygon_surface(Geometry::Hyperbolic, 2, Gluing::Canonical, 3).unwrap();
+    let l = layout::<Hyperbolic>(&s.cut, &s.cut_lengths, None).unwrap();
+    let g = deck_group::<Hyperbolic>(&l, &s.polygon).unwrap();
+    let base = l.positions[s.cut.face(ricci::layout::place::central_face(&s.cut))[0] as usize];
+    let tiles = tiles_by_radius::<Hyperbolic>(&g, &s.polygon, base, 6.0, 5000).unwrap();
+    assert!(tiles.len() > 50);
+    for t in &tiles {
+        let w = g.word(&t.word).unwrap();
+        assert!(w.distance(&t.map) < 1e-8, "{:?}", t.word);
+    }
+    // The copies across the 8 sides of F are among the tiles.
+    for side in 0..8 {
+        let sm = g.side_map(side).unwrap();
+        assert!(tiles.iter().any(|t| t.map.distance(&sm) < 1e-9));
+    }
+    // Distinct tiles have distinct base images; words of length ≤ 2: 1 + 8 + 8·7.
+    let w = tiles_by_words(&g, 2, 1000).unwrap();
+    assert_eq!(w.len(), 1 + 8 + 56);
+}

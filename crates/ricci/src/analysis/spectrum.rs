@@ -62,7 +62,7 @@ pub fn lattice_spectrum(w1: Complex, w2: Complex, count: usize) -> Result<Vec<f6
     let tr = g11 + g22;
     let det = g11 * g22 - g12 * g12;
     let lmin = det / (0.5 * tr + (0.25 * tr * tr - det).max(0.0).sqrt());
-    if !(lmin > 0.0) {
+    if lmin.is_nan() || lmin <= 0.0 {
         return Err(Error::numerical("degenerate translation lattice"));
     }
     let mut l = b.norm() * 2.0;

@@ -7,12 +7,18 @@
 //!   the sphere) with a metric, generic over the background geometry ([`Space`]).
 //! * [`deck`] — fundamental polygons with paired sides, side pairings, deck transformation
 //!   generators and the group relation.
+//! * [`cover`] — finite portions of the universal cover: copies of the polygon by words or by
+//!   radius.
+//! * [`svg`], [`export`] — pictures of the fundamental domain and tilings; OBJ with UVs.
 //! * [`synthetic`] — closed surfaces with exact flat / hyperbolic metrics and known polygons
 //!   (flat tori, regular 4g-gons), the references of the tests.
 
+pub mod cover;
 pub mod deck;
+pub mod export;
 pub mod isometry;
 pub mod place;
+pub mod svg;
 pub mod synthetic;
 
 pub use deck::{deck_group, DeckGroup, Polygon, Side, SidePairing};
