@@ -16,6 +16,9 @@ use super::place::Space;
 use crate::error::{Error, Result};
 use std::collections::{HashMap, VecDeque};
 
+/// A word in the generators: (letter index, inverse).
+pub type Word = Vec<(usize, bool)>;
+
 /// One copy of the fundamental polygon.
 #[derive(Debug, Clone)]
 pub struct Tile<I> {
@@ -135,7 +138,7 @@ pub fn tiles_by_radius<S: Space>(
         side_words[m] = Some(inverse_word(&w));
         side_words[s] = Some(w);
     }
-    let maps: Vec<(S::Iso, Vec<(usize, bool)>)> = (0..n)
+    let maps: Vec<(S::Iso, Word)> = (0..n)
         .filter_map(|s| Some((group.side_map(s)?, side_words[s].clone()?)))
         .collect();
     if maps.is_empty() {
