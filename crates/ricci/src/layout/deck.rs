@@ -171,8 +171,10 @@ pub struct SidePairing<I> {
     pub endpoints: I,
     /// Least squares over all vertices of the side (used for the deck group).
     pub map: I,
-    /// Largest distance between a map computed from one edge of the side and the end-point
-    /// map (paper 001 Table II); in the metric of [`Isometry::distance`].
+    /// How far a map computed from one edge of the side can be from the end-point map (paper
+    /// 001 Table II): the largest geodesic distance, over all edges, between the images of the
+    /// partner side's first, middle and last vertices under the two maps. (A distance between
+    /// the matrices would grow with the distance of the side from the origin of the model.)
     pub edge_spread: f64,
     /// Largest distance, in the model space, between `map(partner vertex)` and the vertex.
     pub max_vertex_error: f64,
@@ -266,9 +268,12 @@ pub fn deck_group<S: Space>(
         let k = v.len() - 1;
         let endpoints = S::Iso::from_pairs(w[0], w[k], v[0], v[k]);
         let mut spread = 0.0f64;
+        let probes = [w[0], w[k / 2], w[k]];
         for t in 0..k {
             let e = S::Iso::from_pairs(w[t], w[t + 1], v[t], v[t + 1]);
-            spread = spread.max(e.distance(&endpoints));
+            for &p in &probes {
+                spread = spread.max(S::distance(e.apply(p), endpoints.apply(p)));
+            }
         }
         let pairs: Vec<(S::Point, S::Point)> = w.iter().copied().zip(v.iter().copied()).collect();
         let map = S::Iso::fit(&pairs)
