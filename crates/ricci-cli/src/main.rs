@@ -25,6 +25,8 @@ enum Command {
     Info(cmd::info::Args),
     /// Procedural test surfaces: sphere, torus, disk, annulus, pants, genus-g.
     Generate(cmd::generate::Args),
+    /// Render a surface to PNG (checkerboard from UVs, scalar fields, zebra) or export glTF.
+    Render(Box<cmd::render::Args>),
 }
 
 fn main() {
@@ -32,6 +34,7 @@ fn main() {
     let result = match cli.command {
         Command::Info(a) => cmd::info::run(a),
         Command::Generate(a) => cmd::generate::run(a),
+        Command::Render(a) => cmd::render::run(*a),
     };
     if let Err(e) = result {
         eprintln!("error: {}", util::sentence(&e));
