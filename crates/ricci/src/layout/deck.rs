@@ -195,6 +195,11 @@ pub struct DeckGroup<I> {
     pub corner_maps: Vec<Option<I>>,
     /// Distance of `D(x_1)⋯D(x_n)` from the identity, when all sides are paired.
     pub relation_error: Option<f64>,
+    /// Product of the sizes of the factors of the relation ([`Isometry::size`]): the rounding
+    /// of the product alone can reach machine epsilon times this, so `relation_error` is
+    /// only meaningful relative to it (long generators on surfaces with far-apart handles
+    /// make it huge).
+    pub relation_condition: f64,
     /// Largest edge spread over all sides.
     pub max_edge_spread: f64,
     /// Largest vertex error of the least-squares side maps.
@@ -329,6 +334,12 @@ pub fn deck_group<S: Space>(
             generators[l] = Some(a.inverse().compose(&b).normalized());
         }
     }
+    let relation_condition: f64 = poly
+        .sides
+        .iter()
+        .filter_map(|s| generators.get(s.letter?).copied().flatten())
+        .map(|g| g.size())
+        .product();
     let relation_error = if poly.is_closed() && generators.iter().all(|g| g.is_some()) {
         let mut prod = S::Iso::identity();
         for side in &poly.sides {
@@ -351,6 +362,7 @@ pub fn deck_group<S: Space>(
         generators,
         corner_maps: q,
         relation_error,
+        relation_condition,
         max_edge_spread,
         max_vertex_error,
     })

@@ -49,6 +49,10 @@ pub trait Isometry: Copy + Clone + std::fmt::Debug + Send + Sync + 'static {
     fn distance(&self, other: &Self) -> f64;
     /// Re-project onto the group (remove accumulated rounding).
     fn normalized(&self) -> Self;
+    /// Size of the isometry as a matrix (Frobenius norm for Möbius maps and rotations,
+    /// `1 + |t|` for rigid motions): rounding in a product of isometries is bounded by the
+    /// machine epsilon times the product of these sizes.
+    fn size(&self) -> f64;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -143,6 +147,9 @@ impl Isometry for RigidMotion {
     /// `|rot₁ − rot₂| + |t₁ − t₂|`.
     fn distance(&self, o: &Self) -> f64 {
         (self.rot - o.rot).norm() + (self.t - o.t).norm()
+    }
+    fn size(&self) -> f64 {
+        1.0 + self.t.norm()
     }
     fn normalized(&self) -> Self {
         let n = self.rot.norm();
@@ -387,6 +394,9 @@ impl Isometry for Mobius {
     fn normalized(&self) -> Self {
         Mobius::new(self.a, self.b).unwrap_or(*self)
     }
+    fn size(&self) -> f64 {
+        (2.0 * (self.a.norm_sqr() + self.b.norm_sqr())).sqrt()
+    }
 }
 
 impl Mobius {
@@ -579,6 +589,9 @@ impl Isometry for Rotation {
             }
         }
         s.sqrt()
+    }
+    fn size(&self) -> f64 {
+        3f64.sqrt()
     }
     /// Gram–Schmidt on the rows.
     fn normalized(&self) -> Self {

@@ -57,6 +57,8 @@ pub trait Space: Background {
     fn orientation(a: Self::Point, b: Self::Point, c: Self::Point) -> f64;
     /// Geodesic distance.
     fn distance(a: Self::Point, b: Self::Point) -> f64;
+    /// The point at fraction `t` of the geodesic from `a` to `b`.
+    fn toward(a: Self::Point, b: Self::Point, t: f64) -> Self::Point;
 }
 
 #[inline]
@@ -95,6 +97,9 @@ impl Space for Euclidean {
     fn distance(a: Complex, b: Complex) -> f64 {
         (a - b).norm()
     }
+    fn toward(a: Complex, b: Complex, t: f64) -> Complex {
+        a + (b - a) * t
+    }
 }
 
 impl Space for Hyperbolic {
@@ -131,6 +136,16 @@ impl Space for Hyperbolic {
     fn distance(a: Complex, b: Complex) -> f64 {
         disk_distance(a, b)
     }
+    fn toward(a: Complex, b: Complex, t: f64) -> Complex {
+        let m = Mobius::to_origin(a);
+        let w = m.apply(b);
+        let r = w.norm();
+        if r == 0.0 {
+            return a;
+        }
+        let d = 2.0 * r.min(1.0 - f64::EPSILON).atanh();
+        m.inverse().apply(w / r * (0.5 * t * d).tanh())
+    }
 }
 
 impl Space for Spherical {
@@ -164,6 +179,23 @@ impl Space for Spherical {
     #[inline]
     fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
         sphere_distance(a, b)
+    }
+    fn toward(a: [f64; 3], b: [f64; 3], t: f64) -> [f64; 3] {
+        let d = sphere_distance(a, b);
+        if d == 0.0 {
+            return a;
+        }
+        let mut q = Self::third(a, b, d, d, t * d);
+        // `third` turns by the angle of an isosceles triangle; go straight instead.
+        let e1 = normalize3(a);
+        let dd = [b[0] - e1[0], b[1] - e1[1], b[2] - e1[2]];
+        let k = dot3(dd, e1);
+        let e2 = normalize3([dd[0] - k * e1[0], dd[1] - k * e1[1], dd[2] - k * e1[2]]);
+        let (sn, cs) = (t * d).sin_cos();
+        for i in 0..3 {
+            q[i] = cs * e1[i] + sn * e2[i];
+        }
+        q
     }
 }
 
@@ -308,7 +340,51 @@ pub fn layout<S: Space>(
         }
         None => central_face(mesh),
     };
-    Ok(layout_unchecked::<S>(mesh, lengths, seed))
+    let first = layout_unchecked::<S>(mesh, lengths, seed);
+    if seed_face.is_some() || !mesh.has_boundary() {
+        return Ok(first);
+    }
+    // Errors grow with the distance from the seed (in H² exponentially, through the
+    // resolution of the model near the unit circle): restart from the face nearest to the
+    // minimax centre of the boundary.
+    let centre = minimax_centre::<S>(&boundary_points(mesh, &first.positions));
+    let best = (0..nf as u32)
+        .min_by(|&f, &g| {
+            let df = S::distance(first.positions[mesh.face(f)[0] as usize], centre);
+            let dg = S::distance(first.positions[mesh.face(g)[0] as usize], centre);
+            df.total_cmp(&dg)
+        })
+        .unwrap_or(seed);
+    if best == seed {
+        return Ok(first);
+    }
+    Ok(layout_unchecked::<S>(mesh, lengths, best))
+}
+
+fn boundary_points<P: Copy>(mesh: &Mesh, pos: &[P]) -> Vec<P> {
+    mesh.boundary_loops()
+        .into_iter()
+        .flatten()
+        .map(|v| pos[v as usize])
+        .collect()
+}
+
+/// Approximate centre of the smallest enclosing ball (Bădoiu–Clarkson: move towards the
+/// farthest point by a shrinking fraction), 300 iterations.
+pub fn minimax_centre<S: Space>(points: &[S::Point]) -> S::Point {
+    let Some(&first) = points.first() else {
+        return S::base_point();
+    };
+    let mut c = first;
+    for it in 1..300 {
+        let far = points
+            .iter()
+            .copied()
+            .max_by(|p, q| S::distance(c, *p).total_cmp(&S::distance(c, *q)))
+            .unwrap_or(c);
+        c = S::toward(c, far, 1.0 / (it as f64 + 1.0));
+    }
+    c
 }
 
 /// Breadth-first placement from `seed` (inputs already validated).
