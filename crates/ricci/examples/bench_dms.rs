@@ -78,13 +78,13 @@ fn main() {
         let mut acc = 0.0;
         let t0 = Instant::now();
         for &(f, u) in &pts {
-            space.evaluate(&c, 3, f, u, 0, &mut ws, &mut out);
+            space.evaluate(&c, 3, f, u, 0, &mut ws, &mut out).unwrap();
             acc += out[2];
         }
         let t_val = t0.elapsed().as_secs_f64() / pts.len() as f64;
         let t0 = Instant::now();
         for &(f, u) in &pts {
-            space.evaluate(&c, 3, f, u, 2, &mut ws, &mut out);
+            space.evaluate(&c, 3, f, u, 2, &mut ws, &mut out).unwrap();
             acc += out[5 * 3 + 2];
         }
         let t_d2 = t0.elapsed().as_secs_f64() / pts.len() as f64;

@@ -4,8 +4,8 @@
 //! Without arguments: horse.ply from `$RICCI_MESHES` and a generated ≈1M-face torus written
 //! by the writers to a temporary directory in every format. Prints one line per file and stage.
 
-use ricci::mesh::io::{self, Encoding, Format};
 use ricci::mesh::generate::torus;
+use ricci::mesh::io::{self, Encoding, Format};
 use ricci::mesh::{build_surface, topology};
 use std::path::{Path, PathBuf};
 use std::time::Instant;

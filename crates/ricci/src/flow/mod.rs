@@ -363,6 +363,19 @@ pub fn ricci_flow(
     let ksum: f64 = ev.ws.curvature.iter().sum();
     let gb = (ksum + geometry.curvature() * ev.ws.area - 2.0 * PI * chi as f64).abs();
     let converged = outcome.converged && max_err <= options.tolerance;
+    if !converged && (target.is_dynamic() || matches!(options.target, TargetSpec::GeodesicBoundary))
+    {
+        let ears = (0..mesh.n_vertices() as u32)
+            .filter(|&v| mesh.is_boundary_vertex(v) && mesh.vertex_faces(v).count() == 1)
+            .count();
+        if ears > 0 {
+            notes.push(format!(
+                "{ears} boundary vertices have a single face (ears): a round or geodesic \
+                 boundary needs their one corner to open to nearly π, which degenerates the \
+                 triangle; split the edges opposite the ears first"
+            ));
+        }
+    }
     if outcome.converged && !converged {
         notes.push(format!(
             "after rescaling, max |K − K̄| = {max_err:.3e} exceeds the tolerance"

@@ -179,9 +179,9 @@ pub fn newton(
         it += 1;
         // Round boundaries: frozen-target (chord) steps on the convex energy while far from the
         // solution, exact Newton steps on the full Jacobian once close (or when chords stall).
-        let exact = !dynamic || (!exact_failed && err < 1e-2);
+        let exact =
+            !dynamic || (!exact_failed && (err < 1e-2 || (err < 0.5 && err > 0.8 * prev_err)));
         exact_failed = false;
-        let _ = prev_err;
         let line_search = if dynamic && !exact {
             LineSearch::Energy
         } else {
@@ -355,7 +355,9 @@ pub fn newton(
                         }
                     }
                 }
-                LineSearch::Residual => res_t <= (1.0 - 2e-4 * t) * res0 || halves,
+                LineSearch::Residual => {
+                    (res_t <= (1.0 - 2e-4 * t) * res0 && err_t <= 2.0 * err) || halves
+                }
             };
             if good {
                 accepted = true;

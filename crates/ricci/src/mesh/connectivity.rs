@@ -190,18 +190,15 @@ impl Mesh {
                 count[v as usize] += 1;
             }
         }
-        for v in 0..self.n_vertices {
+        for (v, &n) in count.iter().enumerate() {
             if self.vertex_he[v] == NONE {
                 continue;
             }
-            let fan = self
-                .vertex_faces(v as u32)
-                .take(count[v] as usize + 1)
-                .count();
-            if fan != count[v] as usize {
+            let fan = self.vertex_faces(v as u32).take(n as usize + 1).count();
+            if fan != n as usize {
                 return Err(Error::invalid_mesh(format!(
                     "non-manifold vertex {v}: its {} faces form more than one fan (the surface is pinched there)",
-                    count[v]
+                    n
                 )));
             }
         }

@@ -9,7 +9,7 @@
 //! shared (the arguments then only involve knots of the edge's vertices); larger `r` ties
 //! more rows of control points to the neighbour's polynomial, `r = n` would make the whole
 //! spline one polynomial. The constraints are homogeneous, `A c̃ = 0`, so `c̃ = c − Aᵀ y` with
-//! `A Aᵀ y = A c`; `A Aᵀ` is singular (both orientations repeat the `β_o = 0` rows), so it is
+//! `A Aᵀ y = A c`; `A Aᵀ` can be singular (constraints around a vertex are dependent), so it is
 //! factored with a tiny diagonal shift (faer sparse Cholesky) and used as the preconditioner
 //! of conjugate gradients on the consistent system until `‖A c̃‖` reaches the tolerance.
 //!
@@ -43,7 +43,8 @@ pub struct Constraint {
     pub weights: Vec<f64>,
 }
 
-/// The constraints of paper 000 eq. 14 for fairness parameter `r` (`0 ≤ r ≤ n − 1`).
+/// The constraints of paper 000 eq. 14 for fairness parameter `r` (`0 ≤ r ≤ n − 1`), for
+/// both orientations of every interior edge (the shared-control-point rows, `β_o = 0`, once).
 pub fn fairness_constraints(space: &DmsSpace, r: usize) -> Result<Vec<Constraint>> {
     let n = space.degree();
     if r >= n {
@@ -66,6 +67,12 @@ pub fn fairness_constraints(space: &DmsSpace, r: usize) -> Result<Vec<Constraint
         let bj = space.triangle(fj);
         for (k, beta) in multi_indices(n).into_iter().enumerate() {
             if beta[o] > r {
+                continue;
+            }
+            // With β_o = 0 the constraint only involves the edge's knots and says that the
+            // two triangles share this control point: the same equation as the opposite
+            // orientation's, so it is imposed once (from the lower face index).
+            if beta[o] == 0 && fi > fj {
                 continue;
             }
             let args = bi.blossom_args(beta);
@@ -522,18 +529,18 @@ fn quadrature(space: &DmsSpace) -> Vec<(u32, Point, f64)> {
 }
 
 /// Thin-plate energy of a spline (the quadrature of [`fit`]).
-pub fn thin_plate_energy(space: &DmsSpace, control: &[f64], dim: usize) -> f64 {
+pub fn thin_plate_energy(space: &DmsSpace, control: &[f64], dim: usize) -> Result<f64> {
     let mut ws = Workspace::default();
     let mut out = vec![0.0; n_partials(2) * dim];
     let mut e = 0.0;
     for (f, u, w) in quadrature(space) {
-        space.evaluate(control, dim, f, u, 2, &mut ws, &mut out);
+        space.evaluate(control, dim, f, u, 2, &mut ws, &mut out)?;
         for d in 0..dim {
             let (xx, xy, yy) = (out[3 * dim + d], out[4 * dim + d], out[5 * dim + d]);
             e += w * (xx * xx + 2.0 * xy * xy + yy * yy);
         }
     }
-    e
+    Ok(e)
 }
 
 /// Least-squares fit of the control points to data with a thin-plate fairness term (module
@@ -596,7 +603,7 @@ pub fn fit(
     let mut rhs = vec![0.0; nc * dim];
     let mut ws = Workspace::default();
     for p in data {
-        let m = space.basis_at(p.face, p.param, 0, &mut ws);
+        let m = space.basis_at(p.face, p.param, 0, &mut ws)?;
         data_blocks.add_point(&ws.indices[..m], &ws.values, 1, &[(0, 1.0 / kdata)]);
         for i in 0..m {
             let g = ws.indices[i] as usize;
@@ -607,7 +614,7 @@ pub fn fit(
     }
     let np2 = n_partials(2);
     for (f, u, w) in quadrature(space) {
-        let m = space.basis_at(f, u, 2, &mut ws);
+        let m = space.basis_at(f, u, 2, &mut ws)?;
         energy_blocks.add_point(
             &ws.indices[..m],
             &ws.values,
@@ -719,24 +726,28 @@ pub fn fit(
     let energy = |c: &[f64], t: &[f64]| c.iter().zip(t).map(|(a, b)| a * b).sum::<f64>();
     let mut errs = Vec::with_capacity(data.len());
     let mut out = vec![0.0; dim];
-    let objective =
-        |c: &[f64], e: f64, errs: &mut Vec<f64>, ws: &mut Workspace, out: &mut [f64]| {
-            errs.clear();
-            let mut s = 0.0;
-            for p in data {
-                space.evaluate(c, dim, p.face, p.param, 0, ws, out);
-                let d2: f64 = (0..dim).map(|d| (out[d] - p.target[d]).powi(2)).sum();
-                errs.push(d2.sqrt());
-                s += d2;
-            }
-            let ridge: f64 = c.iter().zip(initial).map(|(a, b)| (a - b) * (a - b)).sum();
-            s / kdata + lam * e + gamma * ridge
-        };
+    let objective = |c: &[f64],
+                     e: f64,
+                     errs: &mut Vec<f64>,
+                     ws: &mut Workspace,
+                     out: &mut [f64]|
+     -> Result<f64> {
+        errs.clear();
+        let mut s = 0.0;
+        for p in data {
+            space.evaluate(c, dim, p.face, p.param, 0, ws, out)?;
+            let d2: f64 = (0..dim).map(|d| (out[d] - p.target[d]).powi(2)).sum();
+            errs.push(d2.sqrt());
+            s += d2;
+        }
+        let ridge: f64 = c.iter().zip(initial).map(|(a, b)| (a - b) * (a - b)).sum();
+        Ok(s / kdata + lam * e + gamma * ridge)
+    };
     let (_, t0) = hx(initial);
     let e0 = energy(initial, &t0);
-    let obj0 = objective(initial, e0, &mut errs, &mut ws, &mut out);
+    let obj0 = objective(initial, e0, &mut errs, &mut ws, &mut out)?;
     let e1 = energy(&x, &tx);
-    let obj1 = objective(&x, e1, &mut errs, &mut ws, &mut out);
+    let obj1 = objective(&x, e1, &mut errs, &mut ws, &mut out)?;
     let rms = (errs.iter().map(|e| e * e).sum::<f64>() / kdata).sqrt();
     let max = errs.iter().fold(0.0f64, |a, &b| a.max(b));
     Ok((

@@ -206,9 +206,7 @@ impl SimplexFamily {
             groups,
             memo: HashMap::new(),
             leaves: Vec::new(),
-            leaf_masks: Vec::new(),
             nodes: Vec::new(),
-            node_masks: Vec::new(),
             min_rel: f64::INFINITY,
             diameter,
         };
@@ -375,9 +373,7 @@ struct Builder<'a> {
     groups: &'a [u8],
     memo: HashMap<u64, u32>,
     leaves: Vec<Leaf>,
-    leaf_masks: Vec<u64>,
     nodes: Vec<Node>,
-    node_masks: Vec<u64>,
     min_rel: f64,
     diameter: f64,
 }
@@ -425,7 +421,6 @@ impl Builder<'_> {
                 lines,
                 inv_det: 1.0 / det,
             });
-            self.leaf_masks.push(mask);
             (self.leaves.len() - 1) as u32
         } else {
             let mut var = [Variant {
@@ -464,7 +459,6 @@ impl Builder<'_> {
                 two: ws.len() == 2,
                 degree: (mask.count_ones() - 3) as f64,
             });
-            self.node_masks.push(mask);
             (self.nodes.len() - 1) as u32 | INTERNAL
         };
         self.memo.insert(mask, id);

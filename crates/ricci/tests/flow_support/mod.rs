@@ -237,60 +237,22 @@ pub fn meshes_dir() -> Option<PathBuf> {
     }
 }
 
-/// Minimal OFF / OBJ reader (until the library's readers are merged): positions and
-/// polygons, validated by `ricci::mesh::build_surface`.
+/// Read a mesh with the library's readers (panics with the file's error message).
 pub fn read_mesh(path: &std::path::Path) -> Surface {
-    use ricci::mesh::{build_surface, PolygonSoup};
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut soup = PolygonSoup::default();
-    let ext = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    if ext == "off" {
-        let mut tokens = text
-            .lines()
-            .map(|l| l.split('#').next().unwrap_or(""))
-            .flat_map(|l| l.split_whitespace())
-            .skip_while(|t| t.ends_with("OFF"));
-        let mut next = || tokens.next().expect("truncated OFF file");
-        let nv: usize = next().parse().unwrap();
-        let nf: usize = next().parse().unwrap();
-        let _ne: usize = next().parse().unwrap();
-        for _ in 0..nv {
-            let p = [next(), next(), next()].map(|t| t.parse::<f64>().unwrap());
-            soup.positions.push(p);
-        }
-        for _ in 0..nf {
-            let k: usize = next().parse().unwrap();
-            soup.polygons
-                .push((0..k).map(|_| next().parse::<u32>().unwrap()).collect());
-        }
-    } else if ext == "obj" {
-        for line in text.lines() {
-            let mut it = line.split_whitespace();
-            match it.next() {
-                Some("v") => {
-                    let p: Vec<f64> = it.take(3).map(|t| t.parse().unwrap()).collect();
-                    soup.positions.push([p[0], p[1], p[2]]);
-                }
-                Some("f") => {
-                    let n = soup.positions.len() as i64;
-                    soup.polygons.push(
-                        it.map(|t| {
-                            let i: i64 = t.split('/').next().unwrap().parse().unwrap();
-                            (if i < 0 { n + i } else { i - 1 }) as u32
-                        })
-                        .collect(),
-                    );
-                }
-                _ => {}
-            }
-        }
-    } else {
-        panic!("{}: unsupported format in the test reader", path.display());
-    }
-    build_surface(soup)
+    ricci::mesh::io::read_surface(path)
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
         .0
+}
+
+/// Upper hemisphere of the unit sphere from `disk(rings)`: the point at radius ρ and angle α
+/// of the disk goes to polar angle ρ·π/2, so the boundary ring lies exactly on the equator.
+pub fn hemisphere(rings: usize) -> Surface {
+    let mut s = disk(rings);
+    for p in s.positions.iter_mut() {
+        let rho = (p[0] * p[0] + p[1] * p[1]).sqrt();
+        let a = p[1].atan2(p[0]);
+        let t = rho * PI / 2.0;
+        *p = [t.sin() * a.cos(), t.sin() * a.sin(), t.cos()];
+    }
+    s
 }
