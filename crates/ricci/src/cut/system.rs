@@ -1,0 +1,769 @@
+//! Greedy construction of a canonical system of loops through the base vertex `x`, handle by
+//! handle, as vertex-disjoint simple edge paths meeting only at `x` (paper 001 App. A,
+//! 002 §6.2.2.1; the loops themselves are shortest-path loops as in Erickson–Whittlesey).
+//!
+//! **Why the loops must be disjoint and how their ends are placed.** Cutting along `2g` simple
+//! loops that meet only at `x` gives a disk iff the complement is connected; the word of the
+//! disk boundary is then fixed by the cyclic order of the `4g` loop ends around `x` (a one-vertex
+//! ribbon graph). Walking the disk boundary with the disk on the left, one arrives at `x` along
+//! the end `E_{j+1}` and leaves along `E_j` (counter-clockwise numbering). Working this out, the
+//! boundary reads `a₁b₁a₁⁻¹b₁⁻¹ … a_g b_g a_g⁻¹ b_g⁻¹` exactly when the ends of every handle are
+//! **interleaved** (`a`, `b`, `a`, `b`) and **contiguous** (no other end between them). So:
+//!
+//! * the ends around `x` are "slots" (outgoing edges of `x`); the free slots between two
+//!   consecutive ends form a *gap*; a new handle must put all its four ends into one gap, and,
+//!   once two handles exist, only gaps between two different handles keep the earlier handles
+//!   contiguous (the gaps inside a handle are lost);
+//! * `a_i` is the shortest loop through `x` leaving and returning through one allowed gap whose
+//!   Z₂ cohomology class is nonzero (non-separating: see [`super::homology`]); it is found in a
+//!   Dijkstra tree from `x` whose branches (one per slot) are disjoint, as a non-tree edge
+//!   between two branches of the same gap;
+//! * `b_i` is the shortest path from a slot strictly between `a_i`'s ends to a slot outside them
+//!   (same gap), avoiding `a_i` and all earlier loops: it crosses `a_i` once, at `x`;
+//! * slots are a budget: every handle may waste at most its fair share of the spare slots, so
+//!   that the later handles still find room (with the valence raised and the neighbourhood
+//!   graded by [`crate::mesh::refine`], there are enough of them).
+//!
+//! With boundary, after the handles every boundary loop is joined to `x` by a shortest path
+//! `c_k` through free vertices; these start from adjacent gaps so the word ends with
+//! `c₁ d₁ c₁⁻¹ … c_b d_b c_b⁻¹` (`d_k` the boundary loop). A closed genus-0 surface is slit along
+//! a path of two edges (word `c₁ c₁⁻¹`).
+//!
+//! When no loop fits the budget the caller refines more around `x` and starts again.
+
+use super::homology::Cohomology;
+use crate::mesh::refine::MinItem;
+use crate::mesh::{Mesh, NONE};
+use std::collections::{BinaryHeap, HashMap};
+
+/// What a constructed path is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum RawKind {
+    /// First (`0`, found as the non-separating loop) or second (`1`) loop of handle `h`.
+    Handle { handle: usize, which: u8 },
+    /// Path from `x` to boundary loop `k` (index into `Mesh::boundary_loops`).
+    Connector { boundary: usize },
+    /// The two-edge slit of a closed genus-0 surface.
+    Slit,
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct RawPath {
+    pub kind: RawKind,
+    /// Vertices; closed loops start and end at `x`.
+    pub vertices: Vec<u32>,
+}
+
+/// Counters describing the search.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct SearchStats {
+    /// Candidate first loops examined (all handles).
+    pub candidates_tried: usize,
+    /// Second-loop searches that found no path (the next candidate was tried).
+    pub failed_second_loops: usize,
+    /// Handles for which the fair slot budget had to be relaxed.
+    pub relaxed_budgets: usize,
+    /// Number of Dijkstra searches.
+    pub searches: usize,
+}
+
+/// Why a construction attempt failed (the caller refines more and retries).
+#[derive(Debug, Clone)]
+pub(crate) struct NoRoom(pub String);
+
+pub(crate) struct Input<'a> {
+    pub mesh: &'a Mesh,
+    pub lengths: &'a [f64],
+    pub coh: &'a Cohomology,
+    pub x: u32,
+    pub genus: usize,
+    pub boundary_loops: Vec<Vec<u32>>,
+}
+
+#[derive(Debug, Clone)]
+struct Gap {
+    /// Slot indices, counter-clockwise.
+    slots: Vec<usize>,
+    /// Path ids of the ends before and after the gap (`NONE` when there are no ends).
+    before: u32,
+    after: u32,
+}
+
+/// Dijkstra buffers with cheap reset.
+struct Search {
+    dist: Vec<f64>,
+    /// Half-edge through which the vertex was reached (origin = parent, `x` for sources).
+    pred: Vec<u32>,
+    settled: Vec<bool>,
+    touched: Vec<u32>,
+    heap: BinaryHeap<MinItem>,
+}
+
+impl Search {
+    fn new(nv: usize) -> Search {
+        Search {
+            dist: vec![f64::INFINITY; nv],
+            pred: vec![NONE; nv],
+            settled: vec![false; nv],
+            touched: Vec::new(),
+            heap: BinaryHeap::new(),
+        }
+    }
+    fn reset(&mut self) {
+        for &v in &self.touched {
+            self.dist[v as usize] = f64::INFINITY;
+            self.pred[v as usize] = NONE;
+            self.settled[v as usize] = false;
+        }
+        self.touched.clear();
+        self.heap.clear();
+    }
+    #[inline]
+    fn offer(&mut self, v: u32, d: f64, h: u32) {
+        if d < self.dist[v as usize] {
+            if self.dist[v as usize] == f64::INFINITY {
+                self.touched.push(v);
+            }
+            self.dist[v as usize] = d;
+            self.pred[v as usize] = h;
+            self.heap.push(MinItem(d, v));
+        }
+    }
+    /// Pop the next vertex to settle, or `None`.
+    fn pop(&mut self) -> Option<(f64, u32)> {
+        while let Some(MinItem(d, v)) = self.heap.pop() {
+            if self.settled[v as usize] || d > self.dist[v as usize] {
+                continue;
+            }
+            self.settled[v as usize] = true;
+            return Some((d, v));
+        }
+        None
+    }
+}
+
+struct State<'a> {
+    inp: &'a Input<'a>,
+    /// Outgoing half-edges of `x`, counter-clockwise.
+    slots: Vec<u32>,
+    /// Path occupying each slot, or `NONE`.
+    slot_path: Vec<u32>,
+    /// Slot index of every neighbour of `x` (`NONE` for other vertices).
+    slot_of: Vec<u32>,
+    blocked: Vec<bool>,
+    paths: Vec<RawPath>,
+    stats: SearchStats,
+    s1: Search,
+    s2: Search,
+    branch: Vec<u32>,
+    parity: Vec<u64>,
+}
+
+#[derive(Debug, Clone)]
+struct Candidate {
+    len: f64,
+    /// Half-edge `u → w` closing the loop (for `x_edge`, the slot half-edge `x → w`).
+    he: u32,
+    x_edge: bool,
+    ends: (usize, usize),
+}
+
+/// Build the raw system. `Err(NoRoom)` means "refine more and retry".
+pub(crate) fn build(inp: &Input) -> Result<(Vec<RawPath>, SearchStats), NoRoom> {
+    let m = inp.mesh;
+    let nv = m.n_vertices();
+    let slots: Vec<u32> = m.outgoing(inp.x).collect();
+    let mut slot_of = vec![NONE; nv];
+    for (i, &h) in slots.iter().enumerate() {
+        slot_of[m.he_tip(h) as usize] = i as u32;
+    }
+    let mut blocked = vec![false; nv];
+    blocked[inp.x as usize] = true;
+    for l in &inp.boundary_loops {
+        for &v in l {
+            blocked[v as usize] = true;
+        }
+    }
+    let mut st = State {
+        inp,
+        slot_path: vec![NONE; slots.len()],
+        slots,
+        slot_of,
+        blocked,
+        paths: Vec::new(),
+        stats: SearchStats::default(),
+        s1: Search::new(nv),
+        s2: Search::new(nv),
+        branch: vec![NONE; nv],
+        parity: vec![0; nv * inp.coh.words],
+    };
+    let nb = inp.boundary_loops.len();
+    if inp.genus == 0 && nb == 0 {
+        st.slit()?;
+    }
+    for i in 0..inp.genus {
+        st.handle(i)?;
+    }
+    if inp.genus > 0 || nb >= 2 {
+        let mut connected = vec![false; nb];
+        for _ in 0..nb {
+            st.connector(&mut connected)?;
+        }
+    }
+    Ok((st.paths, st.stats))
+}
+
+impl<'a> State<'a> {
+    fn mesh(&self) -> &'a Mesh {
+        self.inp.mesh
+    }
+    fn slot_len(&self, s: usize) -> f64 {
+        self.inp.lengths[self.mesh().he_edge(self.slots[s]) as usize]
+    }
+    fn slot_nbr(&self, s: usize) -> u32 {
+        self.mesh().he_tip(self.slots[s])
+    }
+    fn usable(&self, s: usize) -> bool {
+        self.slot_path[s] == NONE && !self.blocked[self.slot_nbr(s) as usize]
+    }
+    fn path_block(&self, p: u32) -> Option<usize> {
+        match self.paths[p as usize].kind {
+            RawKind::Handle { handle, .. } => Some(handle),
+            _ => None,
+        }
+    }
+    fn is_connector(&self, p: u32) -> bool {
+        matches!(self.paths[p as usize].kind, RawKind::Connector { .. })
+    }
+
+    /// Gaps between consecutive ends around `x`.
+    fn gaps(&self) -> Vec<Gap> {
+        let d = self.slots.len();
+        let ends: Vec<usize> = (0..d).filter(|&s| self.slot_path[s] != NONE).collect();
+        if ends.is_empty() {
+            return vec![Gap {
+                slots: (0..d).collect(),
+                before: NONE,
+                after: NONE,
+            }];
+        }
+        let mut out = Vec::with_capacity(ends.len());
+        for (k, &e) in ends.iter().enumerate() {
+            let e2 = ends[(k + 1) % ends.len()];
+            let mut slots = Vec::new();
+            let mut s = (e + 1) % d;
+            while s != e2 {
+                slots.push(s);
+                s = (s + 1) % d;
+            }
+            out.push(Gap {
+                slots,
+                before: self.slot_path[e],
+                after: self.slot_path[e2],
+            });
+        }
+        out
+    }
+
+    fn n_handle_blocks(&self) -> usize {
+        self.paths
+            .iter()
+            .filter(|p| matches!(p.kind, RawKind::Handle { which: 0, .. }))
+            .count()
+    }
+
+    /// Whether a new handle may use gap `g`.
+    fn handle_allowed(&self, g: &Gap) -> bool {
+        if g.before == NONE || self.n_handle_blocks() <= 1 {
+            return true;
+        }
+        self.path_block(g.before) != self.path_block(g.after)
+    }
+
+    fn usable_count(&self, slots: &[usize], extra_blocked: &[bool]) -> usize {
+        slots
+            .iter()
+            .filter(|&&s| self.usable(s) && !extra_blocked[s])
+            .count()
+    }
+
+    /// Free capacity for later handles (see module docs): with a single handle only one of its
+    /// gaps will ever be used, otherwise all gaps between different handles stay usable.
+    fn capacity(&self) -> usize {
+        let none = vec![false; self.slots.len()];
+        let gaps = self.gaps();
+        if self.n_handle_blocks() <= 1 {
+            gaps.iter()
+                .map(|g| self.usable_count(&g.slots, &none))
+                .max()
+                .unwrap_or(0)
+        } else {
+            gaps.iter()
+                .filter(|g| self.handle_allowed(g))
+                .map(|g| self.usable_count(&g.slots, &none))
+                .sum()
+        }
+    }
+
+    /// Dijkstra from all usable slots in `sources` (slot list); settles every reachable free
+    /// vertex, recording branch (slot) and cohomology parity of the tree path from `x`.
+    fn grow_tree(&mut self, sources: &[usize]) {
+        let m = self.mesh();
+        let words = self.inp.coh.words;
+        self.s1.reset();
+        self.stats.searches += 1;
+        for &s in sources {
+            if self.usable(s) {
+                let v = self.slot_nbr(s);
+                let l = self.slot_len(s);
+                self.s1.offer(v, l, self.slots[s]);
+            }
+        }
+        while let Some((d, v)) = self.s1.pop() {
+            let h = self.s1.pred[v as usize];
+            let u = m.he_origin(h);
+            let om = self.inp.coh.edge(m.he_edge(h));
+            if u == self.inp.x {
+                self.branch[v as usize] = self.slot_of[v as usize];
+                self.parity[v as usize * words..(v as usize + 1) * words].copy_from_slice(om);
+            } else {
+                self.branch[v as usize] = self.branch[u as usize];
+                for w in 0..words {
+                    self.parity[v as usize * words + w] = self.parity[u as usize * words + w] ^ om[w];
+                }
+            }
+            for g in m.outgoing(v) {
+                let w = m.he_tip(g);
+                if self.blocked[w as usize] || self.s1.settled[w as usize] {
+                    continue;
+                }
+                let l = self.inp.lengths[m.he_edge(g) as usize];
+                self.s1.offer(w, d + l, g);
+            }
+        }
+    }
+
+    /// Vertices of the tree path `x → … → v` in the first search.
+    fn trace(search: &Search, m: &Mesh, x: u32, v: u32) -> Vec<u32> {
+        let mut out = vec![v];
+        let mut cur = v;
+        while cur != x {
+            let h = search.pred[cur as usize];
+            cur = m.he_origin(h);
+            out.push(cur);
+        }
+        out.reverse();
+        out
+    }
+
+    fn mark_path(&mut self, id: u32, verts: &[u32]) {
+        let x = self.inp.x;
+        for &v in verts {
+            if v != x {
+                self.blocked[v as usize] = true;
+            }
+        }
+        // End slots: the first and (for loops) the last edge at x.
+        let first = verts[1];
+        self.slot_path[self.slot_of[first as usize] as usize] = id;
+        if verts.len() > 2 && *verts.last().unwrap_or(&NONE) == x {
+            let last = verts[verts.len() - 2];
+            self.slot_path[self.slot_of[last as usize] as usize] = id;
+        }
+    }
+
+    /// One handle: the loops `a_i` (non-separating) and `b_i` (crossing it once at `x`).
+    fn handle(&mut self, i: usize) -> Result<(), NoRoom> {
+        let m = self.mesh();
+        let x = self.inp.x;
+        let words = self.inp.coh.words;
+        let h_rem = self.inp.genus - i;
+        let need_after = 4 * (h_rem - 1) + self.inp.boundary_loops.len();
+        let cap_before = self.capacity();
+        if cap_before < 4 * h_rem + self.inp.boundary_loops.len() {
+            return Err(NoRoom(format!(
+                "only {cap_before} free edges at the base vertex for {h_rem} more handle(s)"
+            )));
+        }
+        let slack = cap_before - 4 * h_rem - self.inp.boundary_loops.len();
+        let gaps = self.gaps();
+        let allowed: Vec<usize> = (0..gaps.len())
+            .filter(|&k| self.handle_allowed(&gaps[k]))
+            .collect();
+        let mut gap_of = vec![NONE; self.slots.len()];
+        let mut pos_of = vec![0usize; self.slots.len()];
+        let mut sources = Vec::new();
+        for &k in &allowed {
+            for (p, &s) in gaps[k].slots.iter().enumerate() {
+                gap_of[s] = k as u32;
+                pos_of[s] = p;
+                sources.push(s);
+            }
+        }
+        self.grow_tree(&sources);
+        // Candidates: non-tree edges between two branches of one gap with odd parity.
+        let mut best: HashMap<(usize, usize, Vec<u64>), Candidate> = HashMap::new();
+        let mut par = vec![0u64; words];
+        let mut consider = |len: f64, he: u32, x_edge: bool, s1: usize, s2: usize, par: &[u64]| {
+            if par.iter().all(|&w| w == 0) {
+                return;
+            }
+            let ends = (s1.min(s2), s1.max(s2));
+            let key = (ends.0, ends.1, par.to_vec());
+            let c = Candidate {
+                len,
+                he,
+                x_edge,
+                ends,
+            };
+            match best.get(&key) {
+                Some(o) if o.len <= len => {}
+                _ => {
+                    best.insert(key, c);
+                }
+            }
+        };
+        for e in 0..m.n_edges() as u32 {
+            let h = m.edge_halfedge(e);
+            let (u, w) = (m.he_origin(h), m.he_tip(h));
+            if !(self.s1.settled[u as usize] && self.s1.settled[w as usize]) {
+                continue;
+            }
+            let (bu, bw) = (self.branch[u as usize], self.branch[w as usize]);
+            if bu == bw || gap_of[bu as usize] != gap_of[bw as usize] {
+                continue;
+            }
+            let om = self.inp.coh.edge(e);
+            for k in 0..words {
+                par[k] = self.parity[u as usize * words + k] ^ self.parity[w as usize * words + k] ^ om[k];
+            }
+            let len = self.s1.dist[u as usize] + self.s1.dist[w as usize] + self.inp.lengths[e as usize];
+            consider(len, h, false, bu as usize, bw as usize, &par);
+        }
+        for &s in &sources {
+            let w = self.slot_nbr(s);
+            if !self.usable(s) || !self.s1.settled[w as usize] {
+                continue;
+            }
+            let bw = self.branch[w as usize] as usize;
+            if bw == s || gap_of[bw] != gap_of[s] {
+                continue;
+            }
+            let om = self.inp.coh.edge(m.he_edge(self.slots[s]));
+            for k in 0..words {
+                par[k] = self.parity[w as usize * words + k] ^ om[k];
+            }
+            let len = self.s1.dist[w as usize] + self.slot_len(s);
+            consider(len, self.slots[s], true, bw, s, &par);
+        }
+        let mut cands: Vec<Candidate> = best.into_values().collect();
+        cands.sort_by(|a, b| a.len.total_cmp(&b.len).then(a.ends.cmp(&b.ends)));
+        if std::env::var("RICCI_CUT_DEBUG").is_ok() {
+            let settled = (0..m.n_vertices()).filter(|&v| self.s1.settled[v]).count();
+            let free = (0..m.n_vertices()).filter(|&v| !self.blocked[v]).count();
+            let gs: Vec<String> = gaps.iter().enumerate().map(|(k, g)| format!("{}{}:{}/{}", if allowed.contains(&k) {"*"} else {""}, k, self.usable_count(&g.slots, &vec![false; self.slots.len()]), g.slots.len())).collect();
+            eprintln!("handle {i}: d={} cap_before={cap_before} slack={slack} settled={settled} free={free} cands={} gaps {}", self.slots.len(), cands.len(), gs.join(" "));
+        }
+        if cands.is_empty() {
+            return Err(NoRoom(format!(
+                "no non-separating loop through the base vertex fits in its free edges (handle {})",
+                i + 1
+            )));
+        }
+        // Capacity left for later handles by this one (see `capacity`): with no handle yet
+        // only the largest of the four new gaps counts; with one handle only the two pieces of
+        // the chosen gap outside the new block count (the other gaps of the first handle become
+        // gaps inside it); with more, the other allowed gaps count as well.
+        let nblocks = self.n_handle_blocks();
+        let none = vec![false; self.slots.len()];
+        // Budgets: fair share of the slack first, then all of it.
+        let fair = slack / h_rem;
+        for (round, waste_max) in [fair, slack].into_iter().enumerate() {
+            if round == 1 {
+                if fair == slack {
+                    break;
+                }
+                self.stats.relaxed_budgets += 1;
+            }
+            let mut tries = 0;
+            for c in &cands {
+                if tries >= 48 {
+                    break;
+                }
+                let g = gap_of[c.ends.0] as usize;
+                let gap = &gaps[g];
+                let cyclic = gap.before == NONE;
+                let (p, q) = {
+                    let (p0, p1) = (pos_of[c.ends.0], pos_of[c.ends.1]);
+                    (p0.min(p1), p0.max(p1))
+                };
+                // Inside = strictly between the ends (the shorter arc when cyclic); outside is
+                // ordered from just after one end of `a` to just before the other.
+                let (inside, outside, after_q): (Vec<usize>, Vec<usize>, usize) = {
+                    let between: Vec<usize> = gap.slots[p + 1..q].to_vec();
+                    let mut rest: Vec<usize> = gap.slots[q + 1..].to_vec();
+                    let after_q = rest.len();
+                    rest.extend_from_slice(&gap.slots[..p]);
+                    if cyclic && between.len() > rest.len() {
+                        let l = between.len();
+                        (rest, between, l)
+                    } else {
+                        (between, rest, after_q)
+                    }
+                };
+                let ui = self.usable_count(&inside, &none);
+                let uo = self.usable_count(&outside, &none);
+                if ui == 0 || uo == 0 {
+                    continue;
+                }
+                let cap_other: usize = if nblocks >= 2 {
+                    allowed
+                        .iter()
+                        .filter(|&&k| k != g)
+                        .map(|&k| self.usable_count(&gaps[k].slots, &none))
+                        .sum()
+                } else {
+                    0
+                };
+                let cap_best = cap_other + uo - 1;
+                if cap_best < need_after || cap_before.saturating_sub(4 + cap_best) > waste_max {
+                    continue;
+                }
+                tries += 1;
+                self.stats.candidates_tried += 1;
+                let a = if c.x_edge {
+                    let w = m.he_tip(c.he);
+                    let mut v = Self::trace(&self.s1, m, x, w);
+                    v.push(x);
+                    v
+                } else {
+                    let (u, w) = (m.he_origin(c.he), m.he_tip(c.he));
+                    let mut v = Self::trace(&self.s1, m, x, u);
+                    let mut back = Self::trace(&self.s1, m, x, w);
+                    back.reverse();
+                    v.extend(back);
+                    v
+                };
+                debug_assert!(is_simple_loop(&a));
+                let on_a = |v: u32| a[1..a.len() - 1].contains(&v);
+                // Targets for b: outside slots that keep the capacity within budget.
+                let mut target_ok = vec![false; self.slots.len()];
+                for (k, &s) in outside.iter().enumerate() {
+                    if !self.usable(s) || on_a(self.slot_nbr(s)) {
+                        continue;
+                    }
+                    let left = self.usable_count(&outside[..k], &none);
+                    let right = self.usable_count(&outside[k + 1..], &none);
+                    let cap = if cyclic {
+                        left.max(right)
+                    } else if k < after_q {
+                        cap_other + right
+                    } else {
+                        cap_other + left
+                    };
+                    if cap >= need_after && cap_before.saturating_sub(4 + cap) <= waste_max {
+                        target_ok[s] = true;
+                    }
+                }
+                if !target_ok.iter().any(|&t| t) {
+                    continue;
+                }
+                match self.second_loop(&a, &inside, &target_ok) {
+                    Some(b) => {
+                        let id = self.paths.len() as u32;
+                        self.mark_path(id, &a);
+                        self.paths.push(RawPath {
+                            kind: RawKind::Handle { handle: i, which: 0 },
+                            vertices: a,
+                        });
+                        self.mark_path(id + 1, &b);
+                        self.paths.push(RawPath {
+                            kind: RawKind::Handle { handle: i, which: 1 },
+                            vertices: b,
+                        });
+                        return Ok(());
+                    }
+                    None => {
+                        self.stats.failed_second_loops += 1;
+                    }
+                }
+            }
+        }
+        Err(NoRoom(format!(
+            "handle {} of {}: no pair of crossing loops fits in the free edges at the base vertex",
+            i + 1,
+            self.inp.genus
+        )))
+    }
+
+    /// Shortest path from a usable slot in `inside` to a slot with `target_ok`, avoiding
+    /// blocked vertices and the vertices of `a`; returned closed at `x`.
+    fn second_loop(&mut self, a: &[u32], inside: &[usize], target_ok: &[bool]) -> Option<Vec<u32>> {
+        let m = self.mesh();
+        let x = self.inp.x;
+        for &v in &a[1..a.len() - 1] {
+            self.blocked[v as usize] = true;
+        }
+        self.s2.reset();
+        self.stats.searches += 1;
+        for &s in inside {
+            if self.usable(s) {
+                let v = self.slot_nbr(s);
+                let l = self.slot_len(s);
+                self.s2.offer(v, l, self.slots[s]);
+            }
+        }
+        let mut best = f64::INFINITY;
+        let mut best_v = NONE;
+        while let Some((d, v)) = self.s2.pop() {
+            if d >= best {
+                break;
+            }
+            let sv = self.slot_of[v as usize];
+            if sv != NONE && target_ok[sv as usize] && m.he_origin(self.s2.pred[v as usize]) != x {
+                let total = d + self.slot_len(sv as usize);
+                if total < best {
+                    best = total;
+                    best_v = v;
+                }
+            }
+            for g in m.outgoing(v) {
+                let w = m.he_tip(g);
+                if self.blocked[w as usize] || self.s2.settled[w as usize] {
+                    continue;
+                }
+                self.s2.offer(w, d + self.inp.lengths[m.he_edge(g) as usize], g);
+            }
+        }
+        for &v in &a[1..a.len() - 1] {
+            self.blocked[v as usize] = false;
+        }
+        if best_v == NONE {
+            return None;
+        }
+        let mut b = Self::trace(&self.s2, m, x, best_v);
+        b.push(x);
+        Some(b)
+    }
+
+    /// Path from `x` to the nearest boundary loop not yet connected.
+    fn connector(&mut self, connected: &mut [bool]) -> Result<(), NoRoom> {
+        let m = self.mesh();
+        let x = self.inp.x;
+        let nb = self.inp.boundary_loops.len();
+        let mut loop_of: HashMap<u32, usize> = HashMap::new();
+        for (k, l) in self.inp.boundary_loops.iter().enumerate() {
+            if !connected[k] {
+                for &v in l {
+                    loop_of.insert(v, k);
+                }
+            }
+        }
+        let remaining = connected.iter().filter(|&&c| !c).count();
+        let gaps = self.gaps();
+        let any_connector = self.paths.iter().enumerate().any(|(p, _)| self.is_connector(p as u32));
+        let mut sources = Vec::new();
+        let free = |st: &Self, s: usize| st.slot_path[s] == NONE && (!st.blocked[st.slot_nbr(s) as usize] || loop_of.contains_key(&st.slot_nbr(s)));
+        for g in &gaps {
+            let ok = if any_connector {
+                (g.before != NONE && self.is_connector(g.before))
+                    || (g.after != NONE && self.is_connector(g.after))
+            } else {
+                self.handle_allowed(g)
+            };
+            let room = g.slots.iter().filter(|&&s| free(self, s)).count();
+            if ok && room >= remaining {
+                sources.extend(g.slots.iter().copied().filter(|&s| free(self, s)));
+            }
+        }
+        // Direct edges from x to a boundary vertex.
+        let mut best = f64::INFINITY;
+        let mut best_end: Option<(u32, u32)> = None; // (vertex before target or x, target)
+        for &s in &sources {
+            let v = self.slot_nbr(s);
+            if loop_of.contains_key(&v) && self.slot_len(s) < best {
+                best = self.slot_len(s);
+                best_end = Some((x, v));
+            }
+        }
+        self.s1.reset();
+        self.stats.searches += 1;
+        for &s in &sources {
+            if self.usable(s) {
+                let v = self.slot_nbr(s);
+                self.s1.offer(v, self.slot_len(s), self.slots[s]);
+            }
+        }
+        while let Some((d, v)) = self.s1.pop() {
+            if d >= best {
+                break;
+            }
+            for g in m.outgoing(v) {
+                let w = m.he_tip(g);
+                let l = self.inp.lengths[m.he_edge(g) as usize];
+                if loop_of.contains_key(&w) {
+                    if d + l < best {
+                        best = d + l;
+                        best_end = Some((v, w));
+                    }
+                    continue;
+                }
+                if self.blocked[w as usize] || self.s1.settled[w as usize] {
+                    continue;
+                }
+                self.s1.offer(w, d + l, g);
+            }
+        }
+        let Some((v, t)) = best_end else {
+            return Err(NoRoom(format!(
+                "{remaining} of {nb} boundary loops cannot be reached from the base vertex through free vertices"
+            )));
+        };
+        let mut path = if v == x {
+            vec![x]
+        } else {
+            Self::trace(&self.s1, m, x, v)
+        };
+        path.push(t);
+        let k = loop_of[&t];
+        connected[k] = true;
+        let id = self.paths.len() as u32;
+        self.paths.push(RawPath {
+            kind: RawKind::Connector { boundary: k },
+            vertices: path.clone(),
+        });
+        self.mark_path(id, &path);
+        Ok(())
+    }
+
+    /// Closed genus 0: slit along the two shortest edges `x → y → z`.
+    fn slit(&mut self) -> Result<(), NoRoom> {
+        let m = self.mesh();
+        let x = self.inp.x;
+        let s = (0..self.slots.len())
+            .min_by(|&a, &b| self.slot_len(a).total_cmp(&self.slot_len(b)))
+            .ok_or_else(|| NoRoom("the base vertex has no edges".into()))?;
+        let y = self.slot_nbr(s);
+        let z = m
+            .outgoing(y)
+            .filter(|&h| m.he_tip(h) != x)
+            .min_by(|&a, &b| {
+                self.inp.lengths[m.he_edge(a) as usize].total_cmp(&self.inp.lengths[m.he_edge(b) as usize])
+            })
+            .map(|h| m.he_tip(h))
+            .ok_or_else(|| NoRoom("the base vertex's neighbour has no other edge".into()))?;
+        let id = self.paths.len() as u32;
+        self.paths.push(RawPath {
+            kind: RawKind::Slit,
+            vertices: vec![x, y, z],
+        });
+        self.mark_path(id, &[x, y, z]);
+        Ok(())
+    }
+}
+
+fn is_simple_loop(v: &[u32]) -> bool {
+    let mut s: Vec<u32> = v[..v.len() - 1].to_vec();
+    s.sort_unstable();
+    s.windows(2).all(|w| w[0] != w[1])
+}
