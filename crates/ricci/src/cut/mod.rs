@@ -55,7 +55,8 @@ pub struct CutOptions {
     /// `max(4g + 4, 8g − 4) + b` (paper 000, Step 2: `8g − 4` lets the single-cone flat metric
     /// exist; `4g + b` edges are needed by the cut itself).
     pub min_valence: Option<usize>,
-    /// Attempts with more refinement when the loops do not fit (default 4).
+    /// Attempts (each refining along the loops found so far) when the loops do not fit
+    /// (default 8).
     pub max_attempts: Option<usize>,
 }
 
@@ -240,7 +241,7 @@ pub fn canonical_cut(
         .unwrap_or(default_valence)
         .max(paths_needed);
     let valence_before = mesh.valence(base);
-    let max_attempts = options.max_attempts.unwrap_or(4).max(1);
+    let max_attempts = options.max_attempts.unwrap_or(8).max(1);
     let expected_dim = if nb == 0 { 2 * genus } else { 2 * genus + nb - 1 };
     let mean_spoke = {
         let s: f64 = mesh
@@ -252,24 +253,25 @@ pub fn canonical_cut(
 
     let mut failed = Vec::new();
     let mut attempt = 0;
-    let (refined, raw, stats) = loop {
+    progress.report(
+        "cut",
+        Some(0.0),
+        &format!("refining around vertex {base} to valence {min_valence}"),
+    );
+    let mut refined = if paths_needed > 0 {
+        let mut r = Refiner::new(mesh, lengths, geometry, positions)?;
+        r.raise_valence(base, min_valence)?;
+        let grade = min_valence.max(2 * paths_needed);
+        let theta = r.cone_angle(base);
+        let radius = 1.5 * grade as f64 * mean_spoke / theta.max(1e-3);
+        r.grade_around(base, grade, radius, 40 * grade * grade + 1000)?;
+        r.finish()?
+    } else {
+        Refined::identity(mesh, lengths, positions)
+    };
+    let mut prior: Vec<RawPath> = Vec::new();
+    let (raw, stats) = loop {
         attempt += 1;
-        progress.report(
-            "cut",
-            Some((attempt - 1) as f64 / max_attempts as f64),
-            &format!("attempt {attempt}: refining around vertex {base} to valence {min_valence}"),
-        );
-        let refined = if paths_needed > 0 {
-            let mut r = Refiner::new(mesh, lengths, geometry, positions)?;
-            r.raise_valence(base, min_valence)?;
-            let grade = min_valence.max(2 * paths_needed) * (1 + attempt) / 2;
-            let theta = r.cone_angle(base);
-            let radius = 1.5 * grade as f64 * mean_spoke / theta.max(1e-3);
-            r.grade_around(base, grade, radius, 40 * grade * grade + 1000)?;
-            r.finish()?
-        } else {
-            Refined::identity(mesh, lengths, positions)
-        };
         let coh = Cohomology::new(&refined.mesh)?;
         if coh.dim != expected_dim {
             return Err(Error::topology(format!(
@@ -287,25 +289,50 @@ pub fn canonical_cut(
         };
         progress.report(
             "cut",
-            Some((attempt - 1) as f64 / max_attempts as f64 + 0.5 / max_attempts as f64),
+            Some(0.1 + 0.8 * (attempt - 1) as f64 / max_attempts as f64),
             &format!("attempt {attempt}: searching {genus} handle(s)"),
         );
-        match system::build(&input) {
-            Ok((raw, stats)) => break (refined, raw, stats),
-            Err(system::NoRoom(msg)) => {
-                failed.push(format!("attempt {attempt} (valence {min_valence}): {msg}"));
+        match system::build(&input, &prior) {
+            Ok(r) => break r,
+            Err((system::NoRoom(msg), partial)) => {
+                failed.push(format!("attempt {attempt}: {msg}"));
+                if let Ok(path) = std::env::var("RICCI_CUT_DUMP") {
+                    let mut t = String::new();
+                    if let Some(p) = &refined.positions {
+                        for q in p {
+                            t.push_str(&format!("v {} {} {}\n", q[0], q[1], q[2]));
+                        }
+                    }
+                    for f in refined.mesh.faces() {
+                        t.push_str(&format!("f {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1));
+                    }
+                    for p in &partial {
+                        t.push_str("l");
+                        for v in &p.vertices {
+                            t.push_str(&format!(" {}", v + 1));
+                        }
+                        t.push('\n');
+                    }
+                    let _ = std::fs::write(format!("{path}.{attempt}.obj"), t);
+                }
                 if attempt >= max_attempts {
                     return Err(Error::numerical(format!(
-                        "no canonical system through vertex {base} was found after {attempt} refinements ({msg}); \
+                        "no canonical system through vertex {base} was found after {attempt} attempts ({msg}); \
                          try another base vertex or a larger --min-valence"
                     )));
                 }
-                min_valence += 4 * genus + 4;
+                // Keep what was found, add a free row of vertices along it and more edges at
+                // the base vertex, and resume.
+                drop(input);
+                min_valence = refined.mesh.valence(base) + 4;
+                refined = widen(refined, &partial, base, geometry, min_valence)?;
+                prior = partial;
             }
         }
     };
     progress.report("cut", Some(0.9), "slicing");
     let mut out = assemble(refined, raw, base, genus, nb, geometry)?;
+    let attempt = attempt;
     out.report = CutReport {
         base_vertex: base,
         base_automatic: automatic,
@@ -320,6 +347,46 @@ pub fn canonical_cut(
     };
     progress.report("cut", Some(1.0), "done");
     Ok(out)
+}
+
+/// Split every edge that touches a vertex of the given paths (except cut edges and edges at the
+/// base vertex): a free row of vertices appears on both sides of every path, so later loops
+/// can pass between earlier ones. The base vertex's valence is raised to `min_valence`.
+fn widen(
+    refined: Refined,
+    paths: &[RawPath],
+    base: u32,
+    geometry: Geometry,
+    min_valence: usize,
+) -> Result<Refined> {
+    let mesh = &refined.mesh;
+    let mut on_path = vec![false; mesh.n_vertices()];
+    let mut cut = std::collections::HashSet::new();
+    for p in paths {
+        for w in p.vertices.windows(2) {
+            cut.insert((w[0].min(w[1]), w[0].max(w[1])));
+        }
+        for &v in &p.vertices {
+            on_path[v as usize] = true;
+        }
+    }
+    on_path[base as usize] = false;
+    let mut todo = Vec::new();
+    for e in 0..mesh.n_edges() as u32 {
+        let [a, b] = mesh.edge_vertices(e);
+        if a == base || b == base || cut.contains(&(a.min(b), a.max(b))) {
+            continue;
+        }
+        if on_path[a as usize] || on_path[b as usize] {
+            todo.push((a, b));
+        }
+    }
+    let mut r = Refiner::resume(refined, geometry)?;
+    for (a, b) in todo {
+        r.split_between(a, b);
+    }
+    r.raise_valence(base, min_valence)?;
+    r.finish()
 }
 
 /// Slice along the raw paths, read the polygon from the cut mesh, label and check it.
@@ -707,20 +774,6 @@ impl CanonicalCut {
             out[2 * i + 1] = -intersection_number(mesh, path, &self.loops[2 * i].halfedges)?;
         }
         Ok(out)
-    }
-}
-
-impl Refined {
-    /// The identity refinement (nothing split).
-    pub fn identity(mesh: &Mesh, lengths: &[f64], positions: Option<&[[f64; 3]]>) -> Refined {
-        Refined {
-            mesh: mesh.clone(),
-            lengths: lengths.to_vec(),
-            positions: positions.map(|p| p.to_vec()),
-            original_vertices: mesh.n_vertices(),
-            new_vertices: Vec::new(),
-            face_origin: (0..mesh.n_faces() as u32).collect(),
-        }
     }
 }
 

@@ -36,6 +36,12 @@ use crate::mesh::refine::MinItem;
 use crate::mesh::{Mesh, NONE};
 use std::collections::{BinaryHeap, HashMap};
 
+/// Extra relative cost of edges next to earlier cuts.
+const NEAR_PENALTY: f64 = 2.0;
+/// Extra relative cost next to the outgoing strand while rerouting the return strand of a
+/// loop, so that the two strands leave room between them for the second loop.
+const REPEL_PENALTY: f64 = 20.0;
+
 /// What a constructed path is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum RawKind {
@@ -151,6 +157,11 @@ struct State<'a> {
     /// Slot index of every neighbour of `x` (`NONE` for other vertices).
     slot_of: Vec<u32>,
     blocked: Vec<bool>,
+    /// Free vertices next to a cut vertex (other than `x`): edges there cost more, so that
+    /// later loops keep a free row of vertices between them and earlier ones.
+    near: Vec<bool>,
+    /// Temporary repulsion (see `REPEL_PENALTY`).
+    repel: Vec<bool>,
     paths: Vec<RawPath>,
     stats: SearchStats,
     s1: Search,
@@ -166,10 +177,17 @@ struct Candidate {
     he: u32,
     x_edge: bool,
     ends: (usize, usize),
+    /// Gap whose tree produced it.
+    gap: usize,
 }
 
-/// Build the raw system. `Err(NoRoom)` means "refine more and retry".
-pub(crate) fn build(inp: &Input) -> Result<(Vec<RawPath>, SearchStats), NoRoom> {
+/// Build the raw system, keeping the complete handles and connectors of `prior` (same vertex
+/// ids). On failure, returns the reason and the paths found so far (the caller refines along
+/// them and resumes).
+pub(crate) fn build(
+    inp: &Input,
+    prior: &[RawPath],
+) -> Result<(Vec<RawPath>, SearchStats), (NoRoom, Vec<RawPath>)> {
     let m = inp.mesh;
     let nv = m.n_vertices();
     let slots: Vec<u32> = m.outgoing(inp.x).collect();
@@ -189,6 +207,8 @@ pub(crate) fn build(inp: &Input) -> Result<(Vec<RawPath>, SearchStats), NoRoom> 
         slot_path: vec![NONE; slots.len()],
         slots,
         slot_of,
+        near: vec![false; nv],
+        repel: vec![false; nv],
         blocked,
         paths: Vec::new(),
         stats: SearchStats::default(),
@@ -197,17 +217,34 @@ pub(crate) fn build(inp: &Input) -> Result<(Vec<RawPath>, SearchStats), NoRoom> 
         branch: vec![NONE; nv],
         parity: vec![0; nv * inp.coh.words],
     };
-    let nb = inp.boundary_loops.len();
-    if inp.genus == 0 && nb == 0 {
-        st.slit()?;
+    for l in &inp.boundary_loops {
+        for &v in l {
+            st.mark_near(v);
+        }
     }
-    for i in 0..inp.genus {
-        st.handle(i)?;
+    let nb = inp.boundary_loops.len();
+    let mut connected = vec![false; nb];
+    let mut handles_done = 0;
+    for p in prior {
+        let id = st.paths.len() as u32;
+        st.mark_path(id, &p.vertices);
+        st.paths.push(p.clone());
+        match p.kind {
+            RawKind::Handle { which: 1, .. } => handles_done += 1,
+            RawKind::Connector { boundary } => connected[boundary] = true,
+            _ => {}
+        }
+    }
+    let fail = |e: NoRoom, st: &State| (e, st.paths.clone());
+    if inp.genus == 0 && nb == 0 && st.paths.is_empty() {
+        st.slit().map_err(|e| fail(e, &st))?;
+    }
+    for i in handles_done..inp.genus {
+        st.handle(i).map_err(|e| fail(e, &st))?;
     }
     if inp.genus > 0 || nb >= 2 {
-        let mut connected = vec![false; nb];
-        for _ in 0..nb {
-            st.connector(&mut connected)?;
+        while connected.iter().any(|&c| !c) {
+            st.connector(&mut connected).map_err(|e| fail(e, &st))?;
         }
     }
     Ok((st.paths, st.stats))
@@ -337,7 +374,7 @@ impl<'a> State<'a> {
                 if self.blocked[w as usize] || self.s1.settled[w as usize] {
                     continue;
                 }
-                let l = self.inp.lengths[m.he_edge(g) as usize];
+                let l = self.cost(g);
                 self.s1.offer(w, d + l, g);
             }
         }
@@ -356,11 +393,30 @@ impl<'a> State<'a> {
         out
     }
 
+    fn mark_near(&mut self, v: u32) {
+        let m = self.mesh();
+        for h in m.outgoing(v) {
+            self.near[m.he_tip(h) as usize] = true;
+        }
+    }
+
+    /// Search cost of half-edge `g`: its length, tripled next to earlier cuts.
+    #[inline]
+    fn cost(&self, g: u32) -> f64 {
+        let m = self.mesh();
+        let l = self.inp.lengths[m.he_edge(g) as usize];
+        let (o, t) = (m.he_origin(g) as usize, m.he_tip(g) as usize);
+        let k = self.near[o] as u8 + self.near[t] as u8;
+        let r = self.repel[o] as u8 + self.repel[t] as u8;
+        l * (1.0 + NEAR_PENALTY * k as f64 * 0.5 + REPEL_PENALTY * r as f64 * 0.5)
+    }
+
     fn mark_path(&mut self, id: u32, verts: &[u32]) {
         let x = self.inp.x;
         for &v in verts {
             if v != x {
                 self.blocked[v as usize] = true;
+                self.mark_near(v);
             }
         }
         // End slots: the first and (for loops) the last edge at x.
@@ -372,54 +428,21 @@ impl<'a> State<'a> {
         }
     }
 
-    /// One handle: the loops `a_i` (non-separating) and `b_i` (crossing it once at `x`).
-    fn handle(&mut self, i: usize) -> Result<(), NoRoom> {
+    /// Collect the candidate first loops of the tree grown from gap `k`: edges `(u, w)` between
+    /// two settled vertices whose fundamental cycle has odd parity, best per (branches, parity).
+    fn collect_candidates(&self, k: usize, sources: &[usize], out: &mut HashMap<(usize, usize, usize, Vec<u64>), Candidate>) {
         let m = self.mesh();
-        let x = self.inp.x;
         let words = self.inp.coh.words;
-        let h_rem = self.inp.genus - i;
-        let need_after = 4 * (h_rem - 1) + self.inp.boundary_loops.len();
-        let cap_before = self.capacity();
-        if cap_before < 4 * h_rem + self.inp.boundary_loops.len() {
-            return Err(NoRoom(format!(
-                "only {cap_before} free edges at the base vertex for {h_rem} more handle(s)"
-            )));
-        }
-        let slack = cap_before - 4 * h_rem - self.inp.boundary_loops.len();
-        let gaps = self.gaps();
-        let allowed: Vec<usize> = (0..gaps.len())
-            .filter(|&k| self.handle_allowed(&gaps[k]))
-            .collect();
-        let mut gap_of = vec![NONE; self.slots.len()];
-        let mut pos_of = vec![0usize; self.slots.len()];
-        let mut sources = Vec::new();
-        for &k in &allowed {
-            for (p, &s) in gaps[k].slots.iter().enumerate() {
-                gap_of[s] = k as u32;
-                pos_of[s] = p;
-                sources.push(s);
-            }
-        }
-        self.grow_tree(&sources);
-        // Candidates: non-tree edges between two branches of one gap with odd parity.
-        let mut best: HashMap<(usize, usize, Vec<u64>), Candidate> = HashMap::new();
         let mut par = vec![0u64; words];
-        let mut consider = |len: f64, he: u32, x_edge: bool, s1: usize, s2: usize, par: &[u64]| {
+        let mut consider = |c: Candidate, par: &[u64]| {
             if par.iter().all(|&w| w == 0) {
                 return;
             }
-            let ends = (s1.min(s2), s1.max(s2));
-            let key = (ends.0, ends.1, par.to_vec());
-            let c = Candidate {
-                len,
-                he,
-                x_edge,
-                ends,
-            };
-            match best.get(&key) {
-                Some(o) if o.len <= len => {}
+            let key = (k, c.ends.0, c.ends.1, par.to_vec());
+            match out.get(&key) {
+                Some(o) if o.len <= c.len => {}
                 _ => {
-                    best.insert(key, c);
+                    out.insert(key, c);
                 }
             }
         };
@@ -429,40 +452,179 @@ impl<'a> State<'a> {
             if !(self.s1.settled[u as usize] && self.s1.settled[w as usize]) {
                 continue;
             }
-            let (bu, bw) = (self.branch[u as usize], self.branch[w as usize]);
-            if bu == bw || gap_of[bu as usize] != gap_of[bw as usize] {
+            // Tree edges close nothing.
+            if self.s1.pred[w as usize] == h || self.s1.pred[u as usize] == m.he_twin(h) {
                 continue;
             }
+            let (bu, bw) = (self.branch[u as usize] as usize, self.branch[w as usize] as usize);
             let om = self.inp.coh.edge(e);
-            for k in 0..words {
-                par[k] = self.parity[u as usize * words + k] ^ self.parity[w as usize * words + k] ^ om[k];
+            for j in 0..words {
+                par[j] = self.parity[u as usize * words + j] ^ self.parity[w as usize * words + j] ^ om[j];
             }
             let len = self.s1.dist[u as usize] + self.s1.dist[w as usize] + self.inp.lengths[e as usize];
-            consider(len, h, false, bu as usize, bw as usize, &par);
+            consider(
+                Candidate { len, he: h, x_edge: false, ends: (bu.min(bw), bu.max(bw)), gap: k },
+                &par,
+            );
         }
-        for &s in &sources {
+        for &s in sources {
             let w = self.slot_nbr(s);
             if !self.usable(s) || !self.s1.settled[w as usize] {
                 continue;
             }
             let bw = self.branch[w as usize] as usize;
-            if bw == s || gap_of[bw] != gap_of[s] {
+            if bw == s {
                 continue;
             }
             let om = self.inp.coh.edge(m.he_edge(self.slots[s]));
-            for k in 0..words {
-                par[k] = self.parity[w as usize * words + k] ^ om[k];
+            for j in 0..words {
+                par[j] = self.parity[w as usize * words + j] ^ om[j];
             }
             let len = self.s1.dist[w as usize] + self.slot_len(s);
-            consider(len, self.slots[s], true, bw, s, &par);
+            consider(
+                Candidate { len, he: self.slots[s], x_edge: true, ends: (bw.min(s), bw.max(s)), gap: k },
+                &par,
+            );
+        }
+    }
+
+    /// The loop of a candidate, simple at `x`: tree path to `u`, the edge, tree path back from
+    /// `w` when `w` lies in another branch, otherwise the shortest path from `w` back to another
+    /// slot of the gap avoiding the path to `u` (the lasso's stem is rerouted).
+    fn candidate_loop(&mut self, c: &Candidate, gap_slots: &[usize]) -> Option<Vec<u32>> {
+        let m = self.mesh();
+        let x = self.inp.x;
+        if c.x_edge {
+            let w = m.he_tip(c.he);
+            let mut v = Self::trace(&self.s1, m, x, w);
+            v.push(x);
+            return Some(v);
+        }
+        let (u, w) = (m.he_origin(c.he), m.he_tip(c.he));
+        let mut a = Self::trace(&self.s1, m, x, u);
+        if self.branch[u as usize] != self.branch[w as usize] {
+            let mut back = Self::trace(&self.s1, m, x, w);
+            back.reverse();
+            a.extend(back);
+            return Some(a);
+        }
+        // Reroute: Dijkstra from w to the other slots of the gap, avoiding a's vertices and
+        // keeping away from them.
+        let mut repelled = Vec::new();
+        for &v in &a[1..] {
+            self.blocked[v as usize] = true;
+            for h in m.outgoing(v) {
+                let z = m.he_tip(h);
+                if !self.repel[z as usize] {
+                    self.repel[z as usize] = true;
+                    repelled.push(z);
+                }
+            }
+        }
+        let mut target = vec![false; self.slots.len()];
+        for &s in gap_slots {
+            if self.usable(s) {
+                target[s] = true;
+            }
+        }
+        self.s2.reset();
+        self.stats.searches += 1;
+        self.s2.offer(w, 0.0, NONE);
+        let mut best = f64::INFINITY;
+        let mut best_v = NONE;
+        while let Some((d, v)) = self.s2.pop() {
+            if d >= best {
+                break;
+            }
+            let sv = self.slot_of[v as usize];
+            if sv != NONE && target[sv as usize] {
+                let t = d + self.slot_len(sv as usize);
+                if t < best {
+                    best = t;
+                    best_v = v;
+                }
+            }
+            for g in m.outgoing(v) {
+                let z = m.he_tip(g);
+                if self.blocked[z as usize] || self.s2.settled[z as usize] {
+                    continue;
+                }
+                self.s2.offer(z, d + self.cost(g), g);
+            }
+        }
+        for &v in &a[1..] {
+            self.blocked[v as usize] = false;
+        }
+        for z in repelled {
+            self.repel[z as usize] = false;
+        }
+        if best_v == NONE {
+            return None;
+        }
+        // Path w → … → best_v, then x.
+        let mut back = vec![best_v];
+        let mut cur = best_v;
+        while cur != w {
+            cur = m.he_origin(self.s2.pred[cur as usize]);
+            back.push(cur);
+        }
+        back.reverse();
+        a.extend(back);
+        a.push(x);
+        Some(a)
+    }
+
+    fn loop_parity_nonzero(&self, a: &[u32]) -> bool {
+        let m = self.mesh();
+        let words = self.inp.coh.words;
+        let mut p = vec![0u64; words];
+        for w in a.windows(2) {
+            let Some(h) = m.halfedge_between(w[0], w[1]) else {
+                return false;
+            };
+            for (x, y) in p.iter_mut().zip(self.inp.coh.edge(m.he_edge(h))) {
+                *x ^= y;
+            }
+        }
+        p.iter().any(|&x| x != 0)
+    }
+
+    /// One handle: the loops `a_i` (non-separating) and `b_i` (crossing it once at `x`).
+    fn handle(&mut self, i: usize) -> Result<(), NoRoom> {
+        let h_rem = self.inp.genus - i;
+        let nbnd = self.inp.boundary_loops.len();
+        let need_after = 4 * (h_rem - 1) + nbnd;
+        let cap_before = self.capacity();
+        if cap_before < 4 * h_rem + nbnd {
+            return Err(NoRoom(format!(
+                "only {cap_before} free edges at the base vertex for {h_rem} more handle(s)"
+            )));
+        }
+        let slack = cap_before - 4 * h_rem - nbnd;
+        let gaps = self.gaps();
+        let none = vec![false; self.slots.len()];
+        let allowed: Vec<usize> = (0..gaps.len())
+            .filter(|&k| self.handle_allowed(&gaps[k]) && self.usable_count(&gaps[k].slots, &none) >= 4)
+            .collect();
+        let mut pos_of = vec![0usize; self.slots.len()];
+        for &k in &allowed {
+            for (p, &s) in gaps[k].slots.iter().enumerate() {
+                pos_of[s] = p;
+            }
+        }
+        // Candidates from one tree per allowed gap.
+        let mut best: HashMap<(usize, usize, usize, Vec<u64>), Candidate> = HashMap::new();
+        let mut tree_gap = usize::MAX;
+        for &k in &allowed {
+            self.grow_tree(&gaps[k].slots);
+            tree_gap = k;
+            self.collect_candidates(k, &gaps[k].slots, &mut best);
         }
         let mut cands: Vec<Candidate> = best.into_values().collect();
         cands.sort_by(|a, b| a.len.total_cmp(&b.len).then(a.ends.cmp(&b.ends)));
         if std::env::var("RICCI_CUT_DEBUG").is_ok() {
-            let settled = (0..m.n_vertices()).filter(|&v| self.s1.settled[v]).count();
-            let free = (0..m.n_vertices()).filter(|&v| !self.blocked[v]).count();
-            let gs: Vec<String> = gaps.iter().enumerate().map(|(k, g)| format!("{}{}:{}/{}", if allowed.contains(&k) {"*"} else {""}, k, self.usable_count(&g.slots, &vec![false; self.slots.len()]), g.slots.len())).collect();
-            eprintln!("handle {i}: d={} cap_before={cap_before} slack={slack} settled={settled} free={free} cands={} gaps {}", self.slots.len(), cands.len(), gs.join(" "));
+            let gs: Vec<String> = gaps.iter().enumerate().map(|(k, g)| format!("{}{}:{}/{}", if allowed.contains(&k) {"*"} else {""}, k, self.usable_count(&g.slots, &none), g.slots.len())).collect();
+            eprintln!("handle {i}: d={} cap_before={cap_before} slack={slack} cands={} gaps {}", self.slots.len(), cands.len(), gs.join(" "));
         }
         if cands.is_empty() {
             return Err(NoRoom(format!(
@@ -470,13 +632,8 @@ impl<'a> State<'a> {
                 i + 1
             )));
         }
-        // Capacity left for later handles by this one (see `capacity`): with no handle yet
-        // only the largest of the four new gaps counts; with one handle only the two pieces of
-        // the chosen gap outside the new block count (the other gaps of the first handle become
-        // gaps inside it); with more, the other allowed gaps count as well.
         let nblocks = self.n_handle_blocks();
-        let none = vec![false; self.slots.len()];
-        // Budgets: fair share of the slack first, then all of it.
+        let mut why = [0usize; 7];
         let fair = slack / h_rem;
         for (round, waste_max) in [fair, slack].into_iter().enumerate() {
             if round == 1 {
@@ -490,13 +647,35 @@ impl<'a> State<'a> {
                 if tries >= 48 {
                     break;
                 }
-                let g = gap_of[c.ends.0] as usize;
+                let g = c.gap;
                 let gap = &gaps[g];
+                if tree_gap != g {
+                    self.grow_tree(&gap.slots);
+                    tree_gap = g;
+                }
                 let cyclic = gap.before == NONE;
+                tries += 1;
+                self.stats.candidates_tried += 1;
+                let Some(a) = self.candidate_loop(c, &gap.slots) else {
+                    why[0] += 1;
+                    continue;
+                };
+                if !is_simple_loop(&a) || !self.loop_parity_nonzero(&a) {
+                    why[1] += 1;
+                    continue;
+                }
+                let (e0, e1) = (
+                    self.slot_of[a[1] as usize] as usize,
+                    self.slot_of[a[a.len() - 2] as usize] as usize,
+                );
                 let (p, q) = {
-                    let (p0, p1) = (pos_of[c.ends.0], pos_of[c.ends.1]);
+                    let (p0, p1) = (pos_of[e0], pos_of[e1]);
                     (p0.min(p1), p0.max(p1))
                 };
+                if q < p + 2 {
+                    why[2] += 1;
+                    continue;
+                }
                 // Inside = strictly between the ends (the shorter arc when cyclic); outside is
                 // ordered from just after one end of `a` to just before the other.
                 let (inside, outside, after_q): (Vec<usize>, Vec<usize>, usize) = {
@@ -511,49 +690,35 @@ impl<'a> State<'a> {
                         (between, rest, after_q)
                     }
                 };
-                let ui = self.usable_count(&inside, &none);
-                let uo = self.usable_count(&outside, &none);
+                let on_a = |v: u32| a[1..a.len() - 1].contains(&v);
+                let usable_not_a = |st: &Self, sl: &[usize]| sl.iter().filter(|&&s| st.usable(s) && !on_a(st.slot_nbr(s))).count();
+                let ui = usable_not_a(self, &inside);
+                let uo = usable_not_a(self, &outside);
                 if ui == 0 || uo == 0 {
+                    why[3] += 1;
                     continue;
                 }
                 let cap_other: usize = if nblocks >= 2 {
-                    allowed
-                        .iter()
-                        .filter(|&&k| k != g)
-                        .map(|&k| self.usable_count(&gaps[k].slots, &none))
+                    (0..gaps.len())
+                        .filter(|&k| k != g && self.handle_allowed(&gaps[k]))
+                        .map(|k| usable_not_a(self, &gaps[k].slots))
                         .sum()
                 } else {
                     0
                 };
                 let cap_best = cap_other + uo - 1;
                 if cap_best < need_after || cap_before.saturating_sub(4 + cap_best) > waste_max {
+                    why[4] += 1;
                     continue;
                 }
-                tries += 1;
-                self.stats.candidates_tried += 1;
-                let a = if c.x_edge {
-                    let w = m.he_tip(c.he);
-                    let mut v = Self::trace(&self.s1, m, x, w);
-                    v.push(x);
-                    v
-                } else {
-                    let (u, w) = (m.he_origin(c.he), m.he_tip(c.he));
-                    let mut v = Self::trace(&self.s1, m, x, u);
-                    let mut back = Self::trace(&self.s1, m, x, w);
-                    back.reverse();
-                    v.extend(back);
-                    v
-                };
-                debug_assert!(is_simple_loop(&a));
-                let on_a = |v: u32| a[1..a.len() - 1].contains(&v);
                 // Targets for b: outside slots that keep the capacity within budget.
                 let mut target_ok = vec![false; self.slots.len()];
                 for (k, &s) in outside.iter().enumerate() {
                     if !self.usable(s) || on_a(self.slot_nbr(s)) {
                         continue;
                     }
-                    let left = self.usable_count(&outside[..k], &none);
-                    let right = self.usable_count(&outside[k + 1..], &none);
+                    let left = usable_not_a(self, &outside[..k]);
+                    let right = usable_not_a(self, &outside[k + 1..]);
                     let cap = if cyclic {
                         left.max(right)
                     } else if k < after_q {
@@ -566,6 +731,7 @@ impl<'a> State<'a> {
                     }
                 }
                 if !target_ok.iter().any(|&t| t) {
+                    why[5] += 1;
                     continue;
                 }
                 match self.second_loop(&a, &inside, &target_ok) {
@@ -584,10 +750,14 @@ impl<'a> State<'a> {
                         return Ok(());
                     }
                     None => {
+                        why[6] += 1;
                         self.stats.failed_second_loops += 1;
                     }
                 }
             }
+        }
+        if std::env::var("RICCI_CUT_DEBUG").is_ok() {
+            eprintln!("  rejected: no reroute {} not simple/even {} adjacent ends {} empty side {} budget {} no target {} no b {}", why[0], why[1], why[2], why[3], why[4], why[5], why[6]);
         }
         Err(NoRoom(format!(
             "handle {} of {}: no pair of crossing loops fits in the free edges at the base vertex",
@@ -632,7 +802,7 @@ impl<'a> State<'a> {
                 if self.blocked[w as usize] || self.s2.settled[w as usize] {
                     continue;
                 }
-                self.s2.offer(w, d + self.inp.lengths[m.he_edge(g) as usize], g);
+                self.s2.offer(w, d + self.cost(g), g);
             }
         }
         for &v in &a[1..a.len() - 1] {
@@ -700,7 +870,7 @@ impl<'a> State<'a> {
             }
             for g in m.outgoing(v) {
                 let w = m.he_tip(g);
-                let l = self.inp.lengths[m.he_edge(g) as usize];
+                let l = self.cost(g);
                 if loop_of.contains_key(&w) {
                     if d + l < best {
                         best = d + l;

@@ -62,6 +62,18 @@ pub struct Refined {
 }
 
 impl Refined {
+    /// The identity refinement (nothing split).
+    pub fn identity(mesh: &Mesh, lengths: &[f64], positions: Option<&[[f64; 3]]>) -> Refined {
+        Refined {
+            mesh: mesh.clone(),
+            lengths: lengths.to_vec(),
+            positions: positions.map(|p| p.to_vec()),
+            original_vertices: mesh.n_vertices(),
+            new_vertices: Vec::new(),
+            face_origin: (0..mesh.n_faces() as u32).collect(),
+        }
+    }
+
     /// Number of edge splits performed.
     pub fn splits(&self) -> usize {
         self.new_vertices.len()
@@ -143,6 +155,42 @@ impl Refiner {
             new_vertices: Vec::new(),
             face_origin: (0..mesh.n_faces() as u32).collect(),
         })
+    }
+
+    /// Continue refining an earlier result (provenance and face origins are kept).
+    pub fn resume(refined: Refined, geometry: Geometry) -> Result<Refiner> {
+        let mut r = Refiner::new(
+            &refined.mesh,
+            &refined.lengths,
+            geometry,
+            refined.positions.as_deref(),
+        )?;
+        r.original_vertices = refined.original_vertices;
+        r.new_vertices = refined.new_vertices;
+        r.face_origin = refined.face_origin;
+        Ok(r)
+    }
+
+    /// Split the edge between `u` and `v` at its midpoint, if it exists; returns the new vertex.
+    pub fn split_between(&mut self, u: u32, v: u32) -> Option<u32> {
+        if u as usize >= self.n_vertices() {
+            return None;
+        }
+        let (fan, closed) = self.fan(u);
+        for &h in &fan {
+            if self.origin(Self::next(h)) == v {
+                return Some(self.split(h, 0.5));
+            }
+        }
+        if !closed {
+            if let Some(&last) = fan.last() {
+                let p = Self::prev(last);
+                if self.origin(p) == v {
+                    return Some(self.split(p, 0.5));
+                }
+            }
+        }
+        None
     }
 
     pub fn n_vertices(&self) -> usize {
