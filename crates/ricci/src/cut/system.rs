@@ -371,7 +371,11 @@ impl<'a> State<'a> {
             }
             for g in m.outgoing(v) {
                 let w = m.he_tip(g);
-                if self.blocked[w as usize] || self.s1.settled[w as usize] {
+                // Neighbours of x are only entered from x: loops must not run along the link.
+                if self.blocked[w as usize]
+                    || self.s1.settled[w as usize]
+                    || self.slot_of[w as usize] != NONE
+                {
                     continue;
                 }
                 let l = self.cost(g);
@@ -546,7 +550,11 @@ impl<'a> State<'a> {
             }
             for g in m.outgoing(v) {
                 let z = m.he_tip(g);
-                if self.blocked[z as usize] || self.s2.settled[z as usize] {
+                let sz = self.slot_of[z as usize];
+                if self.blocked[z as usize]
+                    || self.s2.settled[z as usize]
+                    || (sz != NONE && !target[sz as usize])
+                {
                     continue;
                 }
                 self.s2.offer(z, d + self.cost(g), g);
@@ -799,7 +807,11 @@ impl<'a> State<'a> {
             }
             for g in m.outgoing(v) {
                 let w = m.he_tip(g);
-                if self.blocked[w as usize] || self.s2.settled[w as usize] {
+                let sw = self.slot_of[w as usize];
+                if self.blocked[w as usize]
+                    || self.s2.settled[w as usize]
+                    || (sw != NONE && !target_ok[sw as usize])
+                {
                     continue;
                 }
                 self.s2.offer(w, d + self.cost(g), g);
@@ -878,7 +890,10 @@ impl<'a> State<'a> {
                     }
                     continue;
                 }
-                if self.blocked[w as usize] || self.s1.settled[w as usize] {
+                if self.blocked[w as usize]
+                    || self.s1.settled[w as usize]
+                    || self.slot_of[w as usize] != NONE
+                {
                     continue;
                 }
                 self.s1.offer(w, d + l, g);
