@@ -26,7 +26,8 @@ fn main() {
     } else {
         args.iter().map(PathBuf::from).collect()
     };
-    let runs = 5;
+    let runs: usize = std::env::var("BENCH_RUNS").ok().and_then(|r| r.parse().ok()).unwrap_or(5);
+    let base: Option<u32> = std::env::var("BENCH_BASE").ok().and_then(|r| r.parse().ok());
     for f in files {
         let (s, _) = match read_surface(&f) {
             Ok(x) => x,
@@ -45,7 +46,10 @@ fn main() {
                 &lengths,
                 Geometry::Euclidean,
                 Some(&s.positions),
-                &CutOptions::default(),
+                &CutOptions {
+                    base,
+                    ..CutOptions::default()
+                },
                 &mut NoProgress,
             );
             times.push(t.elapsed().as_secs_f64());
