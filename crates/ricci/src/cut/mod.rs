@@ -296,25 +296,6 @@ pub fn canonical_cut(
             Ok(r) => break r,
             Err((system::NoRoom(msg), partial)) => {
                 failed.push(format!("attempt {attempt}: {msg}"));
-                if let Ok(path) = std::env::var("RICCI_CUT_DUMP") {
-                    let mut t = String::new();
-                    if let Some(p) = &refined.positions {
-                        for q in p {
-                            t.push_str(&format!("v {} {} {}\n", q[0], q[1], q[2]));
-                        }
-                    }
-                    for f in refined.mesh.faces() {
-                        t.push_str(&format!("f {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1));
-                    }
-                    for p in &partial {
-                        t.push_str("l");
-                        for v in &p.vertices {
-                            t.push_str(&format!(" {}", v + 1));
-                        }
-                        t.push('\n');
-                    }
-                    let _ = std::fs::write(format!("{path}.{attempt}.obj"), t);
-                }
                 if attempt >= max_attempts {
                     return Err(Error::numerical(format!(
                         "no canonical system through vertex {base} was found after {attempt} attempts ({msg}); \

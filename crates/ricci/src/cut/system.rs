@@ -71,6 +71,10 @@ pub struct SearchStats {
     pub relaxed_budgets: usize,
     /// Number of Dijkstra searches.
     pub searches: usize,
+    /// Candidate first loops rejected, by reason: no simple return path, not simple or
+    /// separating, ends adjacent at the base vertex, no free edge on one side, over the slot
+    /// budget, no admissible end for the second loop, no second loop.
+    pub rejected: [usize; 7],
 }
 
 /// Why a construction attempt failed (the caller refines more and retries).
@@ -630,10 +634,6 @@ impl<'a> State<'a> {
         }
         let mut cands: Vec<Candidate> = best.into_values().collect();
         cands.sort_by(|a, b| a.len.total_cmp(&b.len).then(a.ends.cmp(&b.ends)));
-        if std::env::var("RICCI_CUT_DEBUG").is_ok() {
-            let gs: Vec<String> = gaps.iter().enumerate().map(|(k, g)| format!("{}{}:{}/{}", if allowed.contains(&k) {"*"} else {""}, k, self.usable_count(&g.slots, &none), g.slots.len())).collect();
-            eprintln!("handle {i}: d={} cap_before={cap_before} slack={slack} cands={} gaps {}", self.slots.len(), cands.len(), gs.join(" "));
-        }
         if cands.is_empty() {
             return Err(NoRoom(format!(
                 "no non-separating loop through the base vertex fits in its free edges (handle {})",
@@ -744,6 +744,9 @@ impl<'a> State<'a> {
                 }
                 match self.second_loop(&a, &inside, &target_ok) {
                     Some(b) => {
+                        for (k, n) in why.iter().enumerate() {
+                            self.stats.rejected[k] += n;
+                        }
                         let id = self.paths.len() as u32;
                         self.mark_path(id, &a);
                         self.paths.push(RawPath {
@@ -764,8 +767,8 @@ impl<'a> State<'a> {
                 }
             }
         }
-        if std::env::var("RICCI_CUT_DEBUG").is_ok() {
-            eprintln!("  rejected: no reroute {} not simple/even {} adjacent ends {} empty side {} budget {} no target {} no b {}", why[0], why[1], why[2], why[3], why[4], why[5], why[6]);
+        for (k, n) in why.iter().enumerate() {
+            self.stats.rejected[k] += n;
         }
         Err(NoRoom(format!(
             "handle {} of {}: no pair of crossing loops fits in the free edges at the base vertex",

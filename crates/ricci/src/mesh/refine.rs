@@ -302,9 +302,9 @@ impl Refiner {
         let l_mb = (1.0 - t) * l_ab;
         // From the nearer endpoint for accuracy.
         let l_mc = if t <= 0.5 {
-            g.side(l_ca, l_am, g.angle(l_bc, l_ab, l_ca))
+            side(g, l_ca, l_am, g.angle(l_bc, l_ab, l_ca))
         } else {
-            g.side(l_bc, l_mb, g.angle(l_ca, l_bc, l_ab))
+            side(g, l_bc, l_mb, g.angle(l_ca, l_bc, l_ab))
         };
         let m = self.vertex_corner.len() as u32;
         let hg = self.twin[h as usize];
@@ -348,9 +348,9 @@ impl Refiner {
             let (t_ad, t_db) = (self.twin[h_ad as usize], self.twin[h_db as usize]);
             debug_assert_eq!(self.len[h_ba as usize], l_ab);
             let l_md = if t <= 0.5 {
-                g.side(l_ad, l_am, g.angle(l_db, l_ab, l_ad))
+                side(g, l_ad, l_am, g.angle(l_db, l_ab, l_ad))
             } else {
-                g.side(l_db, l_mb, g.angle(l_ad, l_db, l_ab))
+                side(g, l_db, l_mb, g.angle(l_ad, l_db, l_ab))
             };
             let g1 = nf + 1;
             self.faces[gf as usize] = [b, m, d];
@@ -627,6 +627,27 @@ pub fn raise_valence(
     let mut r = Refiner::new(mesh, lengths, geometry, positions)?;
     r.raise_valence(x, min_valence)?;
     r.finish()
+}
+
+/// Side opposite the angle `theta` between sides `b` and `c`, in the half-angle (haversine)
+/// form, accurate for short sides too: E² `a² = (b−c)² + 4bc sin²(θ/2)`, H²
+/// `sinh²(a/2) = sinh²((b−c)/2) + sinh b sinh c sin²(θ/2)`, S²
+/// `sin²(a/2) = sin²((b−c)/2) + sin b sin c sin²(θ/2)`. (`Geometry::side` goes through
+/// `acosh`/`acos` of a number near 1 in H² and S², which loses about `ε/a²` relative accuracy
+/// on short sides; splits nest deeply, so they need the stable form.)
+pub fn side(g: Geometry, b: f64, c: f64, theta: f64) -> f64 {
+    let h = (0.5 * theta).sin();
+    match g {
+        Geometry::Euclidean => g.side(b, c, theta),
+        Geometry::Hyperbolic => {
+            let d = (0.5 * (b - c)).sinh();
+            2.0 * (d * d + b.sinh() * c.sinh() * h * h).max(0.0).sqrt().asinh()
+        }
+        Geometry::Spherical => {
+            let d = (0.5 * (b - c)).sin();
+            2.0 * (d * d + b.sin() * c.sin() * h * h).max(0.0).sqrt().min(1.0).asin()
+        }
+    }
 }
 
 /// Min-heap item for Dijkstra (smallest distance first).
