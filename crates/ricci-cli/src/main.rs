@@ -23,12 +23,15 @@ struct Cli {
 enum Command {
     /// Validate a mesh and report its topology and triangle quality.
     Info(cmd::info::Args),
+    /// Procedural test surfaces: sphere, torus, disk, annulus, pants, genus-g.
+    Generate(cmd::generate::Args),
 }
 
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Info(a) => cmd::info::run(a),
+        Command::Generate(a) => cmd::generate::run(a),
     };
     if let Err(e) = result {
         eprintln!("error: {}", util::sentence(&e));

@@ -251,7 +251,7 @@ fn resolve(tok: &[u8], count: usize, line: usize, what: &str, face: usize) -> Re
             line,
             format!("face {face} uses {what} index 0; OBJ indices start at 1 (or are negative)"),
         )),
-        Some(i) if i > 0 && i <= u32::MAX as i64 - 1 => Ok((i - 1) as u32),
+        Some(i) if i > 0 && i < u32::MAX as i64 => Ok((i - 1) as u32),
         Some(i) if i < 0 && -i <= count as i64 => Ok((count as i64 + i) as u32),
         Some(i) if i < 0 => Err(at_line(
             line,

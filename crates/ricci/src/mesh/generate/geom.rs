@@ -1,0 +1,77 @@
+//! Small vector helpers and triangle-quality measures shared by the generators.
+
+pub(crate) type P3 = [f64; 3];
+
+#[inline]
+pub(crate) fn sub(a: P3, b: P3) -> P3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+#[inline]
+pub(crate) fn add(a: P3, b: P3) -> P3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+#[inline]
+pub(crate) fn scale(a: P3, s: f64) -> P3 {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+#[inline]
+pub(crate) fn dot(a: P3, b: P3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+#[inline]
+pub(crate) fn cross(a: P3, b: P3) -> P3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+#[inline]
+pub(crate) fn norm(a: P3) -> f64 {
+    dot(a, a).sqrt()
+}
+#[inline]
+pub(crate) fn dist(a: P3, b: P3) -> f64 {
+    norm(sub(a, b))
+}
+#[inline]
+pub(crate) fn lerp(a: P3, b: P3, t: f64) -> P3 {
+    [
+        a[0] + t * (b[0] - a[0]),
+        a[1] + t * (b[1] - a[1]),
+        a[2] + t * (b[2] - a[2]),
+    ]
+}
+
+/// Unnormalised normal `(b − a) × (c − a)` (twice the area vector).
+#[inline]
+pub(crate) fn tri_normal(a: P3, b: P3, c: P3) -> P3 {
+    cross(sub(b, a), sub(c, a))
+}
+
+/// Corner angle at `a` of triangle `(a, b, c)`, radians, in `[0, π]`.
+#[inline]
+pub(crate) fn corner_angle(a: P3, b: P3, c: P3) -> f64 {
+    let (u, w) = (sub(b, a), sub(c, a));
+    norm(cross(u, w)).atan2(dot(u, w))
+}
+
+/// Smallest corner angle of triangle `(a, b, c)`, radians.
+#[inline]
+pub(crate) fn min_angle(a: P3, b: P3, c: P3) -> f64 {
+    corner_angle(a, b, c)
+        .min(corner_angle(b, c, a))
+        .min(corner_angle(c, a, b))
+}
+
+/// Smallest corner angle of triangle `(a, b, c)`, or `-1` when its normal does not point into
+/// the half-space of `up` by at least `cos_limit` (the triangle would be folded over).
+#[inline]
+pub(crate) fn oriented_min_angle(a: P3, b: P3, c: P3, up: P3, cos_limit: f64) -> f64 {
+    let n = tri_normal(a, b, c);
+    let nn = norm(n) * norm(up);
+    if nn == 0.0 || dot(n, up) <= cos_limit * nn {
+        return -1.0;
+    }
+    min_angle(a, b, c)
+}
