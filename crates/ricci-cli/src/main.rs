@@ -25,6 +25,8 @@ enum Command {
     Info(cmd::info::Args),
     /// Procedural test surfaces: sphere, torus, disk, annulus, pants, genus-g.
     Generate(cmd::generate::Args),
+    /// Canonical fundamental group generators through a base vertex; slice the mesh into a disk.
+    Cut(cmd::cut::Args),
 }
 
 fn main() {
@@ -32,6 +34,7 @@ fn main() {
     let result = match cli.command {
         Command::Info(a) => cmd::info::run(a),
         Command::Generate(a) => cmd::generate::run(a),
+        Command::Cut(a) => cmd::cut::run(a),
     };
     if let Err(e) = result {
         eprintln!("error: {}", util::sentence(&e));

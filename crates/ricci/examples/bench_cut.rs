@@ -26,8 +26,13 @@ fn main() {
     } else {
         args.iter().map(PathBuf::from).collect()
     };
-    let runs: usize = std::env::var("BENCH_RUNS").ok().and_then(|r| r.parse().ok()).unwrap_or(5);
-    let base: Option<u32> = std::env::var("BENCH_BASE").ok().and_then(|r| r.parse().ok());
+    let runs: usize = std::env::var("BENCH_RUNS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(5);
+    let base: Option<u32> = std::env::var("BENCH_BASE")
+        .ok()
+        .and_then(|r| r.parse().ok());
     for f in files {
         let (s, _) = match read_surface(&f) {
             Ok(x) => x,
@@ -56,7 +61,10 @@ fn main() {
             last = Some(c);
         }
         times.sort_by(|a, b| a.total_cmp(b));
-        let name = f.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+        let name = f
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .unwrap_or_default();
         match last {
             Some(Ok(c)) => {
                 let total: f64 = c.loops.iter().map(|l| l.length).sum();

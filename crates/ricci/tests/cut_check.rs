@@ -92,7 +92,10 @@ pub fn read_word(c: &CanonicalCut) -> Vec<String> {
                 (c.loops[i].label.clone(), m.he_origin(lh) == from)
             }
             None => {
-                assert!(m.is_boundary_edge(e), "boundary of the cut mesh on uncut edge {e}");
+                assert!(
+                    m.is_boundary_edge(e),
+                    "boundary of the cut mesh on uncut edge {e}"
+                );
                 ("d".to_string(), true)
             }
         };
@@ -120,7 +123,11 @@ pub fn verify(c: &CanonicalCut, g: usize, nb: usize, what: &str) {
     let t = topology(&c.cut_mesh);
     assert_eq!(t.components.len(), 1, "{what}: components");
     assert_eq!(t.euler_characteristic(), 1, "{what}: χ of the cut mesh");
-    assert_eq!(t.boundary_loops(), 1, "{what}: boundary loops of the cut mesh");
+    assert_eq!(
+        t.boundary_loops(),
+        1,
+        "{what}: boundary loops of the cut mesh"
+    );
     // Faces of the cut mesh are the refined faces with copied vertices.
     for f in 0..c.cut_mesh.n_faces() as u32 {
         let cf = c.cut_mesh.face(f).map(|v| c.cut_vertex_origin[v as usize]);
@@ -129,15 +136,27 @@ pub fn verify(c: &CanonicalCut, g: usize, nb: usize, what: &str) {
     // Loops: simple, through the base vertex, meeting only there.
     let mut owner: HashMap<u32, usize> = HashMap::new();
     for (i, l) in c.loops.iter().enumerate() {
-        assert_eq!(l.vertices[0], c.base, "{what}: {} starts at the base", l.label);
+        assert_eq!(
+            l.vertices[0], c.base,
+            "{what}: {} starts at the base",
+            l.label
+        );
         let inner: &[u32] = if i < 2 * g {
-            assert_eq!(*l.vertices.last().unwrap(), c.base, "{what}: {} is closed", l.label);
+            assert_eq!(
+                *l.vertices.last().unwrap(),
+                c.base,
+                "{what}: {} is closed",
+                l.label
+            );
             &l.vertices[1..l.vertices.len() - 1]
         } else {
             &l.vertices[1..]
         };
         for &v in inner {
-            assert!(owner.insert(v, i).is_none(), "{what}: vertex {v} is on two loops");
+            assert!(
+                owner.insert(v, i).is_none(),
+                "{what}: vertex {v} is on two loops"
+            );
         }
     }
     // The word read from the cut mesh is canonical, and so is the reported one.
@@ -168,14 +187,28 @@ pub fn verify(c: &CanonicalCut, g: usize, nb: usize, what: &str) {
     // The read word may start at any corner: compare cyclically.
     let ws: Vec<&str> = normalized.split(' ').collect();
     let es: Vec<&str> = expected.split(' ').collect();
-    assert_eq!(ws.len(), es.len(), "{what}: word {normalized} vs {expected}");
+    assert_eq!(
+        ws.len(),
+        es.len(),
+        "{what}: word {normalized} vs {expected}"
+    );
     let ok = (0..ws.len()).any(|r| (0..ws.len()).all(|i| ws[(r + i) % ws.len()] == es[i]));
-    assert!(ok, "{what}: word read from the cut mesh {normalized}, expected {expected}");
-    let reported = if g == 0 && nb == 1 { "d1".to_string() } else { expected.clone() };
+    assert!(
+        ok,
+        "{what}: word read from the cut mesh {normalized}, expected {expected}"
+    );
+    let reported = if g == 0 && nb == 1 {
+        "d1".to_string()
+    } else {
+        expected.clone()
+    };
     assert_eq!(c.boundary_word, reported, "{what}: reported word");
     assert_eq!(c.polygon.len(), es.len(), "{what}: polygon sides");
     // Intersection matrix by the push-off formula.
-    let gens: Vec<Vec<u32>> = c.loops[..2 * g].iter().map(|l| l.halfedges.clone()).collect();
+    let gens: Vec<Vec<u32>> = c.loops[..2 * g]
+        .iter()
+        .map(|l| l.halfedges.clone())
+        .collect();
     let j = intersection_matrix(&c.refined.mesh, &gens).unwrap();
     assert_eq!(j, symplectic(g), "{what}: intersection matrix");
 }

@@ -40,7 +40,13 @@ fn run(file: &str, g: usize, nb: usize, base: Option<u32>) {
 
 #[test]
 fn closed_genus_one() {
-    for f in ["torus.off", "knot.obj", "kitten.nf20k.off", "rocker-arm.off", "camel.off"] {
+    for f in [
+        "torus.off",
+        "knot.obj",
+        "kitten.nf20k.off",
+        "rocker-arm.off",
+        "camel.off",
+    ] {
         run(f, 1, 0, None);
     }
 }

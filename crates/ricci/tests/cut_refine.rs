@@ -75,7 +75,11 @@ fn area(g: Geometry, mesh: &Mesh, lengths: &[f64]) -> f64 {
     (0..mesh.n_faces() as u32)
         .map(|f| {
             let e = mesh.face_edges_opposite(f);
-            g.area(lengths[e[0] as usize], lengths[e[1] as usize], lengths[e[2] as usize])
+            g.area(
+                lengths[e[0] as usize],
+                lengths[e[1] as usize],
+                lengths[e[2] as usize],
+            )
         })
         .sum()
 }
@@ -90,7 +94,11 @@ fn check(g: Geometry, mesh: &Mesh, lengths: &[f64], r: &Refined) {
         let v = r.mesh.corner_vertex(c);
         if (v as usize) < mesh.n_vertices() {
             let f0 = r.face_origin[(c / 3) as usize];
-            let i = mesh.face(f0).iter().position(|&w| w == v).expect("vertex of the origin face");
+            let i = mesh
+                .face(f0)
+                .iter()
+                .position(|&w| w == v)
+                .expect("vertex of the origin face");
             sum[(3 * f0 as usize) + i] += a1[c as usize];
         }
     }
@@ -105,14 +113,28 @@ fn check(g: Geometry, mesh: &Mesh, lengths: &[f64], r: &Refined) {
     let s0 = angle_sums(mesh, &a0);
     let s1 = angle_sums(&r.mesh, &a1);
     for v in 0..mesh.n_vertices() {
-        assert!((s0[v] - s1[v]).abs() < 1e-12, "{g:?}: curvature of vertex {v} changed");
+        assert!(
+            (s0[v] - s1[v]).abs() < 1e-12,
+            "{g:?}: curvature of vertex {v} changed"
+        );
     }
     for v in mesh.n_vertices()..r.mesh.n_vertices() {
-        let flat = if r.mesh.is_boundary_vertex(v as u32) { PI } else { 2.0 * PI };
-        assert!((s1[v] - flat).abs() < 1e-12, "{g:?}: new vertex {v} is not flat: {}", s1[v]);
+        let flat = if r.mesh.is_boundary_vertex(v as u32) {
+            PI
+        } else {
+            2.0 * PI
+        };
+        assert!(
+            (s1[v] - flat).abs() < 1e-12,
+            "{g:?}: new vertex {v} is not flat: {}",
+            s1[v]
+        );
     }
     let (ar0, ar1) = (area(g, mesh, lengths), area(g, &r.mesh, &r.lengths));
-    assert!((ar0 - ar1).abs() < 1e-11 * ar0.max(1.0), "{g:?}: area {ar0} vs {ar1}");
+    assert!(
+        (ar0 - ar1).abs() < 1e-11 * ar0.max(1.0),
+        "{g:?}: area {ar0} vs {ar1}"
+    );
     // Provenance: every new vertex lies on an edge between older vertices.
     for (k, p) in r.new_vertices.iter().enumerate() {
         let v = (r.original_vertices + k) as u32;
@@ -150,7 +172,9 @@ fn refinement_preserves_random_metrics_in_all_three_geometries() {
 #[test]
 fn boundary_edges_split_and_positions_interpolate() {
     // A fan around vertex 0 with one boundary: splitting its link (boundary edges) works.
-    let faces: Vec<[u32; 3]> = (1..7).map(|i| [0, i, if i == 6 { 1 } else { i + 1 }]).collect();
+    let faces: Vec<[u32; 3]> = (1..7)
+        .map(|i| [0, i, if i == 6 { 1 } else { i + 1 }])
+        .collect();
     let mesh = Mesh::from_triangles(7, faces).unwrap();
     let pos: Vec<[f64; 3]> = std::iter::once([0.0, 0.0, 0.0])
         .chain((0..6).map(|k| {
@@ -165,8 +189,9 @@ fn boundary_edges_split_and_positions_interpolate() {
             ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
         })
         .collect();
-    let r = ricci::mesh::refine::raise_valence(&mesh, &lengths, Geometry::Euclidean, Some(&pos), 0, 15)
-        .unwrap();
+    let r =
+        ricci::mesh::refine::raise_valence(&mesh, &lengths, Geometry::Euclidean, Some(&pos), 0, 15)
+            .unwrap();
     assert_eq!(r.mesh.valence(0), 15);
     check(Geometry::Euclidean, &mesh, &lengths, &r);
     // Positions are consistent with the lengths (the embedding is planar and exact here).

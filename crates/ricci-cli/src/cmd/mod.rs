@@ -1,4 +1,5 @@
 //! One module per subcommand; each has `Args` (clap) and `run`.
 
+pub mod cut;
 pub mod generate;
 pub mod info;

@@ -242,7 +242,11 @@ pub fn canonical_cut(
         .max(paths_needed);
     let valence_before = mesh.valence(base);
     let max_attempts = options.max_attempts.unwrap_or(8).max(1);
-    let expected_dim = if nb == 0 { 2 * genus } else { 2 * genus + nb - 1 };
+    let expected_dim = if nb == 0 {
+        2 * genus
+    } else {
+        2 * genus + nb - 1
+    };
     let mean_spoke = {
         let s: f64 = mesh
             .outgoing(base)
@@ -701,8 +705,12 @@ impl CanonicalCut {
         for s in self.crossings(path)? {
             let side = &self.polygon[s];
             let (g, sign) = match side.generator {
-                Generator::A { handle } => (Generator::B { handle }, if side.inverse { 1 } else { -1 }),
-                Generator::B { handle } => (Generator::A { handle }, if side.inverse { -1 } else { 1 }),
+                Generator::A { handle } => {
+                    (Generator::B { handle }, if side.inverse { 1 } else { -1 })
+                }
+                Generator::B { handle } => {
+                    (Generator::A { handle }, if side.inverse { -1 } else { 1 })
+                }
                 Generator::C { boundary } => {
                     (Generator::D { boundary }, if side.inverse { 1 } else { -1 })
                 }

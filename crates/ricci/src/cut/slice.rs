@@ -43,7 +43,10 @@ pub fn slice(mesh: &Mesh, cut: &[bool]) -> Result<(Mesh, Vec<u32>)> {
             if mesh.is_boundary_halfedge(h) {
                 continue;
             }
-            if is_cut(h) && !(first && !boundary) && !(boundary && mesh.is_boundary_edge(mesh.he_edge(h))) {
+            if is_cut(h)
+                && !(first && !boundary)
+                && !(boundary && mesh.is_boundary_edge(mesh.he_edge(h)))
+            {
                 copy += 1;
             }
             first = false;
@@ -146,10 +149,12 @@ mod tests {
         let mesh = Mesh::from_triangles((n * m) as usize, f).unwrap();
         let mut cut = vec![false; mesh.n_edges()];
         for i in 0..n {
-            cut[mesh.he_edge(mesh.halfedge_between(id(i, 0), id(i + 1, 0)).unwrap()) as usize] = true;
+            cut[mesh.he_edge(mesh.halfedge_between(id(i, 0), id(i + 1, 0)).unwrap()) as usize] =
+                true;
         }
         for j in 0..m {
-            cut[mesh.he_edge(mesh.halfedge_between(id(0, j), id(0, j + 1)).unwrap()) as usize] = true;
+            cut[mesh.he_edge(mesh.halfedge_between(id(0, j), id(0, j + 1)).unwrap()) as usize] =
+                true;
         }
         let (cm, origin) = slice(&mesh, &cut).unwrap();
         // (n+1)(m+1) grid vertices, one boundary loop of 2(n+m) edges, χ = 1.

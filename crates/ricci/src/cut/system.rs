@@ -370,7 +370,8 @@ impl<'a> State<'a> {
             } else {
                 self.branch[v as usize] = self.branch[u as usize];
                 for w in 0..words {
-                    self.parity[v as usize * words + w] = self.parity[u as usize * words + w] ^ om[w];
+                    self.parity[v as usize * words + w] =
+                        self.parity[u as usize * words + w] ^ om[w];
                 }
             }
             for g in m.outgoing(v) {
@@ -438,7 +439,12 @@ impl<'a> State<'a> {
 
     /// Collect the candidate first loops of the tree grown from gap `k`: edges `(u, w)` between
     /// two settled vertices whose fundamental cycle has odd parity, best per (branches, parity).
-    fn collect_candidates(&self, k: usize, sources: &[usize], out: &mut HashMap<(usize, usize, usize, Vec<u64>), Candidate>) {
+    fn collect_candidates(
+        &self,
+        k: usize,
+        sources: &[usize],
+        out: &mut HashMap<(usize, usize, usize, Vec<u64>), Candidate>,
+    ) {
         let m = self.mesh();
         let words = self.inp.coh.words;
         let mut par = vec![0u64; words];
@@ -464,14 +470,26 @@ impl<'a> State<'a> {
             if self.s1.pred[w as usize] == h || self.s1.pred[u as usize] == m.he_twin(h) {
                 continue;
             }
-            let (bu, bw) = (self.branch[u as usize] as usize, self.branch[w as usize] as usize);
+            let (bu, bw) = (
+                self.branch[u as usize] as usize,
+                self.branch[w as usize] as usize,
+            );
             let om = self.inp.coh.edge(e);
             for j in 0..words {
-                par[j] = self.parity[u as usize * words + j] ^ self.parity[w as usize * words + j] ^ om[j];
+                par[j] = self.parity[u as usize * words + j]
+                    ^ self.parity[w as usize * words + j]
+                    ^ om[j];
             }
-            let len = self.s1.dist[u as usize] + self.s1.dist[w as usize] + self.inp.lengths[e as usize];
+            let len =
+                self.s1.dist[u as usize] + self.s1.dist[w as usize] + self.inp.lengths[e as usize];
             consider(
-                Candidate { len, he: h, x_edge: false, ends: (bu.min(bw), bu.max(bw)), gap: k },
+                Candidate {
+                    len,
+                    he: h,
+                    x_edge: false,
+                    ends: (bu.min(bw), bu.max(bw)),
+                    gap: k,
+                },
                 &par,
             );
         }
@@ -490,7 +508,13 @@ impl<'a> State<'a> {
             }
             let len = self.s1.dist[w as usize] + self.slot_len(s);
             consider(
-                Candidate { len, he: self.slots[s], x_edge: true, ends: (bw.min(s), bw.max(s)), gap: k },
+                Candidate {
+                    len,
+                    he: self.slots[s],
+                    x_edge: true,
+                    ends: (bw.min(s), bw.max(s)),
+                    gap: k,
+                },
                 &par,
             );
         }
@@ -616,7 +640,9 @@ impl<'a> State<'a> {
         let gaps = self.gaps();
         let none = vec![false; self.slots.len()];
         let allowed: Vec<usize> = (0..gaps.len())
-            .filter(|&k| self.handle_allowed(&gaps[k]) && self.usable_count(&gaps[k].slots, &none) >= 4)
+            .filter(|&k| {
+                self.handle_allowed(&gaps[k]) && self.usable_count(&gaps[k].slots, &none) >= 4
+            })
             .collect();
         let mut pos_of = vec![0usize; self.slots.len()];
         for &k in &allowed {
@@ -699,7 +725,11 @@ impl<'a> State<'a> {
                     }
                 };
                 let on_a = |v: u32| a[1..a.len() - 1].contains(&v);
-                let usable_not_a = |st: &Self, sl: &[usize]| sl.iter().filter(|&&s| st.usable(s) && !on_a(st.slot_nbr(s))).count();
+                let usable_not_a = |st: &Self, sl: &[usize]| {
+                    sl.iter()
+                        .filter(|&&s| st.usable(s) && !on_a(st.slot_nbr(s)))
+                        .count()
+                };
                 let ui = usable_not_a(self, &inside);
                 let uo = usable_not_a(self, &outside);
                 if ui == 0 || uo == 0 {
@@ -750,12 +780,18 @@ impl<'a> State<'a> {
                         let id = self.paths.len() as u32;
                         self.mark_path(id, &a);
                         self.paths.push(RawPath {
-                            kind: RawKind::Handle { handle: i, which: 0 },
+                            kind: RawKind::Handle {
+                                handle: i,
+                                which: 0,
+                            },
                             vertices: a,
                         });
                         self.mark_path(id + 1, &b);
                         self.paths.push(RawPath {
-                            kind: RawKind::Handle { handle: i, which: 1 },
+                            kind: RawKind::Handle {
+                                handle: i,
+                                which: 1,
+                            },
                             vertices: b,
                         });
                         return Ok(());
@@ -846,9 +882,16 @@ impl<'a> State<'a> {
         }
         let remaining = connected.iter().filter(|&&c| !c).count();
         let gaps = self.gaps();
-        let any_connector = self.paths.iter().enumerate().any(|(p, _)| self.is_connector(p as u32));
+        let any_connector = self
+            .paths
+            .iter()
+            .enumerate()
+            .any(|(p, _)| self.is_connector(p as u32));
         let mut sources = Vec::new();
-        let free = |st: &Self, s: usize| st.slot_path[s] == NONE && (!st.blocked[st.slot_nbr(s) as usize] || loop_of.contains_key(&st.slot_nbr(s)));
+        let free = |st: &Self, s: usize| {
+            st.slot_path[s] == NONE
+                && (!st.blocked[st.slot_nbr(s) as usize] || loop_of.contains_key(&st.slot_nbr(s)))
+        };
         for g in &gaps {
             let ok = if any_connector {
                 (g.before != NONE && self.is_connector(g.before))
@@ -936,7 +979,8 @@ impl<'a> State<'a> {
             .outgoing(y)
             .filter(|&h| m.he_tip(h) != x)
             .min_by(|&a, &b| {
-                self.inp.lengths[m.he_edge(a) as usize].total_cmp(&self.inp.lengths[m.he_edge(b) as usize])
+                self.inp.lengths[m.he_edge(a) as usize]
+                    .total_cmp(&self.inp.lengths[m.he_edge(b) as usize])
             })
             .map(|h| m.he_tip(h))
             .ok_or_else(|| NoRoom("the base vertex's neighbour has no other edge".into()))?;

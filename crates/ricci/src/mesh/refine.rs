@@ -452,7 +452,11 @@ impl Refiner {
         let mut fill = start.clone();
         let mut adj = vec![(0u32, 0.0f64); start[nv] as usize];
         for h in 0..self.len.len() as u32 {
-            let (a, b, l) = (self.origin(h), self.origin(Self::next(h)), self.len[h as usize]);
+            let (a, b, l) = (
+                self.origin(h),
+                self.origin(Self::next(h)),
+                self.len[h as usize],
+            );
             adj[fill[a as usize] as usize] = (b, l);
             fill[a as usize] += 1;
             adj[fill[b as usize] as usize] = (a, l);
@@ -641,11 +645,18 @@ pub fn side(g: Geometry, b: f64, c: f64, theta: f64) -> f64 {
         Geometry::Euclidean => g.side(b, c, theta),
         Geometry::Hyperbolic => {
             let d = (0.5 * (b - c)).sinh();
-            2.0 * (d * d + b.sinh() * c.sinh() * h * h).max(0.0).sqrt().asinh()
+            2.0 * (d * d + b.sinh() * c.sinh() * h * h)
+                .max(0.0)
+                .sqrt()
+                .asinh()
         }
         Geometry::Spherical => {
             let d = (0.5 * (b - c)).sin();
-            2.0 * (d * d + b.sin() * c.sin() * h * h).max(0.0).sqrt().min(1.0).asin()
+            2.0 * (d * d + b.sin() * c.sin() * h * h)
+                .max(0.0)
+                .sqrt()
+                .min(1.0)
+                .asin()
         }
     }
 }
