@@ -118,6 +118,7 @@ fn check(g: Geometry, mesh: &Mesh, lengths: &[f64], r: &Refined) {
             "{g:?}: curvature of vertex {v} changed"
         );
     }
+    #[allow(clippy::needless_range_loop)]
     for v in mesh.n_vertices()..r.mesh.n_vertices() {
         let flat = if r.mesh.is_boundary_vertex(v as u32) {
             PI

@@ -43,10 +43,14 @@ pub fn slice(mesh: &Mesh, cut: &[bool]) -> Result<(Mesh, Vec<u32>)> {
             if mesh.is_boundary_halfedge(h) {
                 continue;
             }
-            if is_cut(h)
-                && !(first && !boundary)
-                && !(boundary && mesh.is_boundary_edge(mesh.he_edge(h)))
-            {
+            // The first wedge of an interior vertex starts at its first cut edge; boundary
+            // edges of a boundary vertex are never cut.
+            let starts_wedge = if boundary {
+                !mesh.is_boundary_edge(mesh.he_edge(h))
+            } else {
+                !first
+            };
+            if is_cut(h) && starts_wedge {
                 copy += 1;
             }
             first = false;

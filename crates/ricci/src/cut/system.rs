@@ -369,9 +369,8 @@ impl<'a> State<'a> {
                 self.parity[v as usize * words..(v as usize + 1) * words].copy_from_slice(om);
             } else {
                 self.branch[v as usize] = self.branch[u as usize];
-                for w in 0..words {
-                    self.parity[v as usize * words + w] =
-                        self.parity[u as usize * words + w] ^ om[w];
+                for (w, &o) in om.iter().enumerate() {
+                    self.parity[v as usize * words + w] = self.parity[u as usize * words + w] ^ o;
                 }
             }
             for g in m.outgoing(v) {
@@ -676,8 +675,7 @@ impl<'a> State<'a> {
                 }
                 self.stats.relaxed_budgets += 1;
             }
-            let mut tries = 0;
-            for c in &cands {
+            for (tries, c) in cands.iter().enumerate() {
                 if tries >= 48 {
                     break;
                 }
@@ -688,7 +686,6 @@ impl<'a> State<'a> {
                     tree_gap = g;
                 }
                 let cyclic = gap.before == NONE;
-                tries += 1;
                 self.stats.candidates_tried += 1;
                 let Some(a) = self.candidate_loop(c, &gap.slots) else {
                     why[0] += 1;

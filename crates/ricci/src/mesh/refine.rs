@@ -564,7 +564,7 @@ impl Refiner {
                 .iter()
                 .map(|&v| dist[v as usize])
                 .fold(f64::INFINITY, f64::min);
-            if !(r < radius) {
+            if r.is_nan() || r >= radius {
                 return false;
             }
             let lmax = s.len[3 * f as usize]
