@@ -69,7 +69,7 @@ fn main() {
             Some(Ok(c)) => {
                 let total: f64 = c.loops.iter().map(|l| l.length).sum();
                 println!(
-                    "{name}: F={} genus={} base={} valence {}→{} splits={} attempts={} sides={} \
+                    "{name}: F={} genus={} base={} valence {}→{} splits={} attempts={} searches={} rejected={:?} sides={} \
                      loops total length {:.4} (bbox diag {:.4}) | median {:.3} s, min {:.3} s over {runs} runs",
                     s.mesh.n_faces(),
                     c.genus,
@@ -78,6 +78,8 @@ fn main() {
                     c.report.valence_after,
                     c.report.refinement_splits,
                     c.report.attempts,
+                    c.report.search.searches,
+                    c.report.search.rejected,
                     c.polygon.len(),
                     total,
                     s.diagonal(),

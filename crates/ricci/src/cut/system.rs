@@ -36,6 +36,10 @@ use crate::mesh::refine::MinItem;
 use crate::mesh::{Mesh, NONE};
 use std::collections::{BinaryHeap, HashMap};
 
+/// Candidate first loops tried per handle and budget round before refining along the loops
+/// found so far (each try costs up to two Dijkstra searches).
+const MAX_TRIES: usize = 12;
+
 /// Extra relative cost of edges next to earlier cuts.
 const NEAR_PENALTY: f64 = 2.0;
 /// Extra relative cost next to the outgoing strand while rerouting the return strand of a
@@ -676,7 +680,7 @@ impl<'a> State<'a> {
                 self.stats.relaxed_budgets += 1;
             }
             for (tries, c) in cands.iter().enumerate() {
-                if tries >= 48 {
+                if tries >= MAX_TRIES {
                     break;
                 }
                 let g = c.gap;
@@ -721,12 +725,21 @@ impl<'a> State<'a> {
                         (between, rest, after_q)
                     }
                 };
-                let on_a = |v: u32| a[1..a.len() - 1].contains(&v);
-                let usable_not_a = |st: &Self, sl: &[usize]| {
-                    sl.iter()
-                        .filter(|&&s| st.usable(s) && !on_a(st.slot_nbr(s)))
-                        .count()
+                // Slots still usable once `a` is cut (a may pass next to x).
+                let ok: Vec<bool> = {
+                    for &v in &a[1..a.len() - 1] {
+                        self.repel[v as usize] = true;
+                    }
+                    let ok = (0..self.slots.len())
+                        .map(|s| self.usable(s) && !self.repel[self.slot_nbr(s) as usize])
+                        .collect();
+                    for &v in &a[1..a.len() - 1] {
+                        self.repel[v as usize] = false;
+                    }
+                    ok
                 };
+                let usable_not_a =
+                    |_: &Self, sl: &[usize]| sl.iter().filter(|&&s| ok[s]).count();
                 let ui = usable_not_a(self, &inside);
                 let uo = usable_not_a(self, &outside);
                 if ui == 0 || uo == 0 {
@@ -748,12 +761,16 @@ impl<'a> State<'a> {
                 }
                 // Targets for b: outside slots that keep the capacity within budget.
                 let mut target_ok = vec![false; self.slots.len()];
+                let mut prefix = vec![0usize; outside.len() + 1];
                 for (k, &s) in outside.iter().enumerate() {
-                    if !self.usable(s) || on_a(self.slot_nbr(s)) {
+                    prefix[k + 1] = prefix[k] + ok[s] as usize;
+                }
+                for (k, &s) in outside.iter().enumerate() {
+                    if !ok[s] {
                         continue;
                     }
-                    let left = usable_not_a(self, &outside[..k]);
-                    let right = usable_not_a(self, &outside[k + 1..]);
+                    let left = prefix[k];
+                    let right = prefix[outside.len()] - prefix[k + 1];
                     let cap = if cyclic {
                         left.max(right)
                     } else if k < after_q {
