@@ -53,6 +53,9 @@ fn main() {
                 Some(&s.positions),
                 &CutOptions {
                     base,
+                    max_attempts: std::env::var("BENCH_ATTEMPTS")
+                        .ok()
+                        .and_then(|r| r.parse().ok()),
                     ..CutOptions::default()
                 },
                 &mut NoProgress,

@@ -274,6 +274,7 @@ pub fn canonical_cut(
         Refined::identity(mesh, lengths, positions)
     };
     let mut prior: Vec<RawPath> = Vec::new();
+    let mut total = SearchStats::default();
     let (raw, stats) = loop {
         attempt += 1;
         let coh = Cohomology::new(&refined.mesh)?;
@@ -297,8 +298,12 @@ pub fn canonical_cut(
             &format!("attempt {attempt}: searching {genus} handle(s)"),
         );
         match system::build(&input, &prior) {
-            Ok(r) => break r,
-            Err((system::NoRoom(msg), partial)) => {
+            Ok((raw, st)) => {
+                total.add(&st);
+                break (raw, total);
+            }
+            Err((system::NoRoom(msg), partial, st)) => {
+                total.add(&st);
                 failed.push(format!("attempt {attempt}: {msg}"));
                 if attempt >= max_attempts {
                     return Err(Error::numerical(format!(

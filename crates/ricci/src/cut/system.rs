@@ -67,6 +67,8 @@ pub(crate) struct RawPath {
 /// Counters describing the search.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct SearchStats {
+    /// Construction attempts (the first, then one per refinement along the loops).
+    pub attempts: usize,
     /// Candidate first loops examined (all handles).
     pub candidates_tried: usize,
     /// Second-loop searches that found no path (the next candidate was tried).
@@ -176,6 +178,9 @@ struct State<'a> {
     s2: Search,
     branch: Vec<u32>,
     parity: Vec<u64>,
+    /// Outgoing half-edges of every vertex with their tips and lengths (CSR).
+    adj_start: Vec<u32>,
+    adj: Vec<(u32, u32, f64)>,
 }
 
 #[derive(Debug, Clone)]
@@ -195,7 +200,7 @@ struct Candidate {
 pub(crate) fn build(
     inp: &Input,
     prior: &[RawPath],
-) -> Result<(Vec<RawPath>, SearchStats), (NoRoom, Vec<RawPath>)> {
+) -> Result<(Vec<RawPath>, SearchStats), (NoRoom, Vec<RawPath>, SearchStats)> {
     let m = inp.mesh;
     let nv = m.n_vertices();
     let slots: Vec<u32> = m.outgoing(inp.x).collect();
@@ -219,12 +224,30 @@ pub(crate) fn build(
         repel: vec![false; nv],
         blocked,
         paths: Vec::new(),
-        stats: SearchStats::default(),
+        stats: SearchStats {
+            attempts: 1,
+            ..SearchStats::default()
+        },
         s1: Search::new(nv),
         s2: Search::new(nv),
         branch: vec![NONE; nv],
         parity: vec![0; nv * inp.coh.words],
+        adj_start: Vec::new(),
+        adj: Vec::new(),
     };
+    {
+        let mut start = Vec::with_capacity(nv + 1);
+        let mut adj = Vec::with_capacity(m.n_halfedges());
+        start.push(0u32);
+        for v in 0..nv as u32 {
+            for h in m.outgoing(v) {
+                adj.push((h, m.he_tip(h), inp.lengths[m.he_edge(h) as usize]));
+            }
+            start.push(adj.len() as u32);
+        }
+        st.adj_start = start;
+        st.adj = adj;
+    }
     for l in &inp.boundary_loops {
         for &v in l {
             st.mark_near(v);
@@ -243,7 +266,7 @@ pub(crate) fn build(
             _ => {}
         }
     }
-    let fail = |e: NoRoom, st: &State| (e, st.paths.clone());
+    let fail = |e: NoRoom, st: &State| (e, st.paths.clone(), st.stats.clone());
     if inp.genus == 0 && nb == 0 && st.paths.is_empty() {
         st.slit().map_err(|e| fail(e, &st))?;
     }
@@ -256,6 +279,20 @@ pub(crate) fn build(
         }
     }
     Ok((st.paths, st.stats))
+}
+
+impl SearchStats {
+    /// Add the counters of another attempt.
+    pub(crate) fn add(&mut self, o: &SearchStats) {
+        self.attempts += o.attempts;
+        self.candidates_tried += o.candidates_tried;
+        self.failed_second_loops += o.failed_second_loops;
+        self.relaxed_budgets += o.relaxed_budgets;
+        self.searches += o.searches;
+        for k in 0..self.rejected.len() {
+            self.rejected[k] += o.rejected[k];
+        }
+    }
 }
 
 impl<'a> State<'a> {
@@ -377,8 +414,8 @@ impl<'a> State<'a> {
                     self.parity[v as usize * words + w] = self.parity[u as usize * words + w] ^ o;
                 }
             }
-            for g in m.outgoing(v) {
-                let w = m.he_tip(g);
+            for k in self.adj_start[v as usize]..self.adj_start[v as usize + 1] {
+                let (g, w, l) = self.adj[k as usize];
                 // Neighbours of x are only entered from x: loops must not run along the link.
                 if self.blocked[w as usize]
                     || self.s1.settled[w as usize]
@@ -386,7 +423,7 @@ impl<'a> State<'a> {
                 {
                     continue;
                 }
-                let l = self.cost(g);
+                let l = self.cost2(v, w, l);
                 self.s1.offer(w, d + l, g);
             }
         }
@@ -412,12 +449,11 @@ impl<'a> State<'a> {
         }
     }
 
-    /// Search cost of half-edge `g`: its length, tripled next to earlier cuts.
+    /// Search cost of the edge `u → w` of length `l`: its length, more next to earlier cuts
+    /// and, while rerouting, next to the outgoing strand.
     #[inline]
-    fn cost(&self, g: u32) -> f64 {
-        let m = self.mesh();
-        let l = self.inp.lengths[m.he_edge(g) as usize];
-        let (o, t) = (m.he_origin(g) as usize, m.he_tip(g) as usize);
+    fn cost2(&self, u: u32, w: u32, l: f64) -> f64 {
+        let (o, t) = (u as usize, w as usize);
         let k = self.near[o] as u8 + self.near[t] as u8;
         let r = self.repel[o] as u8 + self.repel[t] as u8;
         l * (1.0 + NEAR_PENALTY * k as f64 * 0.5 + REPEL_PENALTY * r as f64 * 0.5)
@@ -579,8 +615,8 @@ impl<'a> State<'a> {
                     best_v = v;
                 }
             }
-            for g in m.outgoing(v) {
-                let z = m.he_tip(g);
+            for k in self.adj_start[v as usize]..self.adj_start[v as usize + 1] {
+                let (g, z, l) = self.adj[k as usize];
                 let sz = self.slot_of[z as usize];
                 if self.blocked[z as usize]
                     || self.s2.settled[z as usize]
@@ -588,7 +624,7 @@ impl<'a> State<'a> {
                 {
                     continue;
                 }
-                self.s2.offer(z, d + self.cost(g), g);
+                self.s2.offer(z, d + self.cost2(v, z, l), g);
             }
         }
         for &v in &a[1..] {
@@ -738,8 +774,7 @@ impl<'a> State<'a> {
                     }
                     ok
                 };
-                let usable_not_a =
-                    |_: &Self, sl: &[usize]| sl.iter().filter(|&&s| ok[s]).count();
+                let usable_not_a = |_: &Self, sl: &[usize]| sl.iter().filter(|&&s| ok[s]).count();
                 let ui = usable_not_a(self, &inside);
                 let uo = usable_not_a(self, &outside);
                 if ui == 0 || uo == 0 {
@@ -858,8 +893,8 @@ impl<'a> State<'a> {
                     best_v = v;
                 }
             }
-            for g in m.outgoing(v) {
-                let w = m.he_tip(g);
+            for k in self.adj_start[v as usize]..self.adj_start[v as usize + 1] {
+                let (g, w, l) = self.adj[k as usize];
                 let sw = self.slot_of[w as usize];
                 if self.blocked[w as usize]
                     || self.s2.settled[w as usize]
@@ -867,7 +902,7 @@ impl<'a> State<'a> {
                 {
                     continue;
                 }
-                self.s2.offer(w, d + self.cost(g), g);
+                self.s2.offer(w, d + self.cost2(v, w, l), g);
             }
         }
         for &v in &a[1..a.len() - 1] {
@@ -940,9 +975,9 @@ impl<'a> State<'a> {
             if d >= best {
                 break;
             }
-            for g in m.outgoing(v) {
-                let w = m.he_tip(g);
-                let l = self.cost(g);
+            for k in self.adj_start[v as usize]..self.adj_start[v as usize + 1] {
+                let (g, w, l) = self.adj[k as usize];
+                let l = self.cost2(v, w, l);
                 if loop_of.contains_key(&w) {
                     if d + l < best {
                         best = d + l;
