@@ -302,7 +302,12 @@ pub fn canonical_cut(
                 total.add(&st);
                 break (raw, total);
             }
-            Err((system::NoRoom(msg), partial, st)) => {
+            Err(fail) => {
+                let system::Failure {
+                    reason: system::NoRoom(msg),
+                    paths: partial,
+                    stats: st,
+                } = *fail;
                 total.add(&st);
                 failed.push(format!("attempt {attempt}: {msg}"));
                 if attempt >= max_attempts {

@@ -87,6 +87,13 @@ pub struct SearchStats {
 #[derive(Debug, Clone)]
 pub(crate) struct NoRoom(pub String);
 
+/// A failed attempt: why, and what was found before (complete handles and connectors).
+pub(crate) struct Failure {
+    pub reason: NoRoom,
+    pub paths: Vec<RawPath>,
+    pub stats: SearchStats,
+}
+
 pub(crate) struct Input<'a> {
     pub mesh: &'a Mesh,
     pub lengths: &'a [f64],
@@ -200,7 +207,7 @@ struct Candidate {
 pub(crate) fn build(
     inp: &Input,
     prior: &[RawPath],
-) -> Result<(Vec<RawPath>, SearchStats), (NoRoom, Vec<RawPath>, SearchStats)> {
+) -> Result<(Vec<RawPath>, SearchStats), Box<Failure>> {
     let m = inp.mesh;
     let nv = m.n_vertices();
     let slots: Vec<u32> = m.outgoing(inp.x).collect();
@@ -266,7 +273,13 @@ pub(crate) fn build(
             _ => {}
         }
     }
-    let fail = |e: NoRoom, st: &State| (e, st.paths.clone(), st.stats.clone());
+    let fail = |e: NoRoom, st: &State| {
+        Box::new(Failure {
+            reason: e,
+            paths: st.paths.clone(),
+            stats: st.stats.clone(),
+        })
+    };
     if inp.genus == 0 && nb == 0 && st.paths.is_empty() {
         st.slit().map_err(|e| fail(e, &st))?;
     }
