@@ -18,8 +18,15 @@
 //! Steps: (1) raise the valence of `x` and grade its neighbourhood by intrinsic,
 //! metric-preserving edge splits ([`crate::mesh::refine`]) so that `4g + b` disjoint paths fit
 //! around it; (2) a Z₂ cohomology basis by tree–cotree ([`homology`]); (3) the loops, handle by
-//! handle, as shortest non-separating loops through the free edges of `x` ([`system`]), refining
-//! more and starting again if they do not fit; (4) slicing ([`slice`]) and reading the polygon.
+//! handle, as short non-separating loops through the free edges of `x` ([`system`]); when a
+//! handle does not fit, the loops found so far are kept, a free row of vertices is split in
+//! along them and the search resumes; (4) slicing ([`slice`]) and reading the polygon.
+//!
+//! This follows the lead's design with three changes found necessary on the shared meshes:
+//! the neighbourhood of `x` is *graded* (valence alone leaves only ~12 vertices in the second
+//! ring, too few for `4g` disjoint paths); a lasso-shaped odd cycle is turned into a simple
+//! loop by rerouting its return strand; and failures resume from the handles already found
+//! after refining along them instead of restarting with a higher valence.
 //!
 //! Genus 0: a closed surface is slit along a path of two edges (word `c₁ c₁⁻¹`); a disk is
 //! already cut (word `d₁`); with `b ≥ 2` boundary loops, `b` paths join them to `x`.

@@ -14,22 +14,30 @@
 //!   consecutive ends form a *gap*; a new handle must put all its four ends into one gap, and,
 //!   once two handles exist, only gaps between two different handles keep the earlier handles
 //!   contiguous (the gaps inside a handle are lost);
-//! * `a_i` is the shortest loop through `x` leaving and returning through one allowed gap whose
-//!   Z₂ cohomology class is nonzero (non-separating: see [`super::homology`]); it is found in a
-//!   Dijkstra tree from `x` whose branches (one per slot) are disjoint, as a non-tree edge
-//!   between two branches of the same gap;
+//! * `a_i` is a short loop through `x` leaving and returning through one allowed gap whose
+//!   Z₂ cohomology class is nonzero (non-separating: see [`super::homology`]). One Dijkstra
+//!   tree is grown from each allowed gap (branches = slots, disjoint); an odd non-tree edge
+//!   between two branches closes a simple loop; an odd edge inside one branch closes a lasso,
+//!   whose return strand is rerouted by a second search to another slot of the gap, kept away
+//!   from the outgoing strand so that room remains between them;
 //! * `b_i` is the shortest path from a slot strictly between `a_i`'s ends to a slot outside them
 //!   (same gap), avoiding `a_i` and all earlier loops: it crosses `a_i` once, at `x`;
 //! * slots are a budget: every handle may waste at most its fair share of the spare slots, so
 //!   that the later handles still find room (with the valence raised and the neighbourhood
-//!   graded by [`crate::mesh::refine`], there are enough of them).
+//!   graded by [`crate::mesh::refine`], there are enough of them);
+//! * searches enter a neighbour of `x` only as a source or a target (loops must not run along
+//!   the link of `x` and use up its slots), and edges next to earlier cuts cost three times
+//!   their length, so that loops keep a free row of vertices between them;
+//! * when no candidate works, the attempt fails with the complete handles found so far; the
+//!   caller ([`super::canonical_cut`]) splits every edge touching them (a free row of vertices
+//!   on both sides of every loop, the metric unchanged), raises the valence of `x` and
+//!   resumes.
 //!
 //! With boundary, after the handles every boundary loop is joined to `x` by a shortest path
 //! `c_k` through free vertices; these start from adjacent gaps so the word ends with
 //! `c₁ d₁ c₁⁻¹ … c_b d_b c_b⁻¹` (`d_k` the boundary loop). A closed genus-0 surface is slit along
 //! a path of two edges (word `c₁ c₁⁻¹`).
 //!
-//! When no loop fits the budget the caller refines more around `x` and starts again.
 
 use super::homology::Cohomology;
 use crate::mesh::refine::MinItem;
