@@ -20,7 +20,7 @@
 //! around it; (2) a Z₂ cohomology basis by tree–cotree ([`homology`]); (3) the loops, handle by
 //! handle, as short non-separating loops through the free edges of `x` ([`system`]); when a
 //! handle does not fit, the loops found so far are kept, a free row of vertices is split in
-//! along them and the search resumes; (4) slicing ([`slice`]) and reading the polygon.
+//! along them and the search resumes; (4) slicing ([`mod@slice`]) and reading the polygon.
 //!
 //! This follows the lead's design with three changes found necessary on the shared meshes:
 //! the neighbourhood of `x` is *graded* (valence alone leaves only ~12 vertices in the second
