@@ -27,6 +27,11 @@ enum Command {
     Generate(cmd::generate::Args),
     /// Canonical fundamental group generators through a base vertex; slice the mesh into a disk.
     Cut(cmd::cut::Args),
+    /// Render a surface to PNG (checkerboard from UVs, scalar fields, zebra) or export glTF.
+    Render(Box<cmd::render::Args>),
+
+    /// Discrete Ricci flow: a flat, hyperbolic or spherical metric with prescribed curvature.
+    Flow(cmd::flow::Args),
 }
 
 fn main() {
@@ -35,6 +40,9 @@ fn main() {
         Command::Info(a) => cmd::info::run(a),
         Command::Generate(a) => cmd::generate::run(a),
         Command::Cut(a) => cmd::cut::run(a),
+        Command::Render(a) => cmd::render::run(*a),
+
+        Command::Flow(a) => cmd::flow::run(a),
     };
     if let Err(e) = result {
         eprintln!("error: {}", util::sentence(&e));

@@ -11,9 +11,9 @@ use crate::color::{self, Rgb};
 use crate::image::Image;
 use crate::render::Uvs;
 use crate::{check_mesh, input_err, Error, Result};
-use std::collections::HashMap;
 use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
+use std::collections::HashMap;
 
 /// What to put in the file besides positions, normals and triangles.
 #[derive(Debug, Clone, Default)]
@@ -69,7 +69,8 @@ pub fn glb(positions: &[[f64; 3]], triangles: &[[u32; 3]], opts: &GlbOptions) ->
             // Split vertices by (vertex, uv) and carry positions, normals and colours along.
             let normals = crate::render::vertex_normals(positions, triangles);
             let mut index: HashMap<(u32, u64, u64), u32> = HashMap::new();
-            let (mut p2, mut n2, mut uv2, mut c2) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            let (mut p2, mut n2, mut uv2, mut c2) =
+                (Vec::new(), Vec::new(), Vec::new(), Vec::new());
             let mut t2 = Vec::with_capacity(triangles.len());
             for (f, t) in triangles.iter().enumerate() {
                 let mut nt = [0u32; 3];
@@ -119,9 +120,15 @@ fn glb_build(
     let n = positions.len();
     if let Some(uv) = uvs {
         if uv.len() != n {
-            return input_err(format!("there are {} texture coordinates for {n} vertices", uv.len()));
+            return input_err(format!(
+                "there are {} texture coordinates for {n} vertices",
+                uv.len()
+            ));
         }
-        if let Some(i) = uv.iter().position(|p| !(p[0].is_finite() && p[1].is_finite())) {
+        if let Some(i) = uv
+            .iter()
+            .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+        {
             return input_err(format!("texture coordinate of vertex {i} is not finite"));
         }
     }
@@ -510,7 +517,8 @@ mod tests {
         let mut corner = Vec::new();
         for f in 0..t.triangles.len() {
             let (i, j) = ((f / 2) / m, (f / 2) % m);
-            let uv = |di: usize, dj: usize| [(i + di) as f64 / n as f64, (j + dj) as f64 / m as f64];
+            let uv =
+                |di: usize, dj: usize| [(i + di) as f64 / n as f64, (j + dj) as f64 / m as f64];
             if f % 2 == 0 {
                 corner.extend([uv(0, 0), uv(1, 0), uv(1, 1)]);
             } else {
@@ -531,7 +539,10 @@ mod tests {
         let prim = g.meshes().next().unwrap().primitives().next().unwrap();
         let reader = prim.reader(|_| Some(blob));
         assert_eq!(reader.read_positions().unwrap().count(), (n + 1) * (m + 1));
-        assert_eq!(reader.read_indices().unwrap().into_u32().count(), 3 * t.triangles.len());
+        assert_eq!(
+            reader.read_indices().unwrap().into_u32().count(),
+            3 * t.triangles.len()
+        );
         let tc: Vec<[f32; 2]> = reader.read_tex_coords(0).unwrap().into_f32().collect();
         let umax = tc.iter().map(|p| p[0]).fold(0.0f32, f32::max);
         assert!((umax - 1.0).abs() < 1e-6);

@@ -37,8 +37,8 @@ pub use camera::{Camera, Projection, View};
 pub use color::{Colormap, Rgb, ScalarRange};
 pub use image::Image;
 pub use render::{
-    render, Background, Checker, Circles, Lighting, Paint, Polyline, RenderOptions, Rendered,
-    Scalar, ScalarLocation, Style, Wireframe, Zebra,
+    render, render_png, Background, Checker, Circles, Lighting, Paint, Polyline, RenderOptions,
+    Rendered, Scalar, ScalarLocation, Style, Wireframe, Zebra,
 };
 
 /// Errors of the renderer: one sentence naming the problem and where it is.

@@ -182,6 +182,9 @@ pub enum Paint<'a> {
     Circles(Circles<'a>),
     Scalar(Scalar<'a>),
     Zebra(Zebra),
+    /// One sRGB colour per face (atlas charts, patches, spline pieces; see
+    /// [`crate::color::categorical`]).
+    FaceColors(&'a [Rgb]),
 }
 
 impl Default for Paint<'_> {
@@ -298,7 +301,19 @@ impl Rendered {
 }
 
 const NO_FACE: u32 = u32::MAX;
+/// Upper bound on supersampled pixels (8 bytes each in the visibility buffers: 2 GiB).
+const MAX_SAMPLES: u64 = 1 << 28;
 const BAND: usize = 32;
+
+/// Render a triangle mesh and encode it as PNG bytes (see [`render`]).
+pub fn render_png(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    style: &Style,
+    opts: &RenderOptions,
+) -> Result<Vec<u8>> {
+    render(positions, triangles, style, opts)?.png()
+}
 
 /// Render a triangle mesh.
 pub fn render(
@@ -318,6 +333,14 @@ pub fn render(
         return input_err(format!(
             "supersampling {} must be between 1 and 8",
             opts.supersample
+        ));
+    }
+    let samples = (opts.width as u64 * opts.supersample as u64)
+        * (opts.height as u64 * opts.supersample as u64);
+    if samples > MAX_SAMPLES {
+        return input_err(format!(
+            "{}x{} pixels with {}x{} supersampling need {samples} samples, more than the {MAX_SAMPLES} this renderer allows; lower the size or the supersampling",
+            opts.width, opts.height, opts.supersample, opts.supersample
         ));
     }
     let (nv, nf) = (positions.len(), triangles.len());
@@ -528,7 +551,7 @@ pub fn render(
                         o[q] = lut.encode(acc[q] / acc[3]);
                     }
                 }
-                o[3] = (acc[3] * inv_n * 255.0).round() as u8;
+                o[3] = fround(acc[3] * inv_n * 255.0) as u8;
             }
             covered
         })
@@ -590,6 +613,14 @@ fn check_paint(paint: &Paint, nv: usize, nf: usize) -> Result<Option<(f64, f64)>
         }
         Paint::Zebra(z) => freq_ok(z.stripes)?,
         Paint::Solid(_) => {}
+        Paint::FaceColors(c) => {
+            if c.len() != nf {
+                return input_err(format!(
+                    "there are {} face colours, but the mesh has {nf} faces",
+                    c.len()
+                ));
+            }
+        }
     }
     Ok(None)
 }
@@ -727,14 +758,14 @@ fn rasterize(
                 let ymax = v[0].y.max(v[1].y).max(v[2].y);
                 let xmin = v[0].x.min(v[1].x).min(v[2].x);
                 let xmax = v[0].x.max(v[1].x).max(v[2].x);
-                let ya = ((ymin - 0.5).ceil().max(y0 as f32)) as usize;
-                let yb = ((ymax - 0.5).floor().min(y1 as f32 - 1.0)).max(-1.0);
+                let ya = (fceil(ymin - 0.5).max(y0 as f32)) as usize;
+                let yb = (ffloor(ymax - 0.5).min(y1 as f32 - 1.0)).max(-1.0);
                 if yb < 0.0 || (yb as usize) < ya {
                     continue;
                 }
                 let yb = yb as usize;
-                let xa0 = (xmin - 0.5).ceil().max(0.0);
-                let xb0 = (xmax - 0.5).floor().min(sw as f32 - 1.0);
+                let xa0 = fceil(xmin - 0.5).max(0.0);
+                let xb0 = ffloor(xmax - 0.5).min(sw as f32 - 1.0);
                 if xb0 < xa0 {
                     continue;
                 }
@@ -750,9 +781,9 @@ fn rasterize(
                         let r = s.b[i] * yc + s.c[i];
                         let a = s.a[i];
                         if a > 0.0 {
-                            lo = lo.max(((EPS - r) / a - 0.5).ceil());
+                            lo = lo.max(fceil((EPS - r) / a - 0.5));
                         } else if a < 0.0 {
-                            hi = hi.min(((EPS - r) / a - 0.5).floor());
+                            hi = hi.min(ffloor((EPS - r) / a - 0.5));
                         } else if r < EPS {
                             hi = -1.0;
                         }
@@ -943,6 +974,7 @@ impl<'a> Shader<'a> {
             Paint::Circles(c) => [c.ink, c.paper],
             Paint::Zebra(z) => [z.dark, z.light],
             Paint::Solid(c) => [*c, *c],
+            Paint::FaceColors(_) => [[0.0; 3], [0.0; 3]],
             Paint::Scalar(_) => [[0.0; 3], [0.0; 3]],
         };
         let map = match &style.paint {
@@ -1030,6 +1062,7 @@ impl<'a> Shader<'a> {
 
         let (mut albedo, shiny) = match self.paint {
             Paint::Solid(_) => (self.two_colors[0], true),
+            Paint::FaceColors(c) => (color::to_linear(c[fi]), true),
             Paint::Checker(c) => {
                 let (uv, fw) = self.uv_and_footprint(&c.uvs, fi, &s, lp, c.frequency);
                 let a = checker(uv[0], fw[0]) * checker(uv[1], fw[1]);
@@ -1038,7 +1071,7 @@ impl<'a> Shader<'a> {
             }
             Paint::Circles(c) => {
                 let (uv, fw) = self.uv_and_footprint(&c.uvs, fi, &s, lp, c.frequency);
-                let (fx, fy) = (uv[0] - uv[0].floor() - 0.5, uv[1] - uv[1].floor() - 0.5);
+                let (fx, fy) = (uv[0] - ffloor(uv[0]) - 0.5, uv[1] - ffloor(uv[1]) - 0.5);
                 let d = (fx * fx + fy * fy).sqrt();
                 let w = 0.5 * (fw[0] + fw[1]).max(1e-6);
                 let inside = ((c.radius as f32 - d) / w + 0.5).clamp(0.0, 1.0);
@@ -1067,7 +1100,7 @@ impl<'a> Shader<'a> {
                         });
                         let g = screen_gradient(&s, vals);
                         let z = tt * sc.isolines as f32;
-                        let dist = (z - z.round()).abs() / g.max(1e-9); // in samples
+                        let dist = (z - fround(z)).abs() / g.max(1e-9); // in samples
                         let cov = ((0.6 * self.ss - dist) / self.ss + 0.5).clamp(0.0, 1.0) * 0.7;
                         c = mix(c, [0.0; 3], cov);
                     }
@@ -1084,7 +1117,7 @@ impl<'a> Shader<'a> {
                 ];
                 let phi = r[1].atan2(r[2]) / std::f32::consts::PI; // in (-1, 1]
                 let u = phi * z.stripes as f32;
-                let fr = u - u.floor();
+                let fr = u - ffloor(u);
                 let tri = (fr - 0.5).abs() * 2.0; // 1 at stripe borders, 0 in the middle
                 let m = ((tri - 0.5) / 0.12 + 0.5).clamp(0.0, 1.0);
                 (mix(self.two_colors[1], self.two_colors[0], m), false)
@@ -1175,11 +1208,11 @@ impl<'a> Shader<'a> {
 #[inline]
 fn checker(x: f32, w: f32) -> f32 {
     let tri = |x: f32| {
-        let m = x - 2.0 * (x * 0.5).floor(); // x mod 2
+        let m = x - 2.0 * ffloor(x * 0.5); // x mod 2
         1.0 - (m - 1.0).abs()
     };
     if w < 1e-4 {
-        let m = x - 2.0 * (x * 0.5).floor();
+        let m = x - 2.0 * ffloor(x * 0.5);
         if m < 1.0 {
             1.0
         } else {
@@ -1288,8 +1321,14 @@ impl Legend {
         };
         let halo = if text[0] > 0.5 { [0.0; 3] } else { [1.0; 3] };
         let cmap = s.colormap;
+        let constant = self.range.1 <= self.range.0;
         for y in top..=bot {
-            let t = (bot - y) as f64 / (bot - top).max(1) as f64;
+            // A constant field has one colour (the centre of the map) and one label.
+            let t = if constant {
+                0.5
+            } else {
+                (bot - y) as f64 / (bot - top).max(1) as f64
+            };
             img.fill_rect(x0, y, bar_w, 1, cmap.eval(t), 1.0);
         }
         // Frame.
@@ -1319,4 +1358,29 @@ impl Legend {
             font::draw_text_halo(img, tx, top - th - 8 * sc, self.scale, &s.label, text, halo);
         }
     }
+}
+
+// f32 floor/ceil/round without a libm call (the default x86-64 target has no SSE4.1 `roundss`);
+// exact for |x| < 2^31.
+#[inline(always)]
+fn ffloor(x: f32) -> f32 {
+    let t = x as i32 as f32;
+    if t > x {
+        t - 1.0
+    } else {
+        t
+    }
+}
+#[inline(always)]
+fn fceil(x: f32) -> f32 {
+    let t = x as i32 as f32;
+    if t < x {
+        t + 1.0
+    } else {
+        t
+    }
+}
+#[inline(always)]
+fn fround(x: f32) -> f32 {
+    ffloor(x + 0.5)
 }

@@ -555,3 +555,81 @@ fn per_corner_uvs_allow_seams() {
     let grey = l.iter().filter(|&&x| x > 60.0 && x < 190.0).count() as f64 / l.len() as f64;
     assert!(grey < 0.2, "{grey}");
 }
+
+#[test]
+fn degenerate_and_far_away_meshes_do_not_break_the_renderer() {
+    // All vertices at one point: nothing visible, no panic.
+    let p = vec![[1.0, 2.0, 3.0]; 3];
+    let r = render(
+        &p,
+        &[[0, 1, 2]],
+        &Style::default(),
+        &opts(32, View::default()),
+    )
+    .unwrap();
+    assert_eq!(r.coverage, 0.0);
+    // A needle far from the origin, and a triangle seen exactly edge-on.
+    let p = vec![
+        [1e8, 1e8, 1e8],
+        [1e8 + 1.0, 1e8, 1e8],
+        [1e8, 1e8 + 1e-6, 1e8],
+    ];
+    render(
+        &p,
+        &[[0, 1, 2]],
+        &Style::default(),
+        &opts(32, View::front()),
+    )
+    .unwrap();
+    let p = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let side = View {
+        eye_direction: [1.0, 0.0, 0.0],
+        ..View::front()
+    };
+    render(&p, &[[0, 1, 2]], &Style::default(), &opts(32, side)).unwrap();
+    // Too many samples is refused, not attempted.
+    let mut o = opts(16384, View::default());
+    o.supersample = 8;
+    let e = render(&p, &[[0, 1, 2]], &Style::default(), &o)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("supersampling"), "{e}");
+    // PNG shortcut.
+    let png = render_png(
+        &p,
+        &[[0, 1, 2]],
+        &Style::default(),
+        &opts(32, View::front()),
+    )
+    .unwrap();
+    assert!(png.starts_with(b"\x89PNG"));
+}
+
+#[test]
+fn face_colours_are_shown_exactly_unlit() {
+    let (p, t, _) = flat_square(2);
+    // Left column of cells red, right column blue.
+    let cols: Vec<Rgb> = t
+        .iter()
+        .map(|f| {
+            let cx = f.iter().map(|&i| p[i as usize][0]).sum::<f64>() / 3.0;
+            if cx < 0.5 {
+                [1.0, 0.0, 0.0]
+            } else {
+                [0.0, 0.0, 1.0]
+            }
+        })
+        .collect();
+    let style = Style {
+        paint: Paint::FaceColors(&cols),
+        ..Default::default()
+    };
+    let r = render(&p, &t, &style, &opts(100, View::front())).unwrap();
+    assert_eq!(r.image.pixel(20, 50), [255, 0, 0, 255]);
+    assert_eq!(r.image.pixel(80, 50), [0, 0, 255, 255]);
+    let bad = Style {
+        paint: Paint::FaceColors(&cols[..3]),
+        ..Default::default()
+    };
+    assert!(render(&p, &t, &bad, &opts(100, View::front())).is_err());
+}

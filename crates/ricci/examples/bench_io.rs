@@ -1,35 +1,14 @@
 //! Benchmark: read + validate + topology of mesh files (issue 2: aim ≥ 2M faces/s).
 //!
 //! `cargo run --release -p ricci --example bench_io [FILES...]`
-//! Without arguments: horse.ply from `$RICCI_MESHES` and a 1M-face torus written by the
-//! writers to a temporary directory in every format. Prints one line per file and stage.
+//! Without arguments: horse.ply from `$RICCI_MESHES` and a generated ≈1M-face torus written
+//! by the writers to a temporary directory in every format. Prints one line per file and stage.
 
+use ricci::mesh::generate::torus;
 use ricci::mesh::io::{self, Encoding, Format};
-use ricci::mesh::{build_surface, topology, Surface};
+use ricci::mesh::{build_surface, topology};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// A torus of revolution (R = 1, r = 0.4) as an n × m grid of quads split in two.
-fn torus(n: usize, m: usize) -> Surface {
-    let mut p = Vec::with_capacity(n * m);
-    for i in 0..n {
-        let u = i as f64 / n as f64 * std::f64::consts::TAU;
-        for j in 0..m {
-            let v = j as f64 / m as f64 * std::f64::consts::TAU;
-            let r = 1.0 + 0.4 * v.cos();
-            p.push([r * u.cos(), r * u.sin(), 0.4 * v.sin()]);
-        }
-    }
-    let id = |i: usize, j: usize| ((i % n) * m + (j % m)) as u32;
-    let mut f = Vec::with_capacity(2 * n * m);
-    for i in 0..n {
-        for j in 0..m {
-            f.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            f.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    Surface::new(p, f).expect("torus grid is a valid mesh")
-}
 
 fn bench(path: &Path) {
     let best = |f: &mut dyn FnMut() -> f64| (0..3).map(|_| f()).fold(f64::INFINITY, f64::min);
@@ -96,7 +75,9 @@ fn main() {
     }
     let dir = std::env::temp_dir().join(format!("ricci-bench-io-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
-    let t = torus(1000, 500);
+    // The project's torus generator (R = 1, r = 0.4): 1000 columns give ≈ 1M faces.
+    let t = torus(1.0, 0.4, 1000).expect("torus");
+    println!("generated torus: {} faces", t.mesh.n_faces());
     for (name, format, enc) in [
         ("torus1M.ply", Format::Ply, Encoding::Binary),
         ("torus1M_ascii.ply", Format::Ply, Encoding::Ascii),

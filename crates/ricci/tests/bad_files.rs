@@ -472,3 +472,39 @@ fn truncations_and_corruptions_never_panic() {
     }
     assert!(runs > 2000);
 }
+
+/// Fuzzing regression (fuzz_stl, crash-480a1253): an ascii STL coordinate of 3.3e110 is a
+/// fine `f64` but overflows the `f32` of binary STL; the binary writer wrote `inf`, which the
+/// reader (rightly) refused. The writer now refuses instead, and ascii STL keeps the value.
+#[test]
+fn fuzz_regression_binary_stl_refuses_coordinates_beyond_f32() {
+    let big = format!("{}0", "3".repeat(110));
+    let mut stl = String::from("solid t\n");
+    let tris = [
+        ["0 0 0", "0 1 0", "1 0 0"],
+        ["0 0 0", "1 0 0", "0 0 1"],
+        ["1 0 0", &format!("0 1 {big}"), "0 0 1"],
+        ["0 1 0", "0 0 0", "0 0 1"],
+    ];
+    for t in tris {
+        stl += " facet normal 0 0 0\n  outer loop\n";
+        for v in t {
+            stl += &format!("   vertex {v}\n");
+        }
+        stl += "  endloop\n endfacet\n";
+    }
+    stl += "endsolid t\n";
+    let (s, _) =
+        ricci::mesh::build_surface(io::parse(stl.as_bytes(), Format::Stl).unwrap()).unwrap();
+    let mut out = Vec::new();
+    let e = io::write_stl(&mut out, &s, true).unwrap_err().to_string();
+    assert_has(&e, &["32-bit", "ascii STL"]);
+    let mut out = Vec::new();
+    io::write_stl(&mut out, &s, false).unwrap();
+    let (back, _) = ricci::mesh::build_surface(io::parse(&out, Format::Stl).unwrap()).unwrap();
+    assert!(back
+        .positions
+        .iter()
+        .flatten()
+        .any(|&x| x == 3.333333333333333e110));
+}

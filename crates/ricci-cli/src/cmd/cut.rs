@@ -7,8 +7,9 @@
 //! the fundamental polygon as a named group with an `l` polyline over the cut mesh's boundary
 //! vertices (`g a1`, `g b1`, `g a1^-1`, …; readers that ignore `l` lines still see the disk).
 //! METRIC.json (from `ricci flow`) gives `geometry` and per-edge `lengths`, either as
-//! `[[u, v, length], …]`, as `[{"u": …, "v": …, "length": …}, …]`, or as a list of numbers
-//! with a parallel list `edges: [[u, v], …]`; its lengths are used for the loops and the
+//! a list of numbers with a parallel list `edge_vertices: [[u, v], …]` (what `ricci flow`
+//! writes), as `[[u, v, length], …]`, or as `[{"u": …, "v": …, "length": …}, …]`; its lengths
+//! are used for the loops and the
 //! refinement. Without it the Euclidean lengths of the positions are used.
 
 use crate::util::{print_json, write_atomic, UsageError};
@@ -63,7 +64,10 @@ fn read_metric(path: &Path, s: &Surface) -> anyhow::Result<(Geometry, Vec<f64>)>
         .get("lengths")
         .and_then(|l| l.as_array())
         .ok_or_else(|| anyhow::anyhow!("{name}: no \"lengths\" array"))?;
-    let edges = v.get("edges").and_then(|e| e.as_array());
+    let edges = v
+        .get("edge_vertices")
+        .and_then(|e| e.as_array())
+        .or_else(|| v.get("edges").and_then(|e| e.as_array()));
     let m = &s.mesh;
     let mut out = vec![f64::NAN; m.n_edges()];
     for (i, item) in lens.iter().enumerate() {
@@ -78,7 +82,7 @@ fn read_metric(path: &Path, s: &Surface) -> anyhow::Result<(Geometry, Vec<f64>)>
                 .and_then(|e| e.get(i))
                 .and_then(|e| e.as_array())
                 .ok_or_else(|| {
-                    anyhow::anyhow!("{name}: lengths[{i}] has no vertex pair in \"edges\"")
+                    anyhow::anyhow!("{name}: lengths[{i}] has no vertex pair in \"edge_vertices\"")
                 })?;
             let f = |k: usize| e.get(k).and_then(|x| x.as_u64());
             match (f(0), f(1)) {

@@ -1,1 +1,410 @@
-//! Target curvatures and Ricci flow solvers (paper 001 §V, paper 000 §4 Step 3).
+//! Target curvatures and Ricci flow solvers (paper 001 §V, paper 000 §4 Step 3, paper 002
+//! §4.3, §6.2.1, §7.1; DESIGN.md §3).
+//!
+//! [`ricci_flow`] takes connectivity and Euclidean edge lengths (never positions), builds the
+//! initial conformal structure of the chosen scheme ([`crate::metric::conformal`]), resolves and
+//! checks the target ([`target`]) and runs Newton's method or the gradient flow ([`newton`]).
+//! The result carries per-vertex `u`, `K`, `K̄`, per-edge final lengths, the residual history
+//! and an honest `converged` flag.
+//!
+//! Conventions of the result:
+//! * Euclidean metrics are determined up to scale; the result is scaled so its area equals the
+//!   area of the input mesh (when no vertex is held fixed).
+//! * Hyperbolic and spherical metrics read the input lengths scaled by `input_scale` (reported;
+//!   by default the factor that makes the Euclidean area equal the area the target asks for).
+//! * Genus-0 closed surfaces in S²: Newton's method on the spherical energy first; if it does
+//!   not converge, the robust route of [`sphere`] (puncture, flat disk with a round boundary,
+//!   stereographic projection, Möbius centring, spherical Newton polish). `route` says which.
+
+#![allow(clippy::needless_range_loop)]
+
+pub mod linear;
+pub mod newton;
+pub mod sphere;
+pub mod target;
+
+pub use target::{separated_vertices, Target, TargetSpec};
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use crate::metric::{euler_characteristic, ConformalStructure, Evaluator, Geometry, Scheme};
+use crate::progress::Progress;
+use serde::Serialize;
+use std::f64::consts::PI;
+use std::fmt;
+use std::str::FromStr;
+use std::time::Instant;
+
+/// The optimizer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Solver {
+    Newton,
+    Gradient,
+}
+
+impl Solver {
+    pub fn name(self) -> &'static str {
+        match self {
+            Solver::Newton => "newton",
+            Solver::Gradient => "gradient",
+        }
+    }
+}
+
+impl fmt::Display for Solver {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Solver {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "newton" => Ok(Solver::Newton),
+            "gradient" | "gradient-descent" | "flow" => Ok(Solver::Gradient),
+            _ => Err(format!(
+                "unknown solver '{s}' (expected newton or gradient)"
+            )),
+        }
+    }
+}
+
+/// How genus-0 closed surfaces reach the sphere.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SphereRoute {
+    /// Spherical Newton first, the puncture route if it fails.
+    Auto,
+    /// Spherical Newton only.
+    Newton,
+    /// The puncture route directly.
+    Puncture,
+}
+
+/// Options of [`ricci_flow`].
+#[derive(Debug, Clone)]
+pub struct FlowOptions {
+    pub geometry: Geometry,
+    pub scheme: Scheme,
+    pub target: TargetSpec,
+    pub solver: Solver,
+    /// Stop when max |K − K̄| ≤ tolerance.
+    pub tolerance: f64,
+    /// Iteration limit (default 30 for Newton, 200 000 for the gradient flow).
+    pub max_iterations: Option<usize>,
+    /// Step ε of the gradient flow (paper 001: "no greater than 0.05").
+    pub gradient_step: f64,
+    /// Scale applied to the input lengths in H² and S² (`None`: automatic, see module docs).
+    pub input_scale: Option<f64>,
+    pub sphere_route: SphereRoute,
+}
+
+impl Default for FlowOptions {
+    fn default() -> Self {
+        FlowOptions {
+            geometry: Geometry::Euclidean,
+            scheme: Scheme::Thurston,
+            target: TargetSpec::Uniform,
+            solver: Solver::Newton,
+            tolerance: 1e-10,
+            max_iterations: None,
+            gradient_step: 0.05,
+            input_scale: None,
+            sphere_route: SphereRoute::Auto,
+        }
+    }
+}
+
+/// One line of the residual history.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct IterationRecord {
+    pub iteration: usize,
+    pub max_curvature_error: f64,
+    /// Convex Ricci energy relative to the start (`None` when the target moves with the
+    /// metric or the energy is not tracked).
+    pub energy: Option<f64>,
+    /// Largest |Δu| of the step that led here.
+    pub step: f64,
+    pub seconds: f64,
+}
+
+/// The outcome of a flow.
+#[derive(Debug, Clone, Serialize)]
+pub struct FlowResult {
+    pub geometry: Geometry,
+    pub scheme: Scheme,
+    pub solver: Solver,
+    /// "newton", "gradient", or for the sphere "newton" / "puncture" (the robust route).
+    pub route: String,
+    pub target_description: String,
+    /// Final variables per vertex (circle packings: `log γ`, `log tanh(γ/2)`, `log tan(γ/2)`;
+    /// vertex scaling: the log conformal factor).
+    pub u: Vec<f64>,
+    /// Final curvature per vertex.
+    pub curvature: Vec<f64>,
+    /// Target curvature per vertex (meaningless where `fixed`).
+    pub target: Vec<f64>,
+    /// Vertices whose `u` was held at its initial value (free boundary).
+    pub fixed: Vec<bool>,
+    /// Final edge lengths by edge id (background geometry).
+    pub lengths: Vec<f64>,
+    pub iterations: usize,
+    pub history: Vec<IterationRecord>,
+    pub converged: bool,
+    pub tolerance: f64,
+    pub max_curvature_error: f64,
+    /// |Σ K + λ·Area − 2πχ| of the final metric.
+    pub gauss_bonnet_error: f64,
+    /// Background area of the final metric.
+    pub area: f64,
+    pub input_scale: f64,
+    /// Thurston: edges whose intersection angle was clamped into [0, π/2].
+    pub clamped_edges: usize,
+    /// Relative difference of the initial scheme lengths from the (scaled) input lengths.
+    pub initial_length_error: f64,
+    /// Faces violating a triangle inequality in the final metric (vertex scaling, inversive).
+    pub degenerate_faces: usize,
+    /// Vertices pinned to remove the E² scale freedom.
+    pub pinned: Vec<u32>,
+    pub seconds: f64,
+    pub notes: Vec<String>,
+}
+
+/// Run discrete Ricci flow on a connected mesh with Euclidean edge `lengths` (by edge id).
+pub fn ricci_flow(
+    mesh: &Mesh,
+    lengths: &[f64],
+    options: &FlowOptions,
+    progress: &mut dyn Progress,
+) -> Result<FlowResult> {
+    let t0 = Instant::now();
+    let topo = crate::mesh::topology(mesh);
+    if topo.components.len() != 1 {
+        return Err(Error::topology(format!(
+            "Ricci flow needs a connected mesh; this one has {} components",
+            topo.components.len()
+        )));
+    }
+    if lengths.len() != mesh.n_edges() {
+        return Err(Error::input(format!(
+            "{} edge lengths given for a mesh with {} edges",
+            lengths.len(),
+            mesh.n_edges()
+        )));
+    }
+    if options.tolerance.is_nan() || options.tolerance <= 0.0 {
+        return Err(Error::input(format!(
+            "tolerance {} must be positive",
+            options.tolerance
+        )));
+    }
+    let geometry = options.geometry;
+    let chi = euler_characteristic(mesh);
+    let mut target = target::resolve(mesh, geometry, &options.target)?;
+    // Input scale.
+    let euclid_area = crate::metric::total_area(mesh, Geometry::Euclidean, lengths);
+    let scale = match (options.input_scale, geometry) {
+        (Some(s), _) => s,
+        (None, Geometry::Euclidean) => 1.0,
+        (None, _) => {
+            let sum: f64 = target.curvature.iter().sum();
+            let want = (geometry.curvature() * (2.0 * PI * chi as f64 - sum)).max(0.0);
+            let has_fixed = target.fixed.iter().any(|&f| f);
+            if want > 0.0 && !has_fixed && euclid_area > 0.0 {
+                (want / euclid_area).sqrt()
+            } else {
+                // Free boundaries in H²/S²: mean edge length 0.1.
+                let mean = lengths.iter().sum::<f64>() / lengths.len().max(1) as f64;
+                0.1 / mean
+            }
+        }
+    };
+    let structure = ConformalStructure::new(mesh, lengths, geometry, options.scheme, scale)?;
+    let mut ev = Evaluator::new(mesh, structure);
+    let u0 = ev.structure.u0.clone();
+    if !ev.evaluate(&u0) {
+        return Err(Error::numerical(
+            "the initial metric lies outside the domain of the scheme",
+        ));
+    }
+    if target.is_dynamic() {
+        target::set_round_totals(
+            mesh,
+            &mut target,
+            &ev.ws.lengths,
+            &ev.ws.dlengths,
+            &ev.data.edges,
+        );
+    }
+    target::check_gauss_bonnet(mesh, geometry, &target)?;
+    let phi = ev
+        .structure
+        .intersection_angles()
+        .unwrap_or_else(|| vec![0.0; mesh.n_edges()]);
+    target::check_chow_luo(mesh, geometry, &target, &phi)?;
+
+    let has_fixed = target
+        .fixed
+        .iter()
+        .enumerate()
+        .any(|(v, &f)| f && !mesh.is_isolated(v as u32));
+    let mut pinned = Vec::new();
+    if geometry == Geometry::Euclidean && !has_fixed {
+        // Pin the interior vertex with the largest valence (ties: smallest id).
+        let v = (0..mesh.n_vertices() as u32)
+            .filter(|&v| !mesh.is_isolated(v))
+            .max_by(|&a, &b| {
+                let ka = (!mesh.is_boundary_vertex(a), mesh.valence(a));
+                let kb = (!mesh.is_boundary_vertex(b), mesh.valence(b));
+                ka.cmp(&kb).then(b.cmp(&a))
+            });
+        if let Some(v) = v {
+            pinned.push(v);
+        }
+    }
+    let line_search = if target.is_dynamic() || geometry == Geometry::Spherical {
+        newton::LineSearch::Residual
+    } else {
+        newton::LineSearch::Energy
+    };
+    let max_it = options.max_iterations.unwrap_or(match options.solver {
+        Solver::Newton => 30,
+        Solver::Gradient => 200_000,
+    });
+    let mut route = options.solver.name().to_string();
+    let mut notes = Vec::new();
+    if ev.structure.clamped_edges > 0 {
+        notes.push(format!(
+            "{} edge(s) had their Thurston intersection angle clamped into [0, π/2]; the initial \
+             metric differs from the input there",
+            ev.structure.clamped_edges
+        ));
+    }
+    let outcome = match options.solver {
+        Solver::Gradient => newton::gradient_flow(
+            &mut ev,
+            &mut target,
+            u0.clone(),
+            &newton::GradientSettings {
+                tolerance: options.tolerance,
+                max_iterations: max_it,
+                step: options.gradient_step,
+                keep_mean: geometry == Geometry::Euclidean && !has_fixed,
+            },
+            progress,
+        )?,
+        Solver::Newton => {
+            let settings = newton::NewtonSettings {
+                tolerance: options.tolerance,
+                max_iterations: max_it,
+                line_search,
+                pinned: pinned.clone(),
+                indefinite: geometry == Geometry::Spherical,
+            };
+            let sphere_case = geometry == Geometry::Spherical && chi == 2 && !has_fixed;
+            if sphere_case && options.sphere_route == SphereRoute::Puncture {
+                route = "puncture".into();
+                sphere::puncture_route(
+                    mesh,
+                    lengths,
+                    &mut ev,
+                    &mut target,
+                    &settings,
+                    options,
+                    progress,
+                )?
+            } else {
+                let out = newton::newton(&mut ev, &mut target, u0.clone(), &settings, progress)?;
+                if sphere_case && !out.converged && options.sphere_route == SphereRoute::Auto {
+                    notes.push(format!(
+                        "spherical Newton did not converge (max |K − K̄| = {:.3e} after {} \
+                         iterations); switched to the puncture route",
+                        out.max_error, out.iterations
+                    ));
+                    notes.extend(out.notes.iter().cloned());
+                    route = "puncture".into();
+                    sphere::puncture_route(
+                        mesh,
+                        lengths,
+                        &mut ev,
+                        &mut target,
+                        &settings,
+                        options,
+                        progress,
+                    )?
+                } else {
+                    out
+                }
+            }
+        }
+    };
+    notes.extend(outcome.notes.iter().cloned());
+    let mut u = outcome.u;
+    // Final evaluation and normalization.
+    if !ev.evaluate(&u) {
+        return Err(Error::numerical(
+            "the final metric lies outside the domain of the scheme",
+        ));
+    }
+    if geometry == Geometry::Euclidean && !has_fixed && ev.ws.area > 0.0 && euclid_area > 0.0 {
+        // Scale to the input area: lengths scale by e^c when every u moves by c.
+        let c = 0.5 * (euclid_area / ev.ws.area).ln();
+        for x in u.iter_mut() {
+            *x += c;
+        }
+        ev.evaluate(&u);
+    }
+    if target.is_dynamic() {
+        target.update_round(&ev.ws.lengths, &ev.ws.dlengths, &ev.data.edges);
+    }
+    let max_err = newton::max_error(&ev.ws.curvature, &target);
+    let ksum: f64 = ev.ws.curvature.iter().sum();
+    let gb = (ksum + geometry.curvature() * ev.ws.area - 2.0 * PI * chi as f64).abs();
+    let converged = outcome.converged && max_err <= options.tolerance;
+    if !converged && (target.is_dynamic() || matches!(options.target, TargetSpec::GeodesicBoundary))
+    {
+        let ears = (0..mesh.n_vertices() as u32)
+            .filter(|&v| mesh.is_boundary_vertex(v) && mesh.vertex_faces(v).count() == 1)
+            .count();
+        if ears > 0 {
+            notes.push(format!(
+                "{ears} boundary vertices have a single face (ears): a round or geodesic \
+                 boundary needs their one corner to open to nearly π, which degenerates the \
+                 triangle; split the edges opposite the ears first"
+            ));
+        }
+    }
+    if outcome.converged && !converged {
+        notes.push(format!(
+            "after rescaling, max |K − K̄| = {max_err:.3e} exceeds the tolerance"
+        ));
+    }
+    Ok(FlowResult {
+        geometry,
+        scheme: options.scheme,
+        solver: options.solver,
+        route,
+        target_description: target.description.clone(),
+        u,
+        curvature: ev.ws.curvature.clone(),
+        target: target.curvature.clone(),
+        fixed: target.fixed.clone(),
+        lengths: ev.ws.lengths.clone(),
+        iterations: outcome.iterations,
+        history: outcome.history,
+        converged,
+        tolerance: options.tolerance,
+        max_curvature_error: max_err,
+        gauss_bonnet_error: gb,
+        area: ev.ws.area,
+        input_scale: scale,
+        clamped_edges: ev.structure.clamped_edges,
+        initial_length_error: ev.structure.initial_length_error,
+        degenerate_faces: ev.ws.degenerate_faces,
+        pinned,
+        seconds: t0.elapsed().as_secs_f64(),
+        notes,
+    })
+}

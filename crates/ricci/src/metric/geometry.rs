@@ -124,6 +124,46 @@ pub trait Background: Copy + Send + Sync + 'static {
 
     /// Area of the triangle with sides `a, b, c` (Heron; angle defect / excess).
     fn area(a: f64, b: f64, c: f64) -> f64;
+
+    // ----- conformal structure helpers (paper 001 eq. 9, 12; DESIGN.md §3) -----
+
+    /// Circle radius γ of the circle-packing variable `u` (paper 001 eq. 9): E² `u = log γ`,
+    /// H² `u = log tanh(γ/2)` (defined for `u < 0` only; NaN otherwise), S² `u = log tan(γ/2)`.
+    fn radius_of_variable(u: f64) -> f64;
+
+    /// Inverse of [`Background::radius_of_variable`].
+    fn variable_of_radius(gamma: f64) -> f64;
+
+    /// `s(l/2)` of a length `l` (the "half-length sine": `l/2`, `sinh(l/2)`, `sin(l/2)`).
+    #[inline]
+    fn half_sine(l: f64) -> f64 {
+        Self::s(0.5 * l)
+    }
+
+    /// Inverse of [`Background::half_sine`]: the length `l` with `s(l/2) = x` (NaN when no
+    /// such length exists, i.e. `x > 1` on the sphere).
+    fn length_of_half_sine(x: f64) -> f64;
+
+    /// `s(l/2) / c(l/2)`: the derivative `dl/du_i` of vertex scaling
+    /// `s(l/2) = e^{(u_i+u_j)/2} s(l⁰/2)`.
+    #[inline]
+    fn half_tangent(l: f64) -> f64 {
+        Self::s(0.5 * l) / Self::c(0.5 * l)
+    }
+
+    /// Length of the edge between circles of radii `gi, gj` meeting with "cosine" `eta`
+    /// (`cos φ` for Thurston packings, the inversive distance `I` for inversive packings), by
+    /// the cosine law of paper 001 eq. 12 written without cancellation:
+    /// `s(l/2)² = s((γi − γj)/2)² + ½ s(γi) s(γj) (1 + η)`. NaN when no such length exists.
+    fn circle_packing_length(gi: f64, gj: f64, eta: f64) -> f64;
+
+    /// Inverse of [`Background::circle_packing_length`] in `eta`: the coefficient that makes
+    /// circles of radii `gi, gj` produce length `l`.
+    fn circle_packing_coefficient(gi: f64, gj: f64, l: f64) -> f64 {
+        let x = Self::half_sine(l);
+        let d = Self::s(0.5 * (gi - gj));
+        2.0 * (x * x - d * d) / (Self::s(gi) * Self::s(gj)) - 1.0
+    }
 }
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -152,6 +192,24 @@ impl Background for Euclidean {
         // a² = (b − c)² + 4bc sin²(θ/2): no cancellation for small θ.
         let h = (0.5 * theta).sin();
         ((b - c) * (b - c) + 4.0 * b * c * h * h).max(0.0).sqrt()
+    }
+    fn radius_of_variable(u: f64) -> f64 {
+        u.exp()
+    }
+    fn variable_of_radius(gamma: f64) -> f64 {
+        gamma.ln()
+    }
+    fn length_of_half_sine(x: f64) -> f64 {
+        2.0 * x
+    }
+    fn circle_packing_length(gi: f64, gj: f64, eta: f64) -> f64 {
+        let d = gi - gj;
+        let l2 = d * d + 2.0 * gi * gj * (1.0 + eta);
+        if l2 >= 0.0 {
+            l2.sqrt()
+        } else {
+            f64::NAN
+        }
     }
     fn area(a: f64, b: f64, c: f64) -> f64 {
         // Kahan's stable Heron formula (sides sorted a ≥ b ≥ c).
@@ -187,6 +245,30 @@ impl Background for Hyperbolic {
     fn area(a: f64, b: f64, c: f64) -> f64 {
         (PI - Self::angle(a, b, c) - Self::angle(b, c, a) - Self::angle(c, a, b)).max(0.0)
     }
+    fn radius_of_variable(u: f64) -> f64 {
+        // γ = 2 atanh(e^u) = log((1 + e^u) / (1 − e^u)).
+        if u < 0.0 {
+            let t = u.exp();
+            (t.ln_1p() - (-t).ln_1p()).max(0.0)
+        } else {
+            f64::NAN
+        }
+    }
+    fn variable_of_radius(gamma: f64) -> f64 {
+        (0.5 * gamma).tanh().ln()
+    }
+    fn length_of_half_sine(x: f64) -> f64 {
+        2.0 * x.asinh()
+    }
+    fn circle_packing_length(gi: f64, gj: f64, eta: f64) -> f64 {
+        let d = (0.5 * (gi - gj)).sinh();
+        let x2 = d * d + 0.5 * gi.sinh() * gj.sinh() * (1.0 + eta);
+        if x2 >= 0.0 {
+            2.0 * x2.sqrt().asinh()
+        } else {
+            f64::NAN
+        }
+    }
 }
 
 impl Background for Spherical {
@@ -212,6 +294,33 @@ impl Background for Spherical {
     }
     fn area(a: f64, b: f64, c: f64) -> f64 {
         (Self::angle(a, b, c) + Self::angle(b, c, a) + Self::angle(c, a, b) - PI).max(0.0)
+    }
+    fn radius_of_variable(u: f64) -> f64 {
+        2.0 * u.exp().atan()
+    }
+    fn variable_of_radius(gamma: f64) -> f64 {
+        (0.5 * gamma).tan().ln()
+    }
+    fn length_of_half_sine(x: f64) -> f64 {
+        if x <= 1.0 {
+            2.0 * x.asin()
+        } else {
+            f64::NAN
+        }
+    }
+    fn circle_packing_length(gi: f64, gj: f64, eta: f64) -> f64 {
+        // sin²(l/2) = sin²((γi−γj)/2) + ½ sin γi sin γj (1 + η),
+        // cos²(l/2) = cos²((γi+γj)/2) + ½ sin γi sin γj (1 − η): atan2 keeps l accurate near 0 and π.
+        let p = 0.5 * gi.sin() * gj.sin();
+        let d = (0.5 * (gi - gj)).sin();
+        let e = (0.5 * (gi + gj)).cos();
+        let x2 = d * d + p * (1.0 + eta);
+        let y2 = e * e + p * (1.0 - eta);
+        if x2 >= 0.0 && y2 >= 0.0 {
+            2.0 * x2.sqrt().atan2(y2.sqrt())
+        } else {
+            f64::NAN
+        }
     }
 }
 

@@ -8,7 +8,7 @@
 //! | generator | resolution means | faces | min angle at the default |
 //! |---|---|---|---|
 //! | [`icosphere`]`(s)` | subdivision levels `s` (default 3) | `20·4^s` | 54° |
-//! | [`torus`]`(R, r, n)` | segments around the major circle (default 48) | `2 n n_w` | 56° (R = 1, r = 0.5) |
+//! | [`torus`](fn@torus)`(R, r, n)` | segments around the major circle (default 48) | `2 n n_w` | 56° (R = 1, r = 0.5) |
 //! | [`disk`]`(n)` | boundary segments (default 64) | ≈ `0.18 n²` | 37° |
 //! | [`annulus`]`(r_in, r_out, n)` | segments on the outer circle (default 64) | ≈ `0.18 n² (1 − r_in²/r_out²)` | 37° |
 //! | [`pair_of_pants`]`(n)` | segments on the outer circle (default 64) | ≈ `0.16 n²` | 37° |

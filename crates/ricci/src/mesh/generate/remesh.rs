@@ -697,3 +697,129 @@ fn optimize_vertices<F: Implicit>(m: &mut TriMesh, field: &F, l: f64, max_step: 
         m.pos[v as usize] = p;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generate::icosphere;
+
+    /// Twins are an involution between opposite half-edges, every live vertex has one closed
+    /// fan whose size is its stored valence, and `vhe` leaves its vertex.
+    fn check_invariants(m: &TriMesh) -> (usize, usize, usize) {
+        let mut ring = Vec::new();
+        let (mut v, mut e2, mut f) = (0, 0, 0);
+        for face in m.live_faces() {
+            f += 1;
+            for h in 3 * face..3 * face + 3 {
+                let t = m.twin[h as usize];
+                assert!(!m.fdead[t as usize / 3], "twin of {h} in a dead face");
+                assert_eq!(m.twin[t as usize], h);
+                assert_eq!(m.org(t), m.dst(h));
+                assert_eq!(m.dst(t), m.org(h));
+                e2 += 1;
+            }
+        }
+        for x in 0..m.pos.len() as u32 {
+            if m.vhe[x as usize] == NONE {
+                continue;
+            }
+            v += 1;
+            assert_eq!(m.org(m.vhe[x as usize]), x);
+            m.ring(x, &mut ring);
+            assert_eq!(ring.len(), m.valence[x as usize] as usize, "vertex {x}");
+            assert!(ring.iter().all(|&h| m.org(h) == x));
+        }
+        (v, e2 / 2, f)
+    }
+
+    fn sphere_mesh() -> TriMesh {
+        let s = icosphere(2).unwrap();
+        TriMesh::new(s.positions, s.mesh.faces().to_vec()).unwrap()
+    }
+
+    #[test]
+    fn split_flip_collapse_keep_the_mesh_valid_and_chi() {
+        let mut m = sphere_mesh();
+        let (v0, e0, f0) = check_invariants(&m);
+        assert_eq!(v0 as i64 - e0 as i64 + f0 as i64, 2);
+        let mut ring = Vec::new();
+        // Deterministic pseudo-random sequence of operations.
+        let mut state = 12345u64;
+        let mut rand = |n: usize| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) as usize % n
+        };
+        let (mut splits, mut flips, mut collapses) = (0, 0, 0);
+        for step in 0..600 {
+            let live: Vec<u32> = m.live_faces().collect();
+            let h = 3 * live[rand(live.len())] + rand(3) as u32;
+            match step % 3 {
+                0 => {
+                    let p = lerp(m.p(m.org(h)), m.p(m.dst(h)), 0.5);
+                    m.split(h, p);
+                    splits += 1;
+                }
+                1 => {
+                    let [a, b, c, d] = m.quad(h);
+                    if m.valence[a as usize] > 3
+                        && m.valence[b as usize] > 3
+                        && m.find_he(c, d).is_none()
+                    {
+                        m.flip(h);
+                        flips += 1;
+                    }
+                }
+                _ => {
+                    if m.link_condition(h, &mut ring) {
+                        let p = lerp(m.p(m.org(h)), m.p(m.dst(h)), 0.5);
+                        m.collapse(h, p, &mut ring);
+                        collapses += 1;
+                    }
+                }
+            }
+            let (v, e, f) = check_invariants(&m);
+            assert_eq!(
+                v as i64 - e as i64 + f as i64,
+                2,
+                "χ changed at step {step}"
+            );
+            assert_eq!(f, m.n_faces());
+        }
+        assert!(splits > 100 && flips > 50 && collapses > 50);
+        let (pos, faces) = m.into_parts();
+        let s = crate::mesh::Surface::new(pos, faces).unwrap();
+        assert_eq!(crate::mesh::topology(&s.mesh).components[0].genus, 0);
+    }
+
+    #[test]
+    fn link_condition_refuses_a_collapse_that_pinches() {
+        // Triangular bipyramid: equator 0, 1, 2, apexes 3 (top) and 4 (bottom). Collapsing an
+        // equator edge would glue the two apex fans along the third equator vertex (three
+        // common neighbours): refused. Collapsing an apex edge gives a tetrahedron: allowed.
+        let pos = vec![
+            [1.0, 0.0, 0.0],
+            [-0.5, 0.8, 0.0],
+            [-0.5, -0.8, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let faces = vec![
+            [0, 1, 3],
+            [1, 2, 3],
+            [2, 0, 3],
+            [1, 0, 4],
+            [2, 1, 4],
+            [0, 2, 4],
+        ];
+        let m = TriMesh::new(pos, faces).unwrap();
+        let mut ring = Vec::new();
+        for h in 0..18 {
+            let equator = m.org(h) < 3 && m.dst(h) < 3;
+            assert_eq!(m.link_condition(h, &mut ring), !equator, "half-edge {h}");
+        }
+        // An open mesh is refused by the constructor.
+        assert!(TriMesh::new(vec![[0.0; 3]; 3], vec![[0, 1, 2]]).is_err());
+    }
+}

@@ -11,11 +11,44 @@ use super::text::{self, at_byte, at_line, parse_f64, show, strip_comment, tokens
 use crate::error::{Error, Result};
 use crate::mesh::{PolygonSoup, Surface};
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 use std::io::Write;
+
+/// A fast hasher for bit patterns of coordinates: multiply–rotate while writing, then the
+/// MurmurHash3 finaliser so that entropy in the high bits (exponents, leading mantissa
+/// bits of "round" numbers) reaches the low bits the table indexes with.
+#[derive(Default)]
+struct BitsHasher(u64);
+
+impl Hasher for BitsHasher {
+    #[inline]
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+    #[inline]
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(23) ^ x).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    }
+    #[inline]
+    fn write_usize(&mut self, x: usize) {
+        self.write_u64(x as u64);
+    }
+    #[inline]
+    fn finish(&self) -> u64 {
+        let mut h = self.0;
+        h ^= h >> 33;
+        h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+        h ^= h >> 33;
+        h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+        h ^ (h >> 33)
+    }
+}
 
 /// Welds corners by exact position.
 struct Welder {
-    index: HashMap<[u64; 3], u32>,
+    index: HashMap<[u64; 3], u32, BuildHasherDefault<BitsHasher>>,
     positions: Vec<[f64; 3]>,
     lines: Vec<usize>,
 }
@@ -23,7 +56,7 @@ struct Welder {
 impl Welder {
     fn new(capacity: usize) -> Self {
         Welder {
-            index: HashMap::with_capacity(capacity),
+            index: HashMap::with_capacity_and_hasher(capacity, Default::default()),
             positions: Vec::with_capacity(capacity),
             lines: Vec::new(),
         }
@@ -230,6 +263,16 @@ pub fn write_stl<W: Write>(w: W, s: &Surface, binary: bool) -> Result<()> {
     if binary {
         let nf = u32::try_from(s.mesh.n_faces())
             .map_err(|_| Error::input("too many faces for a binary STL file"))?;
+        // Binary STL stores f32: a larger coordinate would become infinite (found by fuzzing).
+        if let Some((v, x)) = s.positions.iter().enumerate().find_map(|(v, p)| {
+            p.iter()
+                .find(|x| !(**x as f32).is_finite())
+                .map(|&x| (v, x))
+        }) {
+            return Err(Error::input(format!(
+                "vertex {v} has the coordinate {x:e}, beyond the 32-bit floats of binary STL; write ascii STL or another format"
+            )));
+        }
         let mut header = [b' '; 80];
         let title = b"binary STL written by ricci";
         header[..title.len()].copy_from_slice(title);

@@ -1,7 +1,16 @@
-//! Scratch: write a few pictures to look at (dev aid).
+//! A gallery of what ricci-render draws, written to a folder (default: the temp directory):
+//! solid, checkerboard, circles, scalar field with legend and isolines, zebra with wireframe
+//! and a polyline, a Poincaré-disk layout with generator sides and a tiling copy, a
+//! histogram, a log-scale line plot and a glTF file.
+//!
+//! `cargo run --release -p ricci-render --example gallery -- OUT_DIR`
 use ricci_render::*;
 fn main() {
-    let out = std::path::PathBuf::from(std::env::args().nth(1).unwrap_or("/tmp".into()));
+    let out = std::path::PathBuf::from(
+        std::env::args()
+            .nth(1)
+            .unwrap_or_else(|| std::env::temp_dir().display().to_string()),
+    );
     let t = shapes::torus(2.0, 0.8, 80, 40);
     let uv: Vec<[f64; 2]> = (0..t.positions.len())
         .map(|k| [(k / 40) as f64 / 80.0, (k % 40) as f64 / 40.0])
@@ -77,9 +86,20 @@ fn main() {
     .unwrap();
     std::fs::write(out.join("circles.png"), r.png().unwrap()).unwrap();
     plots(&out);
+    let glb = gltf::glb(
+        &t.positions,
+        &t.triangles,
+        &gltf::GlbOptions {
+            uvs: Some(render::Uvs::PerVertex(&uv)),
+            checker_frequency: Some(8.0),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    std::fs::write(out.join("torus.glb"), glb).unwrap();
+    println!("pictures written to {}", out.display());
 }
 
-#[allow(dead_code)]
 fn plots(out: &std::path::Path) {
     use ricci_render::plot::*;
     let n = 48;

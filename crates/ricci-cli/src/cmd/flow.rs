@@ -1,0 +1,202 @@
+//! `ricci flow MESH --geometry … --scheme … --target … --solver … --tolerance T
+//! [--max-iterations N] [--out METRIC.json] [--json]`: discrete Ricci flow (`ricci::flow`).
+//!
+//! METRIC.json holds the final discrete metric: geometry, scheme, per-vertex `u`, `curvature`
+//! and `target_curvature` (null where the vertex was held fixed), and per-edge `lengths` with
+//! `edge_vertices` (edge `i` joins `edge_vertices[i]`), so other tools can match edges.
+
+use crate::util::{print_json, write_atomic};
+use indicatif::{ProgressBar, ProgressStyle};
+use ricci::flow::{ricci_flow, FlowOptions, FlowResult, Solver, SphereRoute, TargetSpec};
+use ricci::mesh::io::read_surface;
+use ricci::metric::{Geometry, Scheme};
+use serde_json::json;
+use std::path::PathBuf;
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum Route {
+    Auto,
+    Newton,
+    Puncture,
+}
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Mesh file (OBJ, OFF, PLY, STL); one connected component.
+    pub mesh: PathBuf,
+    /// Background geometry: euclidean, hyperbolic or spherical.
+    #[arg(long, default_value = "euclidean")]
+    pub geometry: Geometry,
+    /// Discrete conformal scheme: thurston, tangential, inversive or yamabe.
+    #[arg(long, default_value = "thurston")]
+    pub scheme: Scheme,
+    /// Target curvature: uniform, cone:V=K,..., single-cone:V, free-boundary, round-boundary,
+    /// geodesic-boundary or file:PATH (K in radians; -2pi, pi/2 accepted).
+    #[arg(long, default_value = "uniform")]
+    pub target: TargetSpec,
+    /// Optimizer: newton or gradient (the papers' flow u += ε(K̄ − K)).
+    #[arg(long, default_value = "newton")]
+    pub solver: Solver,
+    /// Stop when max |K − K̄| is at most this.
+    #[arg(long, default_value_t = 1e-10)]
+    pub tolerance: f64,
+    /// Iteration limit (default 30 for Newton, 200000 for the gradient flow).
+    #[arg(long)]
+    pub max_iterations: Option<usize>,
+    /// Step ε of the gradient flow.
+    #[arg(long, default_value_t = 0.05)]
+    pub step: f64,
+    /// Factor applied to the input lengths in H² and S² (default: match the target's area).
+    #[arg(long)]
+    pub input_scale: Option<f64>,
+    /// Genus-0 surfaces to the sphere: spherical Newton, the puncture route, or Newton then
+    /// the puncture route if Newton fails.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub sphere_route: Route,
+    /// Write the final metric (per-vertex u, K, K̄; per-edge lengths) to this JSON file.
+    #[arg(long, short = 'o')]
+    pub out: Option<PathBuf>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn metric_json(r: &FlowResult, mesh: &ricci::mesh::Mesh, source: &str) -> serde_json::Value {
+    let target: Vec<serde_json::Value> = r
+        .target
+        .iter()
+        .zip(&r.fixed)
+        .map(|(&t, &f)| if f { serde_json::Value::Null } else { json!(t) })
+        .collect();
+    let edge_vertices: Vec<[u32; 2]> = (0..mesh.n_edges() as u32)
+        .map(|e| mesh.edge_vertices(e))
+        .collect();
+    json!({
+        "mesh": source,
+        "geometry": r.geometry,
+        "scheme": r.scheme,
+        "solver": r.solver,
+        "route": r.route,
+        "target": r.target_description,
+        "converged": r.converged,
+        "max_curvature_error": r.max_curvature_error,
+        "gauss_bonnet_error": r.gauss_bonnet_error,
+        "input_scale": r.input_scale,
+        "area": r.area,
+        "vertices": mesh.n_vertices(),
+        "edges": mesh.n_edges(),
+        "u": r.u,
+        "curvature": r.curvature,
+        "target_curvature": target,
+        "edge_vertices": edge_vertices,
+        "lengths": r.lengths,
+    })
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let (surface, _report) = read_surface(&a.mesh)?;
+    let options = FlowOptions {
+        geometry: a.geometry,
+        scheme: a.scheme,
+        target: a.target.clone(),
+        solver: a.solver,
+        tolerance: a.tolerance,
+        max_iterations: a.max_iterations,
+        gradient_step: a.step,
+        input_scale: a.input_scale,
+        sphere_route: match a.sphere_route {
+            Route::Auto => SphereRoute::Auto,
+            Route::Newton => SphereRoute::Newton,
+            Route::Puncture => SphereRoute::Puncture,
+        },
+    };
+    let bar = ProgressBar::new(1000);
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed:>4} [{bar:30}] {prefix}: {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    let mut progress = |stage: &str, fraction: Option<f64>, message: &str| {
+        bar.set_prefix(stage.to_string());
+        if let Some(f) = fraction {
+            bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
+        }
+        bar.set_message(message.to_string());
+    };
+    let lengths = surface.edge_lengths();
+    let result = ricci_flow(&surface.mesh, &lengths, &options, &mut progress);
+    bar.finish_and_clear();
+    let r = result.map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?;
+    let source = a.mesh.display().to_string();
+    if let Some(out) = &a.out {
+        let v = metric_json(&r, &surface.mesh, &source);
+        write_atomic(out, serde_json::to_string(&v)?.as_bytes())?;
+    }
+    if !r.converged {
+        eprintln!(
+            "warning: {}: the flow did not converge (max |K − K̄| = {:.3e} > {:.1e} after {} \
+             iterations)",
+            source, r.max_curvature_error, r.tolerance, r.iterations
+        );
+    }
+    if a.json {
+        print_json(&json!({
+            "mesh": source,
+            "vertices": surface.mesh.n_vertices(),
+            "faces": surface.mesh.n_faces(),
+            "geometry": r.geometry,
+            "scheme": r.scheme,
+            "solver": r.solver,
+            "route": r.route,
+            "method": format!("{} ({})", r.solver, r.route),
+            "target": r.target_description,
+            "iterations": r.iterations,
+            "max_curvature_error": r.max_curvature_error,
+            "gauss_bonnet_error": r.gauss_bonnet_error,
+            "converged": r.converged,
+            "tolerance": r.tolerance,
+            "seconds": r.seconds,
+            "area": r.area,
+            "input_scale": r.input_scale,
+            "clamped_edges": r.clamped_edges,
+            "initial_length_error": r.initial_length_error,
+            "degenerate_faces": r.degenerate_faces,
+            "pinned": r.pinned,
+            "notes": r.notes,
+            "history": r.history,
+            "out": a.out.as_ref().map(|p| p.display().to_string()),
+        }));
+    } else {
+        println!(
+            "{source}: {} {} metric ({}), target {}",
+            r.geometry, r.scheme, r.route, r.target_description
+        );
+        println!(
+            "  {} after {} {} iteration(s): max |K − K̄| = {:.3e}, Gauss–Bonnet residual {:.3e}, \
+             {:.3} s",
+            if r.converged {
+                "converged"
+            } else {
+                "NOT converged"
+            },
+            r.iterations,
+            r.solver,
+            r.max_curvature_error,
+            r.gauss_bonnet_error,
+            r.seconds
+        );
+        for h in &r.history {
+            println!(
+                "    {:5}  max |K − K̄| {:.3e}  step {:.2e}  {:.3} s",
+                h.iteration, h.max_curvature_error, h.step, h.seconds
+            );
+        }
+        for n in &r.notes {
+            println!("  note: {n}");
+        }
+        if let Some(out) = &a.out {
+            println!("  metric written to {}", out.display());
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,184 @@
+//! `ricci flow`: one JSON object on stdout with the contract's keys, METRIC.json that other
+//! tools can use (its lengths really have the reported curvature), exit codes 1 (bad input) and
+//! 2 (bad arguments) with nothing written.
+
+use ricci::mesh::io::read_surface;
+use ricci::metric::{self, Geometry};
+use std::path::PathBuf;
+use std::process::Command;
+
+fn ricci() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_ricci"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ricci-cli-flow-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn generate(kind: &str, file: &str) -> PathBuf {
+    let out = scratch(file);
+    let o = ricci()
+        .args(["generate", kind, "-n", "16", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    out
+}
+
+#[test]
+fn hyperbolic_flow_writes_a_usable_metric() {
+    let mesh = generate("genus2", "g2.off");
+    let metric_file = scratch("g2-metric.json");
+    let o = ricci()
+        .arg("flow")
+        .arg(&mesh)
+        .args([
+            "--geometry",
+            "hyperbolic",
+            "--tolerance",
+            "1e-11",
+            "--json",
+            "--out",
+        ])
+        .arg(&metric_file)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value =
+        serde_json::from_slice(&o.stdout).expect("stdout is one JSON object");
+    for key in [
+        "geometry",
+        "scheme",
+        "solver",
+        "iterations",
+        "max_curvature_error",
+        "gauss_bonnet_error",
+        "converged",
+        "seconds",
+        "route",
+        "history",
+    ] {
+        assert!(v.get(key).is_some(), "missing key {key}");
+    }
+    assert_eq!(v["geometry"], "hyperbolic");
+    assert_eq!(v["scheme"], "thurston");
+    assert_eq!(v["converged"], true);
+    assert!(v["max_curvature_error"].as_f64().unwrap() <= 1e-11);
+    assert_eq!(
+        v["history"].as_array().unwrap().len(),
+        v["iterations"].as_u64().unwrap() as usize + 1
+    );
+    // The metric file: per-vertex u, K, K̄; per-edge lengths with their vertices.
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&metric_file).unwrap()).unwrap();
+    let (s, _) = read_surface(&mesh).unwrap();
+    let n = s.mesh.n_vertices();
+    assert_eq!(m["u"].as_array().unwrap().len(), n);
+    assert_eq!(m["curvature"].as_array().unwrap().len(), n);
+    assert_eq!(m["target_curvature"].as_array().unwrap().len(), n);
+    let ev = m["edge_vertices"].as_array().unwrap();
+    let lengths: Vec<f64> = m["lengths"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert_eq!(lengths.len(), s.mesh.n_edges());
+    for (e, pair) in ev.iter().enumerate() {
+        let a = pair[0].as_u64().unwrap() as u32;
+        let b = pair[1].as_u64().unwrap() as u32;
+        let mut want = s.mesh.edge_vertices(e as u32);
+        want.sort();
+        let mut got = [a, b];
+        got.sort();
+        assert_eq!(got, want, "edge {e}");
+    }
+    // Recompute the curvature of the written lengths: zero everywhere (uniform H² target).
+    let k = metric::curvature(&s.mesh, Geometry::Hyperbolic, &lengths);
+    assert!(
+        k.iter().all(|x| x.abs() < 1e-9),
+        "written metric is not hyperbolic"
+    );
+    let area = metric::total_area(&s.mesh, Geometry::Hyperbolic, &lengths);
+    assert!(
+        (area - 4.0 * std::f64::consts::PI).abs() < 1e-8,
+        "area {area}"
+    );
+}
+
+#[test]
+fn free_boundary_marks_fixed_vertices_with_null_targets() {
+    let mesh = generate("disk", "disk.obj");
+    let metric_file = scratch("disk-metric.json");
+    let o = ricci()
+        .arg("flow")
+        .arg(&mesh)
+        .args(["--target", "free-boundary", "--scheme", "yamabe", "--out"])
+        .arg(&metric_file)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("converged"), "{text}");
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&metric_file).unwrap()).unwrap();
+    let (s, _) = read_surface(&mesh).unwrap();
+    for v in 0..s.mesh.n_vertices() {
+        let t = &m["target_curvature"][v];
+        assert_eq!(
+            t.is_null(),
+            s.mesh.is_boundary_vertex(v as u32),
+            "vertex {v}"
+        );
+        if s.mesh.is_boundary_vertex(v as u32) {
+            assert_eq!(m["u"][v].as_f64().unwrap(), 0.0, "boundary u stays 0");
+        }
+    }
+}
+
+#[test]
+fn refusals_exit_with_the_right_code_and_write_nothing() {
+    let mesh = generate("torus", "torus.off");
+    let metric_file = scratch("refused.json");
+    // Bad argument: exit 2.
+    let o = ricci()
+        .arg("flow")
+        .arg(&mesh)
+        .args(["--scheme", "banana", "--out"])
+        .arg(&metric_file)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(o.stdout.is_empty());
+    // Inadmissible target (Gauss–Bonnet): exit 1, one sentence naming the problem.
+    let o = ricci()
+        .arg("flow")
+        .arg(&mesh)
+        .args(["--target", "cone:0=pi", "--json", "--out"])
+        .arg(&metric_file)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(o.stdout.is_empty(), "nothing on stdout on error");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("Gauss–Bonnet") && err.contains("off by"),
+        "{err}"
+    );
+    // A target file with a bad line: exit 1, the file and line named.
+    let tf = scratch("targets.txt");
+    std::fs::write(&tf, "0\n0\nnot-a-number\n").unwrap();
+    let o = ricci()
+        .arg("flow")
+        .arg(&mesh)
+        .arg(format!("--target=file:{}", tf.display()))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("line 3"), "{err}");
+    assert!(!metric_file.exists(), "no metric written on refusal");
+}

@@ -1,0 +1,615 @@
+//! Newton's method and the papers' gradient flow for the Ricci energy (paper 001 §V Step 3,
+//! paper 000 §4 Step 3).
+//!
+//! **Newton.** Solve `H δ = K̄ − K` over the free vertices with `H = ∂K/∂u` (sparse Cholesky,
+//! symbolic factorization once), then `u += t δ` with a backtracking line search:
+//! * on the convex energy (E², H² with a fixed target): accept `t` when the Simpson estimate of
+//!   `E(u + tδ) − E(u) = ∫₀ᵗ (K(u+sδ) − K̄)·δ ds` satisfies Armijo's condition with
+//!   `c = 10⁻⁴`, or when the largest curvature error at least halves;
+//! * on the residual (S², round boundaries): accept when `‖K̄ − K‖²` decreases by Armijo's
+//!   factor `1 − 2ct`, or the largest error at least halves.
+//!
+//! Steps that leave the domain (a hyperbolic radius variable `u ≥ 0`, a length that does not
+//! exist) are halved. The E² scale kernel is removed by holding one vertex fixed (its equation
+//! follows from Gauss–Bonnet).
+//!
+//! **S².** The Hessian is indefinite: near a round metric `H ≈ L − 2M` (cotangent-like
+//! Laplacian minus twice the lumped area matrix), with generalized eigenvalues
+//! `l(l+1) − 2 = −2, 0, 0, 0, 4, 10, …` — one negative direction (close to the global scale)
+//! and a three-dimensional near-kernel (Möbius transformations of the sphere move spherical
+//! circle packings and vertex-scaled metrics along the solution set). Steps solve
+//! `(H + μM) δ = K̄ − K` by LDLᵀ with `μ = min(½, √max|K − K̄|)`: a Levenberg–Marquardt damping
+//! in the metric of `M` that keeps the system regular (μ stays away from 2), bounds the steps
+//! along the Möbius near-kernel and vanishes at the solution (superlinear convergence).
+//!
+//! **Round boundaries.** The target depends on the metric (`K̄ = T w/L`, see
+//! [`super::target`]). Far from the solution (max error ≥ 10⁻²) steps freeze the target and
+//! minimize the convex energy (chord steps); close to it, exact Newton steps use the full
+//! symmetric Jacobian `J = H − Σ_loops [(T/L)∇²L − (T/L²) w wᵀ]`: the sparse part is
+//! factorized by LDLᵀ, the rank-one parts are applied with Woodbury's identity. An exact step
+//! the line search rejects is replaced by a chord step.
+//!
+//! **Gradient flow** (reference): `u += ε (K̄ − K)`, with `ε` halved whenever a step leaves the
+//! domain or increases the largest error tenfold; in E² without fixed vertices the mean of `u`
+//! is kept (the papers' normalization `Σ u = const`).
+
+use super::linear::SymmetricSolver;
+use super::target::Target;
+use super::IterationRecord;
+use crate::error::Result;
+use crate::metric::{Evaluator, Geometry, HessianPattern};
+use crate::progress::Progress;
+use std::time::Instant;
+
+/// How steps are accepted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LineSearch {
+    Energy,
+    Residual,
+}
+
+/// Settings of one Newton solve.
+#[derive(Debug, Clone)]
+pub struct NewtonSettings {
+    pub tolerance: f64,
+    pub max_iterations: usize,
+    pub line_search: LineSearch,
+    /// Vertices held fixed in addition to the target's fixed vertices (E² scale pin).
+    pub pinned: Vec<u32>,
+    /// Use LDLᵀ with Levenberg–Marquardt damping (S²) instead of LLᵀ.
+    pub indefinite: bool,
+}
+
+/// What a solve produced.
+#[derive(Debug, Clone)]
+pub struct SolveOutcome {
+    pub u: Vec<f64>,
+    pub iterations: usize,
+    pub history: Vec<IterationRecord>,
+    pub converged: bool,
+    pub max_error: f64,
+    pub notes: Vec<String>,
+}
+
+/// Largest |K − K̄| over the vertices with a prescribed curvature.
+pub fn max_error(curvature: &[f64], target: &Target) -> f64 {
+    curvature
+        .iter()
+        .zip(&target.curvature)
+        .zip(&target.fixed)
+        .filter(|(_, &f)| !f)
+        .map(|((k, t), _)| (k - t).abs())
+        .fold(0.0, f64::max)
+}
+
+fn progress_fraction(e0: f64, e: f64, tol: f64) -> f64 {
+    if e0 <= tol || e <= tol {
+        return 1.0;
+    }
+    ((e0 / e).ln() / (e0 / tol).ln()).clamp(0.0, 1.0)
+}
+
+/// Evaluate at `u` (with targets following the metric unless `frozen`); false outside the
+/// domain.
+fn eval(ev: &mut Evaluator, target: &mut Target, u: &[f64], update_targets: bool) -> bool {
+    if !ev.evaluate(u) {
+        return false;
+    }
+    if update_targets && target.is_dynamic() {
+        target.update_round(&ev.ws.lengths, &ev.ws.dlengths, &ev.data.edges);
+    }
+    true
+}
+
+/// Newton's method from `u_start`.
+pub fn newton(
+    ev: &mut Evaluator,
+    target: &mut Target,
+    u_start: Vec<f64>,
+    settings: &NewtonSettings,
+    progress: &mut dyn Progress,
+) -> Result<SolveOutcome> {
+    let t0 = Instant::now();
+    let n = ev.data.n_vertices();
+    let mut held = target.fixed.clone();
+    for &p in &settings.pinned {
+        held[p as usize] = true;
+    }
+    let pattern = HessianPattern::new(&ev.data, &held);
+    let mut solver = SymmetricSolver::new(&pattern)?;
+    let nf = pattern.n();
+    let mut values = vec![0.0; pattern.nnz()];
+    let mut shifted = vec![0.0; pattern.nnz()];
+    let mut rhs = vec![0.0; nf];
+    let mut delta = vec![0.0; n];
+    let mut trial = vec![0.0; n];
+    let mut half = vec![0.0; n];
+    let mut frozen = target.curvature.clone();
+    let mut u = u_start;
+    let mut history = Vec::new();
+    let mut notes = Vec::new();
+    let mut energy = 0.0;
+    let mut last_step = 0.0;
+    let mut converged = false;
+    let mut err = f64::INFINITY;
+    let mut e0 = f64::NAN;
+    let mut it = 0;
+    let mut shifted_steps = 0usize;
+    let mut chord_steps = 0usize;
+    let mut exact_failed = false;
+    let mut rejected_exact = 0usize;
+    let mut mass = vec![0.0; n];
+    let dynamic = target.is_dynamic();
+    loop {
+        if !ev.evaluate_with_hessian(&u, &pattern, &mut values) {
+            notes.push("the metric left the domain of the scheme".into());
+            break;
+        }
+        if dynamic {
+            target.update_round(&ev.ws.lengths, &ev.ws.dlengths, &ev.data.edges);
+        }
+        let prev_err = err;
+        err = max_error(&ev.ws.curvature, target);
+        if e0.is_nan() {
+            e0 = err;
+        }
+        history.push(IterationRecord {
+            iteration: it,
+            max_curvature_error: err,
+            energy: (settings.line_search == LineSearch::Energy).then_some(energy),
+            step: last_step,
+            seconds: t0.elapsed().as_secs_f64(),
+        });
+        progress.report(
+            "newton",
+            Some(progress_fraction(e0, err, settings.tolerance)),
+            &format!("iteration {it}: max |K − K̄| = {err:.3e}"),
+        );
+        if !err.is_finite() {
+            notes.push("the curvature became non-finite".into());
+            break;
+        }
+        if err <= settings.tolerance {
+            converged = true;
+            break;
+        }
+        if it >= settings.max_iterations {
+            break;
+        }
+        it += 1;
+        // Round boundaries: frozen-target (chord) steps on the convex energy while far from the
+        // solution, exact Newton steps on the full Jacobian once close (or when chords stall).
+        let exact =
+            !dynamic || (!exact_failed && (err < 1e-2 || (err < 0.5 && err > 0.8 * prev_err)));
+        exact_failed = false;
+        let line_search = if dynamic && !exact {
+            LineSearch::Energy
+        } else {
+            settings.line_search
+        };
+        if dynamic && !exact {
+            chord_steps += 1;
+            frozen.copy_from_slice(&target.curvature);
+        }
+        // Right-hand side r = K̄ − K on the free vertices.
+        for (c, &v) in pattern.free_vertex.iter().enumerate() {
+            rhs[c] = target.curvature[v as usize] - ev.ws.curvature[v as usize];
+        }
+        let r0 = rhs.clone();
+        // Round boundaries, exact steps: J = H − Σ_loops [(T/L)∇²L − (T/L²) w wᵀ]; the sparse
+        // part goes into the matrix, the rank-one parts are applied by Woodbury's identity.
+        let mut low_rank: Vec<(Vec<f64>, f64)> = Vec::new();
+        if dynamic && exact {
+            for lp in &target.round_loops {
+                let total_len: f64 = lp.edges.iter().map(|&e| ev.ws.lengths[e as usize]).sum();
+                let k = lp.total / total_len;
+                let mut w = vec![0.0; nf];
+                for &e in &lp.edges {
+                    let [a, b] = ev.data.edges[e as usize];
+                    let (_, d, h) = crate::metric::scheme::euclidean_length_hessian(
+                        ev.structure.scheme,
+                        ev.structure.eta[e as usize],
+                        u[a as usize],
+                        u[b as usize],
+                    );
+                    for (v, dv, hv) in [(a, d[0], h[0]), (b, d[1], h[2])] {
+                        let s = pattern.diag_slot[v as usize];
+                        if s != crate::mesh::NONE {
+                            values[s as usize] -= k * hv;
+                            w[pattern.free_index[v as usize] as usize] += dv;
+                        }
+                    }
+                    let s = pattern.edge_slot[e as usize];
+                    if s != crate::mesh::NONE {
+                        values[s as usize] -= k * h[1];
+                    }
+                }
+                low_rank.push((w, lp.total / (total_len * total_len)));
+            }
+        }
+        let indefinite = settings.indefinite || (dynamic && exact);
+        if settings.indefinite {
+            // S²: Levenberg–Marquardt damping with the lumped spherical mass matrix,
+            // (H + μM)δ = K̄ − K. On a round sphere H ≈ L − 2M has generalized eigenvalues
+            // l(l+1) − 2 = −2, 0 (×3, Möbius), 4, 10, …: μ < 1 keeps the system regular and
+            // bounds the steps along the Möbius near-kernel.
+            let mu = err.sqrt().min(0.5);
+            mass.iter_mut().for_each(|m| *m = 0.0);
+            for (f, t) in ev.data.faces.iter().enumerate() {
+                let a = (ev.ws.angles[3 * f] + ev.ws.angles[3 * f + 1] + ev.ws.angles[3 * f + 2]
+                    - std::f64::consts::PI)
+                    .max(0.0)
+                    / 3.0;
+                for &w in t {
+                    mass[w as usize] += a;
+                }
+            }
+            for &w in &pattern.free_vertex {
+                values[pattern.diag_slot[w as usize] as usize] += mu * mass[w as usize];
+            }
+        }
+        let mut ok = if indefinite {
+            solver.factor_ldlt(&values)
+        } else {
+            solver.factor_llt(&values)
+        };
+        if !ok {
+            let dmax = pattern
+                .free_vertex
+                .iter()
+                .map(|&v| values[pattern.diag_slot[v as usize] as usize].abs())
+                .fold(0.0, f64::max);
+            let mut mu = 1e-12 * dmax.max(1e-300);
+            for _ in 0..6 {
+                shifted.copy_from_slice(&values);
+                for &v in &pattern.free_vertex {
+                    shifted[pattern.diag_slot[v as usize] as usize] += mu;
+                }
+                let good = if indefinite {
+                    solver.factor_ldlt(&shifted)
+                } else {
+                    solver.factor_llt(&shifted)
+                };
+                if good {
+                    ok = true;
+                    shifted_steps += 1;
+                    break;
+                }
+                mu *= 100.0;
+            }
+        }
+        if !ok {
+            notes.push(format!(
+                "iteration {it}: the Hessian could not be factorized (singular or indefinite)"
+            ));
+            break;
+        }
+        solver.solve(&mut rhs);
+        if !low_rank.is_empty() {
+            woodbury(&mut solver, &low_rank, &mut rhs);
+        }
+        delta.iter_mut().for_each(|d| *d = 0.0);
+        for (c, &v) in pattern.free_vertex.iter().enumerate() {
+            delta[v as usize] = rhs[c];
+        }
+        if delta.iter().any(|d| !d.is_finite()) {
+            notes.push(format!("iteration {it}: the Newton step is not finite"));
+            break;
+        }
+        // Line search. `tk` is the target the step is measured against (frozen for chords).
+        let use_frozen = dynamic && !exact;
+        let g0: f64 = -r0.iter().zip(&rhs).map(|(r, d)| r * d).sum::<f64>(); // ∇E·δ < 0
+        let res0: f64 = r0.iter().map(|r| r * r).sum();
+        let mut t = 1.0;
+        let mut accepted = false;
+        for _ in 0..40 {
+            for i in 0..n {
+                trial[i] = u[i] + t * delta[i];
+            }
+            if !eval(ev, target, &trial, !use_frozen) {
+                t *= 0.5;
+                continue;
+            }
+            let tk: &[f64] = if use_frozen {
+                &frozen
+            } else {
+                &target.curvature
+            };
+            let err_t = max_error_against(&ev.ws.curvature, tk, &target.fixed);
+            let gt: f64 = (0..n)
+                .filter(|&i| !held[i])
+                .map(|i| (ev.ws.curvature[i] - tk[i]) * delta[i])
+                .sum();
+            let res_t: f64 = (0..n)
+                .filter(|&i| !held[i])
+                .map(|i| (ev.ws.curvature[i] - tk[i]).powi(2))
+                .sum();
+            let halves = err_t <= 0.5 * err && err_t.is_finite();
+            let good = match line_search {
+                LineSearch::Energy => {
+                    if halves {
+                        true
+                    } else {
+                        for i in 0..n {
+                            half[i] = u[i] + 0.5 * t * delta[i];
+                        }
+                        if !eval(ev, target, &half, !use_frozen) {
+                            t *= 0.5;
+                            continue;
+                        }
+                        let tk: &[f64] = if use_frozen {
+                            &frozen
+                        } else {
+                            &target.curvature
+                        };
+                        let gh: f64 = (0..n)
+                            .filter(|&i| !held[i])
+                            .map(|i| (ev.ws.curvature[i] - tk[i]) * delta[i])
+                            .sum();
+                        let de = t / 6.0 * (g0 + 4.0 * gh + gt);
+                        if de <= 1e-4 * t * g0 {
+                            energy += de;
+                            true
+                        } else {
+                            false
+                        }
+                    }
+                }
+                LineSearch::Residual => {
+                    (res_t <= (1.0 - 2e-4 * t) * res0 && err_t <= 2.0 * err) || halves
+                }
+            };
+            if good {
+                accepted = true;
+                break;
+            }
+            t *= 0.5;
+        }
+        if !accepted {
+            if dynamic && exact {
+                // Take a frozen-target step instead.
+                exact_failed = true;
+                rejected_exact += 1;
+                continue;
+            }
+            notes.push(format!(
+                "iteration {it}: the line search found no acceptable step (stagnation at max \
+                 |K − K̄| = {err:.3e})"
+            ));
+            break;
+        }
+        for i in 0..n {
+            u[i] += t * delta[i];
+        }
+        last_step = t * delta.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+    }
+    if shifted_steps > 0 {
+        notes.push(format!(
+            "{shifted_steps} Newton step(s) needed a diagonal shift to factorize the Hessian"
+        ));
+    }
+    if settings.indefinite && it > 0 {
+        notes.push(
+            "spherical steps were damped: (H + μM)δ = K̄ − K with M the lumped area matrix and \
+             μ = min(½, √max|K − K̄|), LDLᵀ factorization"
+                .into(),
+        );
+    }
+    if rejected_exact > 0 {
+        notes.push(format!(
+            "{rejected_exact} exact round-boundary Newton step(s) were rejected by the line \
+             search and replaced by frozen-target steps"
+        ));
+    }
+    if chord_steps > 0 {
+        notes.push(format!(
+            "{chord_steps} step(s) with the round-boundary target frozen (convex chord steps)"
+        ));
+    }
+    Ok(SolveOutcome {
+        u,
+        iterations: it,
+        history,
+        converged,
+        max_error: err,
+        notes,
+    })
+}
+
+/// Largest |K − target| over the vertices that are not fixed.
+fn max_error_against(curvature: &[f64], target: &[f64], fixed: &[bool]) -> f64 {
+    curvature
+        .iter()
+        .zip(target)
+        .zip(fixed)
+        .filter(|(_, &f)| !f)
+        .map(|((k, t), _)| (k - t).abs())
+        .fold(0.0, f64::max)
+}
+
+/// Given `y = A⁻¹ r` in `x`, overwrite it with `(A + Σ c_k w_k w_kᵀ)⁻¹ r` (Woodbury).
+fn woodbury(solver: &mut SymmetricSolver, terms: &[(Vec<f64>, f64)], x: &mut [f64]) {
+    let b = terms.len();
+    let z: Vec<Vec<f64>> = terms
+        .iter()
+        .map(|(w, _)| {
+            let mut z = w.clone();
+            solver.solve(&mut z);
+            z
+        })
+        .collect();
+    // M = C⁻¹ + Uᵀ Z, rhs = Uᵀ y.
+    let mut m = vec![0.0; b * b];
+    let mut q = vec![0.0; b];
+    for i in 0..b {
+        for j in 0..b {
+            m[i * b + j] = dot(&terms[i].0, &z[j]);
+        }
+        m[i * b + i] += 1.0 / terms[i].1;
+        q[i] = dot(&terms[i].0, x);
+    }
+    // Solve M s = q by Gaussian elimination with partial pivoting (b is the number of loops).
+    for c in 0..b {
+        let p = (c..b)
+            .max_by(|&i, &j| m[i * b + c].abs().total_cmp(&m[j * b + c].abs()))
+            .unwrap_or(c);
+        if p != c {
+            for j in 0..b {
+                m.swap(c * b + j, p * b + j);
+            }
+            q.swap(c, p);
+        }
+        let d = m[c * b + c];
+        if d == 0.0 {
+            return;
+        }
+        for i in c + 1..b {
+            let f = m[i * b + c] / d;
+            for j in c..b {
+                m[i * b + j] -= f * m[c * b + j];
+            }
+            q[i] -= f * q[c];
+        }
+    }
+    let mut s = vec![0.0; b];
+    for i in (0..b).rev() {
+        let mut acc = q[i];
+        for j in i + 1..b {
+            acc -= m[i * b + j] * s[j];
+        }
+        s[i] = acc / m[i * b + i];
+    }
+    for (k, zk) in z.iter().enumerate() {
+        for (xi, zi) in x.iter_mut().zip(zk) {
+            *xi -= s[k] * zi;
+        }
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// Settings of the gradient flow.
+#[derive(Debug, Clone)]
+pub struct GradientSettings {
+    pub tolerance: f64,
+    pub max_iterations: usize,
+    pub step: f64,
+    /// Keep the mean of `u` (E² without fixed vertices).
+    pub keep_mean: bool,
+}
+
+/// The papers' discrete Ricci flow `u += ε (K̄ − K)` from `u_start`.
+pub fn gradient_flow(
+    ev: &mut Evaluator,
+    target: &mut Target,
+    u_start: Vec<f64>,
+    settings: &GradientSettings,
+    progress: &mut dyn Progress,
+) -> Result<SolveOutcome> {
+    let t0 = Instant::now();
+    let n = ev.data.n_vertices();
+    let free: Vec<usize> = (0..n).filter(|&i| !target.fixed[i]).collect();
+    let mut u = u_start;
+    let mut notes = Vec::new();
+    let mut history = Vec::new();
+    let mut eps = settings.step;
+    let mut trial = u.clone();
+    let mean = |u: &[f64]| free.iter().map(|&i| u[i]).sum::<f64>() / free.len().max(1) as f64;
+    let m0 = mean(&u);
+    if !eval(ev, target, &u, true) {
+        return Err(crate::error::Error::numerical(
+            "the initial metric lies outside the domain of the scheme",
+        ));
+    }
+    let mut err = max_error(&ev.ws.curvature, target);
+    let e0 = err;
+    let mut r: Vec<f64> = (0..n)
+        .map(|i| target.curvature[i] - ev.ws.curvature[i])
+        .collect();
+    let mut energy = 0.0;
+    let mut converged = false;
+    let mut it = 0;
+    let mut next_record = 0usize;
+    let mut last_step = 0.0;
+    let record_every = (settings.max_iterations / 2000).max(1);
+    loop {
+        if it >= next_record || err <= settings.tolerance || it >= settings.max_iterations {
+            history.push(IterationRecord {
+                iteration: it,
+                max_curvature_error: err,
+                energy: Some(energy),
+                step: last_step,
+                seconds: t0.elapsed().as_secs_f64(),
+            });
+            next_record = it + record_every;
+            progress.report(
+                "gradient",
+                Some(progress_fraction(e0, err, settings.tolerance)),
+                &format!("iteration {it}: max |K − K̄| = {err:.3e}"),
+            );
+        }
+        if err <= settings.tolerance {
+            converged = true;
+            break;
+        }
+        if it >= settings.max_iterations || !err.is_finite() {
+            break;
+        }
+        it += 1;
+        let mut accepted = false;
+        for _ in 0..30 {
+            trial.copy_from_slice(&u);
+            for &i in &free {
+                trial[i] += eps * r[i];
+            }
+            if settings.keep_mean {
+                let d = mean(&trial) - m0;
+                for &i in &free {
+                    trial[i] -= d;
+                }
+            }
+            if eval(ev, target, &trial, true) {
+                let e = max_error(&ev.ws.curvature, target);
+                if e.is_finite() && e <= 10.0 * err {
+                    // Trapezoid estimate of the energy change along the step.
+                    let mut de = 0.0;
+                    for &i in &free {
+                        let k1 = ev.ws.curvature[i] - target.curvature[i];
+                        de += 0.5 * (-r[i] + k1) * (trial[i] - u[i]);
+                    }
+                    energy += de;
+                    err = e;
+                    accepted = true;
+                    break;
+                }
+            }
+            eps *= 0.5;
+        }
+        if !accepted {
+            notes.push(format!("iteration {it}: no admissible gradient step"));
+            break;
+        }
+        last_step = free
+            .iter()
+            .map(|&i| (trial[i] - u[i]).abs())
+            .fold(0.0, f64::max);
+        std::mem::swap(&mut u, &mut trial);
+        for i in 0..n {
+            r[i] = target.curvature[i] - ev.ws.curvature[i];
+        }
+    }
+    if eps < settings.step {
+        notes.push(format!("step length reduced to ε = {eps:.3e}"));
+    }
+    let _ = Geometry::Euclidean;
+    Ok(SolveOutcome {
+        u,
+        iterations: it,
+        history,
+        converged,
+        max_error: err,
+        notes,
+    })
+}

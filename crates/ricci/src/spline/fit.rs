@@ -1,0 +1,766 @@
+//! Fairing and fitting of DMS splines (paper 000 §5).
+//!
+//! **Fairing** (paper 000 eq. 14, Fig. 13). Given control points `c`, find `c̃` minimising
+//! `Σ ‖c̃_{I,β} − c_{I,β}‖²` subject to, for every interior edge shared by triangles `I` and
+//! `J` and every `β` of `I` with `β_o ≤ r` (`o` = the vertex of `I` opposite the edge),
+//! `c̃_{I,β} = f^J(t^I_{0,0..β_0−1}, t^I_{1,0..β_1−1}, t^I_{2,0..β_2−1})`: the control point of `I`
+//! equals the blossom of `J`'s B-patch polynomial (built from `c̃_J`) at `I`'s arguments. Both
+//! orientations of every edge are imposed. `r = 0` makes the control points along each edge
+//! shared (the arguments then only involve knots of the edge's vertices); larger `r` ties
+//! more rows of control points to the neighbour's polynomial, `r = n` would make the whole
+//! spline one polynomial. The constraints are homogeneous, `A c̃ = 0`, so `c̃ = c − Aᵀ y` with
+//! `A Aᵀ y = A c`; `A Aᵀ` can be singular (constraints around a vertex are dependent), so it is
+//! factored with a tiny diagonal shift (faer sparse Cholesky) and used as the preconditioner
+//! of conjugate gradients on the consistent system until `‖A c̃‖` reaches the tolerance.
+//!
+//! **Fitting.** Given data `(face, parameter point) → target`, minimise
+//! `(1/K) Σ_k ‖F(u_k) − p_k‖² + λ (h̄² / |D|) E(F) + γ ‖c − c₀‖²`, where `E` is the thin-plate
+//! energy `∫_D |F_xx|² + 2|F_xy|² + |F_yy|²` (quadrature: every domain triangle split into four,
+//! three points of degree 2 each), `h̄` the mean domain edge length and `|D|` the domain area
+//! (so `λ` is scale-free), and `γ` a tiny ridge towards `c₀` that keeps control points that
+//! neither term determines where they were. The normal equations are solved by sparse
+//! Cholesky (faer).
+
+use std::collections::HashMap;
+
+use faer::linalg::solvers::Solve;
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{Mat, Side};
+
+use crate::error::{Error, Result};
+
+use super::dms::{multi_indices, DmsSpace, Workspace};
+use super::simplex::{n_partials, Point};
+
+/// One fairing constraint `c̃[single] − Σ_b weights[b] c̃[target * nb + b] = 0`.
+#[derive(Debug, Clone)]
+pub struct Constraint {
+    /// Global index of the constrained control point (of triangle `I`).
+    pub single: u32,
+    /// The neighbouring triangle `J` whose B-patch blossom it must equal.
+    pub target: u32,
+    /// Blossom weights of `J`'s control points (one per β of `J`).
+    pub weights: Vec<f64>,
+}
+
+/// The constraints of paper 000 eq. 14 for fairness parameter `r` (`0 ≤ r ≤ n − 1`), for
+/// both orientations of every interior edge (the shared-control-point rows, `β_o = 0`, once).
+pub fn fairness_constraints(space: &DmsSpace, r: usize) -> Result<Vec<Constraint>> {
+    let n = space.degree();
+    if r >= n {
+        return Err(Error::input(format!(
+            "fairness parameter r = {r} must be between 0 and n − 1 = {}",
+            n - 1
+        )));
+    }
+    let mesh = space.domain().mesh();
+    let nb = space.per_triangle();
+    let mut out = Vec::new();
+    for h in 0..mesh.n_corners() as u32 {
+        let t = mesh.he_twin(h);
+        if mesh.is_boundary_halfedge(t) {
+            continue;
+        }
+        let (fi, fj) = (h / 3, t / 3);
+        let o = (h as usize % 3 + 2) % 3; // vertex of I opposite the edge
+        let bi = space.triangle(fi);
+        let bj = space.triangle(fj);
+        for (k, beta) in multi_indices(n).into_iter().enumerate() {
+            if beta[o] > r {
+                continue;
+            }
+            // With β_o = 0 the constraint only involves the edge's knots and says that the
+            // two triangles share this control point: the same equation as the opposite
+            // orientation's, so it is imposed once (from the lower face index).
+            if beta[o] == 0 && fi > fj {
+                continue;
+            }
+            let args = bi.blossom_args(beta);
+            let mut w = vec![0.0; nb];
+            bj.blossom_weights(&args, &mut w);
+            out.push(Constraint {
+                single: (fi as usize * nb + k) as u32,
+                target: fj,
+                weights: w,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// Residuals `A c` of the constraints (`dim` numbers per constraint).
+pub fn constraint_residuals(
+    space: &DmsSpace,
+    cons: &[Constraint],
+    control: &[f64],
+    dim: usize,
+) -> Vec<f64> {
+    let nb = space.per_triangle();
+    let mut r = vec![0.0; cons.len() * dim];
+    for (i, c) in cons.iter().enumerate() {
+        for d in 0..dim {
+            let mut s = control[c.single as usize * dim + d];
+            for (b, w) in c.weights.iter().enumerate() {
+                s -= w * control[(c.target as usize * nb + b) * dim + d];
+            }
+            r[i * dim + d] = s;
+        }
+    }
+    r
+}
+
+/// What [`fair`] did.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct FairingReport {
+    pub fairness: usize,
+    pub constraints: usize,
+    /// `max_i |A_i c̃| / (‖A_i‖₁ max |c|)`: constraint residual relative to the size of its terms.
+    pub max_constraint_residual: f64,
+    /// Requested tolerance for the above.
+    pub tolerance: f64,
+    /// `sqrt(mean ‖c̃ − c‖²)` over control points.
+    pub rms_change: f64,
+    /// Objective of eq. 14, `Σ ‖c̃ − c‖²`.
+    pub objective: f64,
+    /// Largest number of preconditioned CG steps (over coordinates).
+    pub refinement_steps: usize,
+    pub converged: bool,
+}
+
+/// Paper 000's fairing (module docs) of control points with `dim` coordinates each.
+pub fn fair(
+    space: &DmsSpace,
+    control: &[f64],
+    dim: usize,
+    r: usize,
+) -> Result<(Vec<f64>, FairingReport)> {
+    let nc = space.n_control_points();
+    if control.len() != nc * dim {
+        return Err(Error::input(format!(
+            "fairing: {} numbers given for {nc} control points of dimension {dim}",
+            control.len()
+        )));
+    }
+    let cons = fairness_constraints(space, r)?;
+    let nb = space.per_triangle();
+    let m = cons.len();
+    let scale = control
+        .iter()
+        .fold(0.0f64, |a, b| a.max(b.abs()))
+        .max(1e-300);
+    let tolerance = 1e-10;
+    if m == 0 {
+        return Ok((
+            control.to_vec(),
+            FairingReport {
+                fairness: r,
+                constraints: 0,
+                max_constraint_residual: 0.0,
+                tolerance,
+                rms_change: 0.0,
+                objective: 0.0,
+                refinement_steps: 0,
+                converged: true,
+            },
+        ));
+    }
+    // Rows touching each triangle's control points (as target) and rows whose single lies in
+    // each triangle.
+    let nf = space.domain().n_faces();
+    let mut by_target: Vec<Vec<u32>> = vec![Vec::new(); nf];
+    let mut by_single_face: Vec<Vec<u32>> = vec![Vec::new(); nf];
+    let mut by_single: HashMap<u32, Vec<u32>> = HashMap::new();
+    for (i, c) in cons.iter().enumerate() {
+        by_target[c.target as usize].push(i as u32);
+        by_single_face[c.single as usize / nb].push(i as u32);
+        by_single.entry(c.single).or_default().push(i as u32);
+    }
+    // A Aᵀ, lower triangle, as triplets (duplicates are summed by faer).
+    let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::new();
+    let push = |a: u32, b: u32, v: f64, trip: &mut Vec<Triplet<usize, usize, f64>>| {
+        let (i, j) = if a >= b { (a, b) } else { (b, a) };
+        trip.push(Triplet::new(i as usize, j as usize, v));
+    };
+    let mut diag_max: f64 = 0.0;
+    for c in &cons {
+        let d = 1.0 + c.weights.iter().map(|w| w * w).sum::<f64>();
+        diag_max = diag_max.max(d);
+    }
+    for (i, c) in cons.iter().enumerate() {
+        let d = 1.0 + c.weights.iter().map(|w| w * w).sum::<f64>();
+        push(i as u32, i as u32, d, &mut trip);
+    }
+    for f in 0..nf {
+        let rows = &by_target[f];
+        // Both rows target f: w_a · w_b.
+        for (x, &a) in rows.iter().enumerate() {
+            for &b in &rows[..x] {
+                let s: f64 = cons[a as usize]
+                    .weights
+                    .iter()
+                    .zip(&cons[b as usize].weights)
+                    .map(|(p, q)| p * q)
+                    .sum();
+                push(a, b, s, &mut trip);
+            }
+        }
+        // Row a's single lies in f, row b targets f: −w_b(local index of a's single).
+        for &a in &by_single_face[f] {
+            let local = cons[a as usize].single as usize % nb;
+            for &b in rows {
+                if a != b {
+                    push(a, b, -cons[b as usize].weights[local], &mut trip);
+                }
+            }
+        }
+    }
+    for rows in by_single.values() {
+        for (x, &a) in rows.iter().enumerate() {
+            for &b in &rows[..x] {
+                push(a, b, 1.0, &mut trip);
+            }
+        }
+    }
+    // A and Aᵀ on one coordinate.
+    let apply_a = |x: &[f64], out: &mut [f64]| {
+        for (i, c) in cons.iter().enumerate() {
+            let mut s = x[c.single as usize];
+            let base = c.target as usize * nb;
+            for (b, w) in c.weights.iter().enumerate() {
+                s -= w * x[base + b];
+            }
+            out[i] = s;
+        }
+    };
+    let apply_at = |y: &[f64], out: &mut [f64]| {
+        out.fill(0.0);
+        for (i, c) in cons.iter().enumerate() {
+            let v = y[i];
+            out[c.single as usize] += v;
+            let base = c.target as usize * nb;
+            for (b, w) in c.weights.iter().enumerate() {
+                out[base + b] -= w * v;
+            }
+        }
+    };
+    // Factor A Aᵀ + shift·I; a shift that is too small for the rounding errors of the
+    // factorisation spoils the preconditioner, so it grows until the iteration converges.
+    let mut best: Option<(Vec<f64>, f64, usize)> = None;
+    for shift_rel in [1e-10, 1e-8, 1e-6, 1e-4] {
+        let shift = shift_rel * diag_max;
+        let mut t2 = trip.clone();
+        for i in 0..m {
+            t2.push(Triplet::new(i, i, shift));
+        }
+        let aat = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &t2)
+            .map_err(|e| Error::numerical(format!("fairing: could not assemble A Aᵀ ({e:?})")))?;
+        drop(t2);
+        let Ok(llt) = aat.sp_cholesky(Side::Lower) else {
+            continue;
+        };
+        let precond = |r: &[f64]| -> Vec<f64> {
+            let mut z = Mat::<f64>::zeros(m, 1);
+            for i in 0..m {
+                z[(i, 0)] = r[i];
+            }
+            llt.solve_in_place(z.as_mut());
+            (0..m).map(|i| z[(i, 0)]).collect()
+        };
+        // Preconditioned conjugate gradients on the consistent system A Aᵀ y = A c, one coordinate
+        // at a time; the shifted factorisation is the preconditioner.
+        let mut x = control.to_vec();
+        let mut steps = 0;
+        let mut worst: f64 = 0.0;
+        // Residuals are measured relative to the size of their terms: |A_i x| / (‖A_i‖₁ max|c|).
+        let row_norm: Vec<f64> = cons
+            .iter()
+            .map(|c| 1.0 + c.weights.iter().map(|w| w.abs()).sum::<f64>())
+            .collect();
+        let rel_max = |r: &[f64]| {
+            r.iter()
+                .zip(&row_norm)
+                .fold(0.0f64, |a, (v, n)| a.max(v.abs() / n))
+                / scale
+        };
+        let dotp = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();
+        let mut xc = vec![0.0; nc];
+        let mut tmp = vec![0.0; nc];
+        for d in 0..dim {
+            for k in 0..nc {
+                xc[k] = control[k * dim + d];
+            }
+            let mut y = vec![0.0; m];
+            let mut it = 0;
+            // Restarted PCG: each restart recomputes the true residual A(c − Aᵀ y).
+            for _restart in 0..4 {
+                let mut r = vec![0.0; m];
+                apply_at(&y, &mut tmp);
+                for k in 0..nc {
+                    tmp[k] = xc[k] - tmp[k];
+                }
+                apply_a(&tmp, &mut r);
+                let mut rmax = rel_max(&r);
+                if rmax <= tolerance {
+                    break;
+                }
+                let mut z = precond(&r);
+                let mut p = z.clone();
+                let mut rz = dotp(&r, &z);
+                let mut q = vec![0.0; m];
+                let mut inner = 0;
+                while rmax > tolerance && inner < 40 {
+                    inner += 1;
+                    it += 1;
+                    apply_at(&p, &mut tmp);
+                    apply_a(&tmp, &mut q);
+                    let pq = dotp(&p, &q);
+                    if !(pq > 0.0) {
+                        break;
+                    }
+                    let alpha = rz / pq;
+                    for i in 0..m {
+                        y[i] += alpha * p[i];
+                        r[i] -= alpha * q[i];
+                    }
+                    rmax = rel_max(&r);
+                    z = precond(&r);
+                    let rz_new = dotp(&r, &z);
+                    let beta = rz_new / rz;
+                    rz = rz_new;
+                    for i in 0..m {
+                        p[i] = z[i] + beta * p[i];
+                    }
+                }
+            }
+            steps = steps.max(it);
+            apply_at(&y, &mut tmp);
+            for k in 0..nc {
+                x[k * dim + d] = control[k * dim + d] - tmp[k];
+            }
+        }
+        // Report the true residual of the result.
+        for d in 0..dim {
+            for k in 0..nc {
+                xc[k] = x[k * dim + d];
+            }
+            let mut r = vec![0.0; m];
+            apply_a(&xc, &mut r);
+            worst = worst.max(rel_max(&r));
+        }
+        let better = best.as_ref().is_none_or(|b| worst < b.1);
+        if better && worst.is_finite() {
+            best = Some((x, worst, steps));
+        }
+        if best.as_ref().is_some_and(|b| b.1 <= tolerance) {
+            break;
+        }
+    }
+    let Some((x, worst, steps)) = best else {
+        return Err(Error::numerical(
+            "fairing: the Cholesky factorisation of A Aᵀ failed for every diagonal shift",
+        ));
+    };
+    if !worst.is_finite() {
+        return Err(Error::numerical(
+            "fairing: the constrained least-squares solve produced non-finite values",
+        ));
+    }
+    let objective: f64 = x.iter().zip(control).map(|(a, b)| (a - b) * (a - b)).sum();
+    Ok((
+        x,
+        FairingReport {
+            fairness: r,
+            constraints: m,
+            max_constraint_residual: worst,
+            tolerance,
+            rms_change: (objective / nc as f64).sqrt(),
+            objective,
+            refinement_steps: steps,
+            converged: worst <= tolerance,
+        },
+    ))
+}
+
+/// One data point for [`fit`]: a parameter point in a domain face and its target.
+#[derive(Debug, Clone)]
+pub struct DataPoint {
+    pub face: u32,
+    pub param: Point,
+    /// `dim` coordinates.
+    pub target: Vec<f64>,
+}
+
+/// Options of [`fit`].
+#[derive(Debug, Clone, Copy)]
+pub struct FitOptions {
+    /// Weight `λ` of the (scale-free) thin-plate energy.
+    pub smoothing: f64,
+    /// Weight `γ` of the ridge towards the initial control points, relative to the data term.
+    pub ridge: f64,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        FitOptions {
+            smoothing: 1e-3,
+            ridge: 1e-9,
+        }
+    }
+}
+
+/// What [`fit`] reached.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct FitReport {
+    pub data_points: usize,
+    /// Root mean square and maximum of `‖F(u_k) − p_k‖`.
+    pub rms_error: f64,
+    pub max_error: f64,
+    /// Thin-plate energy `E(F)` before (initial control points) and after.
+    pub energy_before: f64,
+    pub energy_after: f64,
+    /// The full objective before and after.
+    pub objective_before: f64,
+    pub objective_after: f64,
+    /// `‖H c − b‖ / ‖b‖` of the normal equations after the solve.
+    pub relative_residual: f64,
+}
+
+/// Dense `nb × nb` blocks of a symmetric matrix over triangle pairs `(I ≥ J)`.
+struct Blocks {
+    nb: usize,
+    index: HashMap<(u32, u32), usize>,
+    data: Vec<f64>,
+}
+
+impl Blocks {
+    fn new(nb: usize) -> Blocks {
+        Blocks {
+            nb,
+            index: HashMap::new(),
+            data: Vec::new(),
+        }
+    }
+    /// Add `w Σ_k a_k ⊗ b_k` for the functions found at one point: `vals[i * stride + k]`
+    /// for function `i` (triangle groups of `nb` consecutive functions) and components `comps`
+    /// (with weights `cw`).
+    fn add_point(&mut self, idx: &[u32], vals: &[f64], stride: usize, comps: &[(usize, f64)]) {
+        let nb = self.nb;
+        let groups = idx.len() / nb;
+        for gi in 0..groups {
+            let ti = idx[gi * nb] / nb as u32;
+            for gj in 0..=gi {
+                let tj = idx[gj * nb] / nb as u32;
+                let (a, b, ga, gb) = if ti >= tj {
+                    (ti, tj, gi, gj)
+                } else {
+                    (tj, ti, gj, gi)
+                };
+                let next = self.data.len();
+                let off = *self.index.entry((a, b)).or_insert(next);
+                if off == next {
+                    self.data.resize(next + nb * nb, 0.0);
+                }
+                let blk = &mut self.data[off..off + nb * nb];
+                for p in 0..nb {
+                    let rp = (ga * nb + p) * stride;
+                    for q in 0..nb {
+                        let rq = (gb * nb + q) * stride;
+                        let mut s = 0.0;
+                        for &(k, w) in comps {
+                            s += w * vals[rp + k] * vals[rq + k];
+                        }
+                        blk[p * nb + q] += s;
+                    }
+                }
+            }
+        }
+    }
+    /// `y += M x` (`dim` columns).
+    fn apply(&self, x: &[f64], dim: usize, y: &mut [f64]) {
+        let nb = self.nb;
+        for (&(a, b), &off) in &self.index {
+            let blk = &self.data[off..off + nb * nb];
+            for p in 0..nb {
+                for q in 0..nb {
+                    let v = blk[p * nb + q];
+                    let (i, j) = (a as usize * nb + p, b as usize * nb + q);
+                    for d in 0..dim {
+                        y[i * dim + d] += v * x[j * dim + d];
+                        if a != b {
+                            y[j * dim + d] += v * x[i * dim + d];
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Thin-plate quadrature: midpoint subdivision into 4, 3-point rule (points at 1/6, 1/6, 2/3)
+/// in each sub-triangle. Returns `(face, point, weight)`.
+fn quadrature(space: &DmsSpace) -> Vec<(u32, Point, f64)> {
+    let dom = space.domain();
+    let mut q = Vec::with_capacity(dom.n_faces() * 12);
+    let subs: [[[f64; 3]; 3]; 4] = [
+        [[1.0, 0.0, 0.0], [0.5, 0.5, 0.0], [0.5, 0.0, 0.5]],
+        [[0.0, 1.0, 0.0], [0.0, 0.5, 0.5], [0.5, 0.5, 0.0]],
+        [[0.0, 0.0, 1.0], [0.5, 0.0, 0.5], [0.0, 0.5, 0.5]],
+        [[0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]],
+    ];
+    let rule = [
+        [2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0],
+        [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
+        [1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0],
+    ];
+    for f in 0..dom.n_faces() as u32 {
+        let [a, b, c] = dom.face_points(f);
+        let area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
+        for s in &subs {
+            for r in &rule {
+                let mut bary = [0.0; 3];
+                for k in 0..3 {
+                    bary[k] = r[0] * s[0][k] + r[1] * s[1][k] + r[2] * s[2][k];
+                }
+                q.push((f, dom.point_in_face(f, bary), area / 12.0));
+            }
+        }
+    }
+    q
+}
+
+/// Thin-plate energy of a spline (the quadrature of [`fit`]).
+pub fn thin_plate_energy(space: &DmsSpace, control: &[f64], dim: usize) -> Result<f64> {
+    let mut ws = Workspace::default();
+    let mut out = vec![0.0; n_partials(2) * dim];
+    let mut e = 0.0;
+    for (f, u, w) in quadrature(space) {
+        space.evaluate(control, dim, f, u, 2, &mut ws, &mut out)?;
+        for d in 0..dim {
+            let (xx, xy, yy) = (out[3 * dim + d], out[4 * dim + d], out[5 * dim + d]);
+            e += w * (xx * xx + 2.0 * xy * xy + yy * yy);
+        }
+    }
+    Ok(e)
+}
+
+/// Least-squares fit of the control points to data with a thin-plate fairness term (module
+/// docs). `initial` (`dim` per control point) is the ridge's anchor.
+pub fn fit(
+    space: &DmsSpace,
+    data: &[DataPoint],
+    initial: &[f64],
+    dim: usize,
+    opts: &FitOptions,
+) -> Result<(Vec<f64>, FitReport)> {
+    let nc = space.n_control_points();
+    let nb = space.per_triangle();
+    if initial.len() != nc * dim {
+        return Err(Error::input(format!(
+            "fit: {} initial numbers for {nc} control points of dimension {dim}",
+            initial.len()
+        )));
+    }
+    if data.is_empty() {
+        return Err(Error::input("fit: no data points"));
+    }
+    let nf = space.domain().n_faces() as u32;
+    for (k, p) in data.iter().enumerate() {
+        if p.face >= nf
+            || p.target.len() != dim
+            || !p.param[0].is_finite()
+            || !p.param[1].is_finite()
+        {
+            return Err(Error::input(format!(
+                "fit: data point {k} has face {} (of {nf}) or {} target coordinates (need {dim})",
+                p.face,
+                p.target.len()
+            )));
+        }
+    }
+    if !(opts.smoothing >= 0.0 && opts.ridge > 0.0) {
+        return Err(Error::input("fit: smoothing must be ≥ 0 and ridge > 0"));
+    }
+    // Scale of the energy term.
+    let dom = space.domain();
+    let mesh = dom.mesh();
+    let mut hsum = 0.0;
+    for e in 0..mesh.n_edges() as u32 {
+        let [a, b] = mesh.edge_vertices(e).map(|v| dom.points()[v as usize]);
+        hsum += (a[0] - b[0]).hypot(a[1] - b[1]);
+    }
+    let hbar = hsum / mesh.n_edges() as f64;
+    let area: f64 = (0..nf)
+        .map(|f| {
+            let [a, b, c] = dom.face_points(f);
+            0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+        })
+        .sum();
+    let kdata = data.len() as f64;
+    let lam = opts.smoothing * hbar * hbar / area;
+
+    let mut data_blocks = Blocks::new(nb);
+    let mut energy_blocks = Blocks::new(nb);
+    let mut rhs = vec![0.0; nc * dim];
+    let mut ws = Workspace::default();
+    for p in data {
+        let m = space.basis_at(p.face, p.param, 0, &mut ws)?;
+        data_blocks.add_point(&ws.indices[..m], &ws.values, 1, &[(0, 1.0 / kdata)]);
+        for i in 0..m {
+            let g = ws.indices[i] as usize;
+            for d in 0..dim {
+                rhs[g * dim + d] += ws.values[i] * p.target[d] / kdata;
+            }
+        }
+    }
+    let np2 = n_partials(2);
+    for (f, u, w) in quadrature(space) {
+        let m = space.basis_at(f, u, 2, &mut ws)?;
+        energy_blocks.add_point(
+            &ws.indices[..m],
+            &ws.values,
+            np2,
+            &[(3, w), (4, 2.0 * w), (5, w)],
+        );
+    }
+    // Ridge relative to the data term's diagonal.
+    let mut diag_mean = 0.0;
+    for (&(a, b), &off) in &data_blocks.index {
+        if a == b {
+            for p in 0..nb {
+                diag_mean += data_blocks.data[off + p * nb + p];
+            }
+        }
+    }
+    diag_mean = (diag_mean / nc as f64).max(1e-300);
+    let gamma = opts.ridge * diag_mean;
+    for k in 0..nc * dim {
+        rhs[k] += gamma * initial[k];
+    }
+    // Assemble H = D + λ T + γ I (lower triangle).
+    let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::new();
+    let mut merged: HashMap<(u32, u32), usize> = data_blocks.index.clone();
+    for k in energy_blocks.index.keys() {
+        merged.entry(*k).or_insert(usize::MAX);
+    }
+    for &(a, b) in merged.keys() {
+        let db = data_blocks
+            .index
+            .get(&(a, b))
+            .map(|&o| &data_blocks.data[o..o + nb * nb]);
+        let eb = energy_blocks
+            .index
+            .get(&(a, b))
+            .map(|&o| &energy_blocks.data[o..o + nb * nb]);
+        for p in 0..nb {
+            for q in 0..nb {
+                let (i, j) = (a as usize * nb + p, b as usize * nb + q);
+                if i < j {
+                    continue;
+                }
+                let mut v =
+                    db.map_or(0.0, |x| x[p * nb + q]) + lam * eb.map_or(0.0, |x| x[p * nb + q]);
+                if i == j {
+                    v += gamma;
+                }
+                if v != 0.0 || i == j {
+                    trip.push(Triplet::new(i, j, v));
+                }
+            }
+        }
+    }
+    // Control points touched by nothing still need their ridge diagonal.
+    let mut touched = vec![false; nc / nb];
+    for &(a, b) in merged.keys() {
+        if a == b {
+            touched[a as usize] = true;
+        }
+    }
+    for (t, &tt) in touched.iter().enumerate() {
+        if !tt {
+            for p in 0..nb {
+                trip.push(Triplet::new(t * nb + p, t * nb + p, gamma));
+            }
+        }
+    }
+    let h = SparseColMat::<usize, f64>::try_new_from_triplets(nc, nc, &trip).map_err(|e| {
+        Error::numerical(format!("fit: could not assemble the normal matrix ({e:?})"))
+    })?;
+    drop(trip);
+    let llt = h.sp_cholesky(Side::Lower).map_err(|e| {
+        Error::numerical(format!("fit: Cholesky of the normal matrix failed ({e:?})"))
+    })?;
+    let mut sol = Mat::<f64>::zeros(nc, dim);
+    for k in 0..nc {
+        for d in 0..dim {
+            sol[(k, d)] = rhs[k * dim + d];
+        }
+    }
+    llt.solve_in_place(sol.as_mut());
+    let mut x = vec![0.0; nc * dim];
+    for k in 0..nc {
+        for d in 0..dim {
+            x[k * dim + d] = sol[(k, d)];
+        }
+    }
+    if x.iter().any(|v| !v.is_finite()) {
+        return Err(Error::numerical(
+            "fit: the normal equations produced non-finite control points",
+        ));
+    }
+    // Objective pieces and the residual of the normal equations.
+    let hx = |c: &[f64]| {
+        let mut y = vec![0.0; nc * dim];
+        data_blocks.apply(c, dim, &mut y);
+        let mut t = vec![0.0; nc * dim];
+        energy_blocks.apply(c, dim, &mut t);
+        (y, t)
+    };
+    let (dx, tx) = hx(&x);
+    let mut res2 = 0.0;
+    let mut b2 = 0.0;
+    for k in 0..nc * dim {
+        let r = dx[k] + lam * tx[k] + gamma * x[k] - rhs[k];
+        res2 += r * r;
+        b2 += rhs[k] * rhs[k];
+    }
+    let energy = |c: &[f64], t: &[f64]| c.iter().zip(t).map(|(a, b)| a * b).sum::<f64>();
+    let mut errs = Vec::with_capacity(data.len());
+    let mut out = vec![0.0; dim];
+    let objective = |c: &[f64],
+                     e: f64,
+                     errs: &mut Vec<f64>,
+                     ws: &mut Workspace,
+                     out: &mut [f64]|
+     -> Result<f64> {
+        errs.clear();
+        let mut s = 0.0;
+        for p in data {
+            space.evaluate(c, dim, p.face, p.param, 0, ws, out)?;
+            let d2: f64 = (0..dim).map(|d| (out[d] - p.target[d]).powi(2)).sum();
+            errs.push(d2.sqrt());
+            s += d2;
+        }
+        let ridge: f64 = c.iter().zip(initial).map(|(a, b)| (a - b) * (a - b)).sum();
+        Ok(s / kdata + lam * e + gamma * ridge)
+    };
+    let (_, t0) = hx(initial);
+    let e0 = energy(initial, &t0);
+    let obj0 = objective(initial, e0, &mut errs, &mut ws, &mut out)?;
+    let e1 = energy(&x, &tx);
+    let obj1 = objective(&x, e1, &mut errs, &mut ws, &mut out)?;
+    let rms = (errs.iter().map(|e| e * e).sum::<f64>() / kdata).sqrt();
+    let max = errs.iter().fold(0.0f64, |a, &b| a.max(b));
+    Ok((
+        x,
+        FitReport {
+            data_points: data.len(),
+            rms_error: rms,
+            max_error: max,
+            energy_before: e0,
+            energy_after: e1,
+            objective_before: obj0,
+            objective_after: obj1,
+            relative_residual: (res2 / b2.max(1e-300)).sqrt(),
+        },
+    ))
+}
