@@ -25,6 +25,8 @@ enum Command {
     Info(cmd::info::Args),
     /// Procedural test surfaces: sphere, torus, disk, annulus, pants, genus-g.
     Generate(cmd::generate::Args),
+    /// Canonical fundamental group generators through a base vertex; slice the mesh into a disk.
+    Cut(cmd::cut::Args),
     /// Render a surface to PNG (checkerboard from UVs, scalar fields, zebra) or export glTF.
     Render(Box<cmd::render::Args>),
 
@@ -37,6 +39,7 @@ fn main() {
     let result = match cli.command {
         Command::Info(a) => cmd::info::run(a),
         Command::Generate(a) => cmd::generate::run(a),
+        Command::Cut(a) => cmd::cut::run(a),
         Command::Render(a) => cmd::render::run(*a),
 
         Command::Flow(a) => cmd::flow::run(a),
