@@ -32,6 +32,10 @@ enum Command {
 
     /// Discrete Ricci flow: a flat, hyperbolic or spherical metric with prescribed curvature.
     Flow(cmd::flow::Args),
+    /// Cut to a disk, lay out isometrically (plane / Poincaré disk / sphere), deck group.
+    Layout(cmd::layout::Args),
+    /// Geodesic length spectrum of a closed surface of genus ≥ 1.
+    Spectrum(cmd::spectrum::Args),
 }
 
 fn main() {
@@ -43,6 +47,8 @@ fn main() {
         Command::Render(a) => cmd::render::run(*a),
 
         Command::Flow(a) => cmd::flow::run(a),
+        Command::Layout(a) => cmd::layout::run(a),
+        Command::Spectrum(a) => cmd::spectrum::run(a),
     };
     if let Err(e) = result {
         eprintln!("error: {}", util::sentence(&e));

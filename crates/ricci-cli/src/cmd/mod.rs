@@ -4,4 +4,6 @@ pub mod cut;
 pub mod flow;
 pub mod generate;
 pub mod info;
+pub mod layout;
 pub mod render;
+pub mod spectrum;

@@ -9,6 +9,8 @@
 //!   generators and the group relation.
 //! * [`cover`] — finite portions of the universal cover: copies of the polygon by words or by
 //!   radius.
+//! * [`pipeline`] — surface with metric → canonical cut → layout → deck group (with the
+//!   uniformization flow when no metric is given).
 //! * [`svg`], [`export`] — pictures of the fundamental domain and tilings; OBJ with UVs.
 //! * [`synthetic`] — closed surfaces with exact flat / hyperbolic metrics and known polygons
 //!   (flat tori, regular 4g-gons), the references of the tests.
@@ -17,6 +19,7 @@ pub mod cover;
 pub mod deck;
 pub mod export;
 pub mod isometry;
+pub mod pipeline;
 pub mod place;
 pub mod svg;
 pub mod synthetic;

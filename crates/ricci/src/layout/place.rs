@@ -212,8 +212,11 @@ pub struct Layout<P> {
     pub degenerate_faces: Vec<u32>,
     /// Largest `|d(p_a, p_b) − l_ab|` over all edges (0 for an exact metric, up to rounding).
     pub max_length_error: f64,
-    /// Largest breadth-first depth (in faces) from the seed face.
+    /// Longest chain of placements from the seed face to a vertex.
     pub depth: u32,
+    /// Largest distance of a vertex from the seed vertex (in H² the Poincaré disk resolves
+    /// points at distance r only to about 1e-16·e^r, so layouts beyond r ≈ 25 lose accuracy).
+    pub max_radius: f64,
 }
 
 /// Check that a metric fits the mesh: one finite positive length per edge (below π on the
@@ -393,47 +396,97 @@ pub(crate) fn layout_unchecked<S: Space>(
     lengths: &[f64],
     seed: u32,
 ) -> Layout<S::Point> {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
     let nv = mesh.n_vertices();
     let nf = mesh.n_faces();
     let len = |h: u32| lengths[mesh.he_edge(h) as usize];
     let mut pos = vec![S::base_point(); nv];
     let mut placed = vec![false; nv];
-    let mut face_depth = vec![u32::MAX; nf];
-    // Queue entries: (face, interior half-edge of that face whose ends are placed).
-    let mut queue: VecDeque<(u32, u32)> = VecDeque::with_capacity(nf);
-    let [h0, h1, h2] = mesh.face_halfedges(seed);
-    let tri = S::seed(len(h0), len(h1), len(h2));
+    // Error-growth estimate per vertex: placing k from the edge (i, j) multiplies the error
+    // of the edge's direction by about max(l_ik, l_jk)/l_ij, so needles (e.g. from refinement
+    // fans) are crossed along their length, not across; the order is a Dijkstra on
+    // cost = Σ ln(1 + max(l_ik, l_jk)/l_ij), i.e. breadth first on well-shaped meshes.
+    let mut cost = vec![f64::INFINITY; nv];
+    let mut vdepth = vec![0u32; nv];
+    let mut heap: BinaryHeap<(Reverse<u64>, u32, u32)> = BinaryHeap::with_capacity(nf);
+    // Every face gets a frame: the isometry taking its canonical triangle (vertex 0 at the
+    // base point, vertex 1 on the reference direction, `Space::seed`) to its place. A
+    // neighbour's frame is the parent's frame composed with the relative placement, which is
+    // computed near the base point from the metric alone; positions are frames applied to
+    // canonical triangles. So no direction is ever taken from the difference of two nearby
+    // far-away points (in the Poincaré disk those lose ~1e-16·e^r / l of accuracy).
+    let canon = |f: u32| {
+        let [a, b, c] = mesh.face_halfedges(f);
+        S::seed(len(a), len(b), len(c))
+    };
+    let mut frame: Vec<Option<S::Iso>> = vec![None; nf];
+    frame[seed as usize] = Some(S::Iso::identity());
+    let tri = canon(seed);
     let fv = mesh.face(seed);
     for i in 0..3 {
         pos[fv[i] as usize] = tri[i];
         placed[fv[i] as usize] = true;
+        cost[fv[i] as usize] = 0.0;
     }
-    face_depth[seed as usize] = 0;
     let mut depth = 0;
-    let push_neighbours = |f: u32, queue: &mut VecDeque<(u32, u32)>, face_depth: &mut [u32]| {
-        let d = face_depth[f as usize];
+    // Heap entries: (cost, face g, half-edge t of g whose ends are placed); the parent is the
+    // face across t.
+    let push = |f: u32,
+                heap: &mut BinaryHeap<(Reverse<u64>, u32, u32)>,
+                cost: &[f64],
+                frame: &[Option<S::Iso>]| {
         for h in mesh.face_halfedges(f) {
             let t = mesh.he_twin(h);
             let g = mesh.he_face(t);
-            if g != NONE && face_depth[g as usize] == u32::MAX {
-                face_depth[g as usize] = d + 1;
-                queue.push_back((g, t));
+            if g == NONE || frame[g as usize].is_some() {
+                continue;
             }
+            let (i, j) = (mesh.he_origin(t), mesh.he_tip(t));
+            let amp =
+                len(mesh.he_next(t)).max(len(mesh.he_prev(t))) / len(t).max(f64::MIN_POSITIVE);
+            let c = cost[i as usize].max(cost[j as usize]) + (1.0 + amp).ln();
+            heap.push((Reverse(c.to_bits()), g, t));
         }
     };
-    push_neighbours(seed, &mut queue, &mut face_depth);
-    while let Some((f, h)) = queue.pop_front() {
-        depth = depth.max(face_depth[f as usize]);
-        let i = mesh.he_origin(h);
-        let j = mesh.he_tip(h);
-        let hn = mesh.he_next(h);
-        let hp = mesh.he_prev(h);
-        let k = mesh.he_tip(hn);
-        if !placed[k as usize] {
-            pos[k as usize] = S::third(pos[i as usize], pos[j as usize], len(h), len(hn), len(hp));
-            placed[k as usize] = true;
+    push(seed, &mut heap, &cost, &frame);
+    while let Some((_, g, t)) = heap.pop() {
+        if frame[g as usize].is_some() {
+            continue;
         }
-        push_neighbours(f, &mut queue, &mut face_depth);
+        let h = mesh.he_twin(t); // the parent's half-edge j → i
+        let f = mesh.he_face(h);
+        let ff = frame[f as usize].expect("parents have frames");
+        // Parent's canonical triangle; the shared edge in it.
+        let cf = canon(f);
+        // h runs j → i: its origin (corner h % 3) is j, its tip is i.
+        let (pj, pi) = (cf[(h % 3) as usize], cf[((h + 1) % 3) as usize]);
+        let (tn, tp) = (mesh.he_next(t), mesh.he_prev(t));
+        // g = (i, j, k) counter-clockwise with t = i → j; place k in the parent's frame.
+        let pk = S::third(pi, pj, len(t), len(tn), len(tp));
+        // Relative placement: g's canonical triangle onto (q_i, q_j, q_k) in f's frame.
+        let cg = canon(g);
+        let ti = (t % 3) as usize; // corner of i in g
+        let q = [pi, pj, pk]; // positions of g's corners ti, ti+1, ti+2
+        let mut target = [pi; 3];
+        for r in 0..3 {
+            target[(ti + r) % 3] = q[r];
+        }
+        let rel = S::Iso::from_pairs(cg[0], cg[1], target[0], target[1]);
+        let fg = ff.compose(&rel).normalized();
+        frame[g as usize] = Some(fg);
+        let k = mesh.he_tip(tn);
+        if !placed[k as usize] {
+            let i = mesh.he_origin(t);
+            let j = mesh.he_tip(t);
+            pos[k as usize] = fg.apply(cg[(ti + 2) % 3]);
+            placed[k as usize] = true;
+            let amp = len(tn).max(len(tp)) / len(t).max(f64::MIN_POSITIVE);
+            cost[k as usize] = cost[i as usize].max(cost[j as usize]) + (1.0 + amp).ln();
+            vdepth[k as usize] = vdepth[i as usize].max(vdepth[j as usize]) + 1;
+            depth = depth.max(vdepth[k as usize]);
+        }
+        push(g, &mut heap, &cost, &frame);
     }
     // Measurements.
     let mut flipped = Vec::new();
@@ -455,8 +508,13 @@ pub(crate) fn layout_unchecked<S: Space>(
         let d = S::distance(pos[a as usize], pos[b as usize]);
         max_err = max_err.max((d - lengths[e as usize]).abs());
     }
+    let max_radius = pos
+        .iter()
+        .map(|&p| S::distance(S::base_point(), p))
+        .fold(0.0, f64::max);
     Layout {
         geometry: S::KIND,
+        max_radius,
         positions: pos,
         seed_face: seed,
         flipped_faces: flipped,
