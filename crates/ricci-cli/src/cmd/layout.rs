@@ -5,7 +5,7 @@
 //!
 //! Closed genus-0 surfaces go onto the sphere whole; disks are laid out as they are; every
 //! other surface is cut first (`ricci::cut`). Without `--metric` the Ricci flow of the
-//! geometry is run (tolerance 1e-12). The seed face is a face id of the cut mesh (default:
+//! geometry is run (tolerance 1e-11). The seed face is a face id of the cut mesh (default:
 //! the face nearest the centre of the polygon). `--tiling N` draws the first N copies of the
 //! fundamental polygon (breadth first through the side pairings) instead of the polygon.
 //! UV.obj keeps the surface's own vertices (`v`) and gives every corner the layout coordinate
@@ -226,7 +226,7 @@ pub fn metric(
     };
     let mut opts = ricci::flow::FlowOptions {
         geometry: g,
-        tolerance: 1e-12,
+        tolerance: 1e-11,
         ..Default::default()
     };
     opts.target = match target {
