@@ -25,11 +25,17 @@ enum Command {
     Info(cmd::info::Args),
     /// Procedural test surfaces: sphere, torus, disk, annulus, pants, genus-g.
     Generate(cmd::generate::Args),
+    /// Canonical fundamental group generators through a base vertex; slice the mesh into a disk.
+    Cut(cmd::cut::Args),
     /// Render a surface to PNG (checkerboard from UVs, scalar fields, zebra) or export glTF.
     Render(Box<cmd::render::Args>),
 
     /// Discrete Ricci flow: a flat, hyperbolic or spherical metric with prescribed curvature.
     Flow(cmd::flow::Args),
+    /// Cut to a disk, lay out isometrically (plane / Poincaré disk / sphere), deck group.
+    Layout(cmd::layout::Args),
+    /// Geodesic length spectrum of a closed surface of genus ≥ 1.
+    Spectrum(cmd::spectrum::Args),
 }
 
 fn main() {
@@ -37,9 +43,12 @@ fn main() {
     let result = match cli.command {
         Command::Info(a) => cmd::info::run(a),
         Command::Generate(a) => cmd::generate::run(a),
+        Command::Cut(a) => cmd::cut::run(a),
         Command::Render(a) => cmd::render::run(*a),
 
         Command::Flow(a) => cmd::flow::run(a),
+        Command::Layout(a) => cmd::layout::run(a),
+        Command::Spectrum(a) => cmd::spectrum::run(a),
     };
     if let Err(e) = result {
         eprintln!("error: {}", util::sentence(&e));

@@ -1,6 +1,9 @@
 //! One module per subcommand; each has `Args` (clap) and `run`.
 
+pub mod cut;
 pub mod flow;
 pub mod generate;
 pub mod info;
+pub mod layout;
 pub mod render;
+pub mod spectrum;

@@ -1,1 +1,6 @@
 //! Distortion statistics, geodesic length spectrum (papers 000 §4, 002 §6.3.3).
+//!
+//! * [`spectrum`] — geodesic length spectra of flat tori (translation lattices) and of
+//!   hyperbolic surfaces (Fuchsian groups), with a completeness guarantee.
+
+pub mod spectrum;

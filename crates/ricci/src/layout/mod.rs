@@ -1,1 +1,29 @@
-//! Isometric layouts, isometries and deck transformations (paper 001 §V Step 4, 002 §6.2.2).
+//! Isometric layouts, isometries and deck transformations (paper 001 §V Step 4 and §VI,
+//! paper 002 §4.3.2–4.3.3 and §6.2.2–6.2.4).
+//!
+//! * [`isometry`] — rigid motions of the plane, Möbius maps of the Poincaré disk (SU(1,1)),
+//!   rotations of the sphere; composition, inverse, fitting from point pairs; Klein matrices.
+//! * [`place`] — breadth-first isometric placement of a disk (or of a closed genus-0 surface on
+//!   the sphere) with a metric, generic over the background geometry ([`Space`]).
+//! * [`deck`] — fundamental polygons with paired sides, side pairings, deck transformation
+//!   generators and the group relation.
+//! * [`cover`] — finite portions of the universal cover: copies of the polygon by words or by
+//!   radius.
+//! * [`pipeline`] — surface with metric → canonical cut → layout → deck group (with the
+//!   uniformization flow when no metric is given).
+//! * [`svg`], [`export`] — pictures of the fundamental domain and tilings; OBJ with UVs.
+//! * [`synthetic`] — closed surfaces with exact flat / hyperbolic metrics and known polygons
+//!   (flat tori, regular 4g-gons), the references of the tests.
+
+pub mod cover;
+pub mod deck;
+pub mod export;
+pub mod isometry;
+pub mod pipeline;
+pub mod place;
+pub mod svg;
+pub mod synthetic;
+
+pub use deck::{deck_group, DeckGroup, Polygon, Side, SidePairing};
+pub use isometry::{Isometry, Mobius, RigidMotion, Rotation};
+pub use place::{align, layout, Layout, Space};

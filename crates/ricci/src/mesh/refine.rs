@@ -1,1 +1,682 @@
-//! Intrinsic refinement: metric-preserving edge splits in E², H², S² (for raising vertex valence).
+//! Intrinsic refinement: metric-preserving edge splits in E², H², S², used to raise the valence
+//! of a vertex and to grade the mesh around it (paper 000, Step 2: "modify local connectivity
+//! around the singular vertex").
+//!
+//! The only operation is the **intrinsic edge split**: a point `m` is inserted on the geodesic
+//! edge `(a, b)` at the fraction `t` of its length, and joined to the opposite vertex of each
+//! adjacent face. The new lengths come from the cosine law of the background geometry: in face
+//! `(a, b, c)` with angle `θ_a` at `a`, `|mc| = side(|ac|, t·|ab|, θ_a)`. Because `m` lies on
+//! the geodesic segment inside both faces, the refined triangulation describes the same cone
+//! metric: every old corner angle is the sum of its new pieces, old vertices keep their
+//! curvature, new vertices are flat (angle sum 2π, or π on the boundary), and areas add up —
+//! exactly up to rounding (tested to 1e-12). Positions, when given, are interpolated linearly
+//! (the split point of a straight edge in R³ stays on that edge).
+//!
+//! Two refinements are built from splits:
+//!
+//! * [`Refiner::raise_valence`] (paper 000, Step 2 (i)): split the longest edge of the link of
+//!   a vertex `x` (opposite `x` in one of its faces) until `x` has the requested valence.
+//! * [`Refiner::grade_around`] (Step 2 (ii), made quantitative): after raising the valence to
+//!   `n`, the first rings around `x` still have only ~6k vertices, too few for `n` disjoint paths
+//!   leaving `x` (a canonical system through `x` needs `4g` of them). Grading splits edges
+//!   (longest-edge propagation, Rivara's LEPP, which keeps angles bounded away from 0) until
+//!   every face at distance `r` from `x` has edges no longer than `Θ·r/n`, `Θ` the cone angle at
+//!   `x`: then every circle around `x` crosses about `n` vertices, out to the distance where the
+//!   input mesh is fine enough by itself.
+//!
+//! Faces keep their ids (a split face keeps its id for one piece, the other pieces are
+//! appended), vertices keep their ids (new ones are appended), and the provenance of every new
+//! vertex (edge endpoints and parameter) is recorded.
+
+use super::connectivity::{Mesh, NONE};
+use crate::error::{Error, Result};
+use crate::metric::Geometry;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+/// Where a vertex created by refinement lies: on the edge from `a` to `b` (ids in the refined
+/// mesh, both smaller than the new vertex) at the fraction `t` of its length from `a`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct SplitVertex {
+    pub a: u32,
+    pub b: u32,
+    pub t: f64,
+}
+
+/// The result of a refinement.
+#[derive(Debug, Clone)]
+pub struct Refined {
+    /// Refined connectivity (old vertices keep their ids; new vertices are appended).
+    pub mesh: Mesh,
+    /// Edge lengths of the refined mesh, by edge id (same geometry as the input metric).
+    pub lengths: Vec<f64>,
+    /// Positions, linearly interpolated, if the input had positions.
+    pub positions: Option<Vec<[f64; 3]>>,
+    /// Number of vertices of the input mesh (`new_vertices[k]` describes vertex
+    /// `original_vertices + k`).
+    pub original_vertices: usize,
+    /// Provenance of the new vertices.
+    pub new_vertices: Vec<SplitVertex>,
+    /// For every refined face, the input face it lies in.
+    pub face_origin: Vec<u32>,
+}
+
+impl Refined {
+    /// The identity refinement (nothing split).
+    pub fn identity(mesh: &Mesh, lengths: &[f64], positions: Option<&[[f64; 3]]>) -> Refined {
+        Refined {
+            mesh: mesh.clone(),
+            lengths: lengths.to_vec(),
+            positions: positions.map(|p| p.to_vec()),
+            original_vertices: mesh.n_vertices(),
+            new_vertices: Vec::new(),
+            face_origin: (0..mesh.n_faces() as u32).collect(),
+        }
+    }
+
+    /// Number of edge splits performed.
+    pub fn splits(&self) -> usize {
+        self.new_vertices.len()
+    }
+}
+
+/// Mutable triangle soup with twins and per-half-edge lengths, supporting intrinsic splits.
+/// Half-edge `3f + i` goes from `faces[f][i]` to `faces[f][(i+1)%3]` (the [`Mesh`] convention).
+#[derive(Debug, Clone)]
+pub struct Refiner {
+    geometry: Geometry,
+    original_vertices: usize,
+    faces: Vec<[u32; 3]>,
+    /// Twin half-edge, `NONE` on the boundary.
+    twin: Vec<u32>,
+    /// Length of every half-edge.
+    len: Vec<f64>,
+    /// One corner (= outgoing interior half-edge) per vertex.
+    vertex_corner: Vec<u32>,
+    positions: Option<Vec<[f64; 3]>>,
+    new_vertices: Vec<SplitVertex>,
+    face_origin: Vec<u32>,
+}
+
+impl Refiner {
+    /// Start from a mesh with edge lengths (by edge id) in the given background geometry and
+    /// optional positions. Lengths must be finite and positive.
+    pub fn new(
+        mesh: &Mesh,
+        lengths: &[f64],
+        geometry: Geometry,
+        positions: Option<&[[f64; 3]]>,
+    ) -> Result<Refiner> {
+        if lengths.len() != mesh.n_edges() {
+            return Err(Error::input(format!(
+                "the metric has {} edge lengths but the mesh has {} edges",
+                lengths.len(),
+                mesh.n_edges()
+            )));
+        }
+        if let Some(p) = positions {
+            if p.len() != mesh.n_vertices() {
+                return Err(Error::input(format!(
+                    "{} positions given for {} vertices",
+                    p.len(),
+                    mesh.n_vertices()
+                )));
+            }
+        }
+        for (e, &l) in lengths.iter().enumerate() {
+            if !(l.is_finite() && l > 0.0) {
+                let [a, b] = mesh.edge_vertices(e as u32);
+                return Err(Error::input(format!(
+                    "edge {e} ({a}, {b}) has length {l}; lengths must be finite and positive"
+                )));
+            }
+        }
+        let nh = mesh.n_corners();
+        let mut twin = vec![NONE; nh];
+        let mut len = vec![0.0; nh];
+        for h in 0..nh as u32 {
+            let t = mesh.he_twin(h);
+            if !mesh.is_boundary_halfedge(t) {
+                twin[h as usize] = t;
+            }
+            len[h as usize] = lengths[mesh.he_edge(h) as usize];
+        }
+        let vertex_corner = (0..mesh.n_vertices() as u32)
+            .map(|v| mesh.vertex_halfedge(v))
+            .collect();
+        Ok(Refiner {
+            geometry,
+            original_vertices: mesh.n_vertices(),
+            faces: mesh.faces().to_vec(),
+            twin,
+            len,
+            vertex_corner,
+            positions: positions.map(|p| p.to_vec()),
+            new_vertices: Vec::new(),
+            face_origin: (0..mesh.n_faces() as u32).collect(),
+        })
+    }
+
+    /// Continue refining an earlier result (provenance and face origins are kept).
+    pub fn resume(refined: Refined, geometry: Geometry) -> Result<Refiner> {
+        let mut r = Refiner::new(
+            &refined.mesh,
+            &refined.lengths,
+            geometry,
+            refined.positions.as_deref(),
+        )?;
+        r.original_vertices = refined.original_vertices;
+        r.new_vertices = refined.new_vertices;
+        r.face_origin = refined.face_origin;
+        Ok(r)
+    }
+
+    /// Split the edge between `u` and `v` at its midpoint, if it exists; returns the new vertex.
+    pub fn split_between(&mut self, u: u32, v: u32) -> Option<u32> {
+        if u as usize >= self.n_vertices() {
+            return None;
+        }
+        let (fan, closed) = self.fan(u);
+        for &h in &fan {
+            if self.origin(Self::next(h)) == v {
+                return Some(self.split(h, 0.5));
+            }
+        }
+        if !closed {
+            if let Some(&last) = fan.last() {
+                let p = Self::prev(last);
+                if self.origin(p) == v {
+                    return Some(self.split(p, 0.5));
+                }
+            }
+        }
+        None
+    }
+
+    pub fn n_vertices(&self) -> usize {
+        self.vertex_corner.len()
+    }
+    pub fn n_faces(&self) -> usize {
+        self.faces.len()
+    }
+    /// Number of splits so far.
+    pub fn splits(&self) -> usize {
+        self.new_vertices.len()
+    }
+
+    #[inline]
+    fn origin(&self, h: u32) -> u32 {
+        self.faces[h as usize / 3][h as usize % 3]
+    }
+    #[inline]
+    fn next(h: u32) -> u32 {
+        3 * (h / 3) + (h % 3 + 1) % 3
+    }
+    #[inline]
+    fn prev(h: u32) -> u32 {
+        3 * (h / 3) + (h % 3 + 2) % 3
+    }
+
+    /// Outgoing interior half-edges of `v` in counter-clockwise order; `closed` tells whether
+    /// the fan closes up (interior vertex).
+    fn fan(&self, v: u32) -> (Vec<u32>, bool) {
+        let start = self.vertex_corner[v as usize];
+        if start == NONE {
+            return (Vec::new(), false);
+        }
+        // Rotate clockwise (h ↦ next(twin(h))) to the first half-edge of an open fan.
+        let mut h = start;
+        let mut closed = false;
+        let mut guard = 0usize;
+        loop {
+            let t = self.twin[h as usize];
+            if t == NONE {
+                break;
+            }
+            let g = Self::next(t);
+            if g == start {
+                closed = true;
+                break;
+            }
+            h = g;
+            guard += 1;
+            if guard > self.faces.len() {
+                break;
+            }
+        }
+        let first = if closed { start } else { h };
+        let mut out = vec![first];
+        let mut h = first;
+        loop {
+            let t = self.twin[Self::prev(h) as usize];
+            if t == NONE || t == first {
+                break;
+            }
+            out.push(t);
+            h = t;
+            if out.len() > self.faces.len() {
+                break;
+            }
+        }
+        (out, closed)
+    }
+
+    /// Valence (number of edges) of `v`.
+    pub fn valence(&self, v: u32) -> usize {
+        let (fan, closed) = self.fan(v);
+        if closed {
+            fan.len()
+        } else if fan.is_empty() {
+            0
+        } else {
+            fan.len() + 1
+        }
+    }
+
+    /// Corner angle at corner `c` (at `faces[c/3][c%3]`).
+    fn corner_angle(&self, c: u32) -> f64 {
+        let f = 3 * (c / 3);
+        let i = c % 3;
+        // Opposite side is half-edge next(c); the adjacent sides are c and prev(c).
+        let opp = self.len[(f + (i + 1) % 3) as usize];
+        let s1 = self.len[c as usize];
+        let s2 = self.len[(f + (i + 2) % 3) as usize];
+        self.geometry.angle(opp, s1, s2)
+    }
+
+    /// Split the edge of half-edge `h` at the fraction `t ∈ (0, 1)` of its length from
+    /// `origin(h)`; returns the new vertex. Both adjacent faces are bisected.
+    pub fn split(&mut self, h: u32, t: f64) -> u32 {
+        let g = self.geometry;
+        let f = h / 3;
+        let i = h % 3;
+        let (h_ab, h_bc, h_ca) = (h, 3 * f + (i + 1) % 3, 3 * f + (i + 2) % 3);
+        let (a, b, c) = (self.origin(h_ab), self.origin(h_bc), self.origin(h_ca));
+        let (l_ab, l_bc, l_ca) = (
+            self.len[h_ab as usize],
+            self.len[h_bc as usize],
+            self.len[h_ca as usize],
+        );
+        let (t_bc, t_ca) = (self.twin[h_bc as usize], self.twin[h_ca as usize]);
+        let l_am = t * l_ab;
+        let l_mb = (1.0 - t) * l_ab;
+        // From the nearer endpoint for accuracy.
+        let l_mc = if t <= 0.5 {
+            side(g, l_ca, l_am, g.angle(l_bc, l_ab, l_ca))
+        } else {
+            side(g, l_bc, l_mb, g.angle(l_ca, l_bc, l_ab))
+        };
+        let m = self.vertex_corner.len() as u32;
+        let hg = self.twin[h as usize];
+        let nf = self.faces.len() as u32;
+        // f = (a, m, c), f1 = (m, b, c)
+        let f1 = nf;
+        self.faces[f as usize] = [a, m, c];
+        self.faces.push([m, b, c]);
+        self.face_origin.push(self.face_origin[f as usize]);
+        self.twin.extend_from_slice(&[NONE; 3]);
+        self.len.extend_from_slice(&[0.0; 3]);
+        let set = |s: &mut Self, x: u32, y: u32| {
+            s.twin[x as usize] = y;
+            if y != NONE {
+                s.twin[y as usize] = x;
+            }
+        };
+        self.len[(3 * f) as usize] = l_am;
+        self.len[(3 * f + 1) as usize] = l_mc;
+        self.len[(3 * f + 2) as usize] = l_ca;
+        self.len[(3 * f1) as usize] = l_mb;
+        self.len[(3 * f1 + 1) as usize] = l_bc;
+        self.len[(3 * f1 + 2) as usize] = l_mc;
+        set(self, 3 * f + 1, 3 * f1 + 2);
+        set(self, 3 * f + 2, t_ca);
+        set(self, 3 * f1 + 1, t_bc);
+        self.vertex_corner.push(3 * f + 1);
+        self.vertex_corner[a as usize] = 3 * f;
+        self.vertex_corner[b as usize] = 3 * f1 + 1;
+        self.vertex_corner[c as usize] = 3 * f + 2;
+        if hg == NONE {
+            self.twin[(3 * f) as usize] = NONE;
+            self.twin[(3 * f1) as usize] = NONE;
+        } else {
+            // G = (b, a, d) → G = (b, m, d), g1 = (m, a, d)
+            let gf = hg / 3;
+            let j = hg % 3;
+            let (h_ba, h_ad, h_db) = (hg, 3 * gf + (j + 1) % 3, 3 * gf + (j + 2) % 3);
+            let d = self.origin(h_db);
+            let (l_ad, l_db) = (self.len[h_ad as usize], self.len[h_db as usize]);
+            let (t_ad, t_db) = (self.twin[h_ad as usize], self.twin[h_db as usize]);
+            debug_assert_eq!(self.len[h_ba as usize], l_ab);
+            let l_md = if t <= 0.5 {
+                side(g, l_ad, l_am, g.angle(l_db, l_ab, l_ad))
+            } else {
+                side(g, l_db, l_mb, g.angle(l_ad, l_db, l_ab))
+            };
+            let g1 = nf + 1;
+            self.faces[gf as usize] = [b, m, d];
+            self.faces.push([m, a, d]);
+            self.face_origin.push(self.face_origin[gf as usize]);
+            self.twin.extend_from_slice(&[NONE; 3]);
+            self.len.extend_from_slice(&[0.0; 3]);
+            self.len[(3 * gf) as usize] = l_mb;
+            self.len[(3 * gf + 1) as usize] = l_md;
+            self.len[(3 * gf + 2) as usize] = l_db;
+            self.len[(3 * g1) as usize] = l_am;
+            self.len[(3 * g1 + 1) as usize] = l_ad;
+            self.len[(3 * g1 + 2) as usize] = l_md;
+            set(self, 3 * f, 3 * g1);
+            set(self, 3 * f1, 3 * gf);
+            set(self, 3 * gf + 1, 3 * g1 + 2);
+            set(self, 3 * gf + 2, t_db);
+            set(self, 3 * g1 + 1, t_ad);
+            self.vertex_corner[d as usize] = 3 * gf + 2;
+        }
+        if let Some(p) = self.positions.as_mut() {
+            let (pa, pb) = (p[a as usize], p[b as usize]);
+            p.push([
+                (1.0 - t) * pa[0] + t * pb[0],
+                (1.0 - t) * pa[1] + t * pb[1],
+                (1.0 - t) * pa[2] + t * pb[2],
+            ]);
+        }
+        self.new_vertices.push(SplitVertex { a, b, t });
+        m
+    }
+
+    fn check_interior(&self, x: u32) -> Result<()> {
+        if x as usize >= self.n_vertices() {
+            return Err(Error::input(format!(
+                "vertex {x} does not exist (the mesh has {} vertices)",
+                self.n_vertices()
+            )));
+        }
+        let (fan, closed) = self.fan(x);
+        if fan.is_empty() {
+            return Err(Error::input(format!("vertex {x} is isolated")));
+        }
+        if !closed {
+            return Err(Error::input(format!(
+                "vertex {x} lies on the boundary; refinement around it needs an interior vertex"
+            )));
+        }
+        Ok(())
+    }
+
+    /// Split the longest edge of the link of `x` (the edge opposite `x` in one of its faces)
+    /// at its midpoint until `x` has at least `min_valence` edges. `x` must be interior.
+    /// Returns the number of splits.
+    pub fn raise_valence(&mut self, x: u32, min_valence: usize) -> Result<usize> {
+        self.check_interior(x)?;
+        let mut n = 0;
+        loop {
+            let (fan, _) = self.fan(x);
+            if fan.len() >= min_valence {
+                return Ok(n);
+            }
+            // Link half-edge of corner c at x: next(c).
+            let best = fan
+                .iter()
+                .map(|&c| Self::next(c))
+                .max_by(|&p, &q| self.len[p as usize].total_cmp(&self.len[q as usize]))
+                .unwrap_or(NONE);
+            let opp = self.twin[best as usize];
+            if opp != NONE && self.origin(Self::prev(opp)) == x {
+                return Err(Error::invalid_mesh(format!(
+                    "vertex {x} appears twice around one of its link edges"
+                )));
+            }
+            self.split(best, 0.5);
+            n += 1;
+        }
+    }
+
+    /// Cone angle at interior vertex `x` (sum of its corner angles).
+    pub fn cone_angle(&self, x: u32) -> f64 {
+        self.fan(x).0.iter().map(|&c| self.corner_angle(c)).sum()
+    }
+
+    /// Shortest-path distances (along edges, with the current lengths) from `x`, up to `cutoff`
+    /// (farther vertices get `INFINITY`).
+    fn distances(&self, x: u32, cutoff: f64) -> Vec<f64> {
+        let nv = self.n_vertices();
+        // CSR adjacency from half-edges, both directions (interior edges appear twice).
+        let mut deg = vec![0u32; nv + 1];
+        for h in 0..self.len.len() as u32 {
+            deg[self.origin(h) as usize] += 1;
+            deg[self.origin(Self::next(h)) as usize] += 1;
+        }
+        let mut start = vec![0u32; nv + 1];
+        for v in 0..nv {
+            start[v + 1] = start[v] + deg[v];
+        }
+        let mut fill = start.clone();
+        let mut adj = vec![(0u32, 0.0f64); start[nv] as usize];
+        for h in 0..self.len.len() as u32 {
+            let (a, b, l) = (
+                self.origin(h),
+                self.origin(Self::next(h)),
+                self.len[h as usize],
+            );
+            adj[fill[a as usize] as usize] = (b, l);
+            fill[a as usize] += 1;
+            adj[fill[b as usize] as usize] = (a, l);
+            fill[b as usize] += 1;
+        }
+        let mut dist = vec![f64::INFINITY; nv];
+        let mut heap = BinaryHeap::new();
+        dist[x as usize] = 0.0;
+        heap.push(MinItem(0.0, x));
+        while let Some(MinItem(d, v)) = heap.pop() {
+            if d > dist[v as usize] || d > cutoff {
+                continue;
+            }
+            for &(w, l) in &adj[start[v as usize] as usize..start[v as usize + 1] as usize] {
+                let nd = d + l;
+                if nd < dist[w as usize] {
+                    dist[w as usize] = nd;
+                    heap.push(MinItem(nd, w));
+                }
+            }
+        }
+        for d in &mut dist {
+            if *d > cutoff {
+                *d = f64::INFINITY;
+            }
+        }
+        dist
+    }
+
+    /// The half-edge along which face `f` is bisected by longest-edge refinement: its longest
+    /// edge, except that faces at `x` are only ever split across their link edge (so the
+    /// distance from `x` to its link never shrinks).
+    fn refinement_edge(&self, f: u32, x: u32) -> u32 {
+        let t = self.faces[f as usize];
+        if let Some(i) = t.iter().position(|&v| v == x) {
+            return 3 * f + (i as u32 + 1) % 3;
+        }
+        let mut best = 3 * f;
+        for k in 1..3 {
+            if self.len[(3 * f + k) as usize] > self.len[best as usize] {
+                best = 3 * f + k;
+            }
+        }
+        best
+    }
+
+    /// One step of Rivara's longest-edge propagation path from face `f`: follow the longest
+    /// edges until an edge is the longest of both its faces (or on the boundary) and split it.
+    fn lepp_step(&mut self, f: u32, x: u32, dist: &mut Vec<f64>) -> u32 {
+        let mut h = self.refinement_edge(f, x);
+        for _ in 0..64 {
+            let t = self.twin[h as usize];
+            if t == NONE {
+                break;
+            }
+            let r = self.refinement_edge(t / 3, x);
+            if r == t || self.len[r as usize] <= self.len[h as usize] {
+                break;
+            }
+            h = r;
+        }
+        let m = self.split(h, 0.5);
+        // Distance of the new vertex: the best over its neighbours.
+        let (fan, closed) = self.fan(m);
+        let mut dm = f64::INFINITY;
+        for &h2 in &fan {
+            let v = self.origin(Self::next(h2));
+            dm = dm.min(dist[v as usize] + self.len[h2 as usize]);
+        }
+        if !closed {
+            if let Some(&last) = fan.last() {
+                let p = Self::prev(last);
+                dm = dm.min(dist[self.origin(p) as usize] + self.len[p as usize]);
+            }
+        }
+        dist.push(dm);
+        m
+    }
+
+    /// Graded refinement around interior vertex `x` so that about `paths` vertex-disjoint paths
+    /// can leave `x` side by side: every face (not incident to `x`) whose nearest vertex lies
+    /// at distance `r < radius` from `x` is refined (by longest-edge bisection) until its
+    /// longest edge is at most `Θ·r/paths`, with `Θ` the cone angle at `x`. `radius` bounds
+    /// the refined region; `max_splits` bounds the work. Returns the number of splits.
+    pub fn grade_around(
+        &mut self,
+        x: u32,
+        paths: usize,
+        radius: f64,
+        max_splits: usize,
+    ) -> Result<usize> {
+        self.check_interior(x)?;
+        let theta = self.cone_angle(x);
+        if !(theta.is_finite() && theta > 0.0) || paths == 0 {
+            return Ok(0);
+        }
+        let k = theta / paths as f64;
+        let mut dist = self.distances(x, radius);
+        let needs = |s: &Self, f: u32, dist: &[f64]| -> bool {
+            let t = s.faces[f as usize];
+            if t.contains(&x) {
+                return false;
+            }
+            let r = t
+                .iter()
+                .map(|&v| dist[v as usize])
+                .fold(f64::INFINITY, f64::min);
+            if r.is_nan() || r >= radius {
+                return false;
+            }
+            let lmax = s.len[3 * f as usize]
+                .max(s.len[3 * f as usize + 1])
+                .max(s.len[3 * f as usize + 2]);
+            lmax > k * r
+        };
+        let mut work: Vec<u32> = (0..self.n_faces() as u32)
+            .filter(|&f| needs(self, f, &dist))
+            .collect();
+        let mut n = 0;
+        while let Some(f) = work.pop() {
+            if n >= max_splits {
+                break;
+            }
+            if !needs(self, f, &dist) {
+                continue;
+            }
+            let nf_before = self.n_faces() as u32;
+            let m = self.lepp_step(f, x, &mut dist);
+            n += 1;
+            work.push(f);
+            for g in nf_before..self.n_faces() as u32 {
+                work.push(g);
+            }
+            // The faces around the new vertex changed too.
+            for c in self.fan(m).0 {
+                work.push(c / 3);
+            }
+        }
+        Ok(n)
+    }
+
+    /// Build the refined mesh (once) with its lengths, positions and provenance.
+    pub fn finish(self) -> Result<Refined> {
+        let nv = self.n_vertices();
+        let mesh = Mesh::from_triangles(nv, self.faces)?;
+        let mut lengths = vec![0.0; mesh.n_edges()];
+        for h in 0..mesh.n_corners() as u32 {
+            lengths[mesh.he_edge(h) as usize] = self.len[h as usize];
+        }
+        Ok(Refined {
+            mesh,
+            lengths,
+            positions: self.positions,
+            original_vertices: self.original_vertices,
+            new_vertices: self.new_vertices,
+            face_origin: self.face_origin,
+        })
+    }
+}
+
+/// Raise the valence of interior vertex `x` to at least `min_valence` by splitting the longest
+/// link edge at its midpoint, repeatedly (see the module docs). The metric is preserved
+/// exactly; positions (if given) are interpolated linearly.
+pub fn raise_valence(
+    mesh: &Mesh,
+    lengths: &[f64],
+    geometry: Geometry,
+    positions: Option<&[[f64; 3]]>,
+    x: u32,
+    min_valence: usize,
+) -> Result<Refined> {
+    let mut r = Refiner::new(mesh, lengths, geometry, positions)?;
+    r.raise_valence(x, min_valence)?;
+    r.finish()
+}
+
+/// Side opposite the angle `theta` between sides `b` and `c`, in the half-angle (haversine)
+/// form, accurate for short sides too: E² `a² = (b−c)² + 4bc sin²(θ/2)`, H²
+/// `sinh²(a/2) = sinh²((b−c)/2) + sinh b sinh c sin²(θ/2)`, S²
+/// `sin²(a/2) = sin²((b−c)/2) + sin b sin c sin²(θ/2)`. (`Geometry::side` goes through
+/// `acosh`/`acos` of a number near 1 in H² and S², which loses about `ε/a²` relative accuracy
+/// on short sides; splits nest deeply, so they need the stable form.)
+pub fn side(g: Geometry, b: f64, c: f64, theta: f64) -> f64 {
+    let h = (0.5 * theta).sin();
+    match g {
+        Geometry::Euclidean => g.side(b, c, theta),
+        Geometry::Hyperbolic => {
+            let d = (0.5 * (b - c)).sinh();
+            2.0 * (d * d + b.sinh() * c.sinh() * h * h)
+                .max(0.0)
+                .sqrt()
+                .asinh()
+        }
+        Geometry::Spherical => {
+            let d = (0.5 * (b - c)).sin();
+            2.0 * (d * d + b.sin() * c.sin() * h * h)
+                .max(0.0)
+                .sqrt()
+                .min(1.0)
+                .asin()
+        }
+    }
+}
+
+/// Min-heap item for Dijkstra (smallest distance first).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct MinItem(pub f64, pub u32);
+impl PartialEq for MinItem {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o) == Ordering::Equal
+    }
+}
+impl Eq for MinItem {}
+impl PartialOrd for MinItem {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for MinItem {
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.0.total_cmp(&self.0).then_with(|| o.1.cmp(&self.1))
+    }
+}

@@ -1,0 +1,476 @@
+//! `ricci layout MESH [--geometry G] [--target T] [--metric METRIC.json] [--base V]
+//! [--seed-face F] [--tiling N] [--out UV.obj] [--svg PIC.svg] [--json]`: cut the surface to a
+//! disk along canonical loops, lay it out isometrically with its uniformization metric (or the
+//! given metric) in the plane, the Poincaré disk or on the sphere, and compute the deck group.
+//!
+//! Closed genus-0 surfaces go onto the sphere whole; disks are laid out as they are; every
+//! other surface is cut first (`ricci::cut`). Without `--metric` the Ricci flow of the
+//! geometry is run (tolerance 1e-11). The seed face is a face id of the cut mesh (default:
+//! the face nearest the centre of the polygon). `--tiling N` draws the first N copies of the
+//! fundamental polygon (breadth first through the side pairings) instead of the polygon.
+//! UV.obj keeps the surface's own vertices (`v`) and gives every corner the layout coordinate
+//! of its cut-mesh vertex (`vt`; for the sphere, `v` are the points on the unit sphere).
+
+use crate::util::{print_json, write_atomic, UsageError};
+use indicatif::{ProgressBar, ProgressStyle};
+use ricci::layout::cover::{tiles_by_radius, word_string};
+use ricci::layout::export::obj_with_uv;
+use ricci::layout::isometry::{Complex, Mobius, RigidMotion};
+use ricci::layout::pipeline::{cut_disk, uniformization_geometry, CutDisk};
+use ricci::layout::place::{layout, minimax_centre, Space};
+use ricci::layout::svg::{fundamental_domain_svg, sphere_svg, tiling_svg};
+use ricci::layout::{deck_group, DeckGroup, Isometry, Layout, Polygon};
+use ricci::mesh::{io::read_surface, topology, Surface};
+use ricci::metric::{Euclidean, Geometry, Hyperbolic, Spherical};
+use serde_json::{json, Value};
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Mesh file (OBJ, OFF, PLY, STL).
+    pub mesh: PathBuf,
+    /// euclidean | hyperbolic | spherical (default: the uniformization geometry).
+    #[arg(long)]
+    pub geometry: Option<String>,
+    /// Target curvature of the flow (see `ricci flow`; default uniform / free-boundary /
+    /// geodesic-boundary by topology). Ignored with --metric.
+    #[arg(long)]
+    pub target: Option<String>,
+    /// Metric from `ricci flow --out` (JSON with `geometry` and per-edge `lengths`).
+    #[arg(long)]
+    pub metric: Option<PathBuf>,
+    /// Base vertex of the canonical loops.
+    #[arg(long)]
+    pub base: Option<u32>,
+    /// Seed face of the layout (a face id of the cut mesh).
+    #[arg(long)]
+    pub seed_face: Option<u32>,
+    /// Draw this many copies of the fundamental polygon (universal cover) in the SVG.
+    #[arg(long)]
+    pub tiling: Option<usize>,
+    /// Output OBJ with texture coordinates.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Output SVG picture.
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Per-edge lengths from a metric file (`ricci flow --out`): `lengths` by edge id, matched by
+/// the vertex pairs in `edge_vertices` (`[[a, b], …]`) when present.
+pub fn read_metric(path: &PathBuf, surface: &Surface) -> anyhow::Result<(Geometry, Vec<f64>)> {
+    let text =
+        std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let v: Value = serde_json::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("{}: not valid JSON ({e})", path.display()))?;
+    let geometry: Geometry = v
+        .get("geometry")
+        .and_then(|g| g.as_str())
+        .ok_or_else(|| anyhow::anyhow!("{}: no \"geometry\" key", path.display()))?
+        .parse()
+        .map_err(|e: String| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let lengths: Vec<f64> = v
+        .get("lengths")
+        .and_then(|l| l.as_array())
+        .ok_or_else(|| anyhow::anyhow!("{}: no \"lengths\" array", path.display()))?
+        .iter()
+        .enumerate()
+        .map(|(i, x)| {
+            x.as_f64()
+                .ok_or_else(|| anyhow::anyhow!("{}: length {i} is not a number", path.display()))
+        })
+        .collect::<anyhow::Result<_>>()?;
+    let m = &surface.mesh;
+    if lengths.len() != m.n_edges() {
+        anyhow::bail!(
+            "{}: {} lengths for a mesh with {} edges",
+            path.display(),
+            lengths.len(),
+            m.n_edges()
+        );
+    }
+    let pairs = v
+        .get("edge_vertices")
+        .or_else(|| v.get("edges"))
+        .and_then(|e| e.as_array());
+    if let Some(edges) = pairs {
+        let mut out = vec![f64::NAN; m.n_edges()];
+        for (i, e) in edges.iter().enumerate() {
+            let pair = e.as_array().map(|p| {
+                p.iter()
+                    .filter_map(|x| x.as_u64())
+                    .map(|x| x as u32)
+                    .collect::<Vec<_>>()
+            });
+            let Some([a, b]) = pair.as_deref().and_then(|p| <[u32; 2]>::try_from(p).ok()) else {
+                anyhow::bail!("{}: edge {i} is not a pair of vertex ids", path.display());
+            };
+            let nv = m.n_vertices() as u32;
+            let h = (a < nv && b < nv)
+                .then(|| m.halfedge_between(a, b))
+                .flatten()
+                .ok_or_else(|| {
+                    anyhow::anyhow!(
+                        "{}: edge {i} ({a}, {b}) is not an edge of the mesh",
+                        path.display()
+                    )
+                })?;
+            out[m.he_edge(h) as usize] = lengths[i];
+        }
+        return Ok((geometry, out));
+    }
+    Ok((geometry, lengths))
+}
+
+fn c2(z: Complex) -> Value {
+    json!([z.re, z.im])
+}
+
+/// JSON of a generator (or side pairing) per isometry type.
+pub trait JsonIso {
+    fn to_json(&self) -> Value;
+}
+impl JsonIso for RigidMotion {
+    fn to_json(&self) -> Value {
+        json!({"kind": "rigid_motion", "angle": self.angle(), "translation": c2(self.t)})
+    }
+}
+impl JsonIso for Mobius {
+    fn to_json(&self) -> Value {
+        let (theta, z0) = self.theta_center();
+        json!({
+            "kind": "mobius", "a": c2(self.a), "b": c2(self.b), "theta": theta, "center": c2(z0),
+            "trace": self.trace(), "translation_length": self.translation_length(),
+            "klein_matrix": self.klein_matrix(),
+        })
+    }
+}
+impl JsonIso for ricci::layout::Rotation {
+    fn to_json(&self) -> Value {
+        json!({"kind": "rotation", "matrix": self.m})
+    }
+}
+
+fn deck_json<I: Isometry + JsonIso>(g: &DeckGroup<I>, poly: &Polygon) -> Value {
+    let gens: Vec<Value> = g
+        .named_generators()
+        .iter()
+        .map(|(l, d)| {
+            let mut v = d.to_json();
+            v["letter"] = json!(l);
+            v
+        })
+        .collect();
+    let pairings: Vec<Value> = g
+        .pairings
+        .iter()
+        .map(|p| {
+            json!({
+                "side": poly.sides[p.side].label, "partner": poly.sides[p.partner].label,
+                "edge_spread": p.edge_spread, "max_vertex_error": p.max_vertex_error,
+                "map": p.map.to_json(),
+            })
+        })
+        .collect();
+    json!({"generators": gens, "side_pairings": pairings})
+}
+
+pub struct Bar(pub ProgressBar);
+impl ricci::progress::Progress for Bar {
+    fn report(&mut self, stage: &str, _f: Option<f64>, message: &str) {
+        self.0.set_message(format!("{stage}: {message}"));
+    }
+}
+
+pub fn spinner(json: bool) -> Bar {
+    let bar = if json {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new_spinner()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {elapsed} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    Bar(bar)
+}
+
+/// The metric to use: from the file or from the flow. Returns the flow report too.
+pub fn metric(
+    surface: &Surface,
+    geometry: Option<Geometry>,
+    target: Option<&str>,
+    metric_file: Option<&PathBuf>,
+    progress: &mut dyn ricci::progress::Progress,
+) -> anyhow::Result<(Geometry, Vec<f64>, Value)> {
+    if let Some(path) = metric_file {
+        let (g, l) = read_metric(path, surface)?;
+        if let Some(want) = geometry {
+            if want != g {
+                return Err(UsageError(format!(
+                    "--geometry {want} contradicts the metric file's geometry {g}"
+                ))
+                .into());
+            }
+        }
+        return Ok((g, l, json!({"source": path.display().to_string()})));
+    }
+    let g = match geometry {
+        Some(g) => g,
+        None => uniformization_geometry(&surface.mesh)?,
+    };
+    let mut opts = ricci::flow::FlowOptions {
+        geometry: g,
+        tolerance: 1e-11,
+        ..Default::default()
+    };
+    opts.target = match target {
+        Some(t) => t
+            .parse()
+            .map_err(|e: String| UsageError(format!("--target: {e}")))?,
+        None if !surface.mesh.has_boundary() => ricci::flow::TargetSpec::Uniform,
+        None if g == Geometry::Hyperbolic => ricci::flow::TargetSpec::GeodesicBoundary,
+        None => ricci::flow::TargetSpec::FreeBoundary,
+    };
+    let r = ricci::flow::ricci_flow(&surface.mesh, &surface.edge_lengths(), &opts, progress)?;
+    let report = json!({
+        "source": "flow", "target": r.target_description, "iterations": r.iterations,
+        "converged": r.converged, "max_curvature_error": r.max_curvature_error,
+        "gauss_bonnet_error": r.gauss_bonnet_error, "seconds": r.seconds,
+    });
+    if !r.converged {
+        anyhow::bail!(
+            "the Ricci flow did not converge (max curvature error {:.3e}); no layout computed",
+            r.max_curvature_error
+        );
+    }
+    Ok((g, r.lengths, report))
+}
+
+fn planar<S: Space<Point = Complex>>(
+    a: &Args,
+    surface: &Surface,
+    disk: Option<&CutDisk>,
+    lengths: &[f64],
+    out: &mut Value,
+) -> anyhow::Result<()>
+where
+    S::Iso: JsonIso,
+{
+    let (mesh, lens) = match disk {
+        Some(d) => (&d.mesh, &d.lengths[..]),
+        None => (&surface.mesh, lengths),
+    };
+    let l: Layout<Complex> = layout::<S>(mesh, lens, a.seed_face)?;
+    out["flipped_faces"] = json!(l.flipped_faces.len());
+    out["degenerate_faces"] = json!(l.degenerate_faces.len());
+    out["seed_face"] = json!(l.seed_face);
+    out["max_length_error"] = json!(l.max_length_error);
+    out["depth"] = json!(l.depth);
+    let poly = disk.map(|d| &d.polygon);
+    let group = match poly {
+        Some(p) if p.sides.iter().any(|s| s.partner.is_some()) => Some(deck_group::<S>(&l, p)?),
+        _ => None,
+    };
+    match (&group, poly) {
+        (Some(g), Some(p)) => {
+            let dj = deck_json(g, p);
+            out["deck_generators"] = dj["generators"].clone();
+            out["side_pairings"] = dj["side_pairings"].clone();
+            out["relation_error"] = json!(g.relation_error);
+            out["relation_condition"] = json!(g.relation_condition);
+            out["max_edge_spread"] = json!(g.max_edge_spread);
+            out["max_vertex_error"] = json!(g.max_vertex_error);
+        }
+        _ => {
+            out["deck_generators"] = json!([]);
+            out["relation_error"] = Value::Null;
+        }
+    }
+    if let Some(path) = &a.out {
+        let uv: Vec<[f64; 2]> = l.positions.iter().map(|z| [z.re, z.im]).collect();
+        let comments = vec![
+            format!("ricci layout of {} ({})", a.mesh.display(), S::KIND.name()),
+            "vt: layout coordinates of the cut mesh (Poincaré disk for hyperbolic)".to_string(),
+        ];
+        let text = obj_with_uv(
+            &surface_positions(surface, disk),
+            &surface_faces(surface, disk),
+            &uv,
+            mesh.faces(),
+            &comments,
+        );
+        write_atomic(path, text.as_bytes())?;
+    }
+    if let Some(path) = &a.svg {
+        let svg = match (a.tiling, &group, poly) {
+            (Some(n), Some(g), Some(p)) => {
+                let base = minimax_centre::<S>(&l.positions);
+                let radius = if S::KIND == Geometry::Hyperbolic {
+                    12.0
+                } else {
+                    f64::MAX
+                };
+                let tiles = tiles_by_radius::<S>(g, p, base, radius, n.max(1))?;
+                out["tiles"] = json!(tiles.len());
+                out["tile_words"] = json!(tiles
+                    .iter()
+                    .take(50)
+                    .map(|t| word_string(&g.letters, &t.word))
+                    .collect::<Vec<_>>());
+                let drawn: Vec<Vec<(Option<usize>, Vec<Complex>)>> = tiles
+                    .iter()
+                    .map(|t| {
+                        p.sides
+                            .iter()
+                            .map(|s| {
+                                (
+                                    s.letter,
+                                    s.vertices
+                                        .iter()
+                                        .map(|&v| t.map.apply(l.positions[v as usize]))
+                                        .collect(),
+                                )
+                            })
+                            .collect()
+                    })
+                    .collect();
+                tiling_svg(&drawn, S::KIND)
+            }
+            _ => fundamental_domain_svg(mesh, &l.positions, poly, S::KIND, 30_000),
+        };
+        write_atomic(path, svg.as_bytes())?;
+    }
+    Ok(())
+}
+
+/// 3D positions for the OBJ: the refined surface's when the cut refined it.
+fn surface_positions(surface: &Surface, disk: Option<&CutDisk>) -> Vec<[f64; 3]> {
+    disk.and_then(|d| d.cut.refined.positions.clone())
+        .unwrap_or_else(|| surface.positions.clone())
+}
+fn surface_faces(surface: &Surface, disk: Option<&CutDisk>) -> Vec<[u32; 3]> {
+    disk.map(|d| d.cut.refined.mesh.faces().to_vec())
+        .unwrap_or_else(|| surface.mesh.faces().to_vec())
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let t0 = Instant::now();
+    let geometry: Option<Geometry> = match &a.geometry {
+        Some(g) => Some(g.parse().map_err(UsageError)?),
+        None => None,
+    };
+    if a.tiling == Some(0) {
+        return Err(UsageError("--tiling needs at least one copy".into()).into());
+    }
+    let (surface, _) = read_surface(&a.mesh)?;
+    let mut bar = spinner(a.json);
+    let (geometry, lengths, metric_report) = metric(
+        &surface,
+        geometry,
+        a.target.as_deref(),
+        a.metric.as_ref(),
+        &mut bar,
+    )?;
+    let t = topology(&surface.mesh);
+    let comp = t
+        .components
+        .first()
+        .ok_or_else(|| anyhow::anyhow!("the mesh has no faces"))?;
+    let mut out = json!({
+        "file": a.mesh.display().to_string(),
+        "geometry": geometry.name(),
+        "genus": comp.genus,
+        "boundary_loops": comp.boundary_loops,
+        "metric": metric_report,
+    });
+    let simply_connected = comp.genus == 0 && comp.boundary_loops <= 1;
+    if geometry == Geometry::Spherical {
+        if !(simply_connected && comp.boundary_loops == 0) {
+            anyhow::bail!("spherical layouts need a closed genus-0 surface");
+        }
+        bar.0.set_message("layout on the sphere");
+        let l = layout::<Spherical>(&surface.mesh, &lengths, a.seed_face)?;
+        out["flipped_faces"] = json!(l.flipped_faces.len());
+        out["degenerate_faces"] = json!(l.degenerate_faces.len());
+        out["seed_face"] = json!(l.seed_face);
+        out["max_length_error"] = json!(l.max_length_error);
+        out["deck_generators"] = json!([]);
+        out["relation_error"] = Value::Null;
+        if let Some(path) = &a.out {
+            let mut text = format!(
+                "# ricci layout of {} on the unit sphere\n",
+                a.mesh.display()
+            );
+            for p in &l.positions {
+                text.push_str(&format!("v {:e} {:e} {:e}\n", p[0], p[1], p[2]));
+            }
+            for t in surface.mesh.faces() {
+                text.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+            }
+            write_atomic(path, text.as_bytes())?;
+        }
+        if let Some(path) = &a.svg {
+            write_atomic(path, sphere_svg(&surface.mesh, &l.positions).as_bytes())?;
+        }
+    } else {
+        let disk = if simply_connected && comp.boundary_loops == 1 {
+            None
+        } else {
+            bar.0.set_message("cutting along canonical loops");
+            let d = cut_disk(
+                &surface.mesh,
+                &lengths,
+                geometry,
+                Some(&surface.positions),
+                a.base,
+                &mut bar,
+            )?;
+            out["boundary_word"] = json!(d.polygon.word());
+            out["base_vertex"] = json!(d.cut.base);
+            out["refinement_splits"] = json!(d.cut.report.refinement_splits);
+            out["loop_lengths"] = json!(d
+                .cut
+                .loops
+                .iter()
+                .map(|l| json!({"label": l.label, "length": l.length}))
+                .collect::<Vec<_>>());
+            Some(d)
+        };
+        bar.0.set_message("layout and deck group");
+        match geometry {
+            Geometry::Hyperbolic => {
+                planar::<Hyperbolic>(&a, &surface, disk.as_ref(), &lengths, &mut out)?
+            }
+            _ => planar::<Euclidean>(&a, &surface, disk.as_ref(), &lengths, &mut out)?,
+        }
+    }
+    bar.0.finish_and_clear();
+    out["seconds"] = json!(t0.elapsed().as_secs_f64());
+    if a.json {
+        print_json(&out);
+    } else {
+        println!("{}: {} layout", a.mesh.display(), geometry.name());
+        println!("  flipped faces: {}", out["flipped_faces"]);
+        if let Some(w) = out.get("boundary_word") {
+            println!("  boundary word: {}", w.as_str().unwrap_or(""));
+        }
+        if !out["relation_error"].is_null() {
+            println!(
+                "  relation error: {:.3e}",
+                out["relation_error"].as_f64().unwrap_or(f64::NAN)
+            );
+            println!(
+                "  max edge spread: {:.3e}",
+                out["max_edge_spread"].as_f64().unwrap_or(f64::NAN)
+            );
+        }
+        println!("  seconds: {:.3}", out["seconds"].as_f64().unwrap_or(0.0));
+    }
+    Ok(())
+}

@@ -1,0 +1,121 @@
+//! `ricci spectrum MESH --count N [--metric METRIC.json] [--base V] [--json]`: geodesic length
+//! spectrum of a closed surface of genus ≥ 1 (paper 002 §6.3.3): uniformization metric (E² for
+//! genus 1, H² for genus ≥ 2; or the given metric), canonical cut, layout, deck group, then
+//! the `N` shortest free homotopy classes (unoriented, powers included), sorted. Genus 1
+//! lengths are normalized by the shortest (paper 002 Table 2); hyperbolic lengths are absolute
+//! (curvature −1, Tables 3–4) and also given normalized.
+
+use super::layout::{metric, spinner};
+use crate::util::{print_json, UsageError};
+use ricci::analysis::spectrum::{fuchsian_spectrum, lattice_spectrum};
+use ricci::layout::deck_group;
+use ricci::layout::pipeline::cut_disk;
+use ricci::layout::place::layout;
+use ricci::mesh::{io::read_surface, topology};
+use ricci::metric::{Euclidean, Geometry, Hyperbolic};
+use serde_json::json;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Mesh file (a closed surface of genus ≥ 1).
+    pub mesh: PathBuf,
+    /// Number of lengths.
+    #[arg(long, default_value_t = 8)]
+    pub count: usize,
+    /// Metric from `ricci flow --out` (flat for genus 1, hyperbolic otherwise).
+    #[arg(long)]
+    pub metric: Option<PathBuf>,
+    /// Base vertex of the canonical loops.
+    #[arg(long)]
+    pub base: Option<u32>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let t0 = Instant::now();
+    if a.count == 0 || a.count > 10_000 {
+        return Err(UsageError("--count must be between 1 and 10000".into()).into());
+    }
+    let (surface, _) = read_surface(&a.mesh)?;
+    let t = topology(&surface.mesh);
+    let comp = t
+        .components
+        .first()
+        .ok_or_else(|| anyhow::anyhow!("the mesh has no faces"))?;
+    if t.components.len() != 1 || comp.boundary_loops != 0 || comp.genus < 1 {
+        anyhow::bail!(
+            "the length spectrum needs one closed surface of genus ≥ 1; this mesh has {} component(s), genus {} and {} boundary loop(s)",
+            t.components.len(),
+            comp.genus,
+            comp.boundary_loops
+        );
+    }
+    let want = if comp.genus == 1 {
+        Geometry::Euclidean
+    } else {
+        Geometry::Hyperbolic
+    };
+    let mut bar = spinner(a.json);
+    let (geometry, lengths, metric_report) =
+        metric(&surface, Some(want), None, a.metric.as_ref(), &mut bar)?;
+    bar.0.set_message("cutting along canonical loops");
+    let disk = cut_disk(&surface.mesh, &lengths, geometry, None, a.base, &mut bar)?;
+    bar.0.set_message("layout, deck group and spectrum");
+    let (abs, extra) = if geometry == Geometry::Euclidean {
+        let l = layout::<Euclidean>(&disk.mesh, &disk.lengths, None)?;
+        let g = deck_group::<Euclidean>(&l, &disk.polygon)?;
+        let gens = g.named_generators();
+        if gens.len() != 2 {
+            anyhow::bail!("expected two translation generators, found {}", gens.len());
+        }
+        let sp = lattice_spectrum(gens[0].1.t, gens[1].1.t, a.count)?;
+        (sp, json!({"relation_error": g.relation_error}))
+    } else {
+        let l = layout::<Hyperbolic>(&disk.mesh, &disk.lengths, None)?;
+        let g = deck_group::<Hyperbolic>(&l, &disk.polygon)?;
+        let sp = fuchsian_spectrum(&l, &disk.polygon, &g, a.count, 2_000_000)?;
+        (
+            sp.lengths(),
+            json!({"relation_error": g.relation_error, "complete_up_to": sp.complete_up_to,
+                   "tiles": sp.tiles, "unmatched_links": sp.unmatched_links}),
+        )
+    };
+    bar.0.finish_and_clear();
+    let shortest = abs.first().copied().unwrap_or(1.0);
+    let normalized: Vec<f64> = abs.iter().map(|x| x / shortest).collect();
+    let lengths_out = if geometry == Geometry::Euclidean {
+        &normalized
+    } else {
+        &abs
+    };
+    let out = json!({
+        "file": a.mesh.display().to_string(),
+        "genus": comp.genus,
+        "geometry": geometry.name(),
+        "lengths": lengths_out,
+        "absolute_lengths": abs,
+        "normalized": normalized,
+        "metric": metric_report,
+        "details": extra,
+        "boundary_word": disk.polygon.word(),
+        "seconds": t0.elapsed().as_secs_f64(),
+    });
+    if a.json {
+        print_json(&out);
+    } else {
+        println!(
+            "{}: genus {}, {} metric",
+            a.mesh.display(),
+            comp.genus,
+            geometry.name()
+        );
+        for (i, (x, n)) in abs.iter().zip(&normalized).enumerate() {
+            println!("  {:>3}  {:.6}  ({:.4})", i + 1, x, n);
+        }
+    }
+    Ok(())
+}

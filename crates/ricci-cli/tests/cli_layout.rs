@@ -1,0 +1,162 @@
+//! `ricci layout` and `ricci spectrum` end to end: JSON contract, files written, exit codes.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn bin() -> PathBuf {
+    PathBuf::from(env!("CARGO_BIN_EXE_ricci"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("ricci-cli-layout-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+/// A generated genus-2 surface (written with `ricci generate`).
+fn genus2() -> PathBuf {
+    let p = tmp("g2.off");
+    if !p.exists() {
+        let st = Command::new(bin())
+            .args(["generate", "genus2", "--resolution", "30", "--out"])
+            .arg(&p)
+            .status()
+            .unwrap();
+        assert!(st.success());
+    }
+    p
+}
+
+#[test]
+fn layout_json_and_files() {
+    let mesh = genus2();
+    let (obj, svg) = (tmp("uv.obj"), tmp("pic.svg"));
+    let out = Command::new(bin())
+        .arg("layout")
+        .arg(&mesh)
+        .arg("--out")
+        .arg(&obj)
+        .arg("--svg")
+        .arg(&svg)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    for k in [
+        "geometry",
+        "flipped_faces",
+        "deck_generators",
+        "relation_error",
+        "seconds",
+        "max_edge_spread",
+    ] {
+        assert!(v.get(k).is_some(), "missing key {k}");
+    }
+    assert_eq!(v["geometry"], "hyperbolic");
+    assert_eq!(v["flipped_faces"], 0);
+    assert_eq!(v["deck_generators"].as_array().unwrap().len(), 4);
+    assert!(v["relation_error"].as_f64().unwrap() < 1e-8);
+    let text = std::fs::read_to_string(&obj).unwrap();
+    let nvt = text.lines().filter(|l| l.starts_with("vt ")).count();
+    let nf = text.lines().filter(|l| l.starts_with("f ")).count();
+    assert!(nvt > 0 && nf > 0);
+    // Every vt lies in the unit disk.
+    for l in text.lines().filter(|l| l.starts_with("vt ")) {
+        let xy: Vec<f64> = l[3..]
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        assert!(xy[0] * xy[0] + xy[1] * xy[1] < 1.0);
+    }
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("<circle"));
+    // Tiling picture.
+    let out = Command::new(bin())
+        .arg("layout")
+        .arg(&mesh)
+        .args(["--tiling", "30", "--svg"])
+        .arg(tmp("tiling.svg"))
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["tiles"], 30);
+}
+
+#[test]
+fn spectrum_json() {
+    let out = Command::new(bin())
+        .arg("spectrum")
+        .arg(genus2())
+        .args(["--count", "6", "--json"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["genus"], 2);
+    let l: Vec<f64> = v["lengths"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let n: Vec<f64> = v["normalized"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert_eq!(l.len(), 6);
+    assert!(l.windows(2).all(|w| w[0] <= w[1]));
+    assert!((n[0] - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn bad_input_and_arguments() {
+    // A sphere has no spectrum: bad input (1). An unknown geometry: bad argument (2).
+    let sphere = tmp("s.off");
+    let st = Command::new(bin())
+        .args(["generate", "sphere", "--out"])
+        .arg(&sphere)
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let out = Command::new(bin())
+        .arg("spectrum")
+        .arg(&sphere)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("genus"));
+    let out = Command::new(bin())
+        .arg("layout")
+        .arg(&sphere)
+        .args(["--geometry", "elliptic"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    // The sphere itself lays out on the sphere.
+    let out = Command::new(bin())
+        .arg("layout")
+        .arg(&sphere)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["geometry"], "spherical");
+    assert_eq!(v["flipped_faces"], 0);
+}

@@ -1,0 +1,101 @@
+//! Benchmark: layout and deck group of large meshes with their hyperbolic uniformization
+//! metric (flow and cut timed separately, as context).
+//!
+//! `RICCI_MESHES=../shared/meshes cargo run --release --example bench_layout [files…]`
+//! (default: botijo.off seahorse2_100K.off).
+
+use ricci::layout::deck_group;
+use ricci::layout::pipeline::{cut_disk, uniformization_metric};
+use ricci::layout::place::layout;
+use ricci::mesh::io::read_surface;
+use ricci::metric::{Geometry, Hyperbolic, Scheme};
+use ricci::progress::NoProgress;
+use std::path::PathBuf;
+use std::time::Instant;
+
+fn main() {
+    let dir =
+        PathBuf::from(std::env::var("RICCI_MESHES").unwrap_or_else(|_| "../shared/meshes".into()));
+    let mut files: Vec<String> = std::env::args().skip(1).collect();
+    if files.is_empty() {
+        files = vec!["botijo.off".into(), "seahorse2_100K.off".into()];
+    }
+    println!("| mesh | faces | genus | scheme | flow s | cut s | layout s | deck s | flipped | max radius | relation error | max edge spread | max length error |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for f in files {
+        let (s, _) = match read_surface(&dir.join(&f)) {
+            Ok(x) => x,
+            Err(e) => {
+                eprintln!("{f}: {e}");
+                continue;
+            }
+        };
+        let genus = ricci::mesh::topology(&s.mesh).genus();
+        let t = Instant::now();
+        // Thurston circle packing (the papers'); vertex scaling if it is refused.
+        let run = |scheme| {
+            uniformization_metric(
+                &s.mesh,
+                &s.edge_lengths(),
+                Geometry::Hyperbolic,
+                scheme,
+                1e-10,
+                &mut NoProgress,
+            )
+        };
+        let mut scheme = Scheme::Thurston;
+        let flow = match run(scheme) {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("{f}: Thurston flow refused ({e}); trying vertex scaling");
+                scheme = Scheme::Yamabe;
+                match run(scheme) {
+                    Ok(r) => r,
+                    Err(e) => {
+                        eprintln!("{f}: flow: {e}");
+                        continue;
+                    }
+                }
+            }
+        };
+        let t_flow = t.elapsed().as_secs_f64();
+        if !flow.converged {
+            eprintln!(
+                "{f}: the flow did not converge (max |K − K̄| = {:.1e} after {} iterations)",
+                flow.max_curvature_error, flow.iterations
+            );
+        }
+        let t = Instant::now();
+        let disk = match cut_disk(
+            &s.mesh,
+            &flow.lengths,
+            Geometry::Hyperbolic,
+            None,
+            None,
+            &mut NoProgress,
+        ) {
+            Ok(d) => d,
+            Err(e) => {
+                eprintln!("{f}: cut: {e}");
+                continue;
+            }
+        };
+        let t_cut = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let l = layout::<Hyperbolic>(&disk.mesh, &disk.lengths, None).expect("layout");
+        let t_layout = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let g = deck_group::<Hyperbolic>(&l, &disk.polygon).expect("deck group");
+        let t_deck = t.elapsed().as_secs_f64();
+        println!(
+            "| {f} | {} | {genus} | {} | {t_flow:.2} | {t_cut:.2} | {t_layout:.3} | {t_deck:.3} | {} | {:.1} | {:.1e} | {:.1e} | {:.1e} |",
+            s.mesh.n_faces(),
+            scheme.name(),
+            l.flipped_faces.len(),
+            l.max_radius,
+            g.relation_error.unwrap_or(f64::NAN),
+            g.max_edge_spread,
+            l.max_length_error
+        );
+    }
+}

