@@ -37,8 +37,10 @@ pub trait FlatCharts {
     /// The charts that contain face `f`.
     fn charts_of_face(&self, f: u32) -> Vec<ChartId>;
     /// A chart that contains, consistently developed, every face that shares a vertex with
-    /// `f` (the closed stars of `f`'s three vertices) — the support of the spline basis of
-    /// the domain triangle `f`. `None` for faces incident to a singular vertex.
+    /// `f` (the closed stars of `f`'s three vertices) except faces incident to a singular
+    /// vertex — the support of the spline basis of the domain triangle `f`. `None` for faces
+    /// incident to a singular vertex (paper 000 §5 removes the one-ring of the extraordinary
+    /// point from the spline domain).
     fn home_chart(&self, f: u32) -> Option<ChartId>;
 
     /// The rigid motion that maps the coordinates of face `f` in chart `from` to its
