@@ -19,7 +19,7 @@ fn temp_file(name: &str, content: &[u8]) -> PathBuf {
 }
 
 fn meshes() -> Option<PathBuf> {
-    let d = PathBuf::from(std::env::var_os("RICCI_MESHES")?);
+    let d = ricci_meshes()?;
     d.is_dir().then_some(d)
 }
 
@@ -170,4 +170,16 @@ fn bad_arguments_exit_2() {
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         assert!(out.stdout.is_empty(), "{args:?}");
     }
+}
+
+/// `$RICCI_MESHES` as a folder. Cargo runs test binaries in the crate's folder, so a relative
+/// path (the README's `../shared/meshes`) is taken from the workspace root when it does not
+/// exist from the current directory.
+fn ricci_meshes() -> Option<std::path::PathBuf> {
+    let d = std::path::PathBuf::from(std::env::var_os("RICCI_MESHES")?);
+    if d.is_relative() && !d.is_dir() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        return Some(root.join(d));
+    }
+    Some(d)
 }

@@ -383,10 +383,7 @@ fn builtin_fields_and_bad_arguments() {
 
 #[test]
 fn real_meshes_are_framed() {
-    let Some(dir) = std::env::var_os("RICCI_MESHES")
-        .map(PathBuf::from)
-        .filter(|d| d.is_dir())
-    else {
+    let Some(dir) = ricci_meshes().filter(|d| d.is_dir()) else {
         eprintln!("note: RICCI_MESHES is not set; skipping real-mesh rendering");
         return;
     };
@@ -430,4 +427,16 @@ fn real_meshes_are_framed() {
         assert!(n as f64 / (256.0 * 256.0) > 0.3, "{file} fills {n} pixels");
         assert!((json_of(&out)["coverage"].as_f64().unwrap() - n as f64 / 65536.0).abs() < 0.02);
     }
+}
+
+/// `$RICCI_MESHES` as a folder. Cargo runs test binaries in the crate's folder, so a relative
+/// path (the README's `../shared/meshes`) is taken from the workspace root when it does not
+/// exist from the current directory.
+fn ricci_meshes() -> Option<std::path::PathBuf> {
+    let d = std::path::PathBuf::from(std::env::var_os("RICCI_MESHES")?);
+    if d.is_relative() && !d.is_dir() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        return Some(root.join(d));
+    }
+    Some(d)
 }

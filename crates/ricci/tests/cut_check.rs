@@ -8,8 +8,7 @@ use ricci::mesh::{topology, Mesh};
 use std::collections::HashMap;
 
 pub fn meshes_dir() -> Option<std::path::PathBuf> {
-    let d = std::env::var("RICCI_MESHES").ok()?;
-    let p = std::path::PathBuf::from(d);
+    let p = ricci_meshes()?;
     if p.is_dir() {
         Some(p)
     } else {
@@ -211,4 +210,16 @@ pub fn verify(c: &CanonicalCut, g: usize, nb: usize, what: &str) {
         .collect();
     let j = intersection_matrix(&c.refined.mesh, &gens).unwrap();
     assert_eq!(j, symplectic(g), "{what}: intersection matrix");
+}
+
+/// `$RICCI_MESHES` as a folder. Cargo runs test binaries in the crate's folder, so a relative
+/// path (the README's `../shared/meshes`) is taken from the workspace root when it does not
+/// exist from the current directory.
+fn ricci_meshes() -> Option<std::path::PathBuf> {
+    let d = std::path::PathBuf::from(std::env::var_os("RICCI_MESHES")?);
+    if d.is_relative() && !d.is_dir() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        return Some(root.join(d));
+    }
+    Some(d)
 }

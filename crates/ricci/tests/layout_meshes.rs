@@ -10,7 +10,7 @@ use ricci::progress::NoProgress;
 use std::path::PathBuf;
 
 fn mesh_dir() -> Option<PathBuf> {
-    let d = PathBuf::from(std::env::var("RICCI_MESHES").ok()?);
+    let d = ricci_meshes()?;
     d.is_dir().then_some(d)
 }
 
@@ -215,4 +215,16 @@ fn no_flipped_faces_on_the_flow_list() {
         }
     }
     assert!(fails.is_empty(), "{fails:#?}");
+}
+
+/// `$RICCI_MESHES` as a folder. Cargo runs test binaries in the crate's folder, so a relative
+/// path (the README's `../shared/meshes`) is taken from the workspace root when it does not
+/// exist from the current directory.
+fn ricci_meshes() -> Option<std::path::PathBuf> {
+    let d = std::path::PathBuf::from(std::env::var_os("RICCI_MESHES")?);
+    if d.is_relative() && !d.is_dir() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        return Some(root.join(d));
+    }
+    Some(d)
 }

@@ -13,15 +13,16 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::PathBuf;
 
 fn meshes_dir() -> Option<PathBuf> {
-    let dir = PathBuf::from(std::env::var_os("RICCI_MESHES")?);
+    let dir = ricci_meshes()?;
     if dir.join("SOURCES.md").is_file() {
         Some(dir)
     } else {
-        eprintln!(
-            "note: RICCI_MESHES={} has no SOURCES.md; skipping",
+        // Set but wrong: fail loudly, or every real-mesh test in the suite would skip silently.
+        panic!(
+            "RICCI_MESHES={} is set but has no SOURCES.md (resolved from the current \
+             directory, then from the workspace root)",
             dir.display()
         );
-        None
     }
 }
 
@@ -347,4 +348,16 @@ fn the_table_parser_reads_a_known_row() {
     assert_eq!((r.nm_vertices, r.orientable, r.degen), (1, false, 3));
     assert!(agrees(1.504, &r.min_angle, 3) && !agrees(1.56, &r.min_angle, 3));
     assert!(agrees(170.249, &r.max_angle, 4) && !agrees(170.4, &r.max_angle, 4));
+}
+
+/// `$RICCI_MESHES` as a folder. Cargo runs test binaries in the crate's folder, so a relative
+/// path (the README's `../shared/meshes`) is taken from the workspace root when it does not
+/// exist from the current directory.
+fn ricci_meshes() -> Option<std::path::PathBuf> {
+    let d = std::path::PathBuf::from(std::env::var_os("RICCI_MESHES")?);
+    if d.is_relative() && !d.is_dir() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        return Some(root.join(d));
+    }
+    Some(d)
 }

@@ -197,7 +197,7 @@ proptest! {
 
 #[test]
 fn real_meshes_round_trip_through_every_format() {
-    let Some(dir) = std::env::var_os("RICCI_MESHES").map(std::path::PathBuf::from) else {
+    let Some(dir) = ricci_meshes() else {
         eprintln!("note: RICCI_MESHES is not set; skipping the real-mesh round trip");
         return;
     };
@@ -232,4 +232,16 @@ fn real_meshes_round_trip_through_every_format() {
         checked += 1;
     }
     assert!(checked >= 15, "only {checked} meshes checked");
+}
+
+/// `$RICCI_MESHES` as a folder. Cargo runs test binaries in the crate's folder, so a relative
+/// path (the README's `../shared/meshes`) is taken from the workspace root when it does not
+/// exist from the current directory.
+fn ricci_meshes() -> Option<std::path::PathBuf> {
+    let d = std::path::PathBuf::from(std::env::var_os("RICCI_MESHES")?);
+    if d.is_relative() && !d.is_dir() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        return Some(root.join(d));
+    }
+    Some(d)
 }

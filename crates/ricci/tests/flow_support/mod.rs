@@ -228,8 +228,8 @@ pub fn plate(g: usize, k: usize) -> Surface {
 
 /// The meshes folder from `RICCI_MESHES`, or `None` (with a note on stderr).
 pub fn meshes_dir() -> Option<PathBuf> {
-    match std::env::var("RICCI_MESHES") {
-        Ok(d) if PathBuf::from(&d).is_dir() => Some(PathBuf::from(d)),
+    match ricci_meshes() {
+        Some(d) if d.is_dir() => Some(d),
         _ => {
             eprintln!("note: RICCI_MESHES is not set or missing; skipping the real-mesh part");
             None
@@ -255,4 +255,16 @@ pub fn hemisphere(rings: usize) -> Surface {
         *p = [t.sin() * a.cos(), t.sin() * a.sin(), t.cos()];
     }
     s
+}
+
+/// `$RICCI_MESHES` as a folder. Cargo runs test binaries in the crate's folder, so a relative
+/// path (the README's `../shared/meshes`) is taken from the workspace root when it does not
+/// exist from the current directory.
+fn ricci_meshes() -> Option<std::path::PathBuf> {
+    let d = std::path::PathBuf::from(std::env::var_os("RICCI_MESHES")?);
+    if d.is_relative() && !d.is_dir() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        return Some(root.join(d));
+    }
+    Some(d)
 }
