@@ -508,3 +508,40 @@ fn attribute_parser_finds_every_link() {
     assert_eq!(t[0]["width"], "3");
     assert_eq!(t[0]["height"], "4");
 }
+
+#[test]
+fn a_failed_stage_is_reported_in_the_page_and_the_exit_status() {
+    let dir = tmp().join("failing");
+    let out = Command::new(bin())
+        .args(["demo", "--json", "--out"])
+        .arg(&dir)
+        .env("RICCI_DEMO_FAIL", "loops")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("loops") && err.contains("index.html"), "{err}");
+    let v: Value = serde_json::from_slice(&out.stdout).expect("the JSON is still printed");
+    assert_eq!(v["ok"], false);
+    let st = |id: &str| v["stages"][id]["status"].as_str().unwrap().to_string();
+    assert_eq!(st("surface"), "ok");
+    assert_eq!(st("flow"), "ok");
+    assert_eq!(st("cone"), "ok", "the cone does not need the loops");
+    assert_eq!(st("loops"), "failed");
+    assert_eq!(st("layout"), "skipped");
+    assert_eq!(st("spectrum"), "skipped");
+    // The page says so, and links nothing that is not there.
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    assert!(html.contains("badge failed") && html.contains("badge skipped"));
+    assert!(html.contains("RICCI_DEMO_FAIL=loops"));
+    for l in attributes(&html, "src")
+        .into_iter()
+        .chain(attributes(&html, "href"))
+    {
+        if !l.starts_with('#') {
+            assert!(dir.join(&l).is_file(), "{l} is linked but missing");
+        }
+    }
+    assert!(!dir.join("loops.png").exists() && !dir.join("polygon.png").exists());
+}

@@ -11,6 +11,9 @@
 //! and moved into DIR when all stages have run, `index.html` last: an interrupted run leaves
 //! no half-written file in DIR.
 //!
+//! For tests of that path, the environment variable `RICCI_DEMO_FAIL=ID` makes stage `ID`
+//! fail at its start (as if the library had returned an error).
+//!
 //! Adding a stage (e.g. the affine atlas, `ricci atlas`, and the manifold spline,
 //! `ricci spline`): write `fn atlas(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section>` in
 //! [`stages`], put what later stages need into [`Ctx`], and add one line to [`STAGES`] (the
@@ -264,7 +267,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 out: &mut out,
                 bar: &mut bar,
             };
-            let result = (st.run)(&mut ctx, &mut env);
+            let result = match std::env::var("RICCI_DEMO_FAIL") {
+                Ok(id) if id == st.id => {
+                    Err(anyhow::anyhow!("failure injected by RICCI_DEMO_FAIL={id}"))
+                }
+                _ => (st.run)(&mut ctx, &mut env),
+            };
             match result {
                 Ok(s) => s,
                 Err(e) => {
