@@ -6,6 +6,8 @@
 //! form and the length inequalities between loops, deck generators and geodesics. Bad
 //! arguments exit 2, an output folder that cannot be written exits 1 with one sentence.
 
+#![allow(clippy::needless_range_loop)] // (i, j) loops over a matrix read best with indices
+
 use ricci_render::Image;
 use serde_json::Value;
 use std::collections::HashMap;

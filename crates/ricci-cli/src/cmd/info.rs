@@ -33,7 +33,7 @@ pub fn info_json(file: &str, surface: &Surface, report: &BuildReport) -> serde_j
     let mut max_angle = vec![0.0f64; nc];
     for f in 0..m.n_faces() as u32 {
         let c = t.face_component[f as usize] as usize;
-        for x in face_angles(&surface, f) {
+        for x in face_angles(surface, f) {
             min_angle[c] = min_angle[c].min(x.to_degrees());
             max_angle[c] = max_angle[c].max(x.to_degrees());
         }
