@@ -135,6 +135,21 @@ pub fn esc(s: &str) -> String {
     o
 }
 
+/// Escaped text with `code` spans (text between backticks) set in `<code>`.
+pub fn inline(s: &str) -> String {
+    let mut o = String::with_capacity(s.len() + 16);
+    for (i, part) in s.split('`').enumerate() {
+        if i % 2 == 1 {
+            o.push_str("<code>");
+            o.push_str(&esc(part));
+            o.push_str("</code>");
+        } else {
+            o.push_str(&esc(part));
+        }
+    }
+    o
+}
+
 /// `1.234e-11`-style for small numbers, fixed otherwise.
 pub fn num(x: f64) -> String {
     if !x.is_finite() {
@@ -285,7 +300,7 @@ pub fn index_html(p: &Page) -> String {
             let _ = writeln!(h, "<div class=\"status {st}\">{}</div>", esc(m));
         }
         for para in &s.paragraphs {
-            let _ = writeln!(h, "<p>{}</p>", esc(para));
+            let _ = writeln!(h, "<p>{}</p>", inline(para));
         }
         if !s.pictures.is_empty() {
             h.push_str("<div class=\"figs\">\n");
@@ -317,7 +332,12 @@ pub fn index_html(p: &Page) -> String {
         if !s.files.is_empty() {
             h.push_str("<ul class=\"files\">\n");
             for (f, d) in &s.files {
-                let _ = writeln!(h, "<li><a href=\"{0}\">{0}</a> — {1}</li>", esc(f), esc(d));
+                let _ = writeln!(
+                    h,
+                    "<li><a href=\"{0}\">{0}</a> — {1}</li>",
+                    esc(f),
+                    inline(d)
+                );
             }
             h.push_str("</ul>\n");
         }
@@ -355,5 +375,6 @@ mod tests {
         assert_eq!(num(1.5e-12), "1.500e-12");
         assert_eq!(num(0.0), "0");
         assert_eq!(num(2.0), "2.000000");
+        assert_eq!(inline("run `a<b` now"), "run <code>a&lt;b</code> now");
     }
 }

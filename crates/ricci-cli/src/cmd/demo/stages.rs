@@ -497,7 +497,7 @@ pub fn single_cone(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "All the curvature 2πχ = {k_cone:.6} on one vertex, flat everywhere else (paper 000). A \
          vertex of valence {valence_before} cannot carry it: the Chow–Luo condition asks for \
          valence ≥ 4 − 2K̄/π = {:.0}, and the flow refuses the target otherwise. So its valence \
-         is first raised to {CONE_VALENCE} by intrinsic edge splits (they keep the metric \
+         is first raised to at least {CONE_VALENCE} by intrinsic edge splits (they keep the metric \
          exactly) and the mesh is graded around it ({} splits in all), then the Euclidean flow \
          runs on the refined mesh.",
         4.0 - 2.0 * k_cone / PI,
