@@ -158,10 +158,10 @@ fn residual_plot(r: &FlowResult, title: &str) -> anyhow::Result<Figure> {
         &LinePlot {
             title: title.into(),
             x_label: "Newton step".into(),
-            y_label: "max |K - Kbar| (rad)".into(),
+            y_label: String::new(),
             log_y: true,
-            width: 560.0,
-            height: 380.0,
+            width: 600.0,
+            height: 400.0,
         },
     )?)
 }
@@ -361,7 +361,7 @@ pub fn hyperbolic_flow(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> 
         r.tolerance,
         -2.0 * PI * ctx.chi as f64
     ));
-    let plot = residual_plot(&r, "H^2 uniformization: residual per Newton step")?;
+    let plot = residual_plot(&r, "H^2 flow: max |K - Kbar| (rad)")?;
     sec.pictures.push(figure(
         env,
         "flow-residuals",
@@ -503,7 +503,7 @@ pub fn single_cone(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         4.0 - 2.0 * k_cone / PI,
         raised + graded
     ));
-    let plot = residual_plot(&r, "E^2, one cone: residual per Newton step")?;
+    let plot = residual_plot(&r, "E^2 one cone: max |K - Kbar| (rad)")?;
     sec.pictures.push(figure(
         env,
         "cone-residuals",
