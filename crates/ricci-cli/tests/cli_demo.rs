@@ -317,6 +317,10 @@ fn single_cone_carries_all_the_curvature() {
     // Chow–Luo: a cone of K̄ needs valence ≥ 4 − 2K̄/π = 12.
     assert!(s["valence_after"].as_u64().unwrap() >= 12);
     assert!(s["valence_before"].as_u64().unwrap() < s["valence_after"].as_u64().unwrap());
+    // On the unrefined surface the same target is refused, for Chow–Luo's reason.
+    let refusal = s["refused_without_refinement"].as_str().expect("a refusal");
+    assert!(refusal.contains("Chow–Luo"), "{refusal}");
+    assert!(refusal.contains(&format!("vertex {}", s["cone_vertex"])), "{refusal}");
     // The metric file: Gauss–Bonnet (λ = 0) over all vertices, the cone where it is said.
     let m: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("cone-metric.json")).unwrap())

@@ -97,6 +97,8 @@ pub struct Section {
     pub tables: Vec<Table>,
     /// Files written by the stage: (file name in the output folder, description).
     pub files: Vec<(String, String)>,
+    /// Commands that compute the same from the files in the folder.
+    pub commands: Vec<String>,
     /// Per-stage summary for `--json` and `demo.json`.
     pub summary: Value,
     pub seconds: f64,
@@ -113,6 +115,7 @@ impl Section {
             pictures: Vec::new(),
             tables: Vec::new(),
             files: Vec::new(),
+            commands: Vec::new(),
             summary: Value::Object(Default::default()),
             seconds: 0.0,
         }
@@ -205,6 +208,9 @@ ul.files { font-size:14px; padding-left:18px; }
 ul.files a { color:var(--accent); font-family: ui-monospace, Menlo, Consolas, monospace; }
 .placeholder { color:var(--muted); border:1px dashed var(--line); border-radius:8px; padding:14px 20px; margin:22px 0; }
 footer { color:var(--muted); font-size:13px; padding:8px 0 40px; }
+pre { background:var(--band); border:1px solid var(--line); border-radius:4px; padding:8px 12px;
+      overflow-x:auto; font: 13px/1.5 ui-monospace, "SF Mono", Menlo, Consolas, monospace; }
+.cmd-title { font-size:14px; color:var(--muted); margin:12px 0 4px; }
 code { font-family: ui-monospace, Menlo, Consolas, monospace; font-size:13px; }
 "#;
 
@@ -340,6 +346,15 @@ pub fn index_html(p: &Page) -> String {
                 );
             }
             h.push_str("</ul>\n");
+        }
+        if !s.commands.is_empty() {
+            h.push_str(
+                "<p class=\"cmd-title\">The same from the command line, in this folder:</p>\n<pre>",
+            );
+            for c in &s.commands {
+                let _ = writeln!(h, "{}", esc(c));
+            }
+            h.push_str("</pre>\n");
         }
         h.push_str("</section>\n");
     }

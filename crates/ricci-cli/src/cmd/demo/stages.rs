@@ -328,6 +328,11 @@ pub fn surface(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "max_angle_deg": q.max_angle_deg,
         "total_angle_defect": total_defect,
     });
+    sec.commands = vec![
+        format!("ricci generate genus2 -n {n} --out surface.off"),
+        "ricci info surface.off --json".into(),
+        "ricci render surface.off --wireframe --out surface-wireframe.png".into(),
+    ];
     ctx.chi = chi;
     ctx.surface = Some(s);
     Ok(sec)
@@ -426,6 +431,11 @@ pub fn hyperbolic_flow(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> 
         "hyperbolic-metric.json".into(),
         "the metric: u, K, K̄ per vertex, lengths per edge (as `ricci flow --out` writes it)".into(),
     )];
+    sec.commands = vec![
+        format!("ricci flow surface.off --geometry hyperbolic --tolerance {FLOW_TOLERANCE:.0e} --out hyperbolic-metric.json"),
+        "ricci render surface.off --scalar angle-defect --out curvature-before.png".into(),
+        "ricci render surface.off --scalar hyperbolic-metric.json:curvature --out curvature-after.png".into(),
+    ];
     sec.summary = flow_summary(&r);
     ctx.hyperbolic = Some(r);
     Ok(sec)
@@ -446,10 +456,23 @@ pub fn single_cone(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         .max_by(|&a, &b| s.positions[a as usize][0].total_cmp(&s.positions[b as usize][0]))
         .ok_or_else(|| anyhow::anyhow!("the surface has no vertex"))?;
     let valence_before = s.mesh.valence(v);
+    // Without the refinement the flow refuses the target (Chow–Luo); show its reason.
+    env.bar.step("the target on the unrefined surface");
+    let lengths = s.edge_lengths();
+    let o = FlowOptions {
+        geometry: Geometry::Euclidean,
+        scheme: Scheme::Thurston,
+        target: TargetSpec::SingleCone(Some(v)),
+        tolerance: FLOW_TOLERANCE,
+        ..FlowOptions::default()
+    };
+    let refusal = match ricci_flow(&s.mesh, &lengths, &o, env.bar) {
+        Err(e) => Some(e.to_string()),
+        Ok(_) => None,
+    };
     env.bar.step(&format!(
         "raising the valence of vertex {v} to {CONE_VALENCE} and grading around it"
     ));
-    let lengths = s.edge_lengths();
     let mut rf = Refiner::new(&s.mesh, &lengths, Geometry::Euclidean, Some(&s.positions))?;
     let raised = rf.raise_valence(v, CONE_VALENCE)?;
     let mean_spoke = {
@@ -470,13 +493,6 @@ pub fn single_cone(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     )?;
     let refined = rf.finish()?;
     let valence_after = refined.mesh.valence(v);
-    let o = FlowOptions {
-        geometry: Geometry::Euclidean,
-        scheme: Scheme::Thurston,
-        target: TargetSpec::SingleCone(Some(v)),
-        tolerance: FLOW_TOLERANCE,
-        ..FlowOptions::default()
-    };
     let r = ricci_flow(&refined.mesh, &refined.lengths, &o, env.bar)?;
     if !r.converged {
         sec.status = Status::Warning(format!(
@@ -503,6 +519,16 @@ pub fn single_cone(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         4.0 - 2.0 * k_cone / PI,
         raised + graded
     ));
+    sec.paragraphs.push(match &refusal {
+        Some(e) => format!(
+            "On the unrefined surface, `ricci flow surface.off --target single-cone:{v}` \
+             refuses: {e}"
+        ),
+        None => format!(
+            "(The unrefined surface was not refused the target single-cone:{v}; the \
+             refinement is done all the same.)"
+        ),
+    });
     let plot = residual_plot(&r, "E^2 one cone: max |K - Kbar| (rad)")?;
     sec.pictures.push(figure(
         env,
@@ -566,6 +592,7 @@ pub fn single_cone(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     )];
     let mut summary = flow_summary(&r);
     summary["cone_vertex"] = json!(v);
+    summary["refused_without_refinement"] = json!(refusal);
     summary["cone_curvature"] = json!(k_at_cone);
     summary["target_cone_curvature"] = json!(k_cone);
     summary["max_curvature_elsewhere"] = json!(max_elsewhere);
@@ -699,6 +726,8 @@ pub fn loops(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "cut_vertices": c.cut_mesh.n_vertices(),
         "cut_faces": c.cut_mesh.n_faces(),
     });
+    sec.commands =
+        vec!["ricci cut surface.off --metric hyperbolic-metric.json --out cut.obj".into()];
     ctx.disk = Some(d);
     Ok(sec)
 }
@@ -951,6 +980,10 @@ pub fn layout(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "tile_words": tiles.iter().take(12).map(|t| word_string(&g.letters, &t.word)).collect::<Vec<_>>(),
         "boundary_word": d.polygon.word(),
     });
+    sec.commands = vec![
+        "ricci layout surface.off --out uv.obj --svg polygon.svg".into(),
+        format!("ricci layout surface.off --tiling {TILES} --svg tiling.svg"),
+    ];
     ctx.layout = Some(l);
     ctx.group = Some(g);
     Ok(sec)
@@ -1007,6 +1040,9 @@ pub fn spectrum(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
             sp.unmatched_links
         ));
     }
+    sec.commands = vec![format!(
+        "ricci spectrum surface.off --count {SPECTRUM_COUNT}"
+    )];
     sec.summary = json!({
         "genus": d.cut.genus,
         "lengths": lengths,
