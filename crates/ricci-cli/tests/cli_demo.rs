@@ -320,7 +320,10 @@ fn single_cone_carries_all_the_curvature() {
     // On the unrefined surface the same target is refused, for Chow–Luo's reason.
     let refusal = s["refused_without_refinement"].as_str().expect("a refusal");
     assert!(refusal.contains("Chow–Luo"), "{refusal}");
-    assert!(refusal.contains(&format!("vertex {}", s["cone_vertex"])), "{refusal}");
+    assert!(
+        refusal.contains(&format!("vertex {}", s["cone_vertex"])),
+        "{refusal}"
+    );
     // The metric file: Gauss–Bonnet (λ = 0) over all vertices, the cone where it is said.
     let m: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("cone-metric.json")).unwrap())
@@ -550,4 +553,44 @@ fn a_failed_stage_is_reported_in_the_page_and_the_exit_status() {
         }
     }
     assert!(!dir.join("loops.png").exists() && !dir.join("polygon.png").exists());
+}
+
+#[test]
+fn the_commands_the_page_shows_work_in_a_copy_of_the_folder() {
+    let (dir, _) = demo();
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    let work = tmp().join("commands");
+    std::fs::create_dir_all(&work).unwrap();
+    for f in ["surface.off", "hyperbolic-metric.json"] {
+        std::fs::copy(dir.join(f), work.join(f)).unwrap();
+    }
+    let mut ran = 0;
+    for block in html.split("<pre>").skip(1) {
+        let block = &block[..block.find("</pre>").unwrap()];
+        for line in block.lines().filter(|l| !l.trim().is_empty()) {
+            let words: Vec<&str> = line.split_whitespace().collect();
+            assert_eq!(words[0], "ricci", "{line}");
+            // The spectrum repeats the demo's most expensive library call; skip it here.
+            if words[1] == "spectrum" {
+                continue;
+            }
+            let out = Command::new(bin())
+                .args(&words[1..])
+                .current_dir(&work)
+                .output()
+                .unwrap();
+            assert!(
+                out.status.success(),
+                "{line}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            ran += 1;
+        }
+    }
+    assert!(ran >= 8, "only {ran} commands");
+    // What they wrote agrees with the demo's files where it is deterministic.
+    let (a, _) = ricci::mesh::io::read_surface(&dir.join("surface.off")).unwrap();
+    let (b, _) = ricci::mesh::io::read_surface(&work.join("surface.off")).unwrap();
+    assert_eq!(a.positions, b.positions);
+    assert_eq!(a.mesh.faces(), b.mesh.faces());
 }
