@@ -296,6 +296,22 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         section.title = st.title.to_string();
         section.reference = st.reference.to_string();
         section.seconds = ts.elapsed().as_secs_f64();
+        bar.bar.println(format!(
+            "{} [{}/{n}] {} ({:.2} s){}",
+            match section.status {
+                Status::Ok => "✓",
+                Status::Warning(_) => "!",
+                _ => "✗",
+            },
+            k + 1,
+            st.title,
+            section.seconds,
+            section
+                .status
+                .message()
+                .map(|m| format!(": {m}"))
+                .unwrap_or_default()
+        ));
         sections.push(section);
     }
     bar.bar.finish_and_clear();
@@ -356,6 +372,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 s.seconds,
                 s.status.message().unwrap_or(&s.title)
             );
+        }
+    }
+    for s in &sections {
+        if let Status::Warning(m) = &s.status {
+            eprintln!("warning: demo stage {}: {m}", s.id);
         }
     }
     if let Some(first) = failed.first() {

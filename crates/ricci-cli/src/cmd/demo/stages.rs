@@ -379,7 +379,11 @@ pub fn hyperbolic_flow(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> 
     let before = fields::angle_defect(&s.positions, s.mesh.faces())?;
     let mut abs: Vec<f64> = before.iter().map(|k| k.abs()).collect();
     abs.sort_by(f64::total_cmp);
-    let m = abs[(abs.len() * 99 / 100).min(abs.len() - 1)].max(1e-6);
+    let m = abs
+        .get((abs.len() * 99 / 100).min(abs.len().saturating_sub(1)))
+        .copied()
+        .unwrap_or(1.0)
+        .max(1e-6);
     for (file, values, caption) in [
         (
             "curvature-before.png",
