@@ -803,7 +803,7 @@ pub fn layout(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         })
         .collect();
     // The fundamental domain with its triangles; every other copy as one filled polygon
-    // (tinted by the length of its word, so neighbours differ) under its sides.
+    // under its sides, tinted by its word so that neighbours differ.
     let mut tp = LayoutPlot::new(LayoutCopy::new(&uv, d.mesh.faces()));
     tp.sides = tiles
         .iter()
@@ -830,14 +830,19 @@ pub fn layout(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
                     [c[0] + r * z.re, c[1] - r * z.im]
                 })
                 .collect();
-            by_depth.entry(t.word.len()).or_default().push(pts);
+            // Neighbouring copies differ in the last letter of their words (or its sign).
+            let last = t.word.last().map_or(0, |&(l, inv)| 2 * l + inv as usize);
+            by_depth
+                .entry((last + t.word.len()) % 8)
+                .or_default()
+                .push(pts);
         }
-        for (k, (depth, polygons)) in by_depth.into_iter().enumerate() {
+        for (k, (tint, polygons)) in by_depth.into_iter().enumerate() {
             fig.items.insert(
                 1 + k,
                 Item::Polygons {
                     polygons,
-                    fill: Some(color::tint(color::categorical(depth % 8), 0.75)),
+                    fill: Some(color::tint(color::categorical(tint), 0.75)),
                     stroke: None,
                     stroke_width: 0.0,
                     class: "tiles",
