@@ -91,6 +91,8 @@ pub struct Section {
     /// Which paper section the stage follows.
     pub reference: String,
     pub status: Status,
+    /// The main result in a few words, for the overview table at the top.
+    pub headline: String,
     /// Plain-text paragraphs (escaped when written).
     pub paragraphs: Vec<String>,
     pub pictures: Vec<Picture>,
@@ -111,6 +113,7 @@ impl Section {
             title: title.into(),
             reference: reference.into(),
             status: Status::Ok,
+            headline: String::new(),
             paragraphs: Vec::new(),
             pictures: Vec::new(),
             tables: Vec::new(),
@@ -186,6 +189,8 @@ section { background:var(--paper); margin:22px 0; padding:22px 26px 18px; border
 h2 { margin:0 0 4px; font-size:22px; font-weight:600; }
 h2 .n { color:var(--muted); font-weight:400; margin-right:6px; }
 .ref { color:var(--muted); font-size:13px; margin:0 0 12px; }
+table.overview .badge { margin-left:0; }
+table.overview a { color:var(--accent); text-decoration:none; }
 .badge { display:inline-block; font-size:12px; font-weight:600; padding:1px 8px; border-radius:10px;
          margin-left:10px; vertical-align:middle; color:#fff; }
 .badge.ok { background:var(--ok); } .badge.warning { background:var(--warn); }
@@ -287,6 +292,32 @@ pub fn index_html(p: &Page) -> String {
         );
     }
     h.push_str("</ol></div></nav>\n<main class=\"wrap\">\n");
+    // Overview: one line per stage.
+    h.push_str("<section id=\"overview\">\n<h2>At a glance</h2>\n<table class=\"overview\">\n");
+    h.push_str("<tr><th>stage</th><th>status</th><th>result</th><th>time (s)</th></tr>\n");
+    for (i, s) in p.sections.iter().enumerate() {
+        let st = s.status.name();
+        let text = if s.headline.is_empty() {
+            s.status.message().unwrap_or("").to_string()
+        } else {
+            s.headline.clone()
+        };
+        let _ = writeln!(
+            h,
+            "<tr><td><a href=\"#{}\">{}. {}</a></td><td><span class=\"badge {st}\">{st}</span></td>\
+             <td>{}</td><td class=\"num\">{:.2}</td></tr>",
+            s.id,
+            i + 1,
+            esc(&s.title),
+            inline(&text),
+            s.seconds
+        );
+    }
+    let _ = writeln!(
+        h,
+        "<tr><td>total</td><td></td><td></td><td class=\"num\">{:.2}</td></tr>\n</table>\n</section>",
+        p.total_seconds
+    );
     for (i, s) in p.sections.iter().enumerate() {
         let st = s.status.name();
         let _ = writeln!(

@@ -333,6 +333,14 @@ pub fn surface(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "ricci info surface.off --json".into(),
         "ricci render surface.off --wireframe --out surface-wireframe.png".into(),
     ];
+    sec.headline = format!(
+        "{} vertices, {} faces, χ = {chi}, genus {}, angles {:.1}°–{:.1}°",
+        s.mesh.n_vertices(),
+        s.mesh.n_faces(),
+        t.genus(),
+        q.min_angle_deg,
+        q.max_angle_deg
+    );
     ctx.chi = chi;
     ctx.surface = Some(s);
     Ok(sec)
@@ -440,6 +448,12 @@ pub fn hyperbolic_flow(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> 
         "ricci render surface.off --scalar angle-defect --out curvature-before.png".into(),
         "ricci render surface.off --scalar hyperbolic-metric.json:curvature --out curvature-after.png".into(),
     ];
+    sec.headline = format!(
+        "{} Newton steps to max |K − K̄| = {:.1e}; hyperbolic area − 4π = {:.1e}",
+        r.iterations,
+        r.max_curvature_error,
+        r.area - 4.0 * PI
+    );
     sec.summary = flow_summary(&r);
     ctx.hyperbolic = Some(r);
     Ok(sec)
@@ -594,6 +608,10 @@ pub fn single_cone(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "cone-metric.json".into(),
         "the flat metric with one cone on the refined mesh (u, K, K̄, lengths)".into(),
     )];
+    sec.headline = format!(
+        "K = {k_at_cone:.6} at vertex {v} (valence {valence_before} → {valence_after}), |K| ≤ {max_elsewhere:.1e} elsewhere; {} Newton steps",
+        r.iterations
+    );
     let mut summary = flow_summary(&r);
     summary["cone_vertex"] = json!(v);
     summary["refused_without_refinement"] = json!(refusal);
@@ -732,6 +750,7 @@ pub fn loops(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     });
     sec.commands =
         vec!["ricci cut surface.off --metric hyperbolic-metric.json --out cut.obj".into()];
+    sec.headline = format!("boundary word `{}`", c.boundary_word);
     ctx.disk = Some(d);
     Ok(sec)
 }
@@ -993,6 +1012,10 @@ pub fn layout(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "ricci layout surface.off --out uv.obj --svg polygon.svg".into(),
         format!("ricci layout surface.off --tiling {TILES} --svg tiling.svg"),
     ];
+    sec.headline = format!(
+        "relation error {relation_error:.1e}, {flipped} flipped faces, {} copies tiled",
+        tiles.len()
+    );
     ctx.layout = Some(l);
     ctx.group = Some(g);
     Ok(sec)
@@ -1052,6 +1075,12 @@ pub fn spectrum(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     sec.commands = vec![format!(
         "ricci spectrum surface.off --count {SPECTRUM_COUNT}"
     )];
+    sec.headline = format!(
+        "systole {:.6}; {} lengths up to {:.4}",
+        first,
+        lengths.len(),
+        lengths.last().copied().unwrap_or(0.0)
+    );
     sec.summary = json!({
         "genus": d.cut.genus,
         "lengths": lengths,
