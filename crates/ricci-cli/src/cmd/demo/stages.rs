@@ -208,6 +208,60 @@ fn generator_color(letters: &[String], label: &str) -> color::Rgb {
     color::categorical(letters.iter().position(|l| l == base).unwrap_or(7))
 }
 
+/// A small black ring around vertex `v` in its tangent plane (radius 2% of the bounding box
+/// diagonal), to mark a point on the surface.
+fn base_marker(pos: &[[f64; 3]], tris: &[[u32; 3]], v: u32) -> Polyline {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in pos {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let diag = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
+    let r = 0.02 * diag;
+    let n = ricci_render::render::vertex_normals(pos, tris)
+        .get(v as usize)
+        .copied()
+        .unwrap_or([0.0, 0.0, 1.0]);
+    // An orthonormal pair (e1, e2) orthogonal to n.
+    let a = if n[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let cross = |x: [f64; 3], y: [f64; 3]| {
+        [
+            x[1] * y[2] - x[2] * y[1],
+            x[2] * y[0] - x[0] * y[2],
+            x[0] * y[1] - x[1] * y[0],
+        ]
+    };
+    let unit = |x: [f64; 3]| {
+        let l = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt().max(1e-300);
+        [x[0] / l, x[1] / l, x[2] / l]
+    };
+    let e1 = unit(cross(n, a));
+    let e2 = unit(cross(n, e1));
+    let c = pos.get(v as usize).copied().unwrap_or([0.0; 3]);
+    Polyline {
+        points: (0..32)
+            .map(|i| {
+                let t = i as f64 * std::f64::consts::TAU / 32.0;
+                let (x, y) = (r * t.cos(), r * t.sin());
+                [
+                    c[0] + x * e1[0] + y * e2[0],
+                    c[1] + x * e1[1] + y * e2[1],
+                    c[2] + x * e1[2] + y * e2[2],
+                ]
+            })
+            .collect(),
+        color: [0.0, 0.0, 0.0],
+        width: 3.0,
+        closed: true,
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // 1. Surface.
 
@@ -664,6 +718,8 @@ pub fn loops(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
             closed: l.vertices.first() != l.vertices.last(),
         })
         .collect();
+    let mut lines = lines;
+    lines.push(base_marker(pos, c.refined.mesh.faces(), c.base));
     let st = Style {
         polylines: lines,
         ..Style::default()
@@ -672,9 +728,22 @@ pub fn loops(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         (
             "loops.png",
             View::default(),
-            "The loops a1 b1 a2 b2 through the base vertex (colours as in the polygon), front.",
+            "The loops a1 b1 a2 b2 through the base vertex (black ring; colours as in the polygon), front.",
         ),
-        ("loops-back.png", back_view(), "The same loops from behind."),
+        (
+            "loops-base.png",
+            View {
+                eye_direction: {
+                    let n = ricci_render::render::vertex_normals(pos, c.refined.mesh.faces())
+                        .get(c.base as usize)
+                        .copied()
+                        .unwrap_or([0.0, 0.0, 1.0]);
+                    [n[0], n[1], n[2] + 0.8]
+                },
+                ..View::default()
+            },
+            "The same loops seen from above the base vertex, where all eight sides meet.",
+        ),
     ] {
         let img = render(pos, c.refined.mesh.faces(), &st, &opts(view))?;
         sec.pictures.push(png(env, file, &img.image, caption)?);
