@@ -36,6 +36,8 @@ enum Command {
     Layout(cmd::layout::Args),
     /// Geodesic length spectrum of a closed surface of genus ≥ 1.
     Spectrum(cmd::spectrum::Args),
+    /// The whole pipeline on the built-in genus-2 surface: pictures, tables, DIR/index.html.
+    Demo(cmd::demo::Args),
 }
 
 fn main() {
@@ -49,6 +51,7 @@ fn main() {
         Command::Flow(a) => cmd::flow::run(a),
         Command::Layout(a) => cmd::layout::run(a),
         Command::Spectrum(a) => cmd::spectrum::run(a),
+        Command::Demo(a) => cmd::demo::run(a),
     };
     if let Err(e) = result {
         eprintln!("error: {}", util::sentence(&e));

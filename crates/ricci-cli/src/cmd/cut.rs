@@ -111,8 +111,8 @@ fn read_metric(path: &Path, s: &Surface) -> anyhow::Result<(Geometry, Vec<f64>)>
     Ok((geometry, out))
 }
 
-/// The cut mesh with the polygon sides as named `l` polylines.
-fn cut_obj(c: &CanonicalCut) -> String {
+/// The cut mesh with the polygon sides as named `l` polylines (also written by `ricci demo`).
+pub fn cut_obj(c: &CanonicalCut) -> String {
     let mut t = String::new();
     let _ = writeln!(
         t,

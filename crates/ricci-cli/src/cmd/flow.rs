@@ -61,7 +61,8 @@ pub struct Args {
     pub json: bool,
 }
 
-fn metric_json(r: &FlowResult, mesh: &ricci::mesh::Mesh, source: &str) -> serde_json::Value {
+/// METRIC.json of a flow result (also written by `ricci demo`).
+pub fn metric_json(r: &FlowResult, mesh: &ricci::mesh::Mesh, source: &str) -> serde_json::Value {
     let target: Vec<serde_json::Value> = r
         .target
         .iter()

@@ -9,6 +9,7 @@ use crate::util::print_json;
 use ricci::mesh::io::read_surface;
 use ricci::mesh::quality::face_angles;
 use ricci::mesh::topology;
+use ricci::mesh::{BuildReport, Surface};
 use serde_json::json;
 use std::path::PathBuf;
 
@@ -21,8 +22,9 @@ pub struct Args {
     pub json: bool,
 }
 
-pub fn run(a: Args) -> anyhow::Result<()> {
-    let (surface, report) = read_surface(&a.mesh)?;
+/// The JSON report of `ricci info` for a validated surface (`file` names it); also written
+/// by `ricci demo` as `info.json`.
+pub fn info_json(file: &str, surface: &Surface, report: &BuildReport) -> serde_json::Value {
     let m = &surface.mesh;
     let t = topology(m);
     let nc = t.components.len();
@@ -31,7 +33,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut max_angle = vec![0.0f64; nc];
     for f in 0..m.n_faces() as u32 {
         let c = t.face_component[f as usize] as usize;
-        for x in face_angles(&surface, f) {
+        for x in face_angles(surface, f) {
             min_angle[c] = min_angle[c].min(x.to_degrees());
             max_angle[c] = max_angle[c].max(x.to_degrees());
         }
@@ -65,8 +67,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         })
         .collect();
     let (lo, hi) = surface.bounding_box();
-    let v = json!({
-        "file": a.mesh.display().to_string(),
+    json!({
+        "file": file,
         "vertices": m.n_vertices(),
         "edges": m.n_edges(),
         "faces": m.n_faces(),
@@ -87,7 +89,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "triangulated_polygons": report.triangulated_polygons,
         "per_component": per_component,
         "notes": report.notes,
-    });
+    })
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let (surface, report) = read_surface(&a.mesh)?;
+    let v = info_json(&a.mesh.display().to_string(), &surface, &report);
+    let m = &surface.mesh;
+    let t = topology(m);
+    let nc = t.components.len();
+    let global_min = v["min_angle_deg"].as_f64().unwrap_or(f64::NAN);
+    let global_max = v["max_angle_deg"].as_f64().unwrap_or(f64::NAN);
+    let (lo, hi) = surface.bounding_box();
     if a.json {
         print_json(&v);
         return Ok(());

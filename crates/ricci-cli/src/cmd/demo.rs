@@ -1,0 +1,418 @@
+//! `ricci demo --out DIR [--json] [--resolution N]`: the whole pipeline on the built-in
+//! genus-2 surface, with pictures, tables and a static `DIR/index.html` (DESIGN.md §1, §4).
+//!
+//! The demo is a list of [`STAGES`]; each stage reads what earlier stages left in the
+//! [`Ctx`], writes its files through the [`Env`] and returns a [`Section`] (text, pictures, tables, files and a JSON
+//! summary) for the page and for `--json`. A stage whose inputs failed is skipped and says so;
+//! a stage that fails is shown as failed in the page, its files are dropped, and the command
+//! exits with status 1 after writing the report of everything else.
+//!
+//! Everything is written into a hidden staging folder inside DIR first (each file atomically)
+//! and moved into DIR when all stages have run, `index.html` last: an interrupted run leaves
+//! no half-written file in DIR.
+//!
+//! For tests of that path, the environment variable `RICCI_DEMO_FAIL=ID` makes stage `ID`
+//! fail at its start (as if the library had returned an error).
+//!
+//! Adding a stage (e.g. the affine atlas, `ricci atlas`, and the manifold spline,
+//! `ricci spline`): write `fn atlas(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section>` in
+//! [`stages`], put what later stages need into [`Ctx`], and add one line to [`STAGES`] (the
+//! marked places below); remove its entry from [`PLACEHOLDERS`].
+
+mod report;
+mod stages;
+
+use crate::util::{print_json, write_atomic, UsageError};
+use indicatif::{ProgressBar, ProgressStyle};
+use report::{Page, Section, Status};
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+pub use stages::Ctx;
+
+/// Where a stage writes its files and reports its progress.
+pub struct Env<'a> {
+    pub out: &'a mut Out,
+    pub bar: &'a mut StageBar,
+}
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Output folder (created if missing; files of the same names are replaced).
+    #[arg(long, short = 'o')]
+    pub out: PathBuf,
+    /// Edges around each handle of the built-in genus-2 surface (12 to 200).
+    #[arg(long, short = 'n', default_value_t = 40)]
+    pub resolution: u32,
+    /// Print one JSON object on stdout (per-stage summaries and the file list).
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// One stage of the demo.
+pub struct Stage {
+    /// Anchor in the page and key in the JSON.
+    pub id: &'static str,
+    pub title: &'static str,
+    /// Paper section the stage follows (shown under the title).
+    pub reference: &'static str,
+    /// Stages whose results this one needs.
+    pub needs: &'static [&'static str],
+    pub run: fn(&mut Ctx, &mut Env) -> anyhow::Result<Section>,
+}
+
+/// The stages, in order.
+pub const STAGES: &[Stage] = &[
+    Stage {
+        id: "surface",
+        title: "Surface",
+        reference: "built-in genus-2 surface (ricci::mesh::generate::genus), validation and topology",
+        needs: &[],
+        run: stages::surface,
+    },
+    Stage {
+        id: "flow",
+        title: "Hyperbolic uniformization",
+        reference: "Thurston circle packing Ricci flow in H², Newton (paper 001 §V, paper 002 §4.3)",
+        needs: &["surface"],
+        run: stages::hyperbolic_flow,
+    },
+    Stage {
+        id: "cone",
+        title: "Flat metric with a single cone",
+        reference: "Euclidean Ricci flow with all curvature 2πχ on one vertex (paper 000 §4 Steps 2–3)",
+        needs: &["surface"],
+        run: stages::single_cone,
+    },
+    Stage {
+        id: "loops",
+        title: "Canonical loops",
+        reference: "canonical fundamental group generators through a base vertex (paper 001 §V, paper 002 §4.3.2)",
+        needs: &["flow"],
+        run: stages::loops,
+    },
+    Stage {
+        id: "layout",
+        title: "Fundamental polygon and universal cover",
+        reference: "isometric layout in the Poincaré disk, deck group, tiling (paper 001 §V–VI, paper 002 §4.3.3)",
+        needs: &["loops"],
+        run: stages::layout,
+    },
+    Stage {
+        id: "spectrum",
+        title: "Geodesic length spectrum",
+        reference: "closed geodesics from the Fuchsian group, ℓ = 2 acosh(|tr|/2) (paper 002 §6.3.3)",
+        needs: &["layout"],
+        run: stages::spectrum,
+    },
+    // ── Affine atlas goes here: Stage { id: "atlas", title: "Affine atlas", needs: &["cone"],
+    //    run: stages::atlas, .. } (charts picture, transition errors, `ricci atlas` JSON).
+    // ── Manifold spline goes here: Stage { id: "spline", title: "Manifold spline",
+    //    needs: &["atlas"], run: stages::spline, .. } (zebra picture, fitting errors).
+];
+
+/// Stages announced in the page but not built yet (title, sentence).
+pub const PLACEHOLDERS: &[(&str, &str)] = &[
+    (
+        "Affine atlas",
+        "the atlas of flat charts with one singular point (ricci atlas) will appear here.",
+    ),
+    (
+        "Manifold spline",
+        "the manifold triangular B-spline on the atlas, with zebra stripes (ricci spline), will appear here.",
+    ),
+];
+
+/// The files of a run, written into a staging folder inside the output folder and moved into
+/// place at the end.
+pub struct Out {
+    dir: PathBuf,
+    staging: PathBuf,
+    files: Vec<String>,
+}
+
+impl Out {
+    fn new(dir: &Path) -> anyhow::Result<Out> {
+        if dir.exists() && !dir.is_dir() {
+            anyhow::bail!(
+                "{}: the output path exists and is not a folder",
+                dir.display()
+            );
+        }
+        std::fs::create_dir_all(dir).map_err(|e| {
+            anyhow::anyhow!("{}: cannot create the output folder ({e})", dir.display())
+        })?;
+        let staging = dir.join(format!(".ricci-demo-{}", std::process::id()));
+        std::fs::create_dir_all(&staging).map_err(|e| {
+            anyhow::anyhow!(
+                "{}: cannot write into the output folder ({e})",
+                dir.display()
+            )
+        })?;
+        Ok(Out {
+            dir: dir.to_path_buf(),
+            staging,
+            files: Vec::new(),
+        })
+    }
+
+    /// Write one file (atomically) into the staging folder.
+    pub fn write(&mut self, name: &str, bytes: &[u8]) -> anyhow::Result<()> {
+        write_atomic(&self.staging.join(name), bytes)?;
+        if !self.files.iter().any(|f| f == name) {
+            self.files.push(name.to_string());
+        }
+        Ok(())
+    }
+
+    /// Forget (and delete) the files written after the first `keep`.
+    fn drop_after(&mut self, keep: usize) {
+        for f in self.files.drain(keep..) {
+            let _ = std::fs::remove_file(self.staging.join(f));
+        }
+    }
+
+    /// Move every file into the output folder, `index.html` last, and remove the staging
+    /// folder.
+    fn commit(&mut self) -> anyhow::Result<()> {
+        self.files.sort_by_key(|f| f == "index.html");
+        for f in &self.files {
+            let to = self.dir.join(f);
+            std::fs::rename(self.staging.join(f), &to)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", to.display()))?;
+        }
+        let _ = std::fs::remove_dir(&self.staging);
+        Ok(())
+    }
+}
+
+impl Drop for Out {
+    fn drop(&mut self) {
+        // After a commit the folder is empty; after an error nothing of it is kept.
+        let _ = std::fs::remove_dir_all(&self.staging);
+    }
+}
+
+/// A spinner per stage on stderr: `[k/N] title — step: message`.
+pub struct StageBar {
+    bar: ProgressBar,
+    prefix: String,
+}
+
+impl StageBar {
+    fn new(hidden: bool) -> StageBar {
+        let bar = if hidden {
+            ProgressBar::hidden()
+        } else {
+            ProgressBar::new_spinner()
+        };
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} {elapsed:>3} {prefix} {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        );
+        bar.enable_steady_tick(std::time::Duration::from_millis(120));
+        StageBar {
+            bar,
+            prefix: String::new(),
+        }
+    }
+    fn stage(&mut self, k: usize, n: usize, title: &str) {
+        self.prefix = format!("[{k}/{n}] {title}");
+        self.bar.set_prefix(self.prefix.clone());
+        self.bar.set_message("");
+    }
+    /// Announce a step of the current stage.
+    pub fn step(&self, msg: &str) {
+        self.bar.set_message(format!("— {msg}"));
+    }
+}
+
+impl ricci::progress::Progress for StageBar {
+    fn report(&mut self, stage: &str, _fraction: Option<f64>, message: &str) {
+        self.bar.set_message(format!("— {stage}: {message}"));
+    }
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let t0 = Instant::now();
+    if !(12..=200).contains(&a.resolution) {
+        return Err(UsageError(format!(
+            "--resolution {} must be between 12 and 200 edges around each handle",
+            a.resolution
+        ))
+        .into());
+    }
+    let mut out = Out::new(&a.out)?;
+    let mut bar = StageBar::new(a.json);
+    let mut ctx = Ctx::new(a.resolution);
+    let mut sections: Vec<Section> = Vec::new();
+    let n = STAGES.len();
+    for (k, st) in STAGES.iter().enumerate() {
+        bar.stage(k + 1, n, st.title);
+        let missing: Vec<&str> = st
+            .needs
+            .iter()
+            .copied()
+            .filter(|id| {
+                !sections
+                    .iter()
+                    .any(|s: &Section| s.id == *id && s.status.usable())
+            })
+            .collect();
+        let ts = Instant::now();
+        let mut section = if missing.is_empty() {
+            let keep = out.files.len();
+            let mut env = Env {
+                out: &mut out,
+                bar: &mut bar,
+            };
+            let result = match std::env::var("RICCI_DEMO_FAIL") {
+                Ok(id) if id == st.id => {
+                    Err(anyhow::anyhow!("failure injected by RICCI_DEMO_FAIL={id}"))
+                }
+                _ => (st.run)(&mut ctx, &mut env),
+            };
+            match result {
+                Ok(s) => s,
+                Err(e) => {
+                    out.drop_after(keep);
+                    let mut s = Section::new(st.id, st.title, st.reference);
+                    s.status =
+                        Status::Failed(format!("this stage failed: {}", crate::util::sentence(&e)));
+                    s
+                }
+            }
+        } else {
+            let mut s = Section::new(st.id, st.title, st.reference);
+            s.status = Status::Skipped(format!(
+                "not run: it needs the stage{} {}, which did not succeed",
+                if missing.len() == 1 { "" } else { "s" },
+                missing.join(", ")
+            ));
+            s
+        };
+        section.id = st.id;
+        section.title = st.title.to_string();
+        section.reference = st.reference.to_string();
+        section.seconds = ts.elapsed().as_secs_f64();
+        bar.bar.println(format!(
+            "{} [{}/{n}] {} ({:.2} s){}",
+            match section.status {
+                Status::Ok => "✓",
+                Status::Warning(_) => "!",
+                _ => "✗",
+            },
+            k + 1,
+            st.title,
+            section.seconds,
+            section
+                .status
+                .message()
+                .map(|m| format!(": {m}"))
+                .unwrap_or_default()
+        ));
+        sections.push(section);
+    }
+    bar.bar.finish_and_clear();
+
+    let failed: Vec<&Section> = sections.iter().filter(|s| !s.status.usable()).collect();
+    // demo.json and index.html; their names go into the file list first so it is complete.
+    for f in ["demo.json", "index.html"] {
+        if !out.files.iter().any(|x| x == f) {
+            out.files.push(f.to_string());
+        }
+    }
+    let total = t0.elapsed().as_secs_f64();
+    let summary = summary_json(&a, &sections, &out.files, total);
+    out.write(
+        "demo.json",
+        serde_json::to_string_pretty(&summary)?.as_bytes(),
+    )?;
+    let page = Page {
+        title: "ricci — the pipeline on a genus-2 surface",
+        subtitle: format!(
+            "Discrete surface Ricci flow on the built-in genus-2 surface (resolution {}): \
+             uniformization, canonical loops, the fundamental polygon in the Poincaré disk, \
+             its tiling, the length spectrum. {} of {} stages succeeded.",
+            a.resolution,
+            sections.len() - failed.len(),
+            sections.len()
+        ),
+        sections: &sections,
+        placeholders: PLACEHOLDERS,
+        total_seconds: total,
+        command: format!(
+            "ricci demo --out {} --resolution {}",
+            a.out.display(),
+            a.resolution
+        ),
+        files: vec![(
+            "demo.json".into(),
+            "the numbers of every stage (as --json prints them)".into(),
+        )],
+    };
+    out.write("index.html", report::index_html(&page).as_bytes())?;
+    out.commit()?;
+
+    if a.json {
+        print_json(&summary);
+    } else {
+        println!(
+            "{}: {} stages in {:.2} s",
+            a.out.join("index.html").display(),
+            sections.len(),
+            total
+        );
+        for s in &sections {
+            println!(
+                "  {:<9} {:<8} {:6.2} s  {}",
+                s.id,
+                s.status.name(),
+                s.seconds,
+                s.status.message().unwrap_or(&s.title)
+            );
+        }
+    }
+    for s in &sections {
+        if let Status::Warning(m) = &s.status {
+            eprintln!("warning: demo stage {}: {m}", s.id);
+        }
+    }
+    if let Some(first) = failed.first() {
+        anyhow::bail!(
+            "{} of {} demo stages did not succeed (first: {}: {}); the report of the others is in {}",
+            failed.len(),
+            sections.len(),
+            first.id,
+            first.status.message().unwrap_or(""),
+            a.out.join("index.html").display()
+        );
+    }
+    Ok(())
+}
+
+fn summary_json(a: &Args, sections: &[Section], files: &[String], total: f64) -> Value {
+    let mut stages = serde_json::Map::new();
+    for s in sections {
+        let mut v = match &s.summary {
+            Value::Object(_) => s.summary.clone(),
+            _ => json!({}),
+        };
+        v["status"] = json!(s.status.name());
+        v["message"] = json!(s.status.message());
+        v["seconds"] = json!(s.seconds);
+        v["files"] = json!(s.files.iter().map(|f| &f.0).collect::<Vec<_>>());
+        stages.insert(s.id.to_string(), v);
+    }
+    json!({
+        "out": a.out.display().to_string(),
+        "resolution": a.resolution,
+        "ok": sections.iter().all(|s| s.status.usable()),
+        "stage_order": sections.iter().map(|s| s.id).collect::<Vec<_>>(),
+        "stages": stages,
+        "placeholders": PLACEHOLDERS.iter().map(|p| p.0).collect::<Vec<_>>(),
+        "files": files,
+        "seconds": total,
+    })
+}
