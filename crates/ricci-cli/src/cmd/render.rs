@@ -220,7 +220,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 
     let uvs: Option<FoundUvs> = match &a.uv {
         Some(path) => Some(uvs_from_file(path, &surface)?),
-        None => surface.uvs.clone().map(FoundUvs::PerVertex),
+        // The mesh's own `vt`: per vertex, or per corner across seams (a layout's uv.obj).
+        None => match &surface.uvs {
+            Some(uv) => Some(FoundUvs::PerVertex(uv.clone())),
+            None if has_corner_uvs(&a.mesh) => Some(uvs_from_file(&a.mesh, &surface)?),
+            None => None,
+        },
     };
 
     // The scalar field, if any: values, where they live, its name and whether it is signed.
@@ -573,11 +578,24 @@ fn scalar_field(spec: &str, s: &Surface, uvs: Option<&FoundUvs>) -> anyhow::Resu
     })
 }
 
+/// Whether `path` is an OBJ file whose every face corner has a `vt`.
+fn has_corner_uvs(path: &Path) -> bool {
+    let is_obj = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    is_obj
+        && ricci::mesh::io::read_soup(path)
+            .map(|s| s.corner_uvs.is_some())
+            .unwrap_or(false)
+}
+
 /// Texture coordinates for `mesh` from a UV file whose faces match it face by face: its `vt`
 /// (or, for a planar mesh without `vt`, its x and y) at the corner with the same position,
 /// or at the same corner when positions differ (a layout written with planar positions).
 fn uvs_from_file(path: &Path, mesh: &Surface) -> anyhow::Result<FoundUvs> {
-    let (u, _) = read_surface(path)?;
+    let soup = ricci::mesh::io::read_soup(path)?;
+    let (in_polygons, in_corner_uvs) = (soup.polygons.clone(), soup.corner_uvs.clone());
+    let (u, report) = ricci::mesh::build_surface(soup)?;
     let (nf, unf) = (mesh.mesh.n_faces(), u.mesh.n_faces());
     if nf != unf {
         bail!(
@@ -589,10 +607,48 @@ fn uvs_from_file(path: &Path, mesh: &Surface) -> anyhow::Result<FoundUvs> {
         let d = u.diagonal().max(f64::MIN_POSITIVE);
         u.positions.iter().all(|p| p[2].abs() <= 1e-9 * d)
     };
-    let coords: Vec<[f64; 2]> = match (&u.uvs, planar) {
-        (Some(uv), _) => uv.clone(),
-        (None, true) => u.positions.iter().map(|p| [p[0], p[1]]).collect(),
-        (None, false) => bail!(
+    // One UV per corner of the UV file's faces: its per-vertex `vt`, else its per-corner `vt`
+    // (a layout of a cut surface has seams: `f v/vt` with several `vt` per vertex), else x, y.
+    let per_vertex = |coords: &[[f64; 2]]| -> Vec<[f64; 2]> {
+        u.mesh
+            .faces()
+            .iter()
+            .flat_map(|t| t.map(|v| coords[v as usize]))
+            .collect()
+    };
+    let ucorner: Vec<[f64; 2]> = match (&u.uvs, &in_corner_uvs, planar) {
+        (Some(uv), _, _) => per_vertex(uv),
+        (None, Some(cuv), _) => {
+            let mut start = Vec::with_capacity(in_polygons.len());
+            let mut acc = 0usize;
+            for p in &in_polygons {
+                start.push(acc);
+                acc += p.len();
+            }
+            let mut out = Vec::with_capacity(3 * unf);
+            for (f, t) in u.mesh.faces().iter().enumerate() {
+                let p = report.face_origin[f] as usize;
+                for &v in t {
+                    let vin = report.vertex_origin[v as usize];
+                    let k = in_polygons[p]
+                        .iter()
+                        .position(|&w| w == vin)
+                        .ok_or_else(|| {
+                            anyhow::anyhow!(
+                                "{}: face {f} lost track of its corners",
+                                path.display()
+                            )
+                        })?;
+                    out.push(cuv[start[p] + k]);
+                }
+            }
+            out
+        }
+        (None, None, true) => {
+            let xy: Vec<[f64; 2]> = u.positions.iter().map(|p| [p[0], p[1]]).collect();
+            per_vertex(&xy)
+        }
+        (None, None, false) => bail!(
             "{}: no texture coordinates (vt lines) and not a planar layout",
             path.display()
         ),
@@ -611,7 +667,7 @@ fn uvs_from_file(path: &Path, mesh: &Surface) -> anyhow::Result<FoundUvs> {
             if j.is_some() {
                 matched_positions += 1;
             }
-            corner.push(coords[ut[j.unwrap_or(i)] as usize]);
+            corner.push(ucorner[3 * f + j.unwrap_or(i)]);
         }
     }
     if matched_positions != 0 && matched_positions != 3 * nf {

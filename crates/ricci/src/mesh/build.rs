@@ -28,6 +28,9 @@ pub struct PolygonSoup {
     pub polygon_lines: Option<Vec<usize>>,
     /// Texture coordinates per vertex, if the file carried them in a per-vertex way.
     pub uvs: Option<Vec<[f64; 2]>>,
+    /// Texture coordinates per polygon corner (flat, in polygon order), when every corner of
+    /// the file has one (OBJ `f v/vt`) — also across texture seams, where `uvs` is `None`.
+    pub corner_uvs: Option<Vec<[f64; 2]>>,
     /// What the reader ignored or changed, one sentence each (copied into the report).
     pub notes: Vec<String>,
 }

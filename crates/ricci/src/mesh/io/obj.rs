@@ -6,7 +6,8 @@
 //! `vp`, `o`, `g`, `s`, `usemtl`, `mtllib`, `l`, `p`, free-form geometry statements, comments.
 //! Texture coordinates are kept as per-vertex UVs only when every referenced vertex carries
 //! one consistent `vt` (same index or same value at every corner); otherwise they are dropped
-//! with a note (a texture seam needs per-corner UVs, which a [`Surface`] does not have).
+//! with a note (a texture seam needs per-corner UVs, which a [`Surface`] does not have); the
+//! per-corner coordinates stay available in [`PolygonSoup::corner_uvs`].
 
 use super::text::{self, at_line, parse_f64, parse_i64, show, strip_comment, tokens};
 use crate::error::{Error, Result};
@@ -233,12 +234,15 @@ pub fn parse_obj(data: &[u8]) -> Result<PolygonSoup> {
     } else {
         None
     };
+    let corner_uvs = (any_vt_corner && corner_vt.iter().all(|&vt| vt != NONE))
+        .then(|| corner_vt.iter().map(|&vt| texcoords[vt as usize]).collect());
     Ok(PolygonSoup {
         positions,
         polygons,
         vertex_lines: Some(vertex_lines),
         polygon_lines: Some(polygon_lines),
         uvs,
+        corner_uvs,
         notes,
     })
 }
@@ -384,6 +388,13 @@ mod tests {
         let s = parse_obj(d).unwrap();
         assert_eq!(s.uvs, None);
         assert!(s.notes[0].contains("vertex 2"), "{:?}", s.notes);
+        // The seam is kept per corner: vertex 2 has (1, 0) in the first face, (9, 9) in the second.
+        let c = s.corner_uvs.expect("every corner has a vt");
+        assert_eq!(c.len(), 6);
+        assert_eq!((c[1], c[3]), ([1.0, 0.0], [9.0, 9.0]));
+        // A corner without vt: no per-corner UVs either.
+        let d = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2 3\n";
+        assert_eq!(parse_obj(d).unwrap().corner_uvs, None);
     }
 
     #[test]
