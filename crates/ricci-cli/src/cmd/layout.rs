@@ -171,7 +171,8 @@ fn deck_json<I: Isometry + JsonIso>(g: &DeckGroup<I>, poly: &Polygon) -> Value {
         .map(|p| {
             json!({
                 "side": poly.sides[p.side].label, "partner": poly.sides[p.partner].label,
-                "edge_spread": p.edge_spread, "max_vertex_error": p.max_vertex_error,
+                "edge_spread": p.edge_spread, "edge_spread_matrix": p.edge_spread_matrix,
+                "max_vertex_error": p.max_vertex_error,
                 "map": p.map.to_json(),
             })
         })
@@ -285,6 +286,7 @@ where
             out["relation_error"] = json!(g.relation_error);
             out["relation_condition"] = json!(g.relation_condition);
             out["max_edge_spread"] = json!(g.max_edge_spread);
+            out["max_edge_spread_matrix"] = json!(g.max_edge_spread_matrix);
             out["max_vertex_error"] = json!(g.max_vertex_error);
         }
         _ => {
