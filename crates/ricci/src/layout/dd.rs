@@ -22,6 +22,9 @@
 //! functions are evaluated in double precision on quantities near the origin (angles and
 //! small length mismatches), where that is accurate to the last digit.
 
+// `!(x > 0.0)` is used on purpose: it is also true for NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use super::isometry::{Complex, Mobius};
 use std::ops::{Add, Div, Mul, Neg, Sub};
 

@@ -731,7 +731,10 @@ pub fn ext_position<S: Space>(l: &Layout<S::Point>, v: usize) -> ExtPoint<S> {
 /// where the double-precision positions of vertices far from the centre of the disk are
 /// resolved only to `~1e-16·e^r`): the least-squares isometry mapping `b` onto `a` and the
 /// largest remaining geodesic distance between corresponding vertices.
-pub fn align_layouts<S: Space>(a: &Layout<S::Point>, b: &Layout<S::Point>) -> Result<(S::Iso, f64)> {
+pub fn align_layouts<S: Space>(
+    a: &Layout<S::Point>,
+    b: &Layout<S::Point>,
+) -> Result<(S::Iso, f64)> {
     if a.positions.len() != b.positions.len() {
         return Err(Error::input(
             "cannot align layouts with different numbers of vertices",
