@@ -214,10 +214,11 @@ pub struct DeckGroup<I> {
     pub corner_maps: Vec<Option<I>>,
     /// Distance of `D(x_1)⋯D(x_n)` from the identity, when all sides are paired.
     pub relation_error: Option<f64>,
-    /// Product of the sizes of the factors of the relation ([`Isometry::size`]): the rounding
-    /// of the product alone can reach machine epsilon times this, so `relation_error` is
-    /// only meaningful relative to it (long generators on surfaces with far-apart handles
-    /// make it huge).
+    /// Product of the sizes of the factors of the relation ([`Isometry::size`]): in double
+    /// precision the rounding of the product alone could reach machine epsilon times this
+    /// (long generators on surfaces with far-apart handles make it huge); the product is
+    /// formed in the working precision of the space (double-double in H², see the module
+    /// docs), where the rounding is ~1e-32 times it.
     pub relation_condition: f64,
     /// Largest edge spread over all sides.
     pub max_edge_spread: f64,
