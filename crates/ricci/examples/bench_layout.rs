@@ -2,7 +2,8 @@
 //! metric (flow and cut timed separately, as context).
 //!
 //! `RICCI_MESHES=../shared/meshes cargo run --release --example bench_layout [files…]`
-//! (default: botijo.off seahorse2_100K.off).
+//! (default: botijo.off seahorse2_100K.off). `FILE@V` cuts through base vertex `V` instead of
+//! the cut's automatic choice. Flow tolerance 1e-12 (as `tests/layout_meshes.rs`).
 
 use ricci::layout::deck_group;
 use ricci::layout::pipeline::{cut_disk, uniformization_metric};
@@ -20,9 +21,13 @@ fn main() {
     if files.is_empty() {
         files = vec!["botijo.off".into(), "seahorse2_100K.off".into()];
     }
-    println!("| mesh | faces | genus | scheme | flow s | cut s | layout s | deck s | flipped | max radius | relation error | max edge spread | max length error |");
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-    for f in files {
+    println!("| mesh | faces | genus | scheme | max abs(K − K̄) | flow s | cut s | layout s | deck s | flipped | max radius | relation error | edge spread (matrices) | edge spread (points) | max length error |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for arg in files {
+        let (f, base) = match arg.split_once('@') {
+            Some((f, b)) => (f.to_string(), b.parse::<u32>().ok()),
+            None => (arg.clone(), None),
+        };
         let (s, _) = match read_surface(&dir.join(&f)) {
             Ok(x) => x,
             Err(e) => {
@@ -39,7 +44,7 @@ fn main() {
                 &s.edge_lengths(),
                 Geometry::Hyperbolic,
                 scheme,
-                1e-10,
+                1e-12,
                 &mut NoProgress,
             )
         };
@@ -71,7 +76,7 @@ fn main() {
             &flow.lengths,
             Geometry::Hyperbolic,
             None,
-            None,
+            base,
             &mut NoProgress,
         ) {
             Ok(d) => d,
@@ -88,12 +93,14 @@ fn main() {
         let g = deck_group::<Hyperbolic>(&l, &disk.polygon).expect("deck group");
         let t_deck = t.elapsed().as_secs_f64();
         println!(
-            "| {f} | {} | {genus} | {} | {t_flow:.2} | {t_cut:.2} | {t_layout:.3} | {t_deck:.3} | {} | {:.1} | {:.1e} | {:.1e} | {:.1e} |",
+            "| {arg} | {} | {genus} | {} | {:.1e} | {t_flow:.2} | {t_cut:.2} | {t_layout:.3} | {t_deck:.3} | {} | {:.1} | {:.1e} | {:.1e} | {:.1e} | {:.1e} |",
             s.mesh.n_faces(),
             scheme.name(),
+            flow.max_curvature_error,
             l.flipped_faces.len(),
             l.max_radius,
             g.relation_error.unwrap_or(f64::NAN),
+            g.max_edge_spread_matrix,
             g.max_edge_spread,
             l.max_length_error
         );

@@ -2,7 +2,7 @@
 //! uniformization metrics: the accuracy checks of paper 002 Table 10 / paper 001 Table II.
 
 use ricci::layout::pipeline::{cut_disk, uniformization_geometry, uniformization_metric};
-use ricci::layout::place::{align, layout};
+use ricci::layout::place::{align_layouts, layout};
 use ricci::layout::{deck_group, Layout};
 use ricci::mesh::io::read_surface;
 use ricci::metric::{Geometry, Hyperbolic, Scheme};
@@ -14,8 +14,18 @@ fn mesh_dir() -> Option<PathBuf> {
     d.is_dir().then_some(d)
 }
 
-/// Flow, cut, lay out from three seeds, deck group; returns (relation, spread, seed disagreement).
-fn accuracy(file: &str) -> (f64, f64, f64, usize) {
+struct Accuracy {
+    relation: f64,
+    /// Edge maps vs the end-point map of the same side, as matrices (Frobenius).
+    spread_matrix: f64,
+    /// The same, as geodesic distances of the images of the side's ends and middle.
+    spread_points: f64,
+    seeds: f64,
+    flipped: usize,
+}
+
+/// Flow, cut, lay out from three seeds, deck group.
+fn accuracy(file: &str) -> Accuracy {
     let dir = mesh_dir().unwrap();
     let (s, _) = read_surface(&dir.join(file)).unwrap();
     let geometry = uniformization_geometry(&s.mesh).unwrap();
@@ -51,26 +61,30 @@ fn accuracy(file: &str) -> (f64, f64, f64, usize) {
         let l = layout::<Hyperbolic>(&disk.mesh, &disk.lengths, seed).unwrap();
         flipped += l.flipped_faces.len();
         if let Some(first) = layouts.first() {
-            let (_, d) = align::<Hyperbolic>(&first.positions, &l.positions).unwrap();
+            let (_, d) = align_layouts::<Hyperbolic>(first, &l).unwrap();
             seed_dev = seed_dev.max(d);
         }
         layouts.push(l);
     }
     let g = deck_group::<Hyperbolic>(&layouts[0], &disk.polygon).unwrap();
     eprintln!(
-        "{file}: relation {:e} (condition {:e}), edge spread {:e}, seeds {:e}, flipped {flipped}, length error {:e}",
+        "{file}: relation {:e}, edge spread {:e} (matrices) {:e} (points), seeds {:e}, \
+         flipped {flipped}, length error {:e}, max radius {:.1}, curvature error {:e}",
         g.relation_error.unwrap(),
-        g.relation_condition,
+        g.max_edge_spread_matrix,
         g.max_edge_spread,
         seed_dev,
-        layouts[0].max_length_error
+        layouts[0].max_length_error,
+        layouts[0].max_radius,
+        flow.max_curvature_error,
     );
-    (
-        g.relation_error.unwrap(),
-        g.max_edge_spread,
-        seed_dev,
+    Accuracy {
+        relation: g.relation_error.unwrap(),
+        spread_matrix: g.max_edge_spread_matrix,
+        spread_points: g.max_edge_spread,
+        seeds: seed_dev,
         flipped,
-    )
+    }
 }
 
 #[test]
@@ -79,25 +93,43 @@ fn hyperbolic_layouts_are_accurate_on_real_meshes() {
         eprintln!("RICCI_MESHES not set: skipping");
         return;
     }
-    // (file, bound on relation error and seed disagreement, bound on the edge spread).
-    // The papers' accuracy (1e-9) is reached where the canonical loops are short. On genus3
-    // and fertility the cut's loops through one base vertex are long (up to 8.1 and 18.4 in
-    // the hyperbolic metric), the polygon reaches far into the disk, and both the layout (the
-    // Poincaré model resolves ~1e-16·e^r at distance r) and the products of generators of
-    // size ~e^(ℓ/2) lose digits: the bounds below are what double precision allows there.
-    // (file, bound on the relation error, on the seed disagreement, on the edge spread).
+    // The issue's accuracy, paper 002 Table 10 / paper 001 Table II: relation error,
+    // disagreement of layouts from three seed faces (geodesic distance after one isometry)
+    // and disagreement of the deck maps computed from different edges of the same side (as
+    // SU(1,1) matrices, the norm of the relation error) all ≤ 1e-9. The layout and the deck
+    // group run in double-double (`ricci::layout::dd`); in double precision genus3 and
+    // fertility reached only 7e-7 and 2e-3 (polygon corners at hyperbolic distance ~13).
+    //
+    // Not met on fertility: the per-edge deck maps. They are limited by the metric, not by
+    // rounding any more: the maps from two edges of a side differ by rotations of the size of
+    // the flow's curvature error (~5e-15 per vertex, the double-precision floor of
+    // K = 2π − Σθ; the double-double layout adds only ~1e-16 per face) about the vertices
+    // between them, and such a rotation at distance r from the centre changes the matrix by
+    // ~κ·sinh r and moves a point at distance d by ~κ·sinh d. Fertility's canonical loops
+    // are long (corners at r ≈ 13, sides up to ~18 long), so its matrix spread is ~6e-9 and
+    // its point spread (ends and middle of each side) ~2e-7; both change with the noise of
+    // the flow's last Newton step (1.5e-9 and 5e-8 after 30 steps), not with the precision
+    // of the layout. Shorter loops from the cut would fix it; the bounds below are 1e-9
+    // where the sides are short.
+    // (file, bound on the matrix spread, on the point spread).
     let cases = [
-        ("eight.off", 1e-9, 1e-9, 1e-9),
-        ("3holes.off", 1e-9, 1e-9, 1e-8),
-        ("genus3.off", 1e-7, 1e-9, 1e-7),
-        ("fertility.off", 1e-2, 1e-4, 1.0),
+        ("eight.off", 1e-9, 1e-9),
+        ("3holes.off", 1e-9, 1e-9),
+        ("genus3.off", 1e-9, 1e-9),
+        ("fertility.off", 2e-8, 1e-6),
     ];
     let mut fails = Vec::new();
-    for (file, rel_tol, seed_tol, spread_tol) in cases {
-        let (rel, spread, seeds, flipped) = accuracy(file);
-        if flipped != 0 || rel > rel_tol || seeds > seed_tol || spread > spread_tol {
+    for (file, matrix_tol, spread_tol) in cases {
+        let a = accuracy(file);
+        if a.flipped != 0
+            || a.relation > 1e-9
+            || a.seeds > 1e-9
+            || a.spread_matrix > matrix_tol
+            || a.spread_points > spread_tol
+        {
             fails.push(format!(
-                "{file}: flipped {flipped} relation {rel:e} spread {spread:e} seeds {seeds:e}"
+                "{file}: flipped {} relation {:e} spread {:e} (matrices) {:e} (points) seeds {:e}",
+                a.flipped, a.relation, a.spread_matrix, a.spread_points, a.seeds
             ));
         }
     }

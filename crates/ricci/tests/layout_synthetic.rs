@@ -285,3 +285,61 @@ fn universal_cover_tiles_carry_words_that_evaluate_to_their_maps() {
     let w = tiles_by_words(&g, 2, 1000).unwrap();
     assert_eq!(w.len(), 1 + 8 + 56);
 }
+
+/// A long thin hyperbolic strip (two rows of vertices at signed distance ±0.05 from a geodesic,
+/// Fermi coordinates, 300 steps of 0.1: length 30) with its exact metric,
+/// `sinh²(d/2) = cosh w₁ cosh w₂ sinh²(Δt/2) + sinh²(Δw/2)`. Laid out from either end it
+/// reaches hyperbolic distance ~30 from the centre of the disk, where double-precision
+/// coordinates resolve only ~1e-16·e^30 ≈ 1e-3: the layout must keep its accuracy through its
+/// double-double positions (lengths, orientation and the alignment of the two layouts).
+#[test]
+fn hyperbolic_layout_keeps_its_accuracy_far_from_the_centre() {
+    use ricci::layout::align_layouts;
+    let (n, h, w0) = (300usize, 0.1f64, 0.05f64);
+    let coord = |v: usize| -> (f64, f64) {
+        let (i, row) = (v / 2, v % 2);
+        (i as f64 * h, if row == 0 { -w0 } else { w0 })
+    };
+    let mut faces = Vec::new();
+    for i in 0..n as u32 {
+        let (a0, b0, a1, b1) = (2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3);
+        faces.push([a0, a1, b0]);
+        faces.push([a1, b1, b0]);
+    }
+    let mesh = Mesh::from_triangles(2 * (n + 1), faces).unwrap();
+    let lengths: Vec<f64> = (0..mesh.n_edges() as u32)
+        .map(|e| {
+            let [p, q] = mesh.edge_vertices(e);
+            let ((t1, w1), (t2, w2)) = (coord(p as usize), coord(q as usize));
+            let s2 = w1.cosh() * w2.cosh() * (0.5 * (t2 - t1)).sinh().powi(2)
+                + (0.5 * (w2 - w1)).sinh().powi(2);
+            2.0 * s2.sqrt().asinh()
+        })
+        .collect();
+    let nf = mesh.n_faces() as u32;
+    let from_start = layout::<Hyperbolic>(&mesh, &lengths, Some(0)).unwrap();
+    let from_end = layout::<Hyperbolic>(&mesh, &lengths, Some(nf - 1)).unwrap();
+    for l in [&from_start, &from_end] {
+        assert!(l.max_radius > 29.0, "radius {}", l.max_radius);
+        assert!(l.flipped_faces.is_empty() && l.degenerate_faces.is_empty());
+        assert!(l.max_length_error < 1e-12, "{:e}", l.max_length_error);
+        assert_eq!(l.positions_lo.len(), l.positions.len());
+        // The premise: the rounded coordinates alone cannot carry this accuracy.
+        let rounded = (0..mesh.n_edges() as u32)
+            .map(|e| {
+                let [p, q] = mesh.edge_vertices(e);
+                let d = Hyperbolic::distance(l.positions[p as usize], l.positions[q as usize]);
+                (d - lengths[e as usize]).abs()
+            })
+            .fold(0.0, f64::max);
+        assert!(
+            rounded > 1e-6,
+            "double-precision coordinates err by {rounded:e}"
+        );
+    }
+    let (_, dev) = align_layouts::<Hyperbolic>(&from_start, &from_end).unwrap();
+    assert!(
+        dev < 1e-10,
+        "the two layouts differ by {dev:e} after one isometry"
+    );
+}

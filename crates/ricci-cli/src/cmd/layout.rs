@@ -5,7 +5,7 @@
 //!
 //! Closed genus-0 surfaces go onto the sphere whole; disks are laid out as they are; every
 //! other surface is cut first (`ricci::cut`). Without `--metric` the Ricci flow of the
-//! geometry is run (tolerance 1e-11). The seed face is a face id of the cut mesh (default:
+//! geometry is run (tolerance 1e-12 in H², 1e-11 otherwise). The seed face is a face id of the cut mesh (default:
 //! the face nearest the centre of the polygon). `--tiling N` draws the first N copies of the
 //! fundamental polygon (breadth first through the side pairings) instead of the polygon.
 //! UV.obj keeps the surface's own vertices (`v`) and gives every corner the layout coordinate
@@ -171,7 +171,8 @@ fn deck_json<I: Isometry + JsonIso>(g: &DeckGroup<I>, poly: &Polygon) -> Value {
         .map(|p| {
             json!({
                 "side": poly.sides[p.side].label, "partner": poly.sides[p.partner].label,
-                "edge_spread": p.edge_spread, "max_vertex_error": p.max_vertex_error,
+                "edge_spread": p.edge_spread, "edge_spread_matrix": p.edge_spread_matrix,
+                "max_vertex_error": p.max_vertex_error,
                 "map": p.map.to_json(),
             })
         })
@@ -224,9 +225,17 @@ pub fn metric(
         Some(g) => g,
         None => uniformization_geometry(&surface.mesh)?,
     };
+    // H²: 1e-12 (Newton's last step then lands near the double-precision floor ~5e-15 on the
+    // shared meshes; the deck group's accuracy is limited by this residual times ~sinh of
+    // the polygon's size, e.g. genus3's relation error is 7e-7 at 3e-12 and 5e-10 at 5e-15).
+    // E² and S²: 1e-11 (1e-12 stalls at rounding on some 20k-face meshes).
     let mut opts = ricci::flow::FlowOptions {
         geometry: g,
-        tolerance: 1e-11,
+        tolerance: if g == Geometry::Hyperbolic {
+            1e-12
+        } else {
+            1e-11
+        },
         ..Default::default()
     };
     opts.target = match target {
@@ -285,6 +294,7 @@ where
             out["relation_error"] = json!(g.relation_error);
             out["relation_condition"] = json!(g.relation_condition);
             out["max_edge_spread"] = json!(g.max_edge_spread);
+            out["max_edge_spread_matrix"] = json!(g.max_edge_spread_matrix);
             out["max_vertex_error"] = json!(g.max_vertex_error);
         }
         _ => {

@@ -28,9 +28,22 @@
 //! torus the generators are translations; for a flat metric with cone points rigid motions
 //! (the relation holds when all cone angles are multiples of 2π); for H² the Fuchsian
 //! generators.
+//!
+//! **Precision.** Everything runs in the working precision of the space ([`Frame`]): in H²
+//! double-double on the double-double positions of the layout ([`Layout::positions_lo`]),
+//! rounded to double precision only for the result. In double precision the generators of a
+//! polygon reaching hyperbolic distance r are resolved to ~1e-16·e^r and the relation product
+//! of 4g such maps (entries ~e^{ℓ/2}) lost every digit on fertility (2e-3) and botijo (1e7).
+//! What limits the result now is the metric: the flow's curvature error κ (~5e-15 per vertex
+//! at the double-precision floor of `K = 2π − Σθ`) makes the maps from different edges of a
+//! side differ by rotations of size κ about the vertices between them, i.e. by ~κ·sinh r in
+//! the matrix norm of [`Isometry::distance`] and ~κ·sinh d at points at distance d
+//! ([`SidePairing::edge_spread`]). Measured (`tests/layout_meshes.rs`, tolerance 1e-12):
+//! relation error 1e-12…5e-10 on eight, 3holes, genus3, fertility; edge spreads ≤ 3e-10 except
+//! on fertility, whose sides are long (6e-9 as matrices, 2e-7 at points).
 
 use super::isometry::Isometry;
-use super::place::{Layout, Space};
+use super::place::{ext_position, ExtPoint, Frame, Layout, Space};
 use crate::error::{Error, Result};
 
 /// One side of a fundamental polygon.
@@ -176,6 +189,12 @@ pub struct SidePairing<I> {
     /// partner side's first, middle and last vertices under the two maps. (A distance between
     /// the matrices would grow with the distance of the side from the origin of the model.)
     pub edge_spread: f64,
+    /// The same comparison as matrices: the largest [`Isometry::distance`] (Frobenius norm
+    /// of the difference of the normalized SU(1,1) matrices in H², the norm of
+    /// `relation_error`) between a map computed from one edge and the end-point map. It
+    /// measures the disagreement as seen from the centre of the layout, the paper's
+    /// Table 10 compares the parameters (θ, z₀) of the same maps, which is less strict.
+    pub edge_spread_matrix: f64,
     /// Largest distance, in the model space, between `map(partner vertex)` and the vertex.
     pub max_vertex_error: f64,
 }
@@ -195,13 +214,16 @@ pub struct DeckGroup<I> {
     pub corner_maps: Vec<Option<I>>,
     /// Distance of `D(x_1)⋯D(x_n)` from the identity, when all sides are paired.
     pub relation_error: Option<f64>,
-    /// Product of the sizes of the factors of the relation ([`Isometry::size`]): the rounding
-    /// of the product alone can reach machine epsilon times this, so `relation_error` is
-    /// only meaningful relative to it (long generators on surfaces with far-apart handles
-    /// make it huge).
+    /// Product of the sizes of the factors of the relation ([`Isometry::size`]): in double
+    /// precision the rounding of the product alone could reach machine epsilon times this
+    /// (long generators on surfaces with far-apart handles make it huge); the product is
+    /// formed in the working precision of the space (double-double in H², see the module
+    /// docs), where the rounding is ~1e-32 times it.
     pub relation_condition: f64,
     /// Largest edge spread over all sides.
     pub max_edge_spread: f64,
+    /// Largest matrix edge spread ([`SidePairing::edge_spread_matrix`]) over all sides.
+    pub max_edge_spread_matrix: f64,
     /// Largest vertex error of the least-squares side maps.
     pub max_vertex_error: f64,
 }
@@ -245,6 +267,11 @@ pub fn deck_group<S: Space>(
 ) -> Result<DeckGroup<S::Iso>> {
     poly.check()?;
     let pos = &layout.positions;
+    if !layout.positions_lo.is_empty() && layout.positions_lo.len() != pos.len() {
+        return Err(Error::input(
+            "the layout's low-order position parts do not match its positions",
+        ));
+    }
     let n = poly.sides.len();
     for side in &poly.sides {
         if let Some(&v) = side.vertices.iter().find(|&&v| v as usize >= pos.len()) {
@@ -255,54 +282,66 @@ pub fn deck_group<S: Space>(
             )));
         }
     }
+    // Everything below runs in the working precision of the space (double-double in H²,
+    // see [`Frame`]) and is rounded to double precision for the result.
+    type F<S> = <S as Space>::Frame;
     let mut pairings = Vec::new();
+    let mut precise_maps: Vec<F<S>> = Vec::new();
     let mut side_pairing = vec![None; n];
     for (s, side) in poly.sides.iter().enumerate() {
         let Some(m) = side.partner else { continue };
         if side.inverse || side_pairing[s].is_some() {
             continue;
         }
-        let v: Vec<S::Point> = side.vertices.iter().map(|&x| pos[x as usize]).collect();
-        let w: Vec<S::Point> = poly.sides[m]
+        let v: Vec<ExtPoint<S>> = side
+            .vertices
+            .iter()
+            .map(|&x| ext_position::<S>(layout, x as usize))
+            .collect();
+        let w: Vec<ExtPoint<S>> = poly.sides[m]
             .vertices
             .iter()
             .rev()
-            .map(|&x| pos[x as usize])
+            .map(|&x| ext_position::<S>(layout, x as usize))
             .collect();
         // Now w[t] ↔ v[t].
         let k = v.len() - 1;
-        let endpoints = S::Iso::from_pairs(w[0], w[k], v[0], v[k]);
+        let endpoints = F::<S>::from_pairs(w[0], w[k], v[0], v[k]);
         let mut spread = 0.0f64;
-        let probes = [w[0], w[k / 2], w[k]];
+        let mut spread_matrix = 0.0f64;
+        let probes = [w[0], w[k / 2], w[k]].map(|p| (p, endpoints.apply(p)));
         for t in 0..k {
-            let e = S::Iso::from_pairs(w[t], w[t + 1], v[t], v[t + 1]);
-            for &p in &probes {
-                spread = spread.max(S::distance(e.apply(p), endpoints.apply(p)));
+            let e = F::<S>::from_pairs(w[t], w[t + 1], v[t], v[t + 1]);
+            spread_matrix = spread_matrix.max(e.distance(&endpoints));
+            for &(p, q) in &probes {
+                spread = spread.max(F::<S>::point_distance(e.apply(p), q));
             }
         }
-        let pairs: Vec<(S::Point, S::Point)> = w.iter().copied().zip(v.iter().copied()).collect();
-        let map = S::Iso::fit(&pairs)
+        let pairs: Vec<(ExtPoint<S>, ExtPoint<S>)> =
+            w.iter().copied().zip(v.iter().copied()).collect();
+        let map = F::<S>::fit(&pairs)
             .map_err(|e| Error::numerical(format!("side {} ({}): {e}", s, side.label)))?;
         let verr = pairs
             .iter()
-            .map(|&(x, y)| S::distance(map.apply(x), y))
+            .map(|&(x, y)| F::<S>::point_distance(map.apply(x), y))
             .fold(0.0, f64::max);
         side_pairing[s] = Some(pairings.len());
         side_pairing[m] = Some(pairings.len());
+        precise_maps.push(map);
         pairings.push(SidePairing {
             side: s,
             partner: m,
-            endpoints,
-            map,
+            endpoints: endpoints.round(),
+            map: map.round(),
             edge_spread: spread,
+            edge_spread_matrix: spread_matrix,
             max_vertex_error: verr,
         });
     }
     // Corner maps: Q_s = S_s Q_{m+1}, Q_{s+1} = S_s Q_m for a positive side s with partner m.
-    let mut adj: Vec<Vec<(usize, S::Iso)>> = vec![Vec::new(); n + 1];
-    for p in &pairings {
+    let mut adj: Vec<Vec<(usize, F<S>)>> = vec![Vec::new(); n + 1];
+    for (p, &t) in pairings.iter().zip(&precise_maps) {
         let (s, m) = (p.side, p.partner);
-        let t = p.map;
         let ti = t.inverse();
         // Q_u = T Q_v  ⇒ edge u → v with Q_v = T⁻¹ Q_u, and v → u with Q_u = T Q_v.
         for (u, v) in [(s, m + 1), (s + 1, m)] {
@@ -310,8 +349,8 @@ pub fn deck_group<S: Space>(
             adj[v].push((u, t));
         }
     }
-    let mut q: Vec<Option<S::Iso>> = vec![None; n + 1];
-    q[0] = Some(S::Iso::identity());
+    let mut q: Vec<Option<F<S>>> = vec![None; n + 1];
+    q[0] = Some(F::<S>::identity());
     let mut stack = vec![0usize];
     while let Some(u) = stack.pop() {
         let qu = q[u].expect("visited nodes have maps");
@@ -322,7 +361,7 @@ pub fn deck_group<S: Space>(
             }
         }
     }
-    let mut generators: Vec<Option<S::Iso>> = vec![None; poly.letters.len()];
+    let mut precise_generators: Vec<Option<F<S>>> = vec![None; poly.letters.len()];
     for (s, side) in poly.sides.iter().enumerate() {
         let (Some(l), Some(_)) = (side.letter, side.partner) else {
             continue;
@@ -331,26 +370,36 @@ pub fn deck_group<S: Space>(
             continue;
         }
         if let (Some(a), Some(b)) = (q[s], q[s + 1]) {
-            generators[l] = Some(a.inverse().compose(&b).normalized());
+            precise_generators[l] = Some(a.inverse().compose(&b).normalized());
         }
     }
+    let generators: Vec<Option<S::Iso>> = precise_generators
+        .iter()
+        .map(|g| g.map(|g| g.round()))
+        .collect();
     let relation_condition: f64 = poly
         .sides
         .iter()
         .filter_map(|s| generators.get(s.letter?).copied().flatten())
         .map(|g| g.size())
         .product();
-    let relation_error = if poly.is_closed() && generators.iter().all(|g| g.is_some()) {
-        let mut prod = S::Iso::identity();
+    let relation_error = if poly.is_closed() && precise_generators.iter().all(|g| g.is_some()) {
+        let mut prod = F::<S>::identity();
         for side in &poly.sides {
-            let g = generators[side.letter.unwrap_or(0)].unwrap_or_else(S::Iso::identity);
-            prod = prod.compose(&if side.inverse { g.inverse() } else { g });
+            let g = precise_generators[side.letter.unwrap_or(0)].unwrap_or_else(F::<S>::identity);
+            prod = prod
+                .compose(&if side.inverse { g.inverse() } else { g })
+                .normalized();
         }
-        Some(prod.distance(&S::Iso::identity()))
+        Some(prod.distance(&F::<S>::identity()))
     } else {
         None
     };
     let max_edge_spread = pairings.iter().map(|p| p.edge_spread).fold(0.0, f64::max);
+    let max_edge_spread_matrix = pairings
+        .iter()
+        .map(|p| p.edge_spread_matrix)
+        .fold(0.0, f64::max);
     let max_vertex_error = pairings
         .iter()
         .map(|p| p.max_vertex_error)
@@ -360,10 +409,11 @@ pub fn deck_group<S: Space>(
         side_pairing,
         letters: poly.letters.clone(),
         generators,
-        corner_maps: q,
+        corner_maps: q.iter().map(|m| m.map(|m| m.round())).collect(),
         relation_error,
         relation_condition,
         max_edge_spread,
+        max_edge_spread_matrix,
         max_vertex_error,
     })
 }

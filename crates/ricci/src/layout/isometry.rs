@@ -401,7 +401,7 @@ impl Isometry for Mobius {
 
 impl Mobius {
     /// `exp([[iα, β], [β̄, −iα]])`, using `X² = (|β|² − α²) I`.
-    fn exp_algebra(alpha: f64, beta: C) -> Self {
+    pub(crate) fn exp_algebra(alpha: f64, beta: C) -> Self {
         let s2 = beta.norm_sqr() - alpha * alpha;
         let (c, sh) = if s2.abs() < 1e-8 {
             // Series: cosh √s2 ≈ 1 + s2/2, sinh √s2 / √s2 ≈ 1 + s2/6.

@@ -1,6 +1,8 @@
 //! Isometric layouts, isometries and deck transformations (paper 001 §V Step 4 and §VI,
 //! paper 002 §4.3.2–4.3.3 and §6.2.2–6.2.4).
 //!
+//! * [`dd`] — double-double arithmetic and Möbius maps, the working precision of hyperbolic
+//!   layouts and deck groups.
 //! * [`isometry`] — rigid motions of the plane, Möbius maps of the Poincaré disk (SU(1,1)),
 //!   rotations of the sphere; composition, inverse, fitting from point pairs; Klein matrices.
 //! * [`place`] — breadth-first isometric placement of a disk (or of a closed genus-0 surface on
@@ -16,6 +18,7 @@
 //!   (flat tori, regular 4g-gons), the references of the tests.
 
 pub mod cover;
+pub mod dd;
 pub mod deck;
 pub mod export;
 pub mod isometry;
@@ -26,4 +29,4 @@ pub mod synthetic;
 
 pub use deck::{deck_group, DeckGroup, Polygon, Side, SidePairing};
 pub use isometry::{Isometry, Mobius, RigidMotion, Rotation};
-pub use place::{align, layout, Layout, Space};
+pub use place::{align, align_layouts, layout, Frame, Layout, Space};

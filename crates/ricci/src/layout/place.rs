@@ -17,6 +17,17 @@
 //! form of the cosine law ([`Background::angle`]), accurate for needle triangles; the papers'
 //! sphere seed formula (which takes chord lengths) is not used: lengths are geodesic (DESIGN.md §3).
 //!
+//! **Precision.** Face frames are composed in the working precision of the space ([`Frame`]):
+//! double precision in E² and S², double-double in H² ([`super::dd`]), where a frame at
+//! distance r from the centre has entries ~e^{r/2} and a double-precision composition would
+//! perturb each step by ~1e-16·e^r. The relative placement of a face on its parent is computed
+//! at the base point in double precision (accurate to ~1e-16, like a perturbation of the input
+//! lengths at that level), positions are kept in double-double ([`Layout::positions_lo`]),
+//! and the measurements (orientation, length error, radius) use them. With the flow's metric
+//! at tolerance 1e-12, layouts from different seed faces agree to ≤ 2e-11 on the shared
+//! genus-2…5 meshes (fertility reaches r ≈ 25 from an off-centre seed), against 5e-5 in double
+//! precision.
+//!
 //! [`layout`] places a seed face (by default the face farthest from the boundary, or a
 //! centre of a closed mesh, to keep the breadth-first depth — along which rounding errors
 //! accumulate — small) and then walks the faces breadth first. Each vertex is placed once, by
@@ -25,6 +36,7 @@
 //! largest disagreement between laid-out distances and the metric, which measures how far the
 //! metric is from being exactly flat / hyperbolic / spherical (curvature error).
 
+use super::dd::{disk_distance_dd, disk_orientation_dd, Cdd, MobiusDd};
 use super::isometry::{
     cross3, det3, disk_distance, dot3, normalize3, sphere_distance, Complex, Isometry, Mobius,
     RigidMotion, Rotation,
@@ -34,10 +46,157 @@ use crate::mesh::{topology, Mesh, NONE};
 use crate::metric::geometry::{Background, Euclidean, Geometry, Hyperbolic, Spherical};
 use std::collections::VecDeque;
 
+/// The working precision of layouts and deck groups: the isometries face frames are composed
+/// in and the points they produce. E² and S² work in double precision (rounding grows only
+/// linearly with the size of the layout there): the frame is the isometry itself. H² works
+/// in double-double ([`super::dd`]), because frames and coordinates far from the centre of
+/// the Poincaré disk lose digits exponentially (`~1e-16·e^r` at distance `r`).
+pub trait Frame: Copy + std::fmt::Debug + Send + Sync + 'static {
+    /// The double-precision isometry this frame rounds to.
+    type Iso: Isometry;
+    /// A point in the working precision.
+    type Ext: Copy + std::fmt::Debug + Send + Sync + 'static;
+    /// Whether points carry a low-order part ([`Layout::positions_lo`]).
+    const EXTENDED: bool;
+    fn identity() -> Self;
+    fn from_iso(i: &Self::Iso) -> Self;
+    /// Rounded to double precision.
+    fn round(&self) -> Self::Iso;
+    /// `self ∘ other`.
+    fn compose(&self, o: &Self) -> Self;
+    fn inverse(&self) -> Self;
+    fn normalized(&self) -> Self;
+    fn apply(&self, p: Self::Ext) -> Self::Ext;
+    /// A working-precision point from its high and low parts (the low part is ignored when
+    /// not [`Frame::EXTENDED`]).
+    fn ext(hi: IsoPoint<Self>, lo: Option<IsoPoint<Self>>) -> Self::Ext;
+    /// High and low parts (`None` when not [`Frame::EXTENDED`]).
+    fn split(p: Self::Ext) -> (IsoPoint<Self>, Option<IsoPoint<Self>>);
+    /// [`Isometry::from_pairs`] in the working precision.
+    fn from_pairs(p0: Self::Ext, q0: Self::Ext, p1: Self::Ext, q1: Self::Ext) -> Self;
+    /// [`Isometry::fit`] in the working precision.
+    fn fit(pairs: &[(Self::Ext, Self::Ext)]) -> Result<Self>;
+    /// Geodesic distance.
+    fn point_distance(a: Self::Ext, b: Self::Ext) -> f64;
+    /// [`Space::orientation`].
+    fn orientation(a: Self::Ext, b: Self::Ext, c: Self::Ext) -> f64;
+    /// [`Isometry::distance`], evaluated in the working precision.
+    fn distance(&self, o: &Self) -> f64;
+}
+
+/// The point type of a frame's isometry.
+pub type IsoPoint<F> = <<F as Frame>::Iso as Isometry>::Point;
+/// The working-precision point of a space.
+pub type ExtPoint<S> = <<S as Space>::Frame as Frame>::Ext;
+
+macro_rules! plain_frame {
+    ($iso:ty, $space:ty) => {
+        impl Frame for $iso {
+            type Iso = $iso;
+            type Ext = <$iso as Isometry>::Point;
+            const EXTENDED: bool = false;
+            fn identity() -> Self {
+                <$iso as Isometry>::identity()
+            }
+            fn from_iso(i: &Self) -> Self {
+                *i
+            }
+            fn round(&self) -> Self {
+                *self
+            }
+            fn compose(&self, o: &Self) -> Self {
+                Isometry::compose(self, o)
+            }
+            fn inverse(&self) -> Self {
+                Isometry::inverse(self)
+            }
+            fn normalized(&self) -> Self {
+                Isometry::normalized(self)
+            }
+            fn apply(&self, p: Self::Ext) -> Self::Ext {
+                Isometry::apply(self, p)
+            }
+            fn ext(hi: Self::Ext, _lo: Option<Self::Ext>) -> Self::Ext {
+                hi
+            }
+            fn split(p: Self::Ext) -> (Self::Ext, Option<Self::Ext>) {
+                (p, None)
+            }
+            fn from_pairs(p0: Self::Ext, q0: Self::Ext, p1: Self::Ext, q1: Self::Ext) -> Self {
+                <$iso as Isometry>::from_pairs(p0, q0, p1, q1)
+            }
+            fn fit(pairs: &[(Self::Ext, Self::Ext)]) -> Result<Self> {
+                <$iso as Isometry>::fit(pairs)
+            }
+            fn point_distance(a: Self::Ext, b: Self::Ext) -> f64 {
+                <$space as Space>::distance(a, b)
+            }
+            fn orientation(a: Self::Ext, b: Self::Ext, c: Self::Ext) -> f64 {
+                <$space as Space>::orientation(a, b, c)
+            }
+            fn distance(&self, o: &Self) -> f64 {
+                Isometry::distance(self, o)
+            }
+        }
+    };
+}
+plain_frame!(RigidMotion, Euclidean);
+plain_frame!(Rotation, Spherical);
+
+impl Frame for MobiusDd {
+    type Iso = Mobius;
+    type Ext = Cdd;
+    const EXTENDED: bool = true;
+    fn identity() -> Self {
+        MobiusDd::IDENTITY
+    }
+    fn from_iso(i: &Mobius) -> Self {
+        MobiusDd::from(*i)
+    }
+    fn round(&self) -> Mobius {
+        MobiusDd::round(self)
+    }
+    fn compose(&self, o: &Self) -> Self {
+        MobiusDd::compose(self, o)
+    }
+    fn inverse(&self) -> Self {
+        MobiusDd::inverse(self)
+    }
+    fn normalized(&self) -> Self {
+        MobiusDd::normalized(self)
+    }
+    fn apply(&self, p: Cdd) -> Cdd {
+        MobiusDd::apply(self, p)
+    }
+    fn ext(hi: Complex, lo: Option<Complex>) -> Cdd {
+        Cdd::from_parts(hi, lo.unwrap_or_default())
+    }
+    fn split(p: Cdd) -> (Complex, Option<Complex>) {
+        (p.hi(), Some(p.lo()))
+    }
+    fn from_pairs(p0: Cdd, q0: Cdd, p1: Cdd, q1: Cdd) -> Self {
+        MobiusDd::from_pairs(p0, q0, p1, q1)
+    }
+    fn fit(pairs: &[(Cdd, Cdd)]) -> Result<Self> {
+        MobiusDd::fit(pairs)
+    }
+    fn point_distance(a: Cdd, b: Cdd) -> f64 {
+        disk_distance_dd(a, b)
+    }
+    fn orientation(a: Cdd, b: Cdd, c: Cdd) -> f64 {
+        disk_orientation_dd(a, b, c)
+    }
+    fn distance(&self, o: &Self) -> f64 {
+        MobiusDd::distance(self, o)
+    }
+}
+
 /// A model space to lay out in: points, isometries and the placement of one triangle.
 pub trait Space: Background {
     type Point: Copy + std::fmt::Debug + Send + Sync + 'static;
     type Iso: Isometry<Point = Self::Point>;
+    /// The working precision of face frames and deck groups (see [`Frame`]).
+    type Frame: Frame<Iso = Self::Iso>;
     /// The counter-clockwise triangle with side lengths `l01 = |p0 p1|`, `l12`, `l20` in its
     /// canonical position: `p0` at the base point, `p1` on the reference direction.
     fn seed(l01: f64, l12: f64, l20: f64) -> [Self::Point; 3] {
@@ -71,6 +230,7 @@ fn angle_cs<B: Background>(opposite: f64, b: f64, c: f64) -> (f64, f64) {
 impl Space for Euclidean {
     type Point = Complex;
     type Iso = RigidMotion;
+    type Frame = RigidMotion;
     fn base_point() -> Complex {
         Complex::new(0.0, 0.0)
     }
@@ -105,6 +265,7 @@ impl Space for Euclidean {
 impl Space for Hyperbolic {
     type Point = Complex;
     type Iso = Mobius;
+    type Frame = MobiusDd;
     fn base_point() -> Complex {
         Complex::new(0.0, 0.0)
     }
@@ -151,6 +312,7 @@ impl Space for Hyperbolic {
 impl Space for Spherical {
     type Point = [f64; 3];
     type Iso = Rotation;
+    type Frame = Rotation;
     fn base_point() -> [f64; 3] {
         [0.0, 0.0, 1.0]
     }
@@ -203,8 +365,12 @@ impl Space for Spherical {
 #[derive(Debug, Clone)]
 pub struct Layout<P> {
     pub geometry: Geometry,
-    /// Position of every vertex of the laid-out mesh.
+    /// Position of every vertex of the laid-out mesh (rounded to double precision).
     pub positions: Vec<P>,
+    /// Low-order parts of the positions when the layout was computed in double-double (H²:
+    /// `positions[v] + positions_lo[v]` is the position to ~32 digits, which matters far out
+    /// in the Poincaré disk); empty in E² and S².
+    pub positions_lo: Vec<P>,
     pub seed_face: u32,
     /// Faces with negative orientation in the layout.
     pub flipped_faces: Vec<u32>,
@@ -214,8 +380,9 @@ pub struct Layout<P> {
     pub max_length_error: f64,
     /// Longest chain of placements from the seed face to a vertex.
     pub depth: u32,
-    /// Largest distance of a vertex from the seed vertex (in H² the Poincaré disk resolves
-    /// points at distance r only to about 1e-16·e^r, so layouts beyond r ≈ 25 lose accuracy).
+    /// Largest distance of a vertex from the seed vertex (in H² the double-precision
+    /// `positions` resolve points at distance r only to about 1e-16·e^r; with
+    /// `positions_lo` to about 1e-32·e^r).
     pub max_radius: f64,
 }
 
@@ -401,7 +568,7 @@ pub(crate) fn layout_unchecked<S: Space>(
     let nv = mesh.n_vertices();
     let nf = mesh.n_faces();
     let len = |h: u32| lengths[mesh.he_edge(h) as usize];
-    let mut pos = vec![S::base_point(); nv];
+    let mut pos: Vec<ExtPoint<S>> = vec![S::Frame::ext(S::base_point(), None); nv];
     let mut placed = vec![false; nv];
     // Error-growth estimate per vertex: placing k from the edge (i, j) multiplies the error
     // of the edge's direction by about max(l_ik, l_jk)/l_ij, so needles (e.g. from refinement
@@ -420,12 +587,15 @@ pub(crate) fn layout_unchecked<S: Space>(
         let [a, b, c] = mesh.face_halfedges(f);
         S::seed(len(a), len(b), len(c))
     };
-    let mut frame: Vec<Option<S::Iso>> = vec![None; nf];
-    frame[seed as usize] = Some(S::Iso::identity());
+    // Frames are composed in the working precision of the space (double-double in H²,
+    // see [`Frame`]); the relative placements are computed near the base point in double
+    // precision, where that is accurate to the last digit.
+    let mut frame: Vec<Option<S::Frame>> = vec![None; nf];
+    frame[seed as usize] = Some(S::Frame::identity());
     let tri = canon(seed);
     let fv = mesh.face(seed);
     for i in 0..3 {
-        pos[fv[i] as usize] = tri[i];
+        pos[fv[i] as usize] = S::Frame::ext(tri[i], None);
         placed[fv[i] as usize] = true;
         cost[fv[i] as usize] = 0.0;
     }
@@ -435,7 +605,7 @@ pub(crate) fn layout_unchecked<S: Space>(
     let push = |f: u32,
                 heap: &mut BinaryHeap<(Reverse<u64>, u32, u32)>,
                 cost: &[f64],
-                frame: &[Option<S::Iso>]| {
+                frame: &[Option<S::Frame>]| {
         for h in mesh.face_halfedges(f) {
             let t = mesh.he_twin(h);
             let g = mesh.he_face(t);
@@ -473,13 +643,13 @@ pub(crate) fn layout_unchecked<S: Space>(
             target[(ti + r) % 3] = q[r];
         }
         let rel = S::Iso::from_pairs(cg[0], cg[1], target[0], target[1]);
-        let fg = ff.compose(&rel).normalized();
+        let fg = ff.compose(&S::Frame::from_iso(&rel)).normalized();
         frame[g as usize] = Some(fg);
         let k = mesh.he_tip(tn);
         if !placed[k as usize] {
             let i = mesh.he_origin(t);
             let j = mesh.he_tip(t);
-            pos[k as usize] = fg.apply(cg[(ti + 2) % 3]);
+            pos[k as usize] = fg.apply(S::Frame::ext(cg[(ti + 2) % 3], None));
             placed[k as usize] = true;
             let amp = len(tn).max(len(tp)) / len(t).max(f64::MIN_POSITIVE);
             cost[k as usize] = cost[i as usize].max(cost[j as usize]) + (1.0 + amp).ln();
@@ -495,7 +665,7 @@ pub(crate) fn layout_unchecked<S: Space>(
         let [a, b, c] = mesh.face(f);
         let [ha, hb, hc] = mesh.face_halfedges(f);
         let metric_area = S::area(len(hb), len(hc), len(ha));
-        let o = S::orientation(pos[a as usize], pos[b as usize], pos[c as usize]);
+        let o = S::Frame::orientation(pos[a as usize], pos[b as usize], pos[c as usize]);
         if o < 0.0 {
             flipped.push(f);
         } else if o == 0.0 || metric_area <= 0.0 {
@@ -505,17 +675,28 @@ pub(crate) fn layout_unchecked<S: Space>(
     let mut max_err = 0.0f64;
     for e in 0..mesh.n_edges() as u32 {
         let [a, b] = mesh.edge_vertices(e);
-        let d = S::distance(pos[a as usize], pos[b as usize]);
+        let d = S::Frame::point_distance(pos[a as usize], pos[b as usize]);
         max_err = max_err.max((d - lengths[e as usize]).abs());
     }
+    let origin = S::Frame::ext(S::base_point(), None);
     let max_radius = pos
         .iter()
-        .map(|&p| S::distance(S::base_point(), p))
+        .map(|&p| S::Frame::point_distance(origin, p))
         .fold(0.0, f64::max);
+    let mut positions = Vec::with_capacity(nv);
+    let mut positions_lo = Vec::new();
+    for &p in &pos {
+        let (hi, lo) = S::Frame::split(p);
+        positions.push(hi);
+        if let Some(lo) = lo {
+            positions_lo.push(lo);
+        }
+    }
     Layout {
         geometry: S::KIND,
         max_radius,
-        positions: pos,
+        positions,
+        positions_lo,
         seed_face: seed,
         flipped_faces: flipped,
         degenerate_faces: degenerate,
@@ -539,6 +720,35 @@ pub fn align<S: Space>(a: &[S::Point], b: &[S::Point]) -> Result<(S::Iso, f64)> 
         .map(|&(x, y)| S::distance(iso.apply(x), y))
         .fold(0.0, f64::max);
     Ok((iso, dev))
+}
+
+/// The position of vertex `v` of a layout in the working precision of its space.
+pub fn ext_position<S: Space>(l: &Layout<S::Point>, v: usize) -> ExtPoint<S> {
+    S::Frame::ext(l.positions[v], l.positions_lo.get(v).copied())
+}
+
+/// [`align`] for two layouts, in the working precision of the space (double-double in H²,
+/// where the double-precision positions of vertices far from the centre of the disk are
+/// resolved only to `~1e-16·e^r`): the least-squares isometry mapping `b` onto `a` and the
+/// largest remaining geodesic distance between corresponding vertices.
+pub fn align_layouts<S: Space>(
+    a: &Layout<S::Point>,
+    b: &Layout<S::Point>,
+) -> Result<(S::Iso, f64)> {
+    if a.positions.len() != b.positions.len() {
+        return Err(Error::input(
+            "cannot align layouts with different numbers of vertices",
+        ));
+    }
+    let pairs: Vec<(ExtPoint<S>, ExtPoint<S>)> = (0..a.positions.len())
+        .map(|v| (ext_position::<S>(b, v), ext_position::<S>(a, v)))
+        .collect();
+    let iso = S::Frame::fit(&pairs)?;
+    let dev = pairs
+        .iter()
+        .map(|&(x, y)| S::Frame::point_distance(iso.apply(x), y))
+        .fold(0.0, f64::max);
+    Ok((iso.round(), dev))
 }
 
 #[cfg(test)]
