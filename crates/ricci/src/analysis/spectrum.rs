@@ -277,7 +277,17 @@ pub fn fuchsian_spectrum(
         ));
     }
     let mut last_err = None;
+    // cosh of the hyperbolic distance from the Lorentz product (X₀ is the last coordinate).
+    let cosh_d = |x: [f64; 3], y: [f64; 3]| x[2] * y[2] - x[0] * y[0] - x[1] * y[1];
+    let nballs = balls.len();
+    let r_max = balls.iter().map(|b| b.1).fold(0.0, f64::max);
+    // Thresholds are widened by a relative 1e-9 so that rounding can only keep a tile more.
+    let widen = |x: f64| x.cosh() * (1.0 + 1e-9) + 1e-9;
     for _round in 0..12 {
+        let pair_limit: Vec<f64> = (0..nballs * nballs)
+            .map(|i| widen(l + balls[i / nballs].1 + balls[i % nballs].1))
+            .collect();
+        let reach: Vec<f64> = balls.iter().map(|b| widen(l + b.1 + rho + r_max)).collect();
         // Breadth-first search over tiles.
         let mut index = TileIndex::new();
         let mut elems: Vec<Mobius> = vec![Mobius::identity()];
@@ -297,11 +307,19 @@ pub fn fuchsian_spectrum(
                 if dcoarse > l {
                     continue;
                 }
+                // Pairs of balls, in cosh form (no acosh per pair): d(c_j, g c_k) ≤ L + r_j + r_k
+                // ⟺ cosh d ≤ cosh(L + r_j + r_k). Balls c_j farther than L + r_j + ρ + r_max
+                // from g o cannot be near any ball of gF (which lies in the ball of radius
+                // ρ + r_max around g o) and are skipped.
                 let gb: Vec<[f64; 3]> = ball_h.iter().map(|&b| apply_h(&k, b)).collect();
                 let mut near = false;
                 'outer: for (j, &cj) in ball_h.iter().enumerate() {
+                    if cosh_d(cj, go) > reach[j] {
+                        continue;
+                    }
+                    let row = &pair_limit[j * nballs..(j + 1) * nballs];
                     for (kk, &gk) in gb.iter().enumerate() {
-                        if hdist(cj, gk) - balls[j].1 - balls[kk].1 <= l {
+                        if cosh_d(cj, gk) <= row[kk] {
                             near = true;
                             break 'outer;
                         }
