@@ -104,9 +104,14 @@ pub struct RefinementReport {
     /// Edge splits of Step 2 (valences) and of the cut's grading.
     pub splits_step2: usize,
     pub splits_cut: usize,
+    /// Splits that gave the cones' one-ring neighbours valence ≥ 6 after the cut.
+    pub splits_ring: usize,
     /// Vertices within `rings` rings of a cone with valence < 6, before and after.
     pub low_valence_before: usize,
     pub low_valence_after: usize,
+    /// One-ring neighbours of a cone with valence < 6 at the end (0 unless a neighbour's
+    /// outer link lies on the cut).
+    pub low_valence_ring1_after: usize,
     pub vertices_before: usize,
     pub vertices_after: usize,
 }
@@ -137,6 +142,9 @@ pub struct AtlasReport {
     pub singular_vertices: Vec<u32>,
     pub placement: Option<Placement>,
     pub refinement: RefinementReport,
+    /// The conformal scheme of the flow that produced the metric (the requested one, or the
+    /// fallback when it did not converge).
+    pub scheme: String,
     pub flow_converged: bool,
     pub flow_iterations: usize,
     pub max_curvature_error: f64,
@@ -305,8 +313,7 @@ impl AffineAtlas {
             Geometry::Euclidean,
             Some(&surface.positions),
         )?;
-        let ring_set = |m: &Mesh, r_: usize| -> Vec<u32> { rings_around(m, &cones, r_) };
-        rep.low_valence_before = ring_set(mesh, options.rings)
+        rep.low_valence_before = rings_around(mesh, &cones, options.rings)
             .iter()
             .filter(|&&w| mesh.valence(w) < 6)
             .count();
@@ -315,13 +322,6 @@ impl AffineAtlas {
             let before = mesh.valence(v);
             r.raise_valence(v, need)?;
             rep.cone_valence.push((v, before, need, 0));
-        }
-        if options.rings > 0 && !cones.is_empty() {
-            for w in ring_set(mesh, options.rings) {
-                if !mesh.is_boundary_vertex(w) && r.valence(w) < 6 {
-                    r.raise_valence(w, 6)?;
-                }
-            }
         }
         rep.splits_step2 = r.splits();
         let step2 = r.finish()?;
@@ -340,7 +340,22 @@ impl AffineAtlas {
             progress,
         )?;
         rep.splits_cut = cut.refined.splits();
-        let rmesh = cut.refined.mesh.clone();
+        // Step 2 (ii) after the cut's grading (which splits link edges of the cone, creating
+        // valence-4 neighbours): the one-ring neighbours of every cone get valence ≥ 6 by
+        // splitting their outer link edges off the cut, so the loops stay edge paths.
+        let mut on_cut = std::collections::HashSet::new();
+        for l in &cut.loops {
+            for w in l.vertices.windows(2) {
+                on_cut.insert((w[0].min(w[1]), w[0].max(w[1])));
+            }
+        }
+        let (refined, ring_splits) = if options.rings > 0 && !cones.is_empty() {
+            raise_ring_valence(cut.refined.clone(), &cones, 6, &on_cut)?
+        } else {
+            (cut.refined.clone(), 0)
+        };
+        rep.splits_ring = ring_splits;
+        let rmesh = refined.mesh.clone();
         rep.vertices_after = rmesh.n_vertices();
         for (k, c) in cones.iter().enumerate() {
             rep.cone_valence[k].3 = rmesh.valence(c.0);
@@ -349,14 +364,16 @@ impl AffineAtlas {
             .iter()
             .filter(|&&w| rmesh.valence(w) < 6)
             .count();
-        let positions = cut
-            .refined
+        rep.low_valence_ring1_after = rings_around(&rmesh, &cones, 1)
+            .iter()
+            .filter(|&&w| rmesh.valence(w) < 6)
+            .count();
+        let positions = refined
             .positions
             .clone()
             .ok_or_else(|| Error::numerical("internal error: the cut lost the positions"))?;
         // Face origin in the input mesh: compose the two refinements.
-        let face_origin: Vec<u32> = cut
-            .refined
+        let face_origin: Vec<u32> = refined
             .face_origin
             .iter()
             .map(|&f| step2.face_origin[f as usize])
@@ -369,18 +386,14 @@ impl AffineAtlas {
             "uniform" => TargetSpec::Uniform,
             _ => TargetSpec::Cones(cones.clone()),
         };
-        let flow = ricci_flow(
+        let (flow, scheme_used, flow_notes) = flat_flow(
             &rmesh,
-            &cut.refined.lengths,
-            &FlowOptions {
-                geometry: Geometry::Euclidean,
-                scheme: options.scheme,
-                target,
-                tolerance: options.tolerance,
-                ..FlowOptions::default()
-            },
-            progress,
+            &refined.lengths,
+            target,
+            options.scheme,
+            options.tolerance,
         )?;
+        notes.extend(flow_notes);
         if !flow.converged {
             notes.push(format!(
                 "the Ricci flow did not converge: max |K − K̄| = {:.3e} > {:.1e} after {} \
@@ -388,11 +401,10 @@ impl AffineAtlas {
                 flow.max_curvature_error, options.tolerance, flow.iterations
             ));
         }
-        notes.extend(flow.notes.iter().cloned());
         let lengths = flow.lengths.clone();
         let area_distortion = area_distortion(
             &rmesh,
-            &cut.refined.lengths,
+            &refined.lengths,
             &lengths,
             &face_origin,
             mesh.n_faces(),
@@ -401,12 +413,20 @@ impl AffineAtlas {
         // Segmentation: the canonical cut plus slits to the other cones.
         let mut cut_edge = vec![false; rmesh.n_edges()];
         for l in &cut.loops {
-            for &h in &l.halfedges {
+            for w in l.vertices.windows(2) {
+                let h = rmesh.halfedge_between(w[0], w[1]).ok_or_else(|| {
+                    Error::numerical(format!(
+                        "internal error: loop {} lost its edge {}–{}",
+                        l.label, w[0], w[1]
+                    ))
+                })?;
                 cut_edge[rmesh.he_edge(h) as usize] = true;
             }
         }
-        let (disk, origin) = if cones.len() > 1 {
+        if cones.len() > 1 {
             add_slits(&rmesh, &lengths, &mut cut_edge, &cones[1..])?;
+        }
+        let (disk, origin) = if cones.len() > 1 || ring_splits > 0 {
             crate::cut::slice(&rmesh, &cut_edge)?
         } else {
             (cut.cut_mesh.clone(), cut.cut_vertex_origin.clone())
@@ -435,7 +455,7 @@ impl AffineAtlas {
             charts: Vec::new(),
             face_charts: Vec::new(),
             home: Vec::new(),
-            input_lengths: cut.refined.lengths.clone(),
+            input_lengths: refined.lengths.clone(),
             original_vertices: mesh.n_vertices(),
             face_origin,
             report: AtlasReport {
@@ -445,6 +465,7 @@ impl AffineAtlas {
                 singular_vertices: cones.iter().map(|c| c.0).collect(),
                 placement,
                 refinement: rep,
+                scheme: scheme_used.name().to_string(),
                 flow_converged: flow.converged,
                 flow_iterations: flow.iterations,
                 max_curvature_error: flow.max_curvature_error,
@@ -828,6 +849,141 @@ impl FlatCharts for AffineAtlas {
         let h = *self.home.get(f as usize)?;
         (h != NONE).then_some(h)
     }
+}
+
+/// The flat metric of `target` by Newton's method (tolerance `tolerance`, at most 400
+/// iterations) with `scheme`; when that does not converge, again with inversive distance
+/// and then tangential circle packing (strong cones can break Thurston's clamped packing).
+/// Returns the result, the scheme used and notes.
+pub fn flat_flow(
+    mesh: &Mesh,
+    lengths: &[f64],
+    target: TargetSpec,
+    scheme: Scheme,
+    tolerance: f64,
+) -> Result<(crate::flow::FlowResult, Scheme, Vec<String>)> {
+    let mut notes = Vec::new();
+    let mut schemes = vec![scheme];
+    for s in [Scheme::Inversive, Scheme::Tangential] {
+        if !schemes.contains(&s) {
+            schemes.push(s);
+        }
+    }
+    let mut last = None;
+    for (k, &s) in schemes.iter().enumerate() {
+        let run = ricci_flow(
+            mesh,
+            lengths,
+            &FlowOptions {
+                geometry: Geometry::Euclidean,
+                scheme: s,
+                target: target.clone(),
+                tolerance,
+                max_iterations: Some(400),
+                ..FlowOptions::default()
+            },
+            &mut crate::progress::NoProgress,
+        );
+        match run {
+            Ok(f) if f.converged => {
+                if k > 0 {
+                    notes.push(format!(
+                        "the {} flow did not converge; the metric comes from the {} scheme",
+                        scheme.name(),
+                        s.name()
+                    ));
+                }
+                notes.extend(f.notes.iter().cloned());
+                return Ok((f, s, notes));
+            }
+            Ok(f) => {
+                notes.push(format!(
+                    "{} flow: max |K − K̄| = {:.3e} after {} iterations (not converged)",
+                    s.name(),
+                    f.max_curvature_error,
+                    f.iterations
+                ));
+                last = Some(Ok((f, s)));
+            }
+            Err(e) => {
+                if k == 0 {
+                    // A refused target (Gauss–Bonnet, Chow–Luo) is refused by every scheme.
+                    if matches!(e, Error::InvalidInput { .. }) {
+                        return Err(e);
+                    }
+                }
+                notes.push(format!("{} flow failed: {e}", s.name()));
+                if last.is_none() {
+                    last = Some(Err(e));
+                }
+            }
+        }
+    }
+    match last {
+        Some(Ok((f, s))) => {
+            notes.extend(f.notes.iter().cloned());
+            Ok((f, s, notes))
+        }
+        Some(Err(e)) => Err(e),
+        None => Err(Error::numerical("no flow was run")),
+    }
+}
+
+/// Give the one-ring neighbours of every cone valence ≥ `min`: in rounds, split the longest
+/// link edge of each such neighbour that avoids the cones and the `protected` edges (vertex
+/// pairs, smaller first). Returns the refinement and the number of splits.
+pub fn raise_ring_valence(
+    refined: crate::mesh::refine::Refined,
+    cones: &[(u32, f64)],
+    min: usize,
+    protected: &std::collections::HashSet<(u32, u32)>,
+) -> Result<(crate::mesh::refine::Refined, usize)> {
+    let mut refined = refined;
+    let mut total = 0;
+    for _round in 0..16 {
+        let m = &refined.mesh;
+        let is_cone = |x: u32| cones.iter().any(|c| c.0 == x);
+        let mut todo: Vec<(u32, u32)> = Vec::new();
+        for &(v, _) in cones {
+            for w in m.vertex_neighbors(v) {
+                if m.is_boundary_vertex(w) || is_cone(w) || m.valence(w) >= min {
+                    continue;
+                }
+                let mut best: Option<(f64, (u32, u32))> = None;
+                for f in m.vertex_faces(w) {
+                    let t = m.face(f);
+                    if t.iter().any(|&x| is_cone(x)) {
+                        continue;
+                    }
+                    let i = t.iter().position(|&x| x == w).unwrap_or(0);
+                    let (a, b) = (t[(i + 1) % 3], t[(i + 2) % 3]);
+                    let key = (a.min(b), a.max(b));
+                    if protected.contains(&key) || todo.contains(&key) {
+                        continue;
+                    }
+                    let e = m.face_edges_opposite(f)[i];
+                    let l = refined.lengths[e as usize];
+                    if best.is_none_or(|b| l > b.0) {
+                        best = Some((l, key));
+                    }
+                }
+                if let Some((_, key)) = best {
+                    todo.push(key);
+                }
+            }
+        }
+        if todo.is_empty() {
+            break;
+        }
+        let mut r = Refiner::resume(refined, Geometry::Euclidean)?;
+        for (a, b) in todo {
+            if r.split_between(a, b).is_some() {
+                total += 1;
+            }
+        }
+        refined = r.finish()?;
+    }
+    Ok((refined, total))
 }
 
 /// Vertices within `rings` edge-rings of the cones (the cones excluded).
