@@ -399,3 +399,27 @@ pub fn place(
         confirm_seconds: t1.elapsed().as_secs_f64(),
     })
 }
+
+/// The paper's brute force: [`measured_distortion`] of every vertex in `candidates`
+/// (`None` where the flow did not converge). Slow: one full flow per candidate.
+pub fn brute_force(
+    mesh: &Mesh,
+    lengths: &[f64],
+    candidates: &[u32],
+    scheme: Scheme,
+    progress: &mut dyn Progress,
+) -> Vec<(u32, Option<f64>)> {
+    let n = candidates.len().max(1);
+    candidates
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            progress.report(
+                "brute force",
+                Some(i as f64 / n as f64),
+                &format!("vertex {v}"),
+            );
+            (v, measured_distortion(mesh, lengths, v, scheme, 1e-9).ok())
+        })
+        .collect()
+}
