@@ -164,6 +164,9 @@ pub struct AtlasReport {
     pub notes: Vec<String>,
 }
 
+/// Corner coordinates of one face in one chart (corner order of [`Mesh::face`]).
+pub type Corners = [[f64; 2]; 3];
+
 /// A chart: faces and corner coordinates.
 #[derive(Debug, Clone)]
 struct Chart {
@@ -811,7 +814,7 @@ impl AffineAtlas {
     }
 
     /// Faces and corner coordinates of chart `c` (for pictures and export).
-    pub fn chart_faces(&self, c: ChartId) -> Option<(&[u32], &[[[f64; 2]; 3]])> {
+    pub fn chart_faces(&self, c: ChartId) -> Option<(&[u32], &[Corners])> {
         self.charts
             .get(c as usize)
             .map(|ch| (ch.faces.as_slice(), ch.coords.as_slice()))
@@ -1071,8 +1074,8 @@ fn add_slits(
     for &(target, _) in others {
         let nv = mesh.n_vertices();
         let mut on_cut = vec![false; nv];
-        for e in 0..mesh.n_edges() {
-            if cut_edge[e] {
+        for (e, _) in cut_edge.iter().enumerate().filter(|x| *x.1) {
+            {
                 let [a, b] = mesh.edge_vertices(e as u32);
                 on_cut[a as usize] = true;
                 on_cut[b as usize] = true;
