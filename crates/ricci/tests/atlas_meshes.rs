@@ -224,6 +224,18 @@ fn generated_torus_and_open_surfaces_have_no_singular_point() {
 }
 
 #[test]
+fn four_cones_on_a_sphere() {
+    let s = generate::icosphere(2).unwrap();
+    let far = ricci::flow::separated_vertices(&s.mesh, 4, 5);
+    let o = AtlasOptions {
+        cones: Some(far.iter().map(|&v| (v, PI)).collect()),
+        ..AtlasOptions::default()
+    };
+    let a = AffineAtlas::build(&s, &o, &mut NoProgress).unwrap();
+    check("sphere, four cones", &s, &a, 4);
+}
+
+#[test]
 fn two_user_cones_on_genus2() {
     let s = generate::genus(2, 24).unwrap();
     let far = ricci::flow::separated_vertices(&s.mesh, 2, 5);
@@ -255,6 +267,16 @@ fn refusals() {
     let sphere = generate::icosphere(2).unwrap();
     let e = AffineAtlas::build(&sphere, &AtlasOptions::default(), &mut NoProgress).unwrap_err();
     assert!(e.to_string().contains("genus-0"), "{e}");
+    let e = AffineAtlas::build(
+        &sphere,
+        &AtlasOptions {
+            cones: Some(vec![(0, 2.0 * PI), (5, 2.0 * PI)]),
+            ..AtlasOptions::default()
+        },
+        &mut NoProgress,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("K̄ < 2π"), "{e}");
     let g = generate::genus(2, 16).unwrap();
     let e = AffineAtlas::build(
         &g,

@@ -245,8 +245,14 @@ impl AffineAtlas {
                      free-boundary flat metric with no singular point",
                 ));
             }
-            for &(v, _) in list {
+            for &(v, k) in list {
                 check_vertex(v, "cone")?;
+                if !(k.is_finite() && k < 2.0 * PI) {
+                    return Err(Error::input(format!(
+                        "cone vertex {v} asks for curvature {k:.6}; a cone angle 2π − K̄ must be \
+                         positive, so K̄ < 2π"
+                    )));
+                }
             }
             let sum: f64 = list.iter().map(|c| c.1).sum();
             if (sum - 2.0 * PI * chi as f64).abs() > 1e-9 {
