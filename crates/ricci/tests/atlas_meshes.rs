@@ -335,3 +335,47 @@ fn open_and_genus1_real_meshes_without_singular_point() {
         check(file, &s, &a, 0);
     }
 }
+
+/// The query API: a vertex on the cut has several coordinates in the central chart; the
+/// transition maps between two charts are the distinct per-face rigid motions, together
+/// covering every common face, and a cut chart straddling the cut meets the central chart in
+/// two different motions (they differ by a deck transformation).
+#[test]
+fn query_api_on_genus2() {
+    let s = generate::genus(2, 24).unwrap();
+    let a = build(&s, Singularity::Auto);
+    let m = a.mesh();
+    let cone = a.singular_vertices()[0];
+    let mut straddling = 0;
+    for c in 1..a.n_charts() as u32 {
+        let common = (0..m.n_faces() as u32)
+            .filter(|&f| a.face_coords(c, f).is_some())
+            .count();
+        let t = a.transitions_between(c, 0);
+        assert_eq!(t.iter().map(|x| x.1).sum::<usize>(), common);
+        for &(mo, _, res) in &t {
+            assert!(res < 1e-9);
+            assert!((mo.rot.norm() - 1.0).abs() < 1e-12);
+        }
+        if t.len() >= 2 {
+            straddling += 1;
+        }
+    }
+    assert!(straddling > 0, "no cut chart straddles the cut");
+    // Cut vertices: more than one copy in the central chart.
+    let multi = (0..m.n_vertices() as u32)
+        .filter(|&v| v != cone)
+        .filter(|&v| a.vertex_coords(v).iter().filter(|x| x.0 == 0).count() >= 2)
+        .count();
+    assert!(multi > 0);
+    let interior = (0..m.n_vertices() as u32)
+        .find(|&v| a.vertex_coords(v).len() == 1)
+        .unwrap();
+    let (c, p) = a.vertex_coords(interior)[0];
+    let f = m.vertex_faces(interior).next().unwrap();
+    let i = m.face(f).iter().position(|&x| x == interior).unwrap();
+    let mut bary = [0.0; 3];
+    bary[i] = 1.0;
+    let hit = a.locate(f, bary).into_iter().find(|x| x.0 == c).unwrap();
+    assert!((hit.1[0] - p[0]).hypot(hit.1[1] - p[1]) < 1e-12);
+}

@@ -11,10 +11,14 @@
 //!    `k` user cones (`cones`) on closed surfaces.
 //! 2. **Connectivity modification** (Step 2): intrinsic, metric-preserving edge splits
 //!    ([`crate::mesh::refine`]) raise the valence of every cone `v` to at least
-//!    `⌈4 − 2K̄(v)/π⌉` and, once, the valence of the vertices within `rings` rings of it to 6
-//!    (each split of a link edge creates a valence-4 vertex, so splits alone cannot reach 6
-//!    everywhere; what was reached is reported). The canonical cut then grades the
-//!    neighbourhood of its base vertex (the cone) so its `4g` loops fit.
+//!    `⌈4 − 2K̄(v)/π⌉`; the canonical cut then grades the neighbourhood of its base vertex
+//!    (the cone) so its `4g` loops fit; finally the cone's one-ring neighbours get valence
+//!    ≥ 6 by splitting their outer link edges off the cut ([`raise_ring_valence`]) — the
+//!    cut's grading leaves valence-4 neighbours, and without this the Chow–Luo condition on
+//!    the cone's closed one-ring refuses the target for genus ≥ 3. The paper's
+//!    "valence ≥ 6 within 3 rings" cannot be reached by splits alone (every link-edge split
+//!    creates a valence-4 vertex); the count of vertices within `rings` rings still below 6
+//!    is reported.
 //! 3. **Flat metric** (Step 3): Euclidean Ricci flow ([`crate::flow`]) on the refined mesh
 //!    with the cone target, from the input metric.
 //! 4. **Segmentation** (Step 4): the canonical cut through the cone ([`crate::cut`]), plus a
@@ -76,8 +80,8 @@ pub struct AtlasOptions {
     pub scheme: Scheme,
     /// Flow tolerance: max |K − K̄| (default 1e-10).
     pub tolerance: f64,
-    /// Step 2 (ii): vertices within this many rings of a cone get valence ≥ 6 (one pass of
-    /// splits; 0 disables).
+    /// Step 2 (ii): the cones' one-ring neighbours get valence ≥ 6 unless this is 0; the
+    /// report counts the vertices within this many rings still below 6 (default 3).
     pub rings: usize,
     /// Options of the automatic placement.
     pub placement: PlacementOptions,
@@ -767,8 +771,8 @@ impl AffineAtlas {
     }
 
     /// The charts containing vertex `v` and its coordinates in each (a vertex on the cut has
-    /// several copies in the central chart; each distinct copy is listed). Empty for a
-    /// singular vertex outside the central chart's corners.
+    /// several copies in the central chart; each distinct copy is listed; a cone appears
+    /// only in the central chart, once per corner of the fundamental polygon).
     pub fn vertex_coords(&self, v: u32) -> Vec<(ChartId, [f64; 2])> {
         let mut out: Vec<(ChartId, [f64; 2])> = Vec::new();
         if v as usize >= self.mesh.n_vertices() {

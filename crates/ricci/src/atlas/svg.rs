@@ -128,7 +128,7 @@ pub fn overview_svg(atlas: &AffineAtlas, size: f64) -> String {
     }
     let _ = writeln!(
         out,
-        "<text x=\"8\" y=\"20\" font-family=\"sans-serif\" font-size=\"14\">{} charts: central chart (blue), cut charts' home faces mapped into it (colours), cone faces red</text>\n</svg>",
+        "<text x=\"8\" y=\"20\" font-family=\"sans-serif\" font-size=\"14\">{} charts: central chart (blue); each cut chart's home faces (colours) placed by its transition on one face — across the cut they appear displaced by the deck motion</text>\n</svg>",
         atlas.n_charts()
     );
     out
