@@ -38,6 +38,8 @@ enum Command {
     Spectrum(cmd::spectrum::Args),
     /// The whole pipeline on the built-in genus-2 surface: pictures, tables, DIR/index.html.
     Demo(cmd::demo::Args),
+    /// Affine atlas with a single extraordinary point (flat cone metric, charts, transitions).
+    Atlas(cmd::atlas::Args),
 }
 
 fn main() {
@@ -52,6 +54,7 @@ fn main() {
         Command::Layout(a) => cmd::layout::run(a),
         Command::Spectrum(a) => cmd::spectrum::run(a),
         Command::Demo(a) => cmd::demo::run(a),
+        Command::Atlas(a) => cmd::atlas::run(a),
     };
     if let Err(e) = result {
         eprintln!("error: {}", util::sentence(&e));
