@@ -56,6 +56,9 @@ fn main() {
                     max_attempts: std::env::var("BENCH_ATTEMPTS")
                         .ok()
                         .and_then(|r| r.parse().ok()),
+                    min_valence: std::env::var("BENCH_VALENCE")
+                        .ok()
+                        .and_then(|r| r.parse().ok()),
                     ..CutOptions::default()
                 },
                 &mut NoProgress,
@@ -70,6 +73,9 @@ fn main() {
             .unwrap_or_default();
         match last {
             Some(Ok(c)) => {
+                for f in &c.report.failed_attempts {
+                    println!("  {f}");
+                }
                 let total: f64 = c.loops.iter().map(|l| l.length).sum();
                 println!(
                     "{name}: F={} genus={} base={} valence {}→{} splits={} attempts={} searches={} rejected={:?} sides={} \

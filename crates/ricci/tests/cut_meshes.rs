@@ -69,13 +69,13 @@ fn closed_genus_four_and_five() {
     run("botijo.off", 5, 0, None);
 }
 
-/// Known failure: from the automatic (central) base vertex the construction runs out of room at
-/// handle 5–8 on the seahorse, even after refining along the loops; from vertex 45000 it
-/// succeeds (31 s). Run with `cargo test --release -- --ignored`.
+/// Genus 8 (100k faces), from the automatic (central) base vertex and from a given one. From
+/// the central vertex the first round of attempts runs out of room at the base vertex and the
+/// construction restarts with a larger graded neighbourhood (see `CutOptions::max_attempts`).
 #[test]
-#[ignore = "genus 8 seahorse: no canonical system from the automatic base vertex yet (see report)"]
 fn closed_genus_eight() {
     run("seahorse2_100K.off", 8, 0, None);
+    run("seahorse2_100K.off", 8, 0, Some(45000));
 }
 
 #[test]
