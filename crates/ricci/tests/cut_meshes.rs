@@ -119,3 +119,45 @@ fn random_base_vertices_on_eight_and_3holes() {
         }
     }
 }
+
+/// The restart rounds: with one attempt per round, genus3 (whose first attempt from the central
+/// vertex runs out of room) must still cut canonically, from a restart with at least 3.5× the
+/// default valence `max(4g + 4, 8g − 4)` at the base vertex.
+#[test]
+fn restart_with_a_larger_valence_still_cuts_canonically() {
+    let Some(dir) = meshes_dir() else {
+        eprintln!("RICCI_MESHES not set: skipping the restart test");
+        return;
+    };
+    let (s, _) = read_surface(&dir.join("genus3.off")).unwrap();
+    let lengths = s.edge_lengths();
+    let opts = CutOptions {
+        max_attempts: Some(1),
+        ..CutOptions::default()
+    };
+    let c = canonical_cut(
+        &s.mesh,
+        &lengths,
+        Geometry::Euclidean,
+        Some(&s.positions),
+        &opts,
+        &mut NoProgress,
+    )
+    .unwrap_or_else(|e| panic!("genus3 with one attempt per round: {e}"));
+    verify(&c, 3, 0, "genus3 restart");
+    let g = 3usize;
+    let default = (4 * g + 4).max(8 * g - 4);
+    eprintln!(
+        "genus3: {} attempt(s), requested valence {} at the end",
+        c.report.attempts, c.report.min_valence
+    );
+    if c.report.attempts > 1 {
+        assert_eq!(c.report.failed_attempts.len(), c.report.attempts - 1);
+        assert!(
+            c.report.min_valence as f64 >= 3.5 * default as f64,
+            "restarted with valence {} < 3.5 × {default}",
+            c.report.min_valence
+        );
+        assert!(c.report.valence_after >= c.report.min_valence);
+    }
+}
