@@ -7,6 +7,9 @@
 //!
 //! Without arguments it runs botijo (82k faces, genus 5) and seahorse2_100K (100k faces,
 //! genus 8) from `$RICCI_MESHES` (default `../shared/meshes`). Reading the file is not timed.
+//! Environment: `BENCH_RUNS` (default 5), `BENCH_BASE` (base vertex), `BENCH_ATTEMPTS`
+//! (attempts per round), `BENCH_VALENCE` (minimum valence at the base vertex). Failed attempts
+//! are printed above each result line.
 
 use ricci::cut::{canonical_cut, CutOptions};
 use ricci::mesh::io::read_surface;
@@ -56,7 +59,9 @@ fn main() {
                     max_attempts: std::env::var("BENCH_ATTEMPTS")
                         .ok()
                         .and_then(|r| r.parse().ok()),
-                    ..CutOptions::default()
+                    min_valence: std::env::var("BENCH_VALENCE")
+                        .ok()
+                        .and_then(|r| r.parse().ok()),
                 },
                 &mut NoProgress,
             );
@@ -70,6 +75,9 @@ fn main() {
             .unwrap_or_default();
         match last {
             Some(Ok(c)) => {
+                for f in &c.report.failed_attempts {
+                    println!("  {f}");
+                }
                 let total: f64 = c.loops.iter().map(|l| l.length).sum();
                 println!(
                     "{name}: F={} genus={} base={} valence {}→{} splits={} attempts={} searches={} rejected={:?} sides={} \

@@ -69,13 +69,13 @@ fn closed_genus_four_and_five() {
     run("botijo.off", 5, 0, None);
 }
 
-/// Known failure: from the automatic (central) base vertex the construction runs out of room at
-/// handle 5–8 on the seahorse, even after refining along the loops; from vertex 45000 it
-/// succeeds (31 s). Run with `cargo test --release -- --ignored`.
+/// Genus 8 (100k faces), from the automatic (central) base vertex and from a given one. From
+/// the central vertex the first round of attempts runs out of room at the base vertex and the
+/// construction restarts with a larger graded neighbourhood (see `CutOptions::max_attempts`).
 #[test]
-#[ignore = "genus 8 seahorse: no canonical system from the automatic base vertex yet (see report)"]
 fn closed_genus_eight() {
     run("seahorse2_100K.off", 8, 0, None);
+    run("seahorse2_100K.off", 8, 0, Some(45000));
 }
 
 #[test]
@@ -117,5 +117,47 @@ fn random_base_vertices_on_eight_and_3holes() {
         for v in random_vertices(s.mesh.n_vertices(), 20, seed) {
             run(f, g, 0, Some(v));
         }
+    }
+}
+
+/// The restart rounds: with one attempt per round, genus3 (whose first attempt from the central
+/// vertex runs out of room) must still cut canonically, from a restart with at least 3.5× the
+/// default valence `max(4g + 4, 8g − 4)` at the base vertex.
+#[test]
+fn restart_with_a_larger_valence_still_cuts_canonically() {
+    let Some(dir) = meshes_dir() else {
+        eprintln!("RICCI_MESHES not set: skipping the restart test");
+        return;
+    };
+    let (s, _) = read_surface(&dir.join("genus3.off")).unwrap();
+    let lengths = s.edge_lengths();
+    let opts = CutOptions {
+        max_attempts: Some(1),
+        ..CutOptions::default()
+    };
+    let c = canonical_cut(
+        &s.mesh,
+        &lengths,
+        Geometry::Euclidean,
+        Some(&s.positions),
+        &opts,
+        &mut NoProgress,
+    )
+    .unwrap_or_else(|e| panic!("genus3 with one attempt per round: {e}"));
+    verify(&c, 3, 0, "genus3 restart");
+    let g = 3usize;
+    let default = (4 * g + 4).max(8 * g - 4);
+    eprintln!(
+        "genus3: {} attempt(s), requested valence {} at the end",
+        c.report.attempts, c.report.min_valence
+    );
+    if c.report.attempts > 1 {
+        assert_eq!(c.report.failed_attempts.len(), c.report.attempts - 1);
+        assert!(
+            c.report.min_valence as f64 >= 3.5 * default as f64,
+            "restarted with valence {} < 3.5 × {default}",
+            c.report.min_valence
+        );
+        assert!(c.report.valence_after >= c.report.min_valence);
     }
 }

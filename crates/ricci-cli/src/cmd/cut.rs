@@ -34,7 +34,8 @@ pub struct Args {
     /// Metric from `ricci flow` (geometry + edge lengths); default: Euclidean lengths.
     #[arg(long)]
     pub metric: Option<PathBuf>,
-    /// Minimum valence of the base vertex after refinement (default max(4g+4, 8g−4) + b).
+    /// Minimum valence of the base vertex after refinement (default max(4g+4, 8g−4) + b;
+    /// raised 3.5× and then 5× when four attempts at it do not fit the loops).
     #[arg(long)]
     pub min_valence: Option<usize>,
     /// Output: the cut mesh with the polygon sides as `l` polylines (.obj).

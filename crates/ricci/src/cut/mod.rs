@@ -20,7 +20,24 @@
 //! around it; (2) a Z₂ cohomology basis by tree–cotree ([`homology`]); (3) the loops, handle by
 //! handle, as short non-separating loops through the free edges of `x` ([`system`]); when a
 //! handle does not fit, the loops found so far are kept, a free row of vertices is split in
-//! along them and the search resumes; (4) slicing ([`mod@slice`]) and reading the polygon.
+//! along them and the search resumes; after [`CutOptions::max_attempts`] such attempts the
+//! construction restarts from the input with 3.5×, then 5× the valence at `x` (and a graded
+//! neighbourhood to match); (4) slicing ([`mod@slice`]) and reading the polygon.
+//!
+//! **Why attempts fail.** A canonical system through `x` always exists topologically; the
+//! failures are discrete. The greedy commits to each handle before the next and must put all
+//! four ends of the next handle into one corner between two earlier handles; the shortest
+//! loops from there run alongside the earlier loops (all loops leave `x` towards the same
+//! nearby handles), so the strip where `b_i` would have to pass is pinched — two cut vertices
+//! joined by an uncut edge (a chord of the cut disk) separate it although the surface is not
+//! separated. Splitting edges along the loops removes the pinches found, but the later handles
+//! meet new ones; more edges at `x` and a wider graded neighbourhood give the room back, which
+//! is why the restart with a larger valence succeeds where the resumed attempts do not. A
+//! construction that cannot fail topologically — any `2g` loops with independent Z₂ classes,
+//! then the cut-and-paste moves of the classification of surfaces on the polygon (two per
+//! handle) — needs a free path between two corners of the current disk for every move, and
+//! stays exposed to the same pinches unless a free row is split in after every loop (a full
+//! mesh rebuild, ~60–75 ms at 100k faces, with the present [`Refiner`]); it is not used.
 //!
 //! This follows the lead's design with three changes found necessary on the shared meshes:
 //! the neighbourhood of `x` is *graded* (valence alone leaves only ~12 vertices in the second
@@ -62,8 +79,9 @@ pub struct CutOptions {
     /// `max(4g + 4, 8g − 4) + b` (paper 000, Step 2: `8g − 4` lets the single-cone flat metric
     /// exist; `4g + b` edges are needed by the cut itself).
     pub min_valence: Option<usize>,
-    /// Attempts (each refining along the loops found so far) when the loops do not fit
-    /// (default 8).
+    /// Attempts per round (each refining along the loops found so far) when the loops do not
+    /// fit (default 4). After a round fails, the construction restarts from the input with the
+    /// valence at the base vertex scaled by 3.5, then by 5 (three rounds in all).
     pub max_attempts: Option<usize>,
 }
 
@@ -248,7 +266,7 @@ pub fn canonical_cut(
         .unwrap_or(default_valence)
         .max(paths_needed);
     let valence_before = mesh.valence(base);
-    let max_attempts = options.max_attempts.unwrap_or(8).max(1);
+    let max_attempts = options.max_attempts.unwrap_or(4).max(1);
     let expected_dim = if nb == 0 {
         2 * genus
     } else {
@@ -269,21 +287,29 @@ pub fn canonical_cut(
         Some(0.0),
         &format!("refining around vertex {base} to valence {min_valence}"),
     );
-    let mut refined = if paths_needed > 0 {
-        let mut r = Refiner::new(mesh, lengths, geometry, positions)?;
-        r.raise_valence(base, min_valence)?;
-        let grade = min_valence.max(2 * paths_needed);
-        let theta = r.cone_angle(base);
-        let radius = 1.5 * grade as f64 * mean_spoke / theta.max(1e-3);
-        r.grade_around(base, grade, radius, 40 * grade * grade + 1000)?;
-        r.finish()?
-    } else {
-        Refined::identity(mesh, lengths, positions)
-    };
+    // Rounds: when every attempt of a round fails, start again from the input mesh with the
+    // valence at the base vertex (and the graded neighbourhood) scaled up.
+    let round_valence: Vec<usize> = RESTART_FACTORS
+        .iter()
+        .map(|f| ((min_valence as f64) * f).ceil() as usize)
+        .collect();
+    let mut round = 0usize;
+    let mut refined = grade_base(
+        mesh,
+        lengths,
+        geometry,
+        positions,
+        base,
+        min_valence,
+        paths_needed,
+        mean_spoke,
+    )?;
     let mut prior: Vec<RawPath> = Vec::new();
     let mut total = SearchStats::default();
+    let mut round_attempt = 0usize;
     let (raw, stats) = loop {
         attempt += 1;
+        round_attempt += 1;
         let coh = Cohomology::new(&refined.mesh)?;
         if coh.dim != expected_dim {
             return Err(Error::topology(format!(
@@ -299,9 +325,10 @@ pub fn canonical_cut(
             genus,
             boundary_loops: refined.mesh.boundary_loops(),
         };
+        let total_attempts = max_attempts * round_valence.len();
         progress.report(
             "cut",
-            Some(0.1 + 0.8 * (attempt - 1) as f64 / max_attempts as f64),
+            Some(0.1 + 0.8 * (attempt - 1) as f64 / total_attempts as f64),
             &format!("attempt {attempt}: searching {genus} handle(s)"),
         );
         match system::build(&input, &prior) {
@@ -316,16 +343,42 @@ pub fn canonical_cut(
                     stats: st,
                 } = *fail;
                 total.add(&st);
-                failed.push(format!("attempt {attempt}: {msg}"));
-                if attempt >= max_attempts {
-                    return Err(Error::numerical(format!(
-                        "no canonical system through vertex {base} was found after {attempt} attempts ({msg}); \
-                         try another base vertex or a larger --min-valence"
-                    )));
+                failed.push(format!(
+                    "attempt {attempt} (valence {}): {msg}",
+                    refined.mesh.valence(base)
+                ));
+                drop(input);
+                if round_attempt >= max_attempts {
+                    round += 1;
+                    if round >= round_valence.len() {
+                        return Err(Error::numerical(format!(
+                            "no canonical system through vertex {base} was found after {attempt} attempts ({msg}); \
+                             try another base vertex or a larger --min-valence"
+                        )));
+                    }
+                    // Start again with a larger graded neighbourhood of the base vertex.
+                    min_valence = round_valence[round];
+                    progress.report(
+                        "cut",
+                        None,
+                        &format!("restarting with valence {min_valence} at vertex {base}"),
+                    );
+                    refined = grade_base(
+                        mesh,
+                        lengths,
+                        geometry,
+                        positions,
+                        base,
+                        min_valence,
+                        paths_needed,
+                        mean_spoke,
+                    )?;
+                    prior = Vec::new();
+                    round_attempt = 0;
+                    continue;
                 }
                 // Keep what was found, add a free row of vertices along it and more edges at
                 // the base vertex, and resume.
-                drop(input);
                 min_valence = refined.mesh.valence(base) + 4;
                 refined = widen(refined, &partial, base, geometry, min_valence)?;
                 prior = partial;
@@ -349,6 +402,35 @@ pub fn canonical_cut(
     };
     progress.report("cut", Some(1.0), "done");
     Ok(out)
+}
+
+/// Valence factors of the restart rounds of [`canonical_cut`] (relative to the requested
+/// minimum valence).
+const RESTART_FACTORS: [f64; 3] = [1.0, 3.5, 5.0];
+
+/// The input refined around the base vertex: valence raised to `min_valence`, neighbourhood
+/// graded so that about `max(min_valence, 2·paths)` vertices lie on every circle around it.
+#[allow(clippy::too_many_arguments)]
+fn grade_base(
+    mesh: &Mesh,
+    lengths: &[f64],
+    geometry: Geometry,
+    positions: Option<&[[f64; 3]]>,
+    base: u32,
+    min_valence: usize,
+    paths_needed: usize,
+    mean_spoke: f64,
+) -> Result<Refined> {
+    if paths_needed == 0 {
+        return Ok(Refined::identity(mesh, lengths, positions));
+    }
+    let mut r = Refiner::new(mesh, lengths, geometry, positions)?;
+    r.raise_valence(base, min_valence)?;
+    let grade = min_valence.max(2 * paths_needed);
+    let theta = r.cone_angle(base);
+    let radius = 1.5 * grade as f64 * mean_spoke / theta.max(1e-3);
+    r.grade_around(base, grade, radius, 40 * grade * grade + 1000)?;
+    r.finish()
 }
 
 /// Split every edge that touches a vertex of the given paths (except cut edges and edges at the
