@@ -146,7 +146,7 @@ fn every_link_of_the_page_is_a_local_non_empty_file() {
         .collect();
     assert_eq!(
         order,
-        ["surface", "flow", "cone", "loops", "layout", "spectrum"]
+        ["surface", "flow", "cone", "loops", "layout", "spectrum", "atlas"]
     );
     let mut at = 0;
     for id in order {
@@ -593,4 +593,35 @@ fn the_commands_the_page_shows_work_in_a_copy_of_the_folder() {
     let (b, _) = ricci::mesh::io::read_surface(&work.join("surface.off")).unwrap();
     assert_eq!(a.positions, b.positions);
     assert_eq!(a.mesh.faces(), b.mesh.faces());
+}
+
+#[test]
+fn atlas_has_one_cone_and_rigid_transitions() {
+    let (dir, v) = demo();
+    let chi = v["stages"]["surface"]["euler_characteristic"]
+        .as_i64()
+        .unwrap() as f64;
+    let s = stage(v, "atlas");
+    assert!(s["singular_vertex"].is_u64(), "{s}");
+    assert_eq!(s["flow_converged"], true);
+    assert!(f(&s["max_curvature_error"]) <= 1e-10, "{s}");
+    assert!(f(&s["gauss_bonnet_error"]) <= 1e-9, "{s}");
+    // The cone's curvature, recomputed by the stage from the flat lengths with the cosine
+    // law: all of 2πχ.
+    assert!(
+        (f(&s["cone_curvature"]) - 2.0 * PI * chi).abs() < 1e-8,
+        "{s}"
+    );
+    assert!(f(&s["max_transition_error"]) <= 1e-9, "{s}");
+    assert_eq!(s["flipped_faces"], 0);
+    assert_eq!(s["faces_without_home"], 0);
+    // A central chart plus at least one chart per cut curve (4g = 8 sides pair into 2g curves).
+    assert!(s["charts"].as_u64().unwrap() >= 1 + 4, "{s}");
+    assert!(f(&s["area_distortion"]).is_finite());
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    let imgs = img_tags(&html);
+    for want in ["atlas-chart.png", "atlas-checker.png"] {
+        assert!(imgs.iter().any(|t| t["src"] == want), "no picture {want}");
+    }
+    assert!(dir.join("atlas-overview.svg").is_file());
 }

@@ -106,18 +106,19 @@ pub const STAGES: &[Stage] = &[
         needs: &["layout"],
         run: stages::spectrum,
     },
-    // ── Affine atlas goes here: Stage { id: "atlas", title: "Affine atlas", needs: &["cone"],
-    //    run: stages::atlas, .. } (charts picture, transition errors, `ricci atlas` JSON).
+    Stage {
+        id: "atlas",
+        title: "Affine atlas with one extraordinary point",
+        reference: "singularity placement, connectivity modification, flat cone metric, charts and transitions (paper 000 §4 Steps 1–5, paper 002 §5.2)",
+        needs: &["surface"],
+        run: stages::atlas,
+    },
     // ── Manifold spline goes here: Stage { id: "spline", title: "Manifold spline",
     //    needs: &["atlas"], run: stages::spline, .. } (zebra picture, fitting errors).
 ];
 
 /// Stages announced in the page but not built yet (title, sentence).
 pub const PLACEHOLDERS: &[(&str, &str)] = &[
-    (
-        "Affine atlas",
-        "the atlas of flat charts with one singular point (ricci atlas) will appear here.",
-    ),
     (
         "Manifold spline",
         "the manifold triangular B-spline on the atlas, with zebra stripes (ricci spline), will appear here.",
