@@ -616,7 +616,7 @@ fn atlas_has_one_cone_and_rigid_transitions() {
     assert_eq!(s["flipped_faces"], 0);
     assert_eq!(s["faces_without_home"], 0);
     // A central chart plus at least one chart per cut curve (4g = 8 sides pair into 2g curves).
-    assert!(s["charts"].as_u64().unwrap() >= 1 + 4, "{s}");
+    assert!(s["charts"].as_u64().unwrap() > 4, "{s}");
     assert!(f(&s["area_distortion"]).is_finite());
     let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
     let imgs = img_tags(&html);
