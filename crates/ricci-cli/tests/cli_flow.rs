@@ -182,3 +182,57 @@ fn refusals_exit_with_the_right_code_and_write_nothing() {
     assert!(err.contains("line 3"), "{err}");
     assert!(!metric_file.exists(), "no metric written on refusal");
 }
+
+/// `--widen-boundary N` refines the mesh, so it needs `--refined-out` (exit 2 without); with
+/// it, the refined mesh is written and the metric file matches it vertex for vertex.
+#[test]
+fn widen_boundary_writes_the_refined_mesh() {
+    let mesh = generate("disk", "disk.off");
+    let o = ricci()
+        .arg("flow")
+        .arg(&mesh)
+        .args(["--widen-boundary", "3"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let refined = scratch("disk-refined.off");
+    let metric_file = scratch("disk-metric.json");
+    let o = ricci()
+        .arg("flow")
+        .arg(&mesh)
+        .args([
+            "--target",
+            "round-boundary",
+            "--widen-boundary",
+            "3",
+            "--json",
+            "--refined-out",
+        ])
+        .arg(&refined)
+        .arg("--out")
+        .arg(&metric_file)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let (r, _) = read_surface(&refined).unwrap();
+    let (s, _) = read_surface(&mesh).unwrap();
+    assert_eq!(
+        j["refinement"]["vertices"].as_u64().unwrap() as usize,
+        r.mesh.n_vertices()
+    );
+    assert_eq!(
+        r.mesh.n_vertices(),
+        s.mesh.n_vertices() + j["refinement"]["splits"].as_u64().unwrap() as usize
+    );
+    for v in r.mesh.boundary_loops().into_iter().flatten() {
+        assert!(r.mesh.vertex_faces(v).count() >= 3);
+    }
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&metric_file).unwrap()).unwrap();
+    assert_eq!(
+        m["vertices"].as_u64().unwrap() as usize,
+        r.mesh.n_vertices()
+    );
+    assert_eq!(j["converged"], true);
+}

@@ -53,6 +53,16 @@ pub struct Args {
     /// the puncture route if Newton fails.
     #[arg(long, value_enum, default_value = "auto")]
     pub sphere_route: Route,
+    /// Before the flow, give every boundary vertex at least N faces by metric-preserving
+    /// splits of the edges opposite it (N = 2 removes boundary "ears", which round and
+    /// geodesic boundaries cannot reach; N = 3 also helps Thurston packing at boundary
+    /// vertices with two faces). Needs --refined-out: the metric is on the refined mesh.
+    #[arg(long, value_name = "N", requires = "refined_out")]
+    pub widen_boundary: Option<usize>,
+    /// Where to write the refined mesh of --widen-boundary (input vertices keep their ids,
+    /// new vertices are appended).
+    #[arg(long, value_name = "MESH", requires = "widen_boundary")]
+    pub refined_out: Option<PathBuf>,
     /// Write the final metric (per-vertex u, K, K̄; per-edge lengths) to this JSON file.
     #[arg(long, short = 'o')]
     pub out: Option<PathBuf>,
@@ -124,11 +134,39 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         bar.set_message(message.to_string());
     };
-    let lengths = surface.edge_lengths();
+    let mut lengths = surface.edge_lengths();
+    let mut surface = surface;
+    let mut refinement = serde_json::Value::Null;
+    if let Some(n) = a.widen_boundary {
+        let r = ricci::mesh::refine::widen_boundary(
+            &surface.mesh,
+            &lengths,
+            Geometry::Euclidean, // the input lengths are Euclidean
+            Some(&surface.positions),
+            n,
+        )
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?;
+        refinement = json!({
+            "min_faces": n,
+            "splits": r.splits(),
+            "vertices": r.mesh.n_vertices(),
+            "faces": r.mesh.n_faces(),
+            "refined_out": a.refined_out.as_ref().map(|p| p.display().to_string()),
+        });
+        lengths = r.lengths;
+        surface = ricci::mesh::Surface {
+            mesh: r.mesh,
+            positions: r.positions.unwrap_or_default(),
+            uvs: None,
+        };
+    }
     let result = ricci_flow(&surface.mesh, &lengths, &options, &mut progress);
     bar.finish_and_clear();
     let r = result.map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?;
     let source = a.mesh.display().to_string();
+    if let Some(path) = &a.refined_out {
+        ricci::mesh::io::write_surface(path, &surface)?;
+    }
     if let Some(out) = &a.out {
         let v = metric_json(&r, &surface.mesh, &source);
         write_atomic(out, serde_json::to_string(&v)?.as_bytes())?;
@@ -164,6 +202,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "degenerate_faces": r.degenerate_faces,
             "pinned": r.pinned,
             "notes": r.notes,
+            "refinement": refinement,
             "history": r.history,
             "out": a.out.as_ref().map(|p| p.display().to_string()),
         }));

@@ -430,6 +430,48 @@ impl Refiner {
         }
     }
 
+    /// Split the longest edge opposite boundary vertex `x` (in one of its faces) at its
+    /// midpoint until `x` has at least `min_faces` faces. A boundary "ear" (one face) cannot
+    /// open its single corner towards π, which a round or geodesic boundary asks of it; two
+    /// faces can (the Chow–Luo condition of paper 000 eq. 7 on its one-ring). Returns the
+    /// number of splits.
+    pub fn widen_boundary_vertex(&mut self, x: u32, min_faces: usize) -> Result<usize> {
+        if x as usize >= self.n_vertices() {
+            return Err(Error::input(format!(
+                "vertex {x} does not exist (the mesh has {} vertices)",
+                self.n_vertices()
+            )));
+        }
+        let mut n = 0;
+        loop {
+            let (fan, closed) = self.fan(x);
+            if closed {
+                return Err(Error::input(format!(
+                    "vertex {x} is interior; widen_boundary_vertex needs a boundary vertex"
+                )));
+            }
+            if fan.is_empty() {
+                return Err(Error::input(format!("vertex {x} is isolated")));
+            }
+            if fan.len() >= min_faces {
+                return Ok(n);
+            }
+            let best = fan
+                .iter()
+                .map(|&c| Self::next(c))
+                .max_by(|&p, &q| self.len[p as usize].total_cmp(&self.len[q as usize]))
+                .unwrap_or(NONE);
+            let opp = self.twin[best as usize];
+            if opp != NONE && self.origin(Self::prev(opp)) == x {
+                return Err(Error::invalid_mesh(format!(
+                    "vertex {x} appears twice around one of its link edges"
+                )));
+            }
+            self.split(best, 0.5);
+            n += 1;
+        }
+    }
+
     /// Cone angle at interior vertex `x` (sum of its corner angles).
     pub fn cone_angle(&self, x: u32) -> f64 {
         self.fan(x).0.iter().map(|&c| self.corner_angle(c)).sum()
@@ -630,6 +672,27 @@ pub fn raise_valence(
 ) -> Result<Refined> {
     let mut r = Refiner::new(mesh, lengths, geometry, positions)?;
     r.raise_valence(x, min_valence)?;
+    r.finish()
+}
+
+/// Give every boundary vertex at least `min_faces` faces by metric-preserving splits of the
+/// edges opposite it ([`Refiner::widen_boundary_vertex`]); `min_faces = 2` removes the boundary
+/// "ears" that round and geodesic boundary targets cannot reach. Vertex ids are kept, new
+/// vertices (on interior edges, so interior and flat) are appended.
+pub fn widen_boundary(
+    mesh: &Mesh,
+    lengths: &[f64],
+    geometry: Geometry,
+    positions: Option<&[[f64; 3]]>,
+    min_faces: usize,
+) -> Result<Refined> {
+    let mut r = Refiner::new(mesh, lengths, geometry, positions)?;
+    let mut boundary: Vec<u32> = mesh.boundary_loops().into_iter().flatten().collect();
+    boundary.sort_unstable();
+    boundary.dedup();
+    for v in boundary {
+        r.widen_boundary_vertex(v, min_faces)?;
+    }
     r.finish()
 }
 
