@@ -335,7 +335,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         subtitle: format!(
             "Discrete surface Ricci flow on the built-in genus-2 surface (resolution {}): \
              uniformization, canonical loops, the fundamental polygon in the Poincaré disk, \
-             its tiling, the length spectrum. {} of {} stages succeeded.",
+             its tiling, the length spectrum, the affine atlas with one extraordinary point and \
+             the manifold spline built on it. {} of {} stages succeeded.",
             a.resolution,
             sections.len() - failed.len(),
             sections.len()
