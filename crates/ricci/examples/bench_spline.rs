@@ -2,7 +2,7 @@
 //! Table 1 (g, N_f, N_c, T_ricci, T_spline, n, continuity) plus errors and the seam's normal
 //! jump.
 //!
-//! `RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_spline [-- [--degree N] [--fairness R] files…]`
+//! `RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_spline [-- [--degree N] [--fairness R] [--fit] files…]`
 //! (default: eight.off 3holes.off fertility.off kitten.nf20k.off face.off; `genus2:RES` is
 //! a generated genus-2 surface).
 
@@ -30,8 +30,8 @@ fn main() {
     if let Some(r) = take("--fairness", &mut args) {
         opts.fairness = r;
     }
-    if let Some(i) = args.iter().position(|a| a == "--no-fit") {
-        opts.fit_smoothing = None;
+    if let Some(i) = args.iter().position(|a| a == "--fit") {
+        opts.fit_smoothing = Some(1e-3);
         args.remove(i);
     }
     if args.is_empty() {

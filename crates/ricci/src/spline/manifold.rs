@@ -37,7 +37,11 @@
 //! faces at a cone are used by no basis function. [`ManifoldSpace`] implements
 //! [`SplineSpace`], so [`crate::spline::fit::fair`] (paper 000 eq. 14) and
 //! [`crate::spline::fit::fit`] work on it unchanged (the fairing constraints of an edge compare
-//! blossoms after mapping the arguments between the two triangles' home charts).
+//! blossoms after mapping the arguments between the two triangles' home charts). The flat
+//! metric of a single cone distorts areas by orders of magnitude, so the thin-plate energy of
+//! the fit is taken per face in the face's own scale (quadrature weight `(h_f / h̄)²`, `h_f` the
+//! face's mean edge length): without it the energy of tiny faces dominates and the normal
+//! equations become numerically singular.
 
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -632,7 +636,7 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
             active: &active,
             corner_motion: &corner_motion,
         };
-        const CANDIDATES: u64 = 24;
+        const CANDIDATES: u64 = 32;
         let mut trial = vec![[0.0; 2]; n + 1];
         let mut dirty = used.clone();
         let mut counter = 0u64;
@@ -1145,12 +1149,18 @@ impl<A: FlatCharts + Sync + ?Sized> SplineSpace for ManifoldSpace<'_, A> {
             [1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0],
         ];
         let mut q = Vec::new();
+        let (hbar, _) = self.domain_scale();
+        let mesh = self.charts.mesh();
+        let lengths = self.charts.lengths();
         for f in 0..self.active.len() as u32 {
             if !self.active[f as usize] {
                 continue;
             }
             let [a, b, c] = self.canon_coords[f as usize];
-            let area = 0.5 * det3(a, b, c);
+            // Each face's energy in its own scale (see the module docs): weight (h_f / h̄)².
+            let l = face_side_lengths(mesh, lengths, f);
+            let hf = (l[0] + l[1] + l[2]) / 3.0;
+            let area = 0.5 * det3(a, b, c) * (hf / hbar).powi(2);
             for s in &subs {
                 for r in &rule {
                     let mut bary = [0.0; 3];

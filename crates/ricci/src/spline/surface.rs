@@ -171,7 +171,7 @@ impl Default for SplineOptions {
         SplineOptions {
             degree: 3,
             fairness: 1,
-            fit_smoothing: Some(1e-3),
+            fit_smoothing: None,
             knots: KnotOptions::default(),
         }
     }
@@ -184,6 +184,8 @@ pub struct ManifoldSpline {
     pub holes: Vec<Hole>,
     pub fairing: FairingReport,
     pub fit: Option<FitReport>,
+    /// Ridge weight the fit needed (1e-9 unless the normal matrix was too ill-conditioned).
+    pub fit_ridge: Option<f64>,
     pub seconds_fairing: f64,
     pub seconds_fit: f64,
     pub seconds_fill: f64,
@@ -201,6 +203,7 @@ pub fn build<A: FlatCharts + Sync + ?Sized>(
     let (c1, fairing) = fair(space, &c0, 3, opts.fairness)?;
     let seconds_fairing = t.elapsed().as_secs_f64();
     let t = Instant::now();
+    let mut fit_ridge = None;
     let (control, fit_report) = if let Some(lam) = opts.fit_smoothing {
         progress.report("fit", None, "least squares to the mesh vertices");
         let charts = space.charts();
@@ -217,16 +220,32 @@ pub fn build<A: FlatCharts + Sync + ?Sized>(
                 });
             }
         }
-        let (c, rep) = fit(
-            space,
-            &data,
-            &c1,
-            3,
-            &FitOptions {
-                smoothing: lam,
-                ..FitOptions::default()
-            },
-        )?;
+        // The normal matrix can be too ill-conditioned for the default ridge (1e-9 of the data
+        // term); retry with a stronger ridge towards the faired control points.
+        let mut result = None;
+        let mut last = None;
+        for ridge in [1e-9, 1e-7, 1e-5] {
+            match fit(
+                space,
+                &data,
+                &c1,
+                3,
+                &FitOptions {
+                    smoothing: lam,
+                    ridge,
+                },
+            ) {
+                Ok(x) => {
+                    result = Some((x, ridge));
+                    break;
+                }
+                Err(e) => last = Some(e),
+            }
+        }
+        let Some(((c, rep), ridge)) = result else {
+            return Err(last.unwrap_or_else(|| Error::numerical("fit failed")));
+        };
+        fit_ridge = Some(ridge);
         (c, Some(rep))
     } else {
         (c1, None)
@@ -243,6 +262,7 @@ pub fn build<A: FlatCharts + Sync + ?Sized>(
         holes,
         fairing,
         fit: fit_report,
+        fit_ridge,
         seconds_fairing,
         seconds_fit,
         seconds_fill: t.elapsed().as_secs_f64(),
@@ -793,6 +813,7 @@ pub struct SplineReport {
     pub space: ManifoldReport,
     pub fairing: FairingReport,
     pub fit: Option<FitReport>,
+    pub fit_ridge: Option<f64>,
     pub seconds_knots: f64,
     pub seconds_fairing: f64,
     pub seconds_fit: f64,
@@ -842,6 +863,7 @@ pub fn run<A: FlatCharts + Sync + ?Sized>(
             space: rep,
             fairing: spline.fairing.clone(),
             fit: spline.fit.clone(),
+            fit_ridge: spline.fit_ridge,
             seconds_knots,
             seconds_fairing: spline.seconds_fairing,
             seconds_fit: spline.seconds_fit,
