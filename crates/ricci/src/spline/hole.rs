@@ -10,7 +10,8 @@
 //! **Seam.** A smooth closed curve `ρ = R(ψ)`, `φ = Θψ/2π`, `ψ ∈ [0, 2π)`, just outside the
 //! link of `s` (so inside the spline's domain): `R` is a truncated Fourier series of the link's
 //! radial function `r_link(φ)`, raised until it exceeds `r_link` everywhere by a margin. The
-//! seam is checked to lie in active faces of the two-ring; otherwise construction fails naming
+//! seam is checked to lie in active faces near the link (the stars of the link vertices and two
+//! more rings of stars, developed into the unrolled cone); otherwise construction fails naming
 //! `s` (a very irregular neighbourhood).
 //!
 //! **Fill.** Over the unit disk `(t, ψ)` a radial cubic Hermite patch
@@ -143,6 +144,44 @@ impl Hole {
                         let (mc, _) = fit_rigid(&cu, &space.canonical_coords(*g));
                         list.push((*g, cu, mc));
                     }
+                }
+            }
+            // One more ring: the stars of the vertices reached so far, aligned through a face
+            // already placed (the seam of an irregular, graded link can leave the two-ring).
+            let mut expanded: Vec<u32> = Vec::new();
+            let mut level = 0;
+            while level < 2 {
+                level += 1;
+                let verts: Vec<u32> = list
+                    .iter()
+                    .flat_map(|x| mesh.face(x.0))
+                    .filter(|&w| w != s)
+                    .collect();
+                for w in verts {
+                    if expanded.contains(&w) {
+                        continue;
+                    }
+                    expanded.push(w);
+                    let Some(wf) = space.vertex_frame(w) else {
+                        continue;
+                    };
+                    let Some((fw, cw, cu)) = wf.faces.iter().find_map(|(g, c)| {
+                        list.iter().find(|x| x.0 == *g).map(|x| (*g, *c, x.1))
+                    }) else {
+                        continue;
+                    };
+                    let _ = fw;
+                    let (m, _) = fit_rigid(&cw, &cu);
+                    let mut add = Vec::new();
+                    for (g, c) in &wf.faces {
+                        if !space.is_active(*g) || list.iter().any(|x| x.0 == *g) {
+                            continue;
+                        }
+                        let cu = c.map(|p| apply(&m, p));
+                        let (mc, _) = fit_rigid(&cu, &space.canonical_coords(*g));
+                        add.push((*g, cu, mc));
+                    }
+                    list.extend(add);
                 }
             }
             sector_faces.push(list);
