@@ -36,6 +36,8 @@ enum Command {
     Layout(cmd::layout::Args),
     /// Geodesic length spectrum of a closed surface of genus ≥ 1.
     Spectrum(cmd::spectrum::Args),
+    /// Manifold triangular B-spline surface with at most one extraordinary point.
+    Spline(cmd::spline::Args),
 }
 
 fn main() {
@@ -49,6 +51,7 @@ fn main() {
         Command::Flow(a) => cmd::flow::run(a),
         Command::Layout(a) => cmd::layout::run(a),
         Command::Spectrum(a) => cmd::spectrum::run(a),
+        Command::Spline(a) => cmd::spline::run(a),
     };
     if let Err(e) = result {
         eprintln!("error: {}", util::sentence(&e));

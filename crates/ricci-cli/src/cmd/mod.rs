@@ -7,3 +7,4 @@ pub mod info;
 pub mod layout;
 pub mod render;
 pub mod spectrum;
+pub mod spline;
