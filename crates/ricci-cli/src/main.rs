@@ -36,6 +36,8 @@ enum Command {
     Layout(cmd::layout::Args),
     /// Geodesic length spectrum of a closed surface of genus ≥ 1.
     Spectrum(cmd::spectrum::Args),
+    /// Affine atlas with a single extraordinary point (flat cone metric, charts, transitions).
+    Atlas(cmd::atlas::Args),
     /// Manifold triangular B-spline surface with at most one extraordinary point.
     Spline(cmd::spline::Args),
 }
@@ -51,6 +53,7 @@ fn main() {
         Command::Flow(a) => cmd::flow::run(a),
         Command::Layout(a) => cmd::layout::run(a),
         Command::Spectrum(a) => cmd::spectrum::run(a),
+        Command::Atlas(a) => cmd::atlas::run(a),
         Command::Spline(a) => cmd::spline::run(a),
     };
     if let Err(e) = result {

@@ -1,5 +1,6 @@
 //! One module per subcommand; each has `Args` (clap) and `run`.
 
+pub mod atlas;
 pub mod cut;
 pub mod flow;
 pub mod generate;

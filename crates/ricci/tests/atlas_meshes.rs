@@ -1,0 +1,315 @@
+//! The affine atlas (paper 000 §4) on generated surfaces and the shared real meshes
+//! (`RICCI_MESHES`): every property is re-checked here from the atlas's raw data, not from
+//! its own report:
+//!
+//! * flatness: the curvature of the returned metric, recomputed from the edge lengths, is
+//!   ≤ 1e-9 at every interior non-singular vertex, the cone carries 2πχ (Gauss–Bonnet), and
+//!   the cone valence satisfies paper 000 Step 2 (i);
+//! * every chart reproduces the metric lengths, has no flipped face, and two charts holding
+//!   the same face are related there by a rigid motion to ≤ 1e-9;
+//! * the home chart of every face not at a cone holds all faces sharing a vertex with it
+//!   with one coordinate per vertex;
+//! * random points (face, barycentric) off the cone are covered, and their coordinates in
+//!   two charts are related by the charts' transition on that face.
+
+use ricci::atlas::{fit_rigid, AffineAtlas, AtlasOptions, FlatCharts, Singularity};
+use ricci::layout::isometry::Isometry;
+use ricci::mesh::io::read_surface;
+use ricci::mesh::{generate, Surface};
+use ricci::metric::{curvature, Geometry};
+use ricci::progress::NoProgress;
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+fn mesh_dir() -> Option<PathBuf> {
+    let d = PathBuf::from(std::env::var("RICCI_MESHES").ok()?);
+    d.is_dir().then_some(d)
+}
+
+fn load(name: &str) -> Option<Surface> {
+    let Some(dir) = mesh_dir() else {
+        eprintln!("RICCI_MESHES is not set: skipping {name}");
+        return None;
+    };
+    Some(read_surface(&dir.join(name)).unwrap().0)
+}
+
+fn euler(s: &Surface) -> i64 {
+    ricci::mesh::topology(&s.mesh).euler_characteristic()
+}
+
+/// Check everything listed in the module docs; `singular` = expected number of cones.
+fn check(name: &str, s: &Surface, a: &AffineAtlas, singular: usize) {
+    let m = a.mesh();
+    let l = a.lengths();
+    let r = &a.report;
+    eprintln!(
+        "{name}: cones {:?}, {} charts, distortion {:.4}, flow {:.2e} ({}), transitions {:.2e}, {:.2} s",
+        r.singular_vertices,
+        a.n_charts(),
+        r.area_distortion,
+        r.max_curvature_error,
+        r.scheme,
+        r.max_transition_error,
+        r.seconds
+    );
+    assert_eq!(
+        a.singular_vertices().len(),
+        singular,
+        "{name}: singular vertices"
+    );
+    assert!(r.flow_converged, "{name}: flow did not converge");
+    assert_eq!(a.positions().len(), m.n_vertices());
+    // Flatness, recomputed.
+    let k = curvature(m, Geometry::Euclidean, l);
+    let chi = euler(s) as f64;
+    for v in 0..m.n_vertices() as u32 {
+        if m.is_boundary_vertex(v) || a.singular_vertices().contains(&v) {
+            continue;
+        }
+        assert!(
+            k[v as usize].abs() <= 1e-9,
+            "{name}: vertex {v} has curvature {:e}",
+            k[v as usize]
+        );
+    }
+    if singular == 1 {
+        let c = a.singular_vertices()[0];
+        assert!(
+            (k[c as usize] - 2.0 * PI * chi).abs() < 1e-8,
+            "{name}: the cone carries {} instead of 2πχ = {}",
+            k[c as usize],
+            2.0 * PI * chi
+        );
+        let need = 4.0 - 2.0 * (2.0 * PI * chi) / PI;
+        assert!(
+            m.valence(c) as f64 >= need,
+            "{name}: cone valence {}",
+            m.valence(c)
+        );
+    }
+    let scale = l.iter().sum::<f64>() / l.len() as f64;
+    // Charts: lengths, orientation, transitions.
+    let mut worst: f64 = 0.0;
+    for f in 0..m.n_faces() as u32 {
+        let cs = a.charts_of_face(f);
+        assert!(!cs.is_empty(), "{name}: face {f} is in no chart");
+        let hs = m.face_halfedges(f);
+        for &c in &cs {
+            let co = a.face_coords(c, f).unwrap();
+            let area2 = (co[1][0] - co[0][0]) * (co[2][1] - co[0][1])
+                - (co[1][1] - co[0][1]) * (co[2][0] - co[0][0]);
+            assert!(area2 > 0.0, "{name}: face {f} is flipped in chart {c}");
+            for i in 0..3 {
+                let (p, q) = (co[i], co[(i + 1) % 3]);
+                let d = (p[0] - q[0]).hypot(p[1] - q[1]);
+                let want = l[m.he_edge(hs[i]) as usize];
+                assert!(
+                    (d - want).abs() <= 1e-9 * scale.max(want),
+                    "{name}: face {f} chart {c}: side {d} vs length {want}"
+                );
+            }
+        }
+        let c0 = a.face_coords(cs[0], f).unwrap();
+        for &c in &cs[1..] {
+            let (_, res) = fit_rigid(&c0, &a.face_coords(c, f).unwrap());
+            worst = worst.max(res);
+        }
+    }
+    assert!(
+        worst <= 1e-9 * scale.max(1.0),
+        "{name}: transition residual {worst:e}"
+    );
+    // Home charts.
+    let at_cone = |f: u32| m.face(f).iter().any(|v| a.singular_vertices().contains(v));
+    for f in 0..m.n_faces() as u32 {
+        if at_cone(f) {
+            assert_eq!(
+                a.home_chart(f),
+                None,
+                "{name}: face {f} at a cone has a home"
+            );
+            continue;
+        }
+        let h = a
+            .home_chart(f)
+            .unwrap_or_else(|| panic!("{name}: face {f} has no home chart"));
+        let mut seen: Vec<(u32, [f64; 2])> = Vec::new();
+        for v in m.face(f) {
+            for g in m.vertex_faces(v) {
+                if at_cone(g) {
+                    continue;
+                }
+                let co = a
+                    .face_coords(h, g)
+                    .unwrap_or_else(|| panic!("{name}: home chart {h} of {f} lacks face {g}"));
+                for (i, &w) in m.face(g).iter().enumerate() {
+                    match seen.iter().find(|x| x.0 == w) {
+                        Some(x) => assert!(
+                            (x.1[0] - co[i][0]).hypot(x.1[1] - co[i][1]) <= 1e-7 * scale,
+                            "{name}: vertex {w} has two coordinates in the home chart of {f}"
+                        ),
+                        None => seen.push((w, co[i])),
+                    }
+                }
+            }
+        }
+    }
+    // Random points.
+    let mut state = 0x2545_F491_4F6C_DD1Du64;
+    let mut rnd = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let nf = m.n_faces();
+    for _ in 0..2000 {
+        let f = ((rnd() * nf as f64) as usize).min(nf - 1) as u32;
+        let (x, y) = (rnd(), rnd());
+        let (x, y) = if x + y > 1.0 {
+            (1.0 - x, 1.0 - y)
+        } else {
+            (x, y)
+        };
+        let bary = [1.0 - x - y, x, y];
+        let hits = a.locate(f, bary);
+        assert!(!hits.is_empty(), "{name}: point on face {f} is not covered");
+        for &(c, p) in &hits[1..] {
+            let (mo, _) = a.transition(hits[0].0, c, f).unwrap();
+            let z = mo.apply(num_complex::Complex64::new(hits[0].1[0], hits[0].1[1]));
+            assert!(
+                (z.re - p[0]).hypot(z.im - p[1]) <= 1e-9 * scale.max(1.0),
+                "{name}: point on face {f}: charts {} and {c} disagree",
+                hits[0].0
+            );
+        }
+    }
+    assert_eq!(r.faces_without_home, 0);
+    assert_eq!(r.flipped_faces, 0);
+}
+
+fn build(s: &Surface, singularity: Singularity) -> AffineAtlas {
+    let o = AtlasOptions {
+        singularity,
+        ..AtlasOptions::default()
+    };
+    AffineAtlas::build(s, &o, &mut NoProgress).unwrap()
+}
+
+#[test]
+fn generated_genus2_auto() {
+    let s = generate::genus(2, 24).unwrap();
+    let a = build(&s, Singularity::Auto);
+    check("genus2", &s, &a, 1);
+    assert!(a.report.placement.is_some());
+}
+
+#[test]
+fn generated_genus3_user_vertex() {
+    let s = generate::genus(3, 20).unwrap();
+    let a = build(&s, Singularity::Vertex(7));
+    check("genus3 generated", &s, &a, 1);
+    assert_eq!(a.singular_vertices(), &[7]);
+}
+
+#[test]
+fn generated_torus_and_open_surfaces_have_no_singular_point() {
+    let t = generate::torus(1.0, 0.5, 24).unwrap();
+    check("torus", &t, &build(&t, Singularity::Auto), 0);
+    let d = generate::disk(32).unwrap();
+    check("disk", &d, &build(&d, Singularity::Auto), 0);
+    let p = generate::pair_of_pants(40).unwrap();
+    check("pants", &p, &build(&p, Singularity::Auto), 0);
+}
+
+#[test]
+fn two_user_cones_on_genus2() {
+    let s = generate::genus(2, 24).unwrap();
+    let far = ricci::flow::separated_vertices(&s.mesh, 2, 5);
+    let o = AtlasOptions {
+        cones: Some(vec![(far[0], -2.0 * PI), (far[1], -2.0 * PI)]),
+        ..AtlasOptions::default()
+    };
+    let a = AffineAtlas::build(&s, &o, &mut NoProgress).unwrap();
+    check("genus2, two cones", &s, &a, 2);
+    let k = curvature(a.mesh(), Geometry::Euclidean, a.lengths());
+    for &c in a.singular_vertices() {
+        assert!((k[c as usize] + 2.0 * PI).abs() < 1e-8);
+    }
+}
+
+#[test]
+fn refusals() {
+    let d = generate::disk(16).unwrap();
+    let e = AffineAtlas::build(
+        &d,
+        &AtlasOptions {
+            singularity: Singularity::Vertex(3),
+            ..AtlasOptions::default()
+        },
+        &mut NoProgress,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("open surface"), "{e}");
+    let sphere = generate::icosphere(2).unwrap();
+    let e = AffineAtlas::build(&sphere, &AtlasOptions::default(), &mut NoProgress).unwrap_err();
+    assert!(e.to_string().contains("genus-0"), "{e}");
+    let g = generate::genus(2, 16).unwrap();
+    let e = AffineAtlas::build(
+        &g,
+        &AtlasOptions {
+            cones: Some(vec![(1, -PI)]),
+            ..AtlasOptions::default()
+        },
+        &mut NoProgress,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("Gauss–Bonnet"), "{e}");
+    let e = AffineAtlas::build(
+        &g,
+        &AtlasOptions {
+            singularity: Singularity::Vertex(1 << 30),
+            ..AtlasOptions::default()
+        },
+        &mut NoProgress,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("does not exist"), "{e}");
+}
+
+#[test]
+fn closed_real_meshes_single_cone() {
+    for (file, user) in [
+        ("eight.off", Some(10)),
+        ("eight.off", None),
+        ("3holes.off", None),
+        ("genus3.off", None),
+        ("fertility.off", None),
+        ("cup_input_simple_10000.off", None),
+    ] {
+        let Some(s) = load(file) else { return };
+        let sing = user.map_or(Singularity::Auto, Singularity::Vertex);
+        let a = build(&s, sing);
+        check(file, &s, &a, 1);
+        if let Some(v) = user {
+            assert_eq!(a.singular_vertices(), &[v]);
+        }
+    }
+}
+
+#[test]
+fn open_and_genus1_real_meshes_without_singular_point() {
+    for file in [
+        "face.off",
+        "camelhead.off",
+        "eight.open.off",
+        "bunny.off",
+        "punctured-torus.obj",
+        "kitten.nf20k.off",
+    ] {
+        let Some(s) = load(file) else { return };
+        let a = build(&s, Singularity::Auto);
+        check(file, &s, &a, 0);
+    }
+}
