@@ -2,7 +2,8 @@
 //! Table 1 (g, N_f, N_c, T_ricci, T_spline, n, continuity) plus errors and the seam's normal
 //! jump.
 //!
-//! `RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_spline [-- [--degree N] [--fairness R] [--fit] files…]`
+//! `RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_spline [-- [--degree N] [--fairness R] [--fit] [--atlas] files…]`
+//! (`--atlas`: charts of `ricci::atlas::AffineAtlas` instead of `LocalCharts`)
 //! (default: eight.off 3holes.off fertility.off kitten.nf20k.off face.off; `genus2:RES` is
 //! a generated genus-2 surface).
 
@@ -29,6 +30,11 @@ fn main() {
     }
     if let Some(r) = take("--fairness", &mut args) {
         opts.fairness = r;
+    }
+    let mut use_atlas = false;
+    if let Some(i) = args.iter().position(|a| a == "--atlas") {
+        use_atlas = true;
+        args.remove(i);
     }
     if let Some(i) = args.iter().position(|a| a == "--fit") {
         opts.fit_smoothing = Some(1e-3);
@@ -60,6 +66,51 @@ fn main() {
             }
         };
         let t = Instant::now();
+        if use_atlas {
+            let atlas = match ricci::atlas::AffineAtlas::build(
+                &surface,
+                &ricci::atlas::AtlasOptions::default(),
+                &mut NoProgress,
+            ) {
+                Ok(a) => a,
+                Err(e) => {
+                    eprintln!("{f}: {e}");
+                    continue;
+                }
+            };
+            let t_ricci = t.elapsed().as_secs_f64();
+            let dist = MeshDistance::new(&surface.positions, surface.mesh.faces());
+            match run(&atlas, &dist, &opts, 4, &mut NoProgress) {
+                Ok((rep, _, _)) => {
+                    let n = rep.degree;
+                    println!(
+                        "| {f} (atlas) | {} | {} | {} | {:.2} | {:.3} | {} | {} | {} | {:.1e} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} |",
+                        atlas.report.genus,
+                        rep.domain_faces,
+                        rep.control_points,
+                        t_ricci,
+                        rep.seconds,
+                        n,
+                        rep.fairness,
+                        rep.continuity.class,
+                        rep.continuity.relative_jumps[n - 1],
+                        if rep.continuity.seams.is_empty() {
+                            "–".to_string()
+                        } else {
+                            format!("{:.2e}", rep.continuity.max_seam_normal_jump_deg)
+                        },
+                        rep.rms_error_percent,
+                        rep.max_error_percent,
+                        rep.seconds_knots,
+                        rep.seconds_fairing,
+                        rep.seconds_fit,
+                        rep.seconds_fill
+                    );
+                }
+                Err(e) => eprintln!("{f} (atlas): {e}"),
+            }
+            continue;
+        }
         let dom = match flat_domain(&surface, Singularity::Auto, &mut NoProgress) {
             Ok(d) => d,
             Err(e) => {

@@ -2,10 +2,11 @@
 //! [--tessellation M] [--out DIR] [--json]`: a manifold triangular B-spline surface with at most
 //! one extraordinary point (paper 000 §5).
 //!
-//! The flat metric comes from the Ricci flow (genus 1: uniform; open: free boundary; genus ≥ 2:
-//! one cone at the singular vertex after raising its valence), the charts from
-//! `ricci::spline::manifold::LocalCharts` (the affine atlas plugs in through the same
-//! `FlatCharts` trait once merged). Then the subdivision control points, the fairing with
+//! The flat metric and charts come from the affine atlas (`--charts atlas`, default:
+//! `ricci::atlas::AffineAtlas`, cone placed by least area distortion) or from the spline's own
+//! provider (`--charts local`: the flow's flat metric — genus 1 uniform, open free boundary,
+//! genus ≥ 2 one cone at the vertex of largest valence after raising its valence — developed by
+//! `ricci::spline::manifold::LocalCharts`). Then the subdivision control points, the fairing with
 //! parameter `r`, optionally the least-squares fit to the mesh vertices, and the G¹ fill patch
 //! at the cone. `--out DIR` writes `surface.obj` (tessellation; the fill patch is group
 //! `fill`), `surface_vertices.json` (per tessellation vertex: domain face and chart, −1 on the
@@ -15,7 +16,7 @@
 
 use crate::cmd::layout::spinner;
 use crate::util::{print_json, write_atomic, UsageError};
-use ricci::atlas::FlatCharts;
+use ricci::atlas::{AffineAtlas, AtlasOptions, FlatCharts, Singularity as AtlasSingularity};
 use ricci::mesh::io::read_surface;
 use ricci::spline::dms::multi_indices;
 use ricci::spline::surface::{flat_domain, run as run_spline, MeshDistance, Singularity, SplineOptions};
@@ -41,6 +42,11 @@ pub struct Args {
     /// weight (e.g. 1e-3).
     #[arg(long)]
     pub fit: Option<f64>,
+    /// Chart provider: atlas (`ricci::atlas::AffineAtlas`: cone placed by least area
+    /// distortion) or local (`LocalCharts` on the flow's flat metric, cone at the vertex of
+    /// largest valence).
+    #[arg(long, default_value = "atlas")]
+    pub charts: String,
     /// Segments per domain edge in the tessellation.
     #[arg(long, default_value_t = 4)]
     pub tessellation: usize,
@@ -79,11 +85,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             UsageError(format!("--singularity must be auto or a vertex id, not '{v}'"))
         })?),
     };
+    let use_atlas = match a.charts.as_str() {
+        "atlas" => true,
+        "local" => false,
+        c => return Err(UsageError(format!("--charts must be atlas or local, not '{c}'")).into()),
+    };
     let (surface, _) = read_surface(&a.mesh)?;
     let mut bar = spinner(a.json);
     let t_ricci = Instant::now();
-    let dom = flat_domain(&surface, singularity, &mut bar)?;
-    let t_ricci = t_ricci.elapsed().as_secs_f64();
     let dist = MeshDistance::new(&surface.positions, surface.mesh.faces());
     let opts = SplineOptions {
         degree: a.degree,
@@ -91,8 +100,24 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         fit_smoothing: a.fit,
         ..SplineOptions::default()
     };
-    let (rep, tess, control) = run_spline(&dom.charts, &dist, &opts, a.tessellation, &mut bar)?;
+    let provider: Box<dyn FlatCharts + Sync> = if use_atlas {
+        let o = AtlasOptions {
+            singularity: match singularity {
+                Singularity::Auto => AtlasSingularity::Auto,
+                Singularity::Vertex(v) => AtlasSingularity::Vertex(v),
+            },
+            ..AtlasOptions::default()
+        };
+        Box::new(AffineAtlas::build(&surface, &o, &mut bar)?)
+    } else {
+        Box::new(flat_domain(&surface, singularity, &mut bar)?.charts)
+    };
+    let t_ricci = t_ricci.elapsed().as_secs_f64();
+    let charts: &(dyn FlatCharts + Sync) = provider.as_ref();
+    let (rep, tess, control) = run_spline(charts, &dist, &opts, a.tessellation, &mut bar)?;
     bar.0.finish_and_clear();
+    let topo = ricci::mesh::topology(&surface.mesh);
+    let singular: Option<u32> = charts.singular_vertices().first().copied();
     let mut out = json!({
         "file": a.mesh.display().to_string(),
         "degree": rep.degree,
@@ -107,12 +132,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "seconds": rep.seconds,
         "seconds_ricci": t_ricci,
         "seconds_total": 0.0,
-        "genus": dom.genus,
-        "boundary_loops": dom.boundary_loops,
-        "singular_vertex": dom.singular,
-        "added_vertices": dom.added_vertices,
-        "flow": {"iterations": dom.flow_iterations, "max_curvature_error": dom.flow_max_curvature_error, "converged": dom.flow_converged},
-        "charts": {"provider": "local", "count": dom.charts.n_charts()},
+        "genus": topo.genus(),
+        "boundary_loops": topo.boundary_loops(),
+        "singular_vertex": singular,
+        "added_vertices": charts.mesh().n_vertices() - surface.mesh.n_vertices(),
+        "charts": {"provider": a.charts, "count": charts.n_charts()},
         "space": rep.space,
         "fairing_report": rep.fairing,
         "fit": rep.fit,
@@ -136,7 +160,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         let side = json!({"face": tess.vertex_face, "chart": tess.vertex_chart});
         // control_net.obj: control points of the active triangles and their nets.
-        let mesh = dom.charts.mesh();
+        let mesh = charts.mesh();
         let n = rep.degree;
         let nb = (n + 1) * (n + 2) / 2;
         let betas = multi_indices(n);
@@ -146,7 +170,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let mut index = vec![0usize; mesh.n_faces()];
         let mut next = 1;
         for f in 0..mesh.n_faces() {
-            let active = mesh.face(f as u32).iter().all(|v| !dom.singular.is_some_and(|s| s == *v));
+            let active = mesh
+                .face(f as u32)
+                .iter()
+                .all(|v| !charts.singular_vertices().contains(v));
             if !active {
                 continue;
             }
