@@ -64,14 +64,18 @@ fn genus2_writes_the_surface_net_boundaries_and_report() {
         assert!(c["max_seam_normal_jump_deg"].as_f64().unwrap() <= 0.5);
         // Error against the input mesh: a cubic spline of a 16-segment surface stays within a
         // few percent of the diagonal.
-        assert!(v["max_error_percent"].as_f64().unwrap() < 5.0, "{charts}: {v}");
+        assert!(
+            v["max_error_percent"].as_f64().unwrap() < 5.0,
+            "{charts}: {v}"
+        );
         // The files, and the OBJ's vertex count matches the side JSON.
         let obj = std::fs::read_to_string(out.join("surface.obj")).unwrap();
         let nv = obj.lines().filter(|l| l.starts_with("v ")).count();
         assert!(obj.contains("g fill"));
-        let side: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(out.join("surface_vertices.json")).unwrap())
-                .unwrap();
+        let side: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(out.join("surface_vertices.json")).unwrap(),
+        )
+        .unwrap();
         assert_eq!(side["face"].as_array().unwrap().len(), nv);
         assert_eq!(side["chart"].as_array().unwrap().len(), nv);
         let net = std::fs::read_to_string(out.join("control_net.obj")).unwrap();
@@ -79,9 +83,12 @@ fn genus2_writes_the_surface_net_boundaries_and_report() {
             net.lines().filter(|l| l.starts_with("v ")).count() as u64,
             v["control_points"].as_u64().unwrap()
         );
-        assert!(std::fs::read_to_string(out.join("boundaries.obj")).unwrap().contains("\nl "));
+        assert!(std::fs::read_to_string(out.join("boundaries.obj"))
+            .unwrap()
+            .contains("\nl "));
         let rep: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(out.join("spline.json")).unwrap()).unwrap();
+            serde_json::from_str(&std::fs::read_to_string(out.join("spline.json")).unwrap())
+                .unwrap();
         assert_eq!(rep["control_points"], v["control_points"]);
     }
 }
@@ -91,7 +98,15 @@ fn torus_has_no_extraordinary_point() {
     let d = tmp("torus");
     let mesh = d.join("t.off");
     generate("torus", "24", &mesh);
-    let v = json(&ricci(&["spline", mesh.to_str().unwrap(), "--degree", "2", "--fairness", "0", "--json"]));
+    let v = json(&ricci(&[
+        "spline",
+        mesh.to_str().unwrap(),
+        "--degree",
+        "2",
+        "--fairness",
+        "0",
+        "--json",
+    ]));
     assert_eq!(v["genus"], 1);
     assert!(v["singular_vertex"].is_null());
     assert_eq!(v["active_faces"], v["domain_faces"]);
@@ -118,7 +133,14 @@ fn bad_arguments_and_bad_input() {
     }
     // A sphere has no flat metric with at most one cone: bad input, exit 1, one sentence.
     let s = d.join("s.off");
-    let o = ricci(&["generate", "sphere", "--subdivisions", "1", "--out", s.to_str().unwrap()]);
+    let o = ricci(&[
+        "generate",
+        "sphere",
+        "--subdivisions",
+        "1",
+        "--out",
+        s.to_str().unwrap(),
+    ]);
     assert!(o.status.success());
     let o = ricci(&["spline", s.to_str().unwrap(), "--charts", "local"]);
     assert_eq!(o.status.code(), Some(1));

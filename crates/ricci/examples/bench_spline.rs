@@ -41,9 +41,15 @@ fn main() {
         args.remove(i);
     }
     if args.is_empty() {
-        args = ["eight.off", "3holes.off", "fertility.off", "kitten.nf20k.off", "face.off"]
-            .map(String::from)
-            .to_vec();
+        args = [
+            "eight.off",
+            "3holes.off",
+            "fertility.off",
+            "kitten.nf20k.off",
+            "face.off",
+        ]
+        .map(String::from)
+        .to_vec();
     }
     println!("| mesh | g | N_f | N_c | T_ricci s | T_spline s | n | r | continuity | max jump order n−1 | seam jump ° | rms % | max % | knots s | fairing s | fit s | fill s |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
@@ -123,11 +129,39 @@ fn main() {
         match run(&dom.charts, &dist, &opts, 4, &mut NoProgress) {
             Ok((rep, tess, _)) => {
                 if std::env::var("SPLINE_DEBUG").is_ok() {
-                    let bad: Vec<usize> = tess.positions.iter().enumerate().filter(|(_, p)| p.iter().any(|x| !x.is_finite())).map(|(i, _)| i).collect();
-                    let infs: Vec<usize> = tess.positions.iter().enumerate().filter(|(_, p)| !dist.distance(**p).is_finite()).map(|(i, _)| i).collect();
-                    eprintln!("inf distance: {} e.g. {:?}", infs.len(), infs.first().map(|&i| tess.positions[i]));
-                    eprintln!("mesh verts 0 {:?} bbox {:?}", surface.positions[0], surface.bounding_box());
-                    eprintln!("non-finite: {} of {}; first faces {:?}", bad.len(), tess.positions.len(), bad.iter().take(5).map(|&i| tess.vertex_face[i]).collect::<Vec<_>>());
+                    let bad: Vec<usize> = tess
+                        .positions
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, p)| p.iter().any(|x| !x.is_finite()))
+                        .map(|(i, _)| i)
+                        .collect();
+                    let infs: Vec<usize> = tess
+                        .positions
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, p)| !dist.distance(**p).is_finite())
+                        .map(|(i, _)| i)
+                        .collect();
+                    eprintln!(
+                        "inf distance: {} e.g. {:?}",
+                        infs.len(),
+                        infs.first().map(|&i| tess.positions[i])
+                    );
+                    eprintln!(
+                        "mesh verts 0 {:?} bbox {:?}",
+                        surface.positions[0],
+                        surface.bounding_box()
+                    );
+                    eprintln!(
+                        "non-finite: {} of {}; first faces {:?}",
+                        bad.len(),
+                        tess.positions.len(),
+                        bad.iter()
+                            .take(5)
+                            .map(|&i| tess.vertex_face[i])
+                            .collect::<Vec<_>>()
+                    );
                 }
                 let n = rep.degree;
                 println!(

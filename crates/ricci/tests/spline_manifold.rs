@@ -95,7 +95,9 @@ fn check_chart_independence<A: FlatCharts + Sync>(
         let c0 = space.canonical_chart(f);
         for b in [SAMPLES[0], SAMPLES[2], SAMPLES[4]] {
             let mut base = vec![0.0; np * 3];
-            space.evaluate(control, 3, f, b, order, &mut ws, &mut base).unwrap();
+            space
+                .evaluate(control, 3, f, b, order, &mut ws, &mut base)
+                .unwrap();
             let scale: Vec<f64> = (0..=order)
                 .map(|k| {
                     (n_partials(k) - k - 1..n_partials(k))
@@ -129,7 +131,8 @@ fn check_chart_independence<A: FlatCharts + Sync>(
                 for k in 1..=order {
                     for i in n_partials(k) - k - 1..n_partials(k) {
                         for d in 0..3 {
-                            worst_d = worst_d.max((out[i * 3 + d] - base[i * 3 + d]).abs() / scale[k]);
+                            worst_d =
+                                worst_d.max((out[i * 3 + d] - base[i * 3 + d]).abs() / scale[k]);
                         }
                     }
                 }
@@ -137,8 +140,14 @@ fn check_chart_independence<A: FlatCharts + Sync>(
             }
         }
     }
-    assert!(worst_v <= 1e-10, "values differ between charts by {worst_v:.2e}");
-    assert!(worst_d <= 1e-6, "partials differ between charts by {worst_d:.2e}");
+    assert!(
+        worst_v <= 1e-10,
+        "values differ between charts by {worst_v:.2e}"
+    );
+    assert!(
+        worst_d <= 1e-6,
+        "partials differ between charts by {worst_d:.2e}"
+    );
     compared
 }
 
@@ -184,7 +193,12 @@ fn rotation_of_partials_matches_a_rotated_polynomial() {
         / (4.0 * h * h);
     let want = [f(u0[0], u0[1]), fx, fy, fxx, fxy, fyy];
     for k in 0..6 {
-        assert!((v[k] - want[k]).abs() < 1e-5 * (1.0 + want[k].abs()), "partial {k}: {} vs {}", v[k], want[k]);
+        assert!(
+            (v[k] - want[k]).abs() < 1e-5 * (1.0 + want[k].abs()),
+            "partial {k}: {} vs {}",
+            v[k],
+            want[k]
+        );
     }
 }
 
@@ -227,8 +241,12 @@ fn generated_genus2_partition_of_unity_charts_and_providers() {
         for bary in [SAMPLES[0], SAMPLES[1], SAMPLES[4]] {
             let mut x = vec![0.0; np * 3];
             let mut y = vec![0.0; np * 3];
-            space.evaluate(&control, 3, f, bary, 2, &mut ws, &mut x).unwrap();
-            space2.evaluate(&control, 3, f, bary, 2, &mut ws, &mut y).unwrap();
+            space
+                .evaluate(&control, 3, f, bary, 2, &mut ws, &mut x)
+                .unwrap();
+            space2
+                .evaluate(&control, 3, f, bary, 2, &mut ws, &mut y)
+                .unwrap();
             for d in 0..3 {
                 let mut col: Vec<f64> = (0..np).map(|k| y[k * 3 + d]).collect();
                 rotate_partials(2, m.rot, &mut col);
@@ -243,8 +261,14 @@ fn generated_genus2_partition_of_unity_charts_and_providers() {
             worst_d = worst_d.max((3..9).map(|i| (x[i] - y[i]).abs()).fold(0.0, f64::max) / s1);
         }
     }
-    assert!(worst < 1e-10 * s.diagonal(), "providers differ by {worst:.2e}");
-    assert!(worst_d < 1e-6, "first partials differ between providers by {worst_d:.2e}");
+    assert!(
+        worst < 1e-10 * s.diagonal(),
+        "providers differ by {worst:.2e}"
+    );
+    assert!(
+        worst_d < 1e-6,
+        "first partials differ between providers by {worst_d:.2e}"
+    );
 }
 
 #[test]
@@ -302,7 +326,10 @@ fn fairing_constraints_hold_on_the_manifold() {
         changes.push(rep.rms_change);
     }
     // More constraints, more change (paper 000 Fig. 13).
-    assert!(changes[0] < changes[1] && changes[1] < changes[2], "{changes:?}");
+    assert!(
+        changes[0] < changes[1] && changes[1] < changes[2],
+        "{changes:?}"
+    );
 }
 
 #[test]
@@ -314,7 +341,11 @@ fn fill_patch_meets_the_spline_g1() {
     let control = subdivided_and_faired(&space, 1);
     let hole = Hole::new(&space, &control, sv).unwrap();
     // Cone angle of 2πχ of curvature: Θ = 2π − 2πχ = 6π for genus 2.
-    assert!((hole.cone_angle - 6.0 * std::f64::consts::PI).abs() < 1e-8, "{}", hole.cone_angle);
+    assert!(
+        (hole.cone_angle - 6.0 * std::f64::consts::PI).abs() < 1e-8,
+        "{}",
+        hole.cone_angle
+    );
     assert!(hole.min_clearance > 0.0);
     let rep = hole.seam_normal_jump(&space, &control, 720).unwrap();
     assert!(rep.max_normal_jump_deg <= 0.5, "{rep:?}");
@@ -329,7 +360,9 @@ fn fill_patch_meets_the_spline_g1() {
         assert!(space.is_active(loc.face));
         let (c, _, _) = hole.seam_data(&space, &control, psi, &mut ws).unwrap();
         let mut out = [0.0; 3];
-        space.evaluate(&control, 3, loc.face, loc.bary, 0, &mut ws, &mut out).unwrap();
+        space
+            .evaluate(&control, 3, loc.face, loc.bary, 0, &mut ws, &mut out)
+            .unwrap();
         for k in 0..3 {
             assert!((c[k] - out[k]).abs() < 1e-9 * s.diagonal());
         }
@@ -357,7 +390,10 @@ fn end_to_end(name: &str, s: &Surface, dom: &FlatDomain, degree: usize, max_erro
     );
     assert!(rep.fairing.converged);
     assert!(rep.max_error_percent < max_error_percent, "{name}: {rep:?}");
-    assert!(tess.positions.iter().all(|p| p.iter().all(|x| x.is_finite())));
+    assert!(tess
+        .positions
+        .iter()
+        .all(|p| p.iter().all(|x| x.is_finite())));
     // Orders below n − 1 to 1e-8; order n − 1 to 1e-6 (rounding of the recurrence on thin
     // triangles, see CONTINUITY_TOLERANCE); order n jumps by O(1).
     for k in 0..n {
@@ -425,12 +461,17 @@ fn atlas_vs_local(s: &Surface, name: &str, stride: usize) {
         if !space.is_active(f) {
             continue;
         }
-        let (m, _) = ricci::atlas::fit_rigid(&space.canonical_coords(f), &space2.canonical_coords(f));
+        let (m, _) =
+            ricci::atlas::fit_rigid(&space.canonical_coords(f), &space2.canonical_coords(f));
         for bary in [SAMPLES[0], SAMPLES[3], SAMPLES[4]] {
             let mut x = vec![0.0; np * 3];
             let mut y = vec![0.0; np * 3];
-            space.evaluate(&control, 3, f, bary, 1, &mut ws, &mut x).unwrap();
-            space2.evaluate(&control, 3, f, bary, 1, &mut ws, &mut y).unwrap();
+            space
+                .evaluate(&control, 3, f, bary, 1, &mut ws, &mut x)
+                .unwrap();
+            space2
+                .evaluate(&control, 3, f, bary, 1, &mut ws, &mut y)
+                .unwrap();
             for d in 0..3 {
                 let mut col: Vec<f64> = (0..np).map(|k| y[k * 3 + d]).collect();
                 rotate_partials(1, m.rot, &mut col);
@@ -444,7 +485,10 @@ fn atlas_vs_local(s: &Surface, name: &str, stride: usize) {
         }
     }
     eprintln!("{name}: atlas vs local: values {worst:.2e}, partials {worst_d:.2e}");
-    assert!(worst < 1e-10 * s.diagonal(), "{name}: providers differ by {worst:.2e}");
+    assert!(
+        worst < 1e-10 * s.diagonal(),
+        "{name}: providers differ by {worst:.2e}"
+    );
     assert!(worst_d < 1e-6, "{name}: partials differ by {worst_d:.2e}");
     let holes: Vec<Hole> = atlas
         .singular_vertices()
@@ -452,7 +496,10 @@ fn atlas_vs_local(s: &Surface, name: &str, stride: usize) {
         .map(|&v| Hole::new(&space, &control, v).unwrap())
         .collect();
     let rep = continuity(&space, &control, &holes, 1e-6).unwrap();
-    eprintln!("{name}: atlas jumps {:?} seam {:.2e}°", rep.relative_jumps, rep.max_seam_normal_jump_deg);
+    eprintln!(
+        "{name}: atlas jumps {:?} seam {:.2e}°",
+        rep.relative_jumps, rep.max_seam_normal_jump_deg
+    );
     assert_eq!(rep.smoothness, Some(2), "{name}: {rep:?}");
     assert!(rep.max_seam_normal_jump_deg <= 0.5, "{name}: {rep:?}");
 }

@@ -19,7 +19,9 @@ use crate::util::{print_json, write_atomic, UsageError};
 use ricci::atlas::{AffineAtlas, AtlasOptions, FlatCharts, Singularity as AtlasSingularity};
 use ricci::mesh::io::read_surface;
 use ricci::spline::dms::multi_indices;
-use ricci::spline::surface::{flat_domain, run as run_spline, MeshDistance, Singularity, SplineOptions};
+use ricci::spline::surface::{
+    flat_domain, run as run_spline, MeshDistance, Singularity, SplineOptions,
+};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -72,7 +74,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .into());
     }
     if !(1..=64).contains(&a.tessellation) {
-        return Err(UsageError(format!("--tessellation {} is not in 1..=64", a.tessellation)).into());
+        return Err(UsageError(format!(
+            "--tessellation {} is not in 1..=64",
+            a.tessellation
+        ))
+        .into());
     }
     if let Some(l) = a.fit {
         if !(l >= 0.0 && l.is_finite()) {
@@ -82,7 +88,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let singularity = match a.singularity.as_str() {
         "auto" => Singularity::Auto,
         v => Singularity::Vertex(v.parse().map_err(|_| {
-            UsageError(format!("--singularity must be auto or a vertex id, not '{v}'"))
+            UsageError(format!(
+                "--singularity must be auto or a vertex id, not '{v}'"
+            ))
         })?),
     };
     let use_atlas = match a.charts.as_str() {
@@ -147,7 +155,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if let Some(dir) = &a.out {
         // surface.obj
         let mut s = String::new();
-        let _ = writeln!(s, "# ricci spline: degree {} fairness {} ({} spline + {} fill triangles)", rep.degree, rep.fairness, tess.spline_triangles, tess.triangles.len() - tess.spline_triangles);
+        let _ = writeln!(
+            s,
+            "# ricci spline: degree {} fairness {} ({} spline + {} fill triangles)",
+            rep.degree,
+            rep.fairness,
+            tess.spline_triangles,
+            tess.triangles.len() - tess.spline_triangles
+        );
         for p in &tess.positions {
             let _ = writeln!(s, "v {} {} {}", p[0], p[1], p[2]);
         }
@@ -166,7 +181,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let betas = multi_indices(n);
         let pos = |b: [usize; 3]| betas.iter().position(|x| *x == b);
         let mut c = String::new();
-        let _ = writeln!(c, "# ricci spline control net: {} control points", rep.control_points);
+        let _ = writeln!(
+            c,
+            "# ricci spline control net: {} control points",
+            rep.control_points
+        );
         let mut index = vec![0usize; mesh.n_faces()];
         let mut next = 1;
         for f in 0..mesh.n_faces() {
@@ -205,7 +224,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         // boundaries.obj
         let mut bo = String::new();
-        let _ = writeln!(bo, "# ricci spline patch boundaries: {} polylines", tess.boundaries.len());
+        let _ = writeln!(
+            bo,
+            "# ricci spline patch boundaries: {} polylines",
+            tess.boundaries.len()
+        );
         let mut vi = 1;
         for line in &tess.boundaries {
             for p in line {
@@ -218,10 +241,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         out["out"] = json!(dir.display().to_string());
         out["seconds_total"] = json!(t0.elapsed().as_secs_f64());
         write_atomic(&dir.join("surface.obj"), s.as_bytes())?;
-        write_atomic(&dir.join("surface_vertices.json"), serde_json::to_string(&side)?.as_bytes())?;
+        write_atomic(
+            &dir.join("surface_vertices.json"),
+            serde_json::to_string(&side)?.as_bytes(),
+        )?;
         write_atomic(&dir.join("control_net.obj"), c.as_bytes())?;
         write_atomic(&dir.join("boundaries.obj"), bo.as_bytes())?;
-        write_atomic(&dir.join("spline.json"), serde_json::to_string_pretty(&out)?.as_bytes())?;
+        write_atomic(
+            &dir.join("spline.json"),
+            serde_json::to_string_pretty(&out)?.as_bytes(),
+        )?;
     }
     out["seconds_total"] = json!(t0.elapsed().as_secs_f64());
     if a.json {

@@ -165,9 +165,11 @@ impl Hole {
                     let Some(wf) = space.vertex_frame(w) else {
                         continue;
                     };
-                    let Some((fw, cw, cu)) = wf.faces.iter().find_map(|(g, c)| {
-                        list.iter().find(|x| x.0 == *g).map(|x| (*g, *c, x.1))
-                    }) else {
+                    let Some((fw, cw, cu)) = wf
+                        .faces
+                        .iter()
+                        .find_map(|(g, c)| list.iter().find(|x| x.0 == *g).map(|x| (*g, *c, x.1)))
+                    else {
                         continue;
                     };
                     let _ = fw;

@@ -315,10 +315,8 @@ impl LocalCharts {
                         let i = h as usize % 3;
                         let j = t as usize % 3;
                         let c2 = develop_face(face_side_lengths(&mesh, &lengths, g2));
-                        let (m, _) = fit_rigid(
-                            &[c2[j], c2[(j + 1) % 3]],
-                            &[cg[(i + 1) % 3], cg[i]],
-                        );
+                        let (m, _) =
+                            fit_rigid(&[c2[j], c2[(j + 1) % 3]], &[cg[(i + 1) % 3], cg[i]]);
                         coords.insert(g2, c2.map(|p| apply(&m, p)));
                         queue.push_back(g2);
                     }
@@ -523,7 +521,9 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         }
         let frames: Vec<Option<StarFrame>> = (0..nv as u32)
             .into_par_iter()
-            .map(|v| (!is_sing[v as usize] && !mesh.is_isolated(v)).then(|| star_frame(mesh, lengths, v)))
+            .map(|v| {
+                (!is_sing[v as usize] && !mesh.is_isolated(v)).then(|| star_frame(mesh, lengths, v))
+            })
             .collect();
         let canon_dev: Vec<[Point; 3]> = (0..nf as u32)
             .map(|f| develop_face(face_side_lengths(mesh, lengths, f)))
@@ -538,7 +538,9 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
                     Error::input(format!("manifold spline: vertex {v} has no star"))
                 })?;
                 let c = fr.coords_of(f).ok_or_else(|| {
-                    Error::input(format!("manifold spline: face {f} missing in the star of {v}"))
+                    Error::input(format!(
+                        "manifold spline: face {f} missing in the star of {v}"
+                    ))
                 })?;
                 corner_motion[3 * f as usize + i] = fit_rigid(c, &canon_dev[f as usize]).0;
             }
@@ -555,7 +557,10 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
             for (_, c) in &fr.faces {
                 let area2 = det3(c[0], c[1], c[2]);
                 // altitude at v = 2A / opposite side; v is the corner at the origin
-                let i = c.iter().position(|p| p[0] == 0.0 && p[1] == 0.0).unwrap_or(0);
+                let i = c
+                    .iter()
+                    .position(|p| p[0] == 0.0 && p[1] == 0.0)
+                    .unwrap_or(0);
                 let (p, q) = (c[(i + 1) % 3], c[(i + 2) % 3]);
                 let opp = (p[0] - q[0]).hypot(p[1] - q[1]);
                 r = r.min(opts.spread * area2.abs() / opp);
@@ -920,15 +925,7 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         Ok(())
     }
 
-    fn push_basis(
-        &self,
-        i: u32,
-        w: Point,
-        dir: Point,
-        back: C,
-        order: usize,
-        ws: &mut Workspace,
-    ) {
+    fn push_basis(&self, i: u32, w: Point, dir: Point, back: C, order: usize, ws: &mut Workspace) {
         let n = self.degree;
         let nb = per_triangle(n);
         let np = n_partials(order);
@@ -952,7 +949,13 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
     /// All basis functions that may be non-zero at `u` (coordinates in the canonical chart of
     /// face `g`), values and partials up to `order` in that chart, as limits from inside `g`;
     /// written to `ws.indices` / `ws.values` like [`crate::spline::dms::DmsSpace::basis_at`].
-    pub fn basis_at_point(&self, g: u32, u: Point, order: usize, ws: &mut Workspace) -> Result<usize> {
+    pub fn basis_at_point(
+        &self,
+        g: u32,
+        u: Point,
+        order: usize,
+        ws: &mut Workspace,
+    ) -> Result<usize> {
         self.check_point(g, u)?;
         ws.indices.clear();
         ws.values.clear();
@@ -1033,7 +1036,16 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         ws: &mut Workspace,
         out: &mut [f64],
     ) -> Result<()> {
-        super::fit::evaluate(self, control, dim, g, self.face_point(g, bary), order, ws, out)
+        super::fit::evaluate(
+            self,
+            control,
+            dim,
+            g,
+            self.face_point(g, bary),
+            order,
+            ws,
+            out,
+        )
     }
 
     /// `F` and partials at the point `u` of face `g` given in chart `chart`, partials in that

@@ -110,7 +110,11 @@ pub fn flat_domain(
         };
         let g = genus as usize;
         let want = (4 * g + 4).max(8 * g - 2);
-        progress.report("valence", None, &format!("raising the valence of {s} to {want}"));
+        progress.report(
+            "valence",
+            None,
+            &format!("raising the valence of {s} to {want}"),
+        );
         // Raise the valence, then grade the neighbourhood (as the cut does) so that the rings
         // around the cone also pass the Chow–Luo check and the seam of the fill has room.
         let mean_spoke = mesh
@@ -151,7 +155,13 @@ pub fn flat_domain(
         )));
     }
     let added = m.n_vertices() - mesh.n_vertices();
-    let charts = LocalCharts::new(m, flow.lengths.clone(), p, singular.into_iter().collect(), None)?;
+    let charts = LocalCharts::new(
+        m,
+        flow.lengths.clone(),
+        p,
+        singular.into_iter().collect(),
+        None,
+    )?;
     Ok(FlatDomain {
         charts,
         genus,
@@ -591,8 +601,10 @@ pub fn tessellate<A: FlatCharts + Sync + ?Sized>(
         }
         for it in 0..nt - 1 {
             for j in 0..npsi {
-                t.triangles.push([at(it, j), at(it + 1, j), at(it + 1, j + 1)]);
-                t.triangles.push([at(it, j), at(it + 1, j + 1), at(it, j + 1)]);
+                t.triangles
+                    .push([at(it, j), at(it + 1, j), at(it + 1, j + 1)]);
+                t.triangles
+                    .push([at(it, j), at(it + 1, j + 1), at(it, j + 1)]);
             }
         }
         let mut seam: Vec<[f64; 3]> = rows[nt - 1].clone();
@@ -702,7 +714,8 @@ impl MeshDistance {
         let cell = (2.0 * mean).max(diagonal / 256.0).max(1e-300);
         let dims: [usize; 3] =
             std::array::from_fn(|k| (((hi[k] - lo[k]) / cell).floor() as usize + 1).min(512));
-        let cidx = |p: f64, k: usize| (((p - lo[k]) / cell).floor().max(0.0) as usize).min(dims[k] - 1);
+        let cidx =
+            |p: f64, k: usize| (((p - lo[k]) / cell).floor().max(0.0) as usize).min(dims[k] - 1);
         let ncell = dims[0] * dims[1] * dims[2];
         let mut count = vec![0u32; ncell + 1];
         let ranges: Vec<[usize; 6]> = tris
@@ -782,8 +795,11 @@ impl MeshDistance {
                         {
                             continue;
                         }
-                        let cell = (z as usize * self.dims[1] + y as usize) * self.dims[0] + x as usize;
-                        for &t in &self.items[self.start[cell] as usize..self.start[cell + 1] as usize] {
+                        let cell =
+                            (z as usize * self.dims[1] + y as usize) * self.dims[0] + x as usize;
+                        for &t in
+                            &self.items[self.start[cell] as usize..self.start[cell + 1] as usize]
+                        {
                             best = best.min(point_triangle_distance(p, &self.tris[t as usize]));
                         }
                     }
