@@ -17,7 +17,7 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
-fn generate(kind: &str, res: &str, path: &PathBuf) {
+fn generate(kind: &str, res: &str, path: &std::path::Path) {
     let o = ricci(&["generate", kind, "-n", res, "--out", path.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }

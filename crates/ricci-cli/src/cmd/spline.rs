@@ -203,8 +203,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             }
             next += nb;
         }
-        for f in 0..mesh.n_faces() {
-            if index[f] == 0 {
+        for &first in &index {
+            if first == 0 {
                 continue;
             }
             for (k, b) in betas.iter().enumerate() {
@@ -217,7 +217,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     q[from] -= 1;
                     q[to] += 1;
                     if let Some(j) = pos(q) {
-                        let _ = writeln!(c, "l {} {}", index[f] + k, index[f] + j);
+                        let _ = writeln!(c, "l {} {}", first + k, first + j);
                     }
                 }
             }

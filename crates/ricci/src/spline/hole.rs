@@ -45,6 +45,9 @@ pub struct Located {
     pub motion: RigidMotion,
 }
 
+/// Seam data at one `ψ`: `C(ψ)`, `D(ψ)` and the spline's partials `(S_X, S_Y)`.
+pub type SeamData = ([f64; 3], [f64; 3], [[f64; 3]; 2]);
+
 /// The hole around one cone vertex, its seam and the fill patch.
 #[derive(Debug, Clone)]
 pub struct Hole {
@@ -367,7 +370,7 @@ impl Hole {
         control: &[f64],
         psi: f64,
         ws: &mut Workspace,
-    ) -> Result<([f64; 3], [f64; 3], [[f64; 3]; 2])> {
+    ) -> Result<SeamData> {
         let phi = self.cone_angle * psi / (2.0 * PI);
         let r = self.radius(psi);
         let loc = self.locate(r, phi).ok_or_else(|| {
