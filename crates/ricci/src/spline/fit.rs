@@ -1,4 +1,5 @@
-//! Fairing and fitting of DMS splines (paper 000 §5).
+//! Fairing and fitting of DMS splines (paper 000 §5), generic over [`SplineSpace`]: the planar
+//! [`DmsSpace`] and the manifold space of [`crate::spline::manifold`].
 //!
 //! **Fairing** (paper 000 eq. 14, Fig. 13). Given control points `c`, find `c̃` minimising
 //! `Σ ‖c̃_{I,β} − c_{I,β}‖²` subject to, for every interior edge shared by triangles `I` and
