@@ -517,8 +517,8 @@ fn affine_atlas_real_meshes() {
 }
 
 #[test]
-fn local_charts_genus3_meshes() {
-    for name in ["3holes.off", "genus3.off"] {
+fn local_charts_genus3_and_4_meshes() {
+    for name in ["3holes.off", "genus3.off", "fertility.off"] {
         let Some(s) = load(name) else { return };
         let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
         let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();

@@ -8,8 +8,10 @@
 //! `s` has unrolled coordinates `ρ e^{iφ}`.
 //!
 //! **Seam.** A smooth closed curve `ρ = R(ψ)`, `φ = Θψ/2π`, `ψ ∈ [0, 2π)`, just outside the
-//! link of `s` (so inside the spline's domain): `R` is a truncated Fourier series of the link's
-//! radial function `r_link(φ)`, raised until it exceeds `r_link` everywhere by a margin. The
+//! link of `s` (so inside the spline's domain): `ln R` is a truncated Fourier series of the
+//! logarithm of the link's radial function `r_link(φ)` (the flat metric of a strong cone
+//! varies over orders of magnitude around it), raised until `R` exceeds `r_link` everywhere by
+//! a relative margin. The
 //! seam is checked to lie in active faces near the link (the stars of the link vertices and two
 //! more rings of stars, developed into the unrolled cone); otherwise construction fails naming
 //! `s` (a very irregular neighbourhood).
@@ -60,7 +62,7 @@ pub struct Hole {
     link: Vec<Point>,
     /// Candidate active faces per sector, with unrolled coordinates.
     sector_faces: Vec<Vec<(u32, [Point; 3], RigidMotion)>>,
-    /// Seam radius: `R(ψ) = a₀ + Σ a_k cos kψ + b_k sin kψ + shift`.
+    /// Seam radius: `ln R(ψ) = a₀ + Σ a_k cos kψ + b_k sin kψ + shift`.
     fourier: Vec<(f64, f64)>,
     shift: f64,
     /// Centre of the fill and its tangent directions (3 coordinates each).
@@ -210,7 +212,6 @@ impl Hole {
         let rl: Vec<f64> = (0..M)
             .map(|j| hole.r_link(theta * j as f64 / M as f64))
             .collect();
-        let mean_r = rl.iter().sum::<f64>() / M as f64;
         let mut last_err = String::new();
         'outer: for harmonics in [d.min(24), d.min(12), d.min(6), 3] {
             let mut fourier = Vec::with_capacity(harmonics + 1);
@@ -218,8 +219,8 @@ impl Hole {
                 let (mut a, mut b) = (0.0, 0.0);
                 for (j, r) in rl.iter().enumerate() {
                     let psi = 2.0 * PI * j as f64 / M as f64;
-                    a += r * (h as f64 * psi).cos();
-                    b += r * (h as f64 * psi).sin();
+                    a += r.ln() * (h as f64 * psi).cos();
+                    b += r.ln() * (h as f64 * psi).sin();
                 }
                 let w = if h == 0 { 1.0 } else { 2.0 } / M as f64;
                 fourier.push((a * w, b * w));
@@ -228,10 +229,10 @@ impl Hole {
             hole.shift = 0.0;
             let mut over = f64::NEG_INFINITY;
             for (j, r) in rl.iter().enumerate() {
-                over = over.max(r - hole.radius(2.0 * PI * j as f64 / M as f64));
+                over = over.max(r.ln() - hole.radius(2.0 * PI * j as f64 / M as f64).ln());
             }
             'margin: for margin in [0.06, 0.03, 0.015] {
-                hole.shift = over + margin * mean_r;
+                hole.shift = over + margin;
                 // Check: seam outside the link and inside active faces.
                 let mut clearance = f64::INFINITY;
                 for (j, r) in rl.iter().enumerate() {
@@ -310,7 +311,7 @@ impl Hole {
                 r += a * (h as f64 * psi).cos() + b * (h as f64 * psi).sin();
             }
         }
-        r
+        r.exp()
     }
 
     /// Locate the point with cone polar coordinates `(rho, phi)` in an active face.
