@@ -510,8 +510,8 @@ fn affine_atlas_generated_genus2() {
 
 #[test]
 fn affine_atlas_real_meshes() {
-    // 3holes.off over the atlas is not here: its partition of unity fails (see the report);
-    // kitten over the atlas takes minutes (the fairing does not converge quickly there).
+    // 3holes.off and kitten over the atlas are not here: the fairing on the atlas's metric
+    // does not converge quickly there (minutes; see BENCHMARKS.md).
     let Some(s) = load("eight.off") else { return };
     atlas_vs_local(&s, "eight.off", 11);
 }

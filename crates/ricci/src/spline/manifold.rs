@@ -419,7 +419,7 @@ pub struct ManifoldSpace<'a, A: FlatCharts + Sync + ?Sized> {
     canon_coords: Vec<[Point; 3]>,
     /// Candidates of each face: `(I, motion canon(g) → home(I))`.
     cand_start: Vec<u32>,
-    cand: Vec<(u32, RigidMotion)>,
+    cand: Vec<(u32, RigidMotion, [Point; 3])>,
     report: ManifoldReport,
 }
 
@@ -713,7 +713,10 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
                 })?;
                 let mut clouds: Vec<Vec<Point>> = Vec::with_capacity(3);
                 let mut worst = 0.0f64;
-                for v in mesh.face(f) {
+                let own = charts.face_coords(h, f).ok_or_else(|| {
+                    Error::input(format!("manifold spline: face {f} is not in its home chart {h}"))
+                })?;
+                for (corner, v) in mesh.face(f).into_iter().enumerate() {
                     let fr = frames[v as usize].as_ref().ok_or_else(|| {
                         Error::input(format!("manifold spline: vertex {v} has no star"))
                     })?;
@@ -744,12 +747,15 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
                             "manifold spline: home chart {h} of face {f} is not a consistent development of the star of vertex {v} (residual {res:.2e} relative to {size:.2e})"
                         )));
                     }
-                    clouds.push(
-                        knots[v as usize * (n + 1)..(v as usize + 1) * (n + 1)]
-                            .iter()
-                            .map(|&p| apply(&m, p))
-                            .collect(),
-                    );
+                    // t_{v,0} = v exactly as the chart places it (the fitted motion is off by
+                    // the chart's rounding), so that points at vertices and on edges, which are
+                    // mapped through the same chart coordinates, land exactly on knot lines.
+                    let mut cl: Vec<Point> = knots[v as usize * (n + 1)..(v as usize + 1) * (n + 1)]
+                        .iter()
+                        .map(|&p| apply(&m, p))
+                        .collect();
+                    cl[0] = own[corner];
+                    clouds.push(cl);
                 }
                 let basis = TriangleBasis::new(n, [&clouds[0], &clouds[1], &clouds[2]])
                     .map_err(|e| Error::input(format!("manifold spline, face {f}: {e}")))?;
@@ -801,9 +807,10 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
                 ))
             })?;
         }
-        let cands: Vec<Vec<(u32, RigidMotion)>> = (0..nf as u32)
+        #[allow(clippy::type_complexity)]
+        let cands: Vec<Vec<(u32, RigidMotion, [Point; 3])>> = (0..nf as u32)
             .into_par_iter()
-            .map(|g| -> Result<Vec<(u32, RigidMotion)>> {
+            .map(|g| -> Result<Vec<(u32, RigidMotion, [Point; 3])>> {
                 if !active[g as usize] {
                     return Ok(Vec::new());
                 }
@@ -825,7 +832,7 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
                                 "manifold spline: face {g} shares a vertex with face {i} but is not in its home chart {hc}"
                             ))
                         })?;
-                        Ok((i, fit_rigid(&canon_coords[g as usize], &b).0))
+                        Ok((i, fit_rigid(&canon_coords[g as usize], &b).0, b))
                     })
                     .collect()
             })
@@ -972,9 +979,21 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
             self.cand_start[g as usize] as usize,
             self.cand_start[g as usize + 1] as usize,
         );
+        // Barycentric coordinates of u in g (exact at g's corners), so that the point is placed
+        // in each home chart from g's own corners there rather than by a fitted motion.
+        let area = det3(c[0], c[1], c[2]);
+        let bary = [
+            det3(u, c[1], c[2]) / area,
+            det3(c[0], u, c[2]) / area,
+            det3(c[0], c[1], u) / area,
+        ];
         for k in a..b {
-            let (i, m) = self.cand[k];
-            self.push_basis(i, apply(&m, u), rotate(m.rot, dir), m.rot, order, ws);
+            let (i, m, x) = self.cand[k];
+            let w = [
+                bary[0] * x[0][0] + bary[1] * x[1][0] + bary[2] * x[2][0],
+                bary[0] * x[0][1] + bary[1] * x[1][1] + bary[2] * x[2][1],
+            ];
+            self.push_basis(i, w, rotate(m.rot, dir), m.rot, order, ws);
         }
         Ok(ws.indices.len())
     }
