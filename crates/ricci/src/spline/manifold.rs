@@ -1154,14 +1154,26 @@ impl<A: FlatCharts + Sync + ?Sized> SplineSpace for ManifoldSpace<'_, A> {
             out.fill(0.0);
             return;
         };
-        let args = bi.blossom_args(beta);
         // Home chart of I → home chart of J, on face I (which shares an edge with J).
         let m = self
             .charts
             .transition(self.home[i as usize], self.home[j as usize], i)
             .map(|x| x.0)
             .unwrap_or(RigidMotion::new(0.0, C::new(0.0, 0.0)));
-        let mapped: Vec<Point> = args.iter().map(|&p| apply(&m, p)).collect();
+        // Knots of the shared vertices are taken from J's own clouds (the same knots, without
+        // the charts' rounding), the others are mapped; arguments are in blossom_args order.
+        let mesh = self.charts.mesh();
+        let (ti, tj) = (mesh.face(i), mesh.face(j));
+        let mut mapped: Vec<Point> = Vec::with_capacity(self.degree);
+        for (mi, &bm) in beta.iter().enumerate() {
+            let mj = tj.iter().position(|&v| v == ti[mi]);
+            for k in 0..bm {
+                mapped.push(match mj {
+                    Some(mj) => bj.knot(mj, k),
+                    None => apply(&m, bi.knot(mi, k)),
+                });
+            }
+        }
         bj.blossom_weights(&mapped, out);
     }
     fn basis_at(&self, face: u32, param: Point, order: usize, ws: &mut Workspace) -> Result<usize> {
