@@ -40,6 +40,8 @@ enum Command {
     Demo(cmd::demo::Args),
     /// Affine atlas with a single extraordinary point (flat cone metric, charts, transitions).
     Atlas(cmd::atlas::Args),
+    /// Manifold triangular B-spline surface with at most one extraordinary point.
+    Spline(cmd::spline::Args),
 }
 
 fn main() {
@@ -55,6 +57,7 @@ fn main() {
         Command::Spectrum(a) => cmd::spectrum::run(a),
         Command::Demo(a) => cmd::demo::run(a),
         Command::Atlas(a) => cmd::atlas::run(a),
+        Command::Spline(a) => cmd::spline::run(a),
     };
     if let Err(e) = result {
         eprintln!("error: {}", util::sentence(&e));

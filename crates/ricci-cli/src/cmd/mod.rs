@@ -9,3 +9,4 @@ pub mod info;
 pub mod layout;
 pub mod render;
 pub mod spectrum;
+pub mod spline;

@@ -178,14 +178,14 @@ pub struct KnotClouds {
     knots: Vec<Point>,
 }
 
-fn hash64(mut x: u64) -> u64 {
+pub(crate) fn hash64(mut x: u64) -> u64 {
     // splitmix64
     x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
     x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     x ^ (x >> 31)
 }
-fn unit(x: u64) -> f64 {
+pub(crate) fn unit(x: u64) -> f64 {
     (hash64(x) >> 11) as f64 / (1u64 << 53) as f64
 }
 
@@ -433,7 +433,7 @@ pub fn general_position(knots: &[Point]) -> f64 {
 /// Smallest [`triple_quality`] over the triples whose first knot is in `0..prefix` (i.e. all
 /// triples with at least one knot there). Stops as soon as the result is known to be
 /// `≤ floor`. Works with squared qualities (no square roots in the loop).
-fn general_position_involving(knots: &[Point], prefix: usize, floor: f64) -> f64 {
+pub(crate) fn general_position_involving(knots: &[Point], prefix: usize, floor: f64) -> f64 {
     let floor2 = floor * floor;
     let mut worst2 = f64::INFINITY;
     let k = knots.len();
@@ -874,8 +874,8 @@ impl Grid {
 /// Scratch space for evaluations (reuse it: evaluation does not allocate once it is warm).
 #[derive(Debug, Default, Clone)]
 pub struct Workspace {
-    simplex: Vec<f64>,
-    local: Vec<f64>,
+    pub(crate) simplex: Vec<f64>,
+    pub(crate) local: Vec<f64>,
     /// Global control-point indices of the basis functions found by [`DmsSpace::basis_at`].
     pub indices: Vec<u32>,
     /// Their values and partials, `n_partials(order)` per function.

@@ -1,4 +1,5 @@
-//! Fairing and fitting of DMS splines (paper 000 §5).
+//! Fairing and fitting of DMS splines (paper 000 §5), generic over [`SplineSpace`]: the planar
+//! [`DmsSpace`] and the manifold space of [`crate::spline::manifold`].
 //!
 //! **Fairing** (paper 000 eq. 14, Fig. 13). Given control points `c`, find `c̃` minimising
 //! `Σ ‖c̃_{I,β} − c_{I,β}‖²` subject to, for every interior edge shared by triangles `I` and
@@ -32,6 +33,126 @@ use crate::error::{Error, Result};
 use super::dms::{multi_indices, DmsSpace, Workspace};
 use super::simplex::{n_partials, Point};
 
+/// What the fairing and the fit need from a spline space: the planar [`DmsSpace`] and the
+/// manifold space of [`crate::spline::manifold`] both provide it. Control points are indexed
+/// `triangle * per_triangle + position of β`; a *parameter point* is whatever the space uses
+/// to name a point of a triangle (the domain point for [`DmsSpace`], the coordinates in the
+/// face's canonical chart for a manifold space), and derivatives are taken in an orthonormal
+/// frame of that parametrisation.
+pub trait SplineSpace: Sync {
+    fn degree(&self) -> usize;
+    /// Number of triangles (control points are stored for all of them; inactive triangles
+    /// carry control points that no basis function uses).
+    fn n_triangles(&self) -> usize;
+    fn per_triangle(&self) -> usize {
+        super::dms::per_triangle(self.degree())
+    }
+    fn n_control_points(&self) -> usize {
+        self.n_triangles() * self.per_triangle()
+    }
+    /// Ordered pairs `(I, J, o)` of triangles of the spline that share an edge, `o` the local
+    /// index of `I`'s vertex opposite the edge (both orientations of every edge).
+    fn neighbour_pairs(&self) -> Vec<(u32, u32, usize)>;
+    /// Blossom weights of `J`'s control points at the blossom arguments of `I`'s control point
+    /// `β` (both expressed in one coordinate system).
+    fn blossom_weights_between(&self, i: u32, beta: [usize; 3], j: u32, out: &mut [f64]);
+    /// All basis functions that may be non-zero at `param` in triangle `face`, with partials
+    /// up to `order` (see [`DmsSpace::basis_at`]).
+    fn basis_at(&self, face: u32, param: Point, order: usize, ws: &mut Workspace) -> Result<usize>;
+    /// Quadrature of the thin-plate energy: `(face, parameter point, weight)`.
+    fn quadrature(&self) -> Vec<(u32, Point, f64)>;
+    /// Mean edge length and total area of the parameter domain (to make `λ` scale-free).
+    fn domain_scale(&self) -> (f64, f64);
+}
+
+impl SplineSpace for DmsSpace {
+    fn degree(&self) -> usize {
+        DmsSpace::degree(self)
+    }
+    fn n_triangles(&self) -> usize {
+        self.domain().n_faces()
+    }
+    fn neighbour_pairs(&self) -> Vec<(u32, u32, usize)> {
+        let mesh = self.domain().mesh();
+        let mut out = Vec::new();
+        for h in 0..mesh.n_corners() as u32 {
+            let t = mesh.he_twin(h);
+            if mesh.is_boundary_halfedge(t) {
+                continue;
+            }
+            out.push((h / 3, t / 3, (h as usize % 3 + 2) % 3));
+        }
+        out
+    }
+    fn blossom_weights_between(&self, i: u32, beta: [usize; 3], j: u32, out: &mut [f64]) {
+        let args = self.triangle(i).blossom_args(beta);
+        self.triangle(j).blossom_weights(&args, out);
+    }
+    fn basis_at(&self, face: u32, param: Point, order: usize, ws: &mut Workspace) -> Result<usize> {
+        DmsSpace::basis_at(self, face, param, order, ws)
+    }
+    fn quadrature(&self) -> Vec<(u32, Point, f64)> {
+        quadrature(self)
+    }
+    fn domain_scale(&self) -> (f64, f64) {
+        let dom = self.domain();
+        let mesh = dom.mesh();
+        let mut hsum = 0.0;
+        for e in 0..mesh.n_edges() as u32 {
+            let [a, b] = mesh.edge_vertices(e).map(|v| dom.points()[v as usize]);
+            hsum += (a[0] - b[0]).hypot(a[1] - b[1]);
+        }
+        let area: f64 = (0..dom.n_faces() as u32)
+            .map(|f| {
+                let [a, b, c] = dom.face_points(f);
+                0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+            })
+            .sum();
+        (hsum / mesh.n_edges().max(1) as f64, area)
+    }
+}
+
+/// `F = Σ c N` and its partials up to `order` at a parameter point of any [`SplineSpace`]
+/// (`out[k * dim + d]`, see [`DmsSpace::evaluate`]).
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate<S: SplineSpace + ?Sized>(
+    space: &S,
+    control: &[f64],
+    dim: usize,
+    face: u32,
+    param: Point,
+    order: usize,
+    ws: &mut Workspace,
+    out: &mut [f64],
+) -> Result<()> {
+    let np = n_partials(order);
+    if control.len() != space.n_control_points() * dim || out.len() < np * dim {
+        return Err(Error::input(format!(
+            "spline evaluation: {} control numbers for {} control points of dimension {dim}, output of {} for {} numbers",
+            control.len(),
+            space.n_control_points(),
+            out.len(),
+            np * dim
+        )));
+    }
+    out[..np * dim].fill(0.0);
+    let m = space.basis_at(face, param, order, ws)?;
+    for i in 0..m {
+        let g = ws.indices[i] as usize;
+        let vals = &ws.values[i * np..(i + 1) * np];
+        let c = &control[g * dim..(g + 1) * dim];
+        for k in 0..np {
+            let v = vals[k];
+            if v != 0.0 {
+                for d in 0..dim {
+                    out[k * dim + d] += v * c[d];
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 /// One fairing constraint `c̃[single] − Σ_b weights[b] c̃[target * nb + b] = 0`.
 #[derive(Debug, Clone)]
 pub struct Constraint {
@@ -45,7 +166,10 @@ pub struct Constraint {
 
 /// The constraints of paper 000 eq. 14 for fairness parameter `r` (`0 ≤ r ≤ n − 1`), for
 /// both orientations of every interior edge (the shared-control-point rows, `β_o = 0`, once).
-pub fn fairness_constraints(space: &DmsSpace, r: usize) -> Result<Vec<Constraint>> {
+pub fn fairness_constraints<S: SplineSpace + ?Sized>(
+    space: &S,
+    r: usize,
+) -> Result<Vec<Constraint>> {
     let n = space.degree();
     if r >= n {
         return Err(Error::input(format!(
@@ -53,18 +177,9 @@ pub fn fairness_constraints(space: &DmsSpace, r: usize) -> Result<Vec<Constraint
             n - 1
         )));
     }
-    let mesh = space.domain().mesh();
     let nb = space.per_triangle();
     let mut out = Vec::new();
-    for h in 0..mesh.n_corners() as u32 {
-        let t = mesh.he_twin(h);
-        if mesh.is_boundary_halfedge(t) {
-            continue;
-        }
-        let (fi, fj) = (h / 3, t / 3);
-        let o = (h as usize % 3 + 2) % 3; // vertex of I opposite the edge
-        let bi = space.triangle(fi);
-        let bj = space.triangle(fj);
+    for (fi, fj, o) in space.neighbour_pairs() {
         for (k, beta) in multi_indices(n).into_iter().enumerate() {
             if beta[o] > r {
                 continue;
@@ -75,9 +190,8 @@ pub fn fairness_constraints(space: &DmsSpace, r: usize) -> Result<Vec<Constraint
             if beta[o] == 0 && fi > fj {
                 continue;
             }
-            let args = bi.blossom_args(beta);
             let mut w = vec![0.0; nb];
-            bj.blossom_weights(&args, &mut w);
+            space.blossom_weights_between(fi, beta, fj, &mut w);
             out.push(Constraint {
                 single: (fi as usize * nb + k) as u32,
                 target: fj,
@@ -89,8 +203,8 @@ pub fn fairness_constraints(space: &DmsSpace, r: usize) -> Result<Vec<Constraint
 }
 
 /// Residuals `A c` of the constraints (`dim` numbers per constraint).
-pub fn constraint_residuals(
-    space: &DmsSpace,
+pub fn constraint_residuals<S: SplineSpace + ?Sized>(
+    space: &S,
     cons: &[Constraint],
     control: &[f64],
     dim: usize,
@@ -128,8 +242,8 @@ pub struct FairingReport {
 }
 
 /// Paper 000's fairing (module docs) of control points with `dim` coordinates each.
-pub fn fair(
-    space: &DmsSpace,
+pub fn fair<S: SplineSpace + ?Sized>(
+    space: &S,
     control: &[f64],
     dim: usize,
     r: usize,
@@ -166,7 +280,7 @@ pub fn fair(
     }
     // Rows touching each triangle's control points (as target) and rows whose single lies in
     // each triangle.
-    let nf = space.domain().n_faces();
+    let nf = space.n_triangles();
     let mut by_target: Vec<Vec<u32>> = vec![Vec::new(); nf];
     let mut by_single_face: Vec<Vec<u32>> = vec![Vec::new(); nf];
     let mut by_single: HashMap<u32, Vec<u32>> = HashMap::new();
@@ -529,12 +643,16 @@ fn quadrature(space: &DmsSpace) -> Vec<(u32, Point, f64)> {
 }
 
 /// Thin-plate energy of a spline (the quadrature of [`fit`]).
-pub fn thin_plate_energy(space: &DmsSpace, control: &[f64], dim: usize) -> Result<f64> {
+pub fn thin_plate_energy<S: SplineSpace + ?Sized>(
+    space: &S,
+    control: &[f64],
+    dim: usize,
+) -> Result<f64> {
     let mut ws = Workspace::default();
     let mut out = vec![0.0; n_partials(2) * dim];
     let mut e = 0.0;
-    for (f, u, w) in quadrature(space) {
-        space.evaluate(control, dim, f, u, 2, &mut ws, &mut out)?;
+    for (f, u, w) in space.quadrature() {
+        evaluate(space, control, dim, f, u, 2, &mut ws, &mut out)?;
         for d in 0..dim {
             let (xx, xy, yy) = (out[3 * dim + d], out[4 * dim + d], out[5 * dim + d]);
             e += w * (xx * xx + 2.0 * xy * xy + yy * yy);
@@ -545,8 +663,8 @@ pub fn thin_plate_energy(space: &DmsSpace, control: &[f64], dim: usize) -> Resul
 
 /// Least-squares fit of the control points to data with a thin-plate fairness term (module
 /// docs). `initial` (`dim` per control point) is the ridge's anchor.
-pub fn fit(
-    space: &DmsSpace,
+pub fn fit<S: SplineSpace + ?Sized>(
+    space: &S,
     data: &[DataPoint],
     initial: &[f64],
     dim: usize,
@@ -563,7 +681,7 @@ pub fn fit(
     if data.is_empty() {
         return Err(Error::input("fit: no data points"));
     }
-    let nf = space.domain().n_faces() as u32;
+    let nf = space.n_triangles() as u32;
     for (k, p) in data.iter().enumerate() {
         if p.face >= nf
             || p.target.len() != dim
@@ -581,20 +699,7 @@ pub fn fit(
         return Err(Error::input("fit: smoothing must be ≥ 0 and ridge > 0"));
     }
     // Scale of the energy term.
-    let dom = space.domain();
-    let mesh = dom.mesh();
-    let mut hsum = 0.0;
-    for e in 0..mesh.n_edges() as u32 {
-        let [a, b] = mesh.edge_vertices(e).map(|v| dom.points()[v as usize]);
-        hsum += (a[0] - b[0]).hypot(a[1] - b[1]);
-    }
-    let hbar = hsum / mesh.n_edges() as f64;
-    let area: f64 = (0..nf)
-        .map(|f| {
-            let [a, b, c] = dom.face_points(f);
-            0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
-        })
-        .sum();
+    let (hbar, area) = space.domain_scale();
     let kdata = data.len() as f64;
     let lam = opts.smoothing * hbar * hbar / area;
 
@@ -613,7 +718,7 @@ pub fn fit(
         }
     }
     let np2 = n_partials(2);
-    for (f, u, w) in quadrature(space) {
+    for (f, u, w) in space.quadrature() {
         let m = space.basis_at(f, u, 2, &mut ws)?;
         energy_blocks.add_point(
             &ws.indices[..m],
@@ -735,7 +840,7 @@ pub fn fit(
         errs.clear();
         let mut s = 0.0;
         for p in data {
-            space.evaluate(c, dim, p.face, p.param, 0, ws, out)?;
+            evaluate(space, c, dim, p.face, p.param, 0, ws, out)?;
             let d2: f64 = (0..dim).map(|d| (out[d] - p.target[d]).powi(2)).sum();
             errs.push(d2.sqrt());
             s += d2;

@@ -6,12 +6,21 @@
 //! * [`dms`] — the DMS basis over a planar triangulation: knot clouds, admissibility, evaluation
 //!   of splines and derivatives, control points of polynomials, B-patch blossoms;
 //! * [`fit`] — paper 000's fairing by constrained least squares (fairness parameter `r`) and a
-//!   least-squares fit to data with a thin-plate fairness term.
+//!   least-squares fit to data with a thin-plate fairness term, generic over [`fit::SplineSpace`];
+//! * [`manifold`] — the same basis over a flat cone metric and its charts (paper 000 §5): knots
+//!   in vertex frames, bases in home charts, chart-independent evaluation, the independent chart
+//!   provider [`manifold::LocalCharts`];
+//! * [`hole`] — the seam around the extraordinary point and the G¹ fill patch;
+//! * [`surface`] — the whole construction (subdivision, fairing, fit, fill), tessellation,
+//!   errors against the input mesh and continuity measurements.
 
 // Negated comparisons are deliberate: they also reject NaN. Index loops mirror the formulas.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
 pub mod dms;
 pub mod fit;
+pub mod hole;
+pub mod manifold;
 pub mod poly;
 pub mod simplex;
+pub mod surface;

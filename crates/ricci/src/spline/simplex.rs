@@ -41,7 +41,7 @@ use crate::error::{Error, Result};
 pub type Point = [f64; 2];
 
 /// Points closer than this fraction of the knot-set diameter to a knot line are on the line.
-const ON_LINE_REL: f64 = 1e-14;
+const ON_LINE_REL: f64 = 1e-11;
 
 #[inline]
 fn sub(a: Point, b: Point) -> Point {

@@ -1,0 +1,274 @@
+//! `ricci spline MESH [--degree N] [--fairness R] [--singularity auto|V] [--fit LAMBDA]
+//! [--tessellation M] [--out DIR] [--json]`: a manifold triangular B-spline surface with at most
+//! one extraordinary point (paper 000 §5).
+//!
+//! The flat metric and charts come from the affine atlas (`--charts atlas`, default:
+//! `ricci::atlas::AffineAtlas`, cone placed by least area distortion) or from the spline's own
+//! provider (`--charts local`: the flow's flat metric — genus 1 uniform, open free boundary,
+//! genus ≥ 2 one cone at the vertex of largest valence after raising its valence — developed by
+//! `ricci::spline::manifold::LocalCharts`). Then the subdivision control points, the fairing with
+//! parameter `r`, optionally the least-squares fit to the mesh vertices, and the G¹ fill patch
+//! at the cone. `--out DIR` writes `surface.obj` (tessellation; the fill patch is group
+//! `fill`), `surface_vertices.json` (per tessellation vertex: domain face and chart, −1 on the
+//! fill), `control_net.obj` (control points and the net of every domain triangle),
+//! `boundaries.obj` (images of the domain edges and the seams as polylines) and
+//! `spline.json` (the report).
+
+use crate::cmd::layout::spinner;
+use crate::util::{print_json, write_atomic, UsageError};
+use ricci::atlas::{AffineAtlas, AtlasOptions, FlatCharts, Singularity as AtlasSingularity};
+use ricci::mesh::io::read_surface;
+use ricci::spline::dms::multi_indices;
+use ricci::spline::surface::{
+    flat_domain, run as run_spline, MeshDistance, Singularity, SplineOptions,
+};
+use serde_json::json;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Mesh file (OBJ, OFF, PLY, STL).
+    pub mesh: PathBuf,
+    /// Spline degree n (2..=5).
+    #[arg(long, default_value_t = 3)]
+    pub degree: usize,
+    /// Fairness parameter r (0 ≤ r ≤ n − 1; paper 000 eq. 14).
+    #[arg(long, default_value_t = 1)]
+    pub fairness: usize,
+    /// Singular vertex of a closed surface of genus ≥ 2: auto (largest valence) or a vertex id.
+    #[arg(long, default_value = "auto")]
+    pub singularity: String,
+    /// After the fairing, fit the control points to the mesh vertices with this thin-plate
+    /// weight (e.g. 1e-3).
+    #[arg(long)]
+    pub fit: Option<f64>,
+    /// Chart provider: atlas (`ricci::atlas::AffineAtlas`: cone placed by least area
+    /// distortion) or local (`LocalCharts` on the flow's flat metric, cone at the vertex of
+    /// largest valence).
+    #[arg(long, default_value = "atlas")]
+    pub charts: String,
+    /// Segments per domain edge in the tessellation.
+    #[arg(long, default_value_t = 4)]
+    pub tessellation: usize,
+    /// Output directory.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let t0 = Instant::now();
+    if !(2..=5).contains(&a.degree) {
+        return Err(UsageError(format!("--degree {} is not in 2..=5", a.degree)).into());
+    }
+    if a.fairness >= a.degree {
+        return Err(UsageError(format!(
+            "--fairness {} must be between 0 and n − 1 = {}",
+            a.fairness,
+            a.degree - 1
+        ))
+        .into());
+    }
+    if !(1..=64).contains(&a.tessellation) {
+        return Err(UsageError(format!(
+            "--tessellation {} is not in 1..=64",
+            a.tessellation
+        ))
+        .into());
+    }
+    if let Some(l) = a.fit {
+        if !(l >= 0.0 && l.is_finite()) {
+            return Err(UsageError(format!("--fit {l} must be a finite weight ≥ 0")).into());
+        }
+    }
+    let singularity = match a.singularity.as_str() {
+        "auto" => Singularity::Auto,
+        v => Singularity::Vertex(v.parse().map_err(|_| {
+            UsageError(format!(
+                "--singularity must be auto or a vertex id, not '{v}'"
+            ))
+        })?),
+    };
+    let use_atlas = match a.charts.as_str() {
+        "atlas" => true,
+        "local" => false,
+        c => return Err(UsageError(format!("--charts must be atlas or local, not '{c}'")).into()),
+    };
+    let (surface, _) = read_surface(&a.mesh)?;
+    let mut bar = spinner(a.json);
+    let t_ricci = Instant::now();
+    let dist = MeshDistance::new(&surface.positions, surface.mesh.faces());
+    let opts = SplineOptions {
+        degree: a.degree,
+        fairness: a.fairness,
+        fit_smoothing: a.fit,
+        ..SplineOptions::default()
+    };
+    let provider: Box<dyn FlatCharts + Sync> = if use_atlas {
+        let o = AtlasOptions {
+            singularity: match singularity {
+                Singularity::Auto => AtlasSingularity::Auto,
+                Singularity::Vertex(v) => AtlasSingularity::Vertex(v),
+            },
+            ..AtlasOptions::default()
+        };
+        Box::new(AffineAtlas::build(&surface, &o, &mut bar)?)
+    } else {
+        Box::new(flat_domain(&surface, singularity, &mut bar)?.charts)
+    };
+    let t_ricci = t_ricci.elapsed().as_secs_f64();
+    let charts: &(dyn FlatCharts + Sync) = provider.as_ref();
+    let (rep, tess, control) = run_spline(charts, &dist, &opts, a.tessellation, &mut bar)?;
+    bar.0.finish_and_clear();
+    let topo = ricci::mesh::topology(&surface.mesh);
+    let singular: Option<u32> = charts.singular_vertices().first().copied();
+    let mut out = json!({
+        "file": a.mesh.display().to_string(),
+        "degree": rep.degree,
+        "fairness": rep.fairness,
+        "control_points": rep.control_points,
+        "domain_faces": rep.domain_faces,
+        "active_faces": rep.active_faces,
+        "rms_error_percent": rep.rms_error_percent,
+        "max_error_percent": rep.max_error_percent,
+        "fill_max_error_percent": rep.fill_max_error_percent,
+        "continuity": rep.continuity,
+        "seconds": rep.seconds,
+        "seconds_ricci": t_ricci,
+        "seconds_total": 0.0,
+        "genus": topo.genus(),
+        "boundary_loops": topo.boundary_loops(),
+        "singular_vertex": singular,
+        "added_vertices": charts.mesh().n_vertices() - surface.mesh.n_vertices(),
+        "charts": {"provider": a.charts, "count": charts.n_charts()},
+        "space": rep.space,
+        "fairing_report": rep.fairing,
+        "fit": rep.fit,
+        "fit_ridge": rep.fit_ridge,
+        "timings": {"knots": rep.seconds_knots, "fairing": rep.seconds_fairing, "fit": rep.seconds_fit, "fill": rep.seconds_fill},
+        "tessellation": {"vertices": tess.positions.len(), "triangles": tess.triangles.len(), "spline_triangles": tess.spline_triangles},
+    });
+    if let Some(dir) = &a.out {
+        // surface.obj
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "# ricci spline: degree {} fairness {} ({} spline + {} fill triangles)",
+            rep.degree,
+            rep.fairness,
+            tess.spline_triangles,
+            tess.triangles.len() - tess.spline_triangles
+        );
+        for p in &tess.positions {
+            let _ = writeln!(s, "v {} {} {}", p[0], p[1], p[2]);
+        }
+        let _ = writeln!(s, "g spline");
+        for (k, t) in tess.triangles.iter().enumerate() {
+            if k == tess.spline_triangles {
+                let _ = writeln!(s, "g fill");
+            }
+            let _ = writeln!(s, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+        }
+        let side = json!({"face": tess.vertex_face, "chart": tess.vertex_chart});
+        // control_net.obj: control points of the active triangles and their nets.
+        let mesh = charts.mesh();
+        let n = rep.degree;
+        let nb = (n + 1) * (n + 2) / 2;
+        let betas = multi_indices(n);
+        let pos = |b: [usize; 3]| betas.iter().position(|x| *x == b);
+        let mut c = String::new();
+        let _ = writeln!(
+            c,
+            "# ricci spline control net: {} control points",
+            rep.control_points
+        );
+        let mut index = vec![0usize; mesh.n_faces()];
+        let mut next = 1;
+        for f in 0..mesh.n_faces() {
+            let active = mesh
+                .face(f as u32)
+                .iter()
+                .all(|v| !charts.singular_vertices().contains(v));
+            if !active {
+                continue;
+            }
+            index[f] = next;
+            for k in 0..nb {
+                let p = &control[(f * nb + k) * 3..(f * nb + k) * 3 + 3];
+                let _ = writeln!(c, "v {} {} {}", p[0], p[1], p[2]);
+            }
+            next += nb;
+        }
+        for &first in &index {
+            if first == 0 {
+                continue;
+            }
+            for (k, b) in betas.iter().enumerate() {
+                // Net edges to β − e_0 + e_1 and β − e_0 + e_2 and β − e_1 + e_2.
+                for (from, to) in [(0, 1), (0, 2), (1, 2)] {
+                    if b[from] == 0 {
+                        continue;
+                    }
+                    let mut q = *b;
+                    q[from] -= 1;
+                    q[to] += 1;
+                    if let Some(j) = pos(q) {
+                        let _ = writeln!(c, "l {} {}", first + k, first + j);
+                    }
+                }
+            }
+        }
+        // boundaries.obj
+        let mut bo = String::new();
+        let _ = writeln!(
+            bo,
+            "# ricci spline patch boundaries: {} polylines",
+            tess.boundaries.len()
+        );
+        let mut vi = 1;
+        for line in &tess.boundaries {
+            for p in line {
+                let _ = writeln!(bo, "v {} {} {}", p[0], p[1], p[2]);
+            }
+            let ids: Vec<String> = (vi..vi + line.len()).map(|i| i.to_string()).collect();
+            let _ = writeln!(bo, "l {}", ids.join(" "));
+            vi += line.len();
+        }
+        out["out"] = json!(dir.display().to_string());
+        out["seconds_total"] = json!(t0.elapsed().as_secs_f64());
+        write_atomic(&dir.join("surface.obj"), s.as_bytes())?;
+        write_atomic(
+            &dir.join("surface_vertices.json"),
+            serde_json::to_string(&side)?.as_bytes(),
+        )?;
+        write_atomic(&dir.join("control_net.obj"), c.as_bytes())?;
+        write_atomic(&dir.join("boundaries.obj"), bo.as_bytes())?;
+        write_atomic(
+            &dir.join("spline.json"),
+            serde_json::to_string_pretty(&out)?.as_bytes(),
+        )?;
+    }
+    out["seconds_total"] = json!(t0.elapsed().as_secs_f64());
+    if a.json {
+        print_json(&out);
+    } else {
+        println!(
+            "{}: degree {} (r = {}), {} control points on {} of {} faces; {}; error rms {:.3}% max {:.3}% of the diagonal; {:.2} s",
+            a.mesh.display(),
+            rep.degree,
+            rep.fairness,
+            rep.control_points,
+            rep.active_faces,
+            rep.domain_faces,
+            rep.continuity.class,
+            rep.rms_error_percent,
+            rep.max_error_percent,
+            rep.seconds
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,480 @@
+//! The hole at an extraordinary point and its G¹ fill patch (paper 000 §5, last paragraph).
+//!
+//! The manifold spline of [`crate::spline::manifold`] is defined on the faces not incident to
+//! the cone vertex `s`. Around `s` the flat cone metric has *cone polar coordinates*
+//! `(ρ, φ)`, `0 ≤ φ < Θ` (`Θ` the cone angle at `s`): the star of `s` developed by angles
+//! ([`crate::spline::manifold::star_frame`]) is the unrolled cone, and the stars of the link
+//! vertices are attached to it through their faces at `s`, so every point of the two-ring of
+//! `s` has unrolled coordinates `ρ e^{iφ}`.
+//!
+//! **Seam.** A smooth closed curve `ρ = R(ψ)`, `φ = Θψ/2π`, `ψ ∈ [0, 2π)`, just outside the
+//! link of `s` (so inside the spline's domain): `ln R` is a truncated Fourier series of the
+//! logarithm of the link's radial function `r_link(φ)` (the flat metric of a strong cone
+//! varies over orders of magnitude around it), raised until `R` exceeds `r_link` everywhere by
+//! a relative margin. The
+//! seam is checked to lie in active faces near the link (the stars of the link vertices and two
+//! more rings of stars, developed into the unrolled cone); otherwise construction fails naming
+//! `s` (a very irregular neighbourhood).
+//!
+//! **Fill.** Over the unit disk `(t, ψ)` a radial cubic Hermite patch
+//! `F(t, ψ) = h₀₀(t) P₀ + h₁₀(t) T(ψ) + h₀₁(t) C(ψ) + h₁₁(t) D(ψ)` with the seam data
+//! `C(ψ) = S(R, φ)` and `D(ψ) = R ∂S/∂ρ` taken from the spline `S` itself, `P₀` the mean of
+//! `C − D` and `T(ψ) = a cos ψ + b sin ψ` the first Fourier mode of `D` (so a plane is
+//! reproduced exactly and the patch has a tangent plane at its centre). At `t = 1` the patch
+//! has the spline's value and its tangents `∂F/∂t = D`, `∂F/∂ψ = dC/dψ` lie in the spline's
+//! tangent plane: the join is G¹ (measured by [`Hole::seam_normal_jump`]). This is not the
+//! paper's planar triangular B-spline fill; it is a single smooth patch, C¹ at its centre.
+
+use std::f64::consts::PI;
+
+use num_complex::Complex64 as C;
+
+use crate::atlas::{fit_rigid, FlatCharts};
+use crate::error::{Error, Result};
+use crate::layout::RigidMotion;
+
+use super::dms::Workspace;
+use super::fit::evaluate;
+use super::manifold::{apply, cz, rotate_partials, star_frame, ManifoldSpace};
+use super::simplex::{det3, Point};
+
+/// A point of the two-ring of a cone: face, barycentric coordinates, and the motion from the
+/// unrolled frame to the face's canonical chart.
+#[derive(Debug, Clone, Copy)]
+pub struct Located {
+    pub face: u32,
+    pub bary: [f64; 3],
+    pub motion: RigidMotion,
+}
+
+/// Seam data at one `ψ`: `C(ψ)`, `D(ψ)` and the spline's partials `(S_X, S_Y)`.
+pub type SeamData = ([f64; 3], [f64; 3], [[f64; 3]; 2]);
+
+/// The hole around one cone vertex, its seam and the fill patch.
+#[derive(Debug, Clone)]
+pub struct Hole {
+    pub vertex: u32,
+    /// Cone angle `Θ` (angle sum at the vertex).
+    pub cone_angle: f64,
+    /// Start angle of each sector (face at the vertex), counter-clockwise; `sector_start[d] = Θ`.
+    sector_start: Vec<f64>,
+    /// Link vertices' unrolled positions, `link[k]` = first link vertex of sector `k`.
+    link: Vec<Point>,
+    /// Candidate active faces per sector, with unrolled coordinates.
+    sector_faces: Vec<Vec<(u32, [Point; 3], RigidMotion)>>,
+    /// Seam radius: `ln R(ψ) = a₀ + Σ a_k cos kψ + b_k sin kψ + shift`.
+    fourier: Vec<(f64, f64)>,
+    shift: f64,
+    /// Centre of the fill and its tangent directions (3 coordinates each).
+    pub center: [f64; 3],
+    tangent_a: [f64; 3],
+    tangent_b: [f64; 3],
+    /// Smallest `R(ψ) / r_link(ψ) − 1` over the checked samples.
+    pub min_clearance: f64,
+}
+
+/// What the fill measured along its seam.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct SeamReport {
+    pub vertex: u32,
+    pub cone_angle: f64,
+    pub samples: usize,
+    /// Largest angle between the spline's and the fill's normals along the seam (degrees).
+    pub max_normal_jump_deg: f64,
+    /// Largest distance between the spline and the fill on the seam, relative to the seam's
+    /// diameter.
+    pub max_position_gap: f64,
+}
+
+impl Hole {
+    /// Build the seam and the fill around cone vertex `s` for the spline with `control`
+    /// (3 numbers per control point).
+    pub fn new<A: FlatCharts + Sync + ?Sized>(
+        space: &ManifoldSpace<'_, A>,
+        control: &[f64],
+        s: u32,
+    ) -> Result<Hole> {
+        let charts = space.charts();
+        let mesh = charts.mesh();
+        let lengths = charts.lengths();
+        if s as usize >= mesh.n_vertices() || mesh.is_boundary_vertex(s) || mesh.is_isolated(s) {
+            return Err(Error::input(format!(
+                "hole filling: vertex {s} is not an interior vertex"
+            )));
+        }
+        let sf = star_frame(mesh, lengths, s);
+        let d = sf.faces.len();
+        let theta = sf.total_angle;
+        let mut sector_start = sf.start_angles.clone();
+        sector_start.push(theta);
+        // Link vertices in sector order: v_k = corner after s in face k.
+        let mut link_ids = Vec::with_capacity(d);
+        let mut link = Vec::with_capacity(d);
+        for (f, c) in &sf.faces {
+            let t = mesh.face(*f);
+            let i = t.iter().position(|&v| v == s).unwrap_or(0);
+            link_ids.push(t[(i + 1) % 3]);
+            link.push(c[(i + 1) % 3]);
+        }
+        // Unrolled coordinates of face j (any integer), continuous across the cut φ = 0.
+        let unrolled = |j: isize| -> [Point; 3] {
+            let k = j.rem_euclid(d as isize) as usize;
+            let turns = j.div_euclid(d as isize) as f64;
+            let r = C::from_polar(1.0, turns * theta);
+            sf.faces[k].1.map(|p| super::manifold::pt(r * cz(p)))
+        };
+        let mut sector_faces = Vec::with_capacity(d);
+        for k in 0..d as isize {
+            let mut list: Vec<(u32, [Point; 3], RigidMotion)> = Vec::new();
+            for j in [k - 1, k, k + 1] {
+                let jj = j.rem_euclid(d as isize) as usize;
+                let fj = sf.faces[jj].0;
+                let uj = unrolled(j);
+                for &w in &mesh.face(fj) {
+                    if w == s {
+                        continue;
+                    }
+                    let Some(wf) = space.vertex_frame(w) else {
+                        continue;
+                    };
+                    let Some(cw) = wf.faces.iter().find(|x| x.0 == fj).map(|x| x.1) else {
+                        continue;
+                    };
+                    let (m, _) = fit_rigid(&cw, &uj);
+                    for (g, c) in &wf.faces {
+                        if !space.is_active(*g) || list.iter().any(|x| x.0 == *g) {
+                            continue;
+                        }
+                        let cu = c.map(|p| apply(&m, p));
+                        let (mc, _) = fit_rigid(&cu, &space.canonical_coords(*g));
+                        list.push((*g, cu, mc));
+                    }
+                }
+            }
+            // One more ring: the stars of the vertices reached so far, aligned through a face
+            // already placed (the seam of an irregular, graded link can leave the two-ring).
+            let mut expanded: Vec<u32> = Vec::new();
+            let mut level = 0;
+            while level < 2 {
+                level += 1;
+                let verts: Vec<u32> = list
+                    .iter()
+                    .flat_map(|x| mesh.face(x.0))
+                    .filter(|&w| w != s)
+                    .collect();
+                for w in verts {
+                    if expanded.contains(&w) {
+                        continue;
+                    }
+                    expanded.push(w);
+                    let Some(wf) = space.vertex_frame(w) else {
+                        continue;
+                    };
+                    let Some((fw, cw, cu)) = wf
+                        .faces
+                        .iter()
+                        .find_map(|(g, c)| list.iter().find(|x| x.0 == *g).map(|x| (*g, *c, x.1)))
+                    else {
+                        continue;
+                    };
+                    let _ = fw;
+                    let (m, _) = fit_rigid(&cw, &cu);
+                    let mut add = Vec::new();
+                    for (g, c) in &wf.faces {
+                        if !space.is_active(*g) || list.iter().any(|x| x.0 == *g) {
+                            continue;
+                        }
+                        let cu = c.map(|p| apply(&m, p));
+                        let (mc, _) = fit_rigid(&cu, &space.canonical_coords(*g));
+                        add.push((*g, cu, mc));
+                    }
+                    list.extend(add);
+                }
+            }
+            sector_faces.push(list);
+        }
+        let mut hole = Hole {
+            vertex: s,
+            cone_angle: theta,
+            sector_start,
+            link,
+            sector_faces,
+            fourier: Vec::new(),
+            shift: 0.0,
+            center: [0.0; 3],
+            tangent_a: [0.0; 3],
+            tangent_b: [0.0; 3],
+            min_clearance: 0.0,
+        };
+        let _ = link_ids;
+        // Seam: Fourier smoothing of the link's radial function, shifted outwards.
+        const M: usize = 1024;
+        let rl: Vec<f64> = (0..M)
+            .map(|j| hole.r_link(theta * j as f64 / M as f64))
+            .collect();
+        let mut last_err = String::new();
+        'outer: for harmonics in [d.min(24), d.min(12), d.min(6), 3] {
+            let mut fourier = Vec::with_capacity(harmonics + 1);
+            for h in 0..=harmonics {
+                let (mut a, mut b) = (0.0, 0.0);
+                for (j, r) in rl.iter().enumerate() {
+                    let psi = 2.0 * PI * j as f64 / M as f64;
+                    a += r.ln() * (h as f64 * psi).cos();
+                    b += r.ln() * (h as f64 * psi).sin();
+                }
+                let w = if h == 0 { 1.0 } else { 2.0 } / M as f64;
+                fourier.push((a * w, b * w));
+            }
+            hole.fourier = fourier;
+            hole.shift = 0.0;
+            let mut over = f64::NEG_INFINITY;
+            for (j, r) in rl.iter().enumerate() {
+                over = over.max(r.ln() - hole.radius(2.0 * PI * j as f64 / M as f64).ln());
+            }
+            'margin: for margin in [0.06, 0.03, 0.015] {
+                hole.shift = over + margin;
+                // Check: seam outside the link and inside active faces.
+                let mut clearance = f64::INFINITY;
+                for (j, r) in rl.iter().enumerate() {
+                    let psi = 2.0 * PI * j as f64 / M as f64;
+                    let rr = hole.radius(psi);
+                    clearance = clearance.min(rr / r - 1.0);
+                    if hole.locate(rr, theta * psi / (2.0 * PI)).is_none() {
+                        last_err = format!(
+                            "the seam point at angle {:.3} rad (radius {rr:.3e}) leaves the two-ring",
+                            theta * psi / (2.0 * PI)
+                        );
+                        continue 'margin;
+                    }
+                }
+                hole.min_clearance = clearance;
+                break 'outer;
+            }
+        }
+        if hole.min_clearance <= 0.0 {
+            return Err(Error::numerical(format!(
+                "hole filling at singular vertex {s}: no smooth seam fits between its link and the two-ring ({last_err})"
+            )));
+        }
+        // Fill centre and tangents from the seam data.
+        let ns = 4 * M.min(64 * d).max(256) / 4;
+        let mut p0 = [0.0; 3];
+        let (mut ta, mut tb) = ([0.0; 3], [0.0; 3]);
+        let mut ws = Workspace::default();
+        for j in 0..ns {
+            let psi = 2.0 * PI * j as f64 / ns as f64;
+            let (c, dd, _) = hole.seam_data(space, control, psi, &mut ws)?;
+            for k in 0..3 {
+                p0[k] += (c[k] - dd[k]) / ns as f64;
+                ta[k] += 2.0 * dd[k] * psi.cos() / ns as f64;
+                tb[k] += 2.0 * dd[k] * psi.sin() / ns as f64;
+            }
+        }
+        hole.center = p0;
+        hole.tangent_a = ta;
+        hole.tangent_b = tb;
+        Ok(hole)
+    }
+
+    /// Radial distance from the cone to its link at unrolled angle `phi` (mod Θ).
+    pub fn r_link(&self, phi: f64) -> f64 {
+        let k = self.sector(phi);
+        let d = self.link.len();
+        let a = self.link[k];
+        let mut b = self.link[(k + 1) % d];
+        if k + 1 == d {
+            let r = C::from_polar(1.0, self.cone_angle);
+            b = super::manifold::pt(r * cz(b));
+        }
+        let e = [phi.cos(), phi.sin()];
+        let ba = [b[0] - a[0], b[1] - a[1]];
+        let cross = |p: Point, q: Point| p[0] * q[1] - p[1] * q[0];
+        cross(a, ba) / cross(e, ba)
+    }
+
+    fn sector(&self, phi: f64) -> usize {
+        let phi = phi.rem_euclid(self.cone_angle);
+        let d = self.link.len();
+        match self.sector_start[..d].binary_search_by(|x| x.total_cmp(&phi)) {
+            Ok(k) => k,
+            Err(k) => k.saturating_sub(1),
+        }
+    }
+
+    /// Seam radius `R(ψ)`.
+    pub fn radius(&self, psi: f64) -> f64 {
+        let mut r = self.shift;
+        for (h, &(a, b)) in self.fourier.iter().enumerate() {
+            if h == 0 {
+                r += a;
+            } else {
+                r += a * (h as f64 * psi).cos() + b * (h as f64 * psi).sin();
+            }
+        }
+        r.exp()
+    }
+
+    /// Locate the point with cone polar coordinates `(rho, phi)` in an active face.
+    pub fn locate(&self, rho: f64, phi: f64) -> Option<Located> {
+        let k = self.sector(phi);
+        // Unrolled angle continuous with sector k.
+        let phi = phi.rem_euclid(self.cone_angle);
+        let p = [rho * phi.cos(), rho * phi.sin()];
+        let mut best: Option<(f64, Located)> = None;
+        for (g, c, m) in &self.sector_faces[k] {
+            let area = det3(c[0], c[1], c[2]);
+            let b = [
+                det3(p, c[1], c[2]) / area,
+                det3(c[0], p, c[2]) / area,
+                det3(c[0], c[1], p) / area,
+            ];
+            let q = b[0].min(b[1]).min(b[2]);
+            if q >= -1e-12 && best.as_ref().is_none_or(|(s, _)| q > *s) {
+                best = Some((
+                    q,
+                    Located {
+                        face: *g,
+                        bary: b,
+                        motion: *m,
+                    },
+                ));
+            }
+        }
+        best.map(|x| x.1)
+    }
+
+    /// Cone polar coordinates of unrolled point relative to this hole: is the point of face `g`
+    /// with barycentric `bary` inside the seam? (`None` when `g` is not in the two-ring.)
+    pub fn inside_seam(&self, g: u32, bary: [f64; 3]) -> Option<bool> {
+        for (k, list) in self.sector_faces.iter().enumerate() {
+            if let Some((_, c, _)) = list.iter().find(|x| x.0 == g) {
+                let p = [
+                    bary[0] * c[0][0] + bary[1] * c[1][0] + bary[2] * c[2][0],
+                    bary[0] * c[0][1] + bary[1] * c[1][1] + bary[2] * c[2][1],
+                ];
+                let mid = 0.5 * (self.sector_start[k] + self.sector_start[k + 1]);
+                let z = cz(p) * C::from_polar(1.0, -mid);
+                let phi = mid + z.arg();
+                let rho = z.norm();
+                let psi = 2.0 * PI * phi / self.cone_angle;
+                return Some(rho < self.radius(psi));
+            }
+        }
+        None
+    }
+
+    /// The seam point at `ψ`: spline value `C(ψ)`, `D(ψ) = R ∂S/∂ρ`, and the spline's partials
+    /// `(S_X, S_Y)` in the unrolled frame.
+    pub fn seam_data<A: FlatCharts + Sync + ?Sized>(
+        &self,
+        space: &ManifoldSpace<'_, A>,
+        control: &[f64],
+        psi: f64,
+        ws: &mut Workspace,
+    ) -> Result<SeamData> {
+        let phi = self.cone_angle * psi / (2.0 * PI);
+        let r = self.radius(psi);
+        let loc = self.locate(r, phi).ok_or_else(|| {
+            Error::numerical(format!(
+                "hole at vertex {}: seam point at angle {phi:.4} not found",
+                self.vertex
+            ))
+        })?;
+        let p = [r * phi.cos(), r * phi.sin()];
+        let u = apply(&loc.motion, p);
+        let mut out = [0.0; 9];
+        evaluate(space, control, 3, loc.face, u, 1, ws, &mut out)?;
+        // Partials in the canonical chart → unrolled frame (u = rot p + t).
+        let mut sx = [0.0; 3];
+        let mut sy = [0.0; 3];
+        for k in 0..3 {
+            let mut v = [out[k], out[3 + k], out[6 + k]];
+            rotate_partials(1, loc.motion.rot, &mut v);
+            sx[k] = v[1];
+            sy[k] = v[2];
+        }
+        let c = [out[0], out[1], out[2]];
+        let mut dd = [0.0; 3];
+        for k in 0..3 {
+            dd[k] = r * (phi.cos() * sx[k] + phi.sin() * sy[k]);
+        }
+        Ok((c, dd, [sx, sy]))
+    }
+
+    /// The fill patch at `(t, ψ)`, `t ∈ [0, 1]` (module docs).
+    pub fn fill_point<A: FlatCharts + Sync + ?Sized>(
+        &self,
+        space: &ManifoldSpace<'_, A>,
+        control: &[f64],
+        t: f64,
+        psi: f64,
+        ws: &mut Workspace,
+    ) -> Result<[f64; 3]> {
+        let (c, dd, _) = self.seam_data(space, control, psi, ws)?;
+        let (t2, t3) = (t * t, t * t * t);
+        let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
+        let h10 = t3 - 2.0 * t2 + t;
+        let h01 = -2.0 * t3 + 3.0 * t2;
+        let h11 = t3 - t2;
+        let mut f = [0.0; 3];
+        for k in 0..3 {
+            let tk = self.tangent_a[k] * psi.cos() + self.tangent_b[k] * psi.sin();
+            f[k] = h00 * self.center[k] + h10 * tk + h01 * c[k] + h11 * dd[k];
+        }
+        Ok(f)
+    }
+
+    /// Measure the join at `samples` seam points: the angle between the spline's normal
+    /// (`S_X × S_Y`, analytic) and the fill's (`F_t × F_ψ` by finite differences of the fill
+    /// itself, one-sided in `t` from inside the hole), and the position gap.
+    pub fn seam_normal_jump<A: FlatCharts + Sync + ?Sized>(
+        &self,
+        space: &ManifoldSpace<'_, A>,
+        control: &[f64],
+        samples: usize,
+    ) -> Result<SeamReport> {
+        let mut ws = Workspace::default();
+        let mut worst: f64 = 0.0;
+        let mut gap: f64 = 0.0;
+        let mut diam: f64 = 0.0;
+        let h = 1e-6;
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let norm = |a: [f64; 3]| (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+        let mut pts = Vec::with_capacity(samples);
+        for j in 0..samples {
+            let psi = 2.0 * PI * (j as f64 + 0.5) / samples as f64;
+            let (c, _, [sx, sy]) = self.seam_data(space, control, psi, &mut ws)?;
+            pts.push(c);
+            let f1 = self.fill_point(space, control, 1.0, psi, &mut ws)?;
+            let fi = self.fill_point(space, control, 1.0 - h, psi, &mut ws)?;
+            let fp = self.fill_point(space, control, 1.0, psi + h, &mut ws)?;
+            let fm = self.fill_point(space, control, 1.0, psi - h, &mut ws)?;
+            let ft: [f64; 3] = std::array::from_fn(|k| (f1[k] - fi[k]) / h);
+            let fpsi: [f64; 3] = std::array::from_fn(|k| (fp[k] - fm[k]) / (2.0 * h));
+            let ns = cross(sx, sy);
+            let nf = cross(ft, fpsi);
+            let cosang = (ns[0] * nf[0] + ns[1] * nf[1] + ns[2] * nf[2]) / (norm(ns) * norm(nf));
+            let ang = cosang.clamp(-1.0, 1.0).acos().to_degrees();
+            worst = worst.max(if ang.is_finite() { ang } else { 180.0 });
+            gap = gap.max(norm(std::array::from_fn(|k| f1[k] - c[k])));
+        }
+        for a in &pts {
+            for b in &pts {
+                diam = diam.max(norm(std::array::from_fn(|k| a[k] - b[k])));
+            }
+        }
+        Ok(SeamReport {
+            vertex: self.vertex,
+            cone_angle: self.cone_angle,
+            samples,
+            max_normal_jump_deg: worst,
+            max_position_gap: gap / diam.max(1e-300),
+        })
+    }
+}

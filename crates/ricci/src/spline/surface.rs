@@ -1,0 +1,908 @@
+//! The manifold spline surface of a mesh, end to end (paper 000 §5, Table 1).
+//!
+//! 1. [`flat_domain`]: a flat metric with at most one cone — genus 1 closed: uniform E²;
+//!    open surfaces: free boundary (all curvature on the boundary); closed genus `g ≥ 2`: the
+//!    valence of the singular vertex is raised to `max(4g + 4, 8g − 2)` by metric-preserving
+//!    link splits and its neighbourhood graded like the cut's base vertex (paper 000 Step 2;
+//!    the Chow–Luo bound for one cone of `2πχ` needs valence `> 8g − 4`, and its rings need
+//!    room too), then the flow puts `2πχ` on it. Its charts are the independent provider
+//!    [`LocalCharts`] (the affine atlas plugs in through the same [`FlatCharts`] trait).
+//! 2. [`build`]: initial control points from the degree-`n` subdivision of the domain, the
+//!    fairing of paper 000 eq. 14 with parameter `r`, optionally a least-squares fit of the
+//!    control points to the mesh vertices with the thin-plate fairness term
+//!    ([`crate::spline::fit`]), and a G¹ fill patch at every cone ([`Hole`]).
+//! 3. Measurements: [`continuity`] (jumps of all partials up to order `n` across every
+//!    interior edge, the two one-sided limits evaluated in their own canonical charts and
+//!    transformed into one), [`tessellate`] and [`MeshDistance`] (errors of spline samples
+//!    against the input mesh as a percentage of the bounding-box diagonal).
+
+use std::time::Instant;
+
+use crate::atlas::FlatCharts;
+use crate::error::{Error, Result};
+use crate::flow::{ricci_flow, FlowOptions, TargetSpec};
+use crate::mesh::{topology, Surface};
+use crate::metric::Geometry;
+use crate::progress::Progress;
+
+use super::dms::{KnotOptions, Workspace};
+use super::fit::{evaluate, fair, fit, DataPoint, FairingReport, FitOptions, FitReport};
+use super::hole::{Hole, SeamReport};
+use super::manifold::{apply, rotate_partials, LocalCharts, ManifoldReport, ManifoldSpace};
+use super::simplex::{n_partials, Point};
+
+/// Where the cone of a closed surface of genus ≥ 2 goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Singularity {
+    /// The interior vertex of largest valence (smallest id among ties).
+    Auto,
+    Vertex(u32),
+}
+
+/// A flat metric with at most one cone and its charts.
+pub struct FlatDomain {
+    pub charts: LocalCharts,
+    pub genus: i64,
+    pub boundary_loops: usize,
+    /// The cone vertex (id in the refined domain = id in the input).
+    pub singular: Option<u32>,
+    /// Vertices added by the valence raising.
+    pub added_vertices: usize,
+    pub flow_iterations: usize,
+    pub flow_max_curvature_error: f64,
+    pub flow_converged: bool,
+    pub seconds: f64,
+}
+
+/// Step 1 (module docs).
+pub fn flat_domain(
+    surface: &Surface,
+    singularity: Singularity,
+    progress: &mut dyn Progress,
+) -> Result<FlatDomain> {
+    let t0 = Instant::now();
+    let mesh = &surface.mesh;
+    let topo = topology(mesh);
+    if topo.components.len() != 1 {
+        return Err(Error::topology(format!(
+            "manifold spline: the mesh has {} components; one is needed",
+            topo.components.len()
+        )));
+    }
+    let genus = topo.genus();
+    let boundary_loops = topo.boundary_loops();
+    let lengths = surface.edge_lengths();
+    let (m, l, p, singular, target) = if boundary_loops > 0 {
+        (
+            mesh.clone(),
+            lengths,
+            surface.positions.clone(),
+            None,
+            TargetSpec::FreeBoundary,
+        )
+    } else if genus == 0 {
+        return Err(Error::topology(
+            "manifold spline: a closed genus-0 surface needs at least two cones; only genus ≥ 1 or open surfaces are supported",
+        ));
+    } else if genus == 1 {
+        (
+            mesh.clone(),
+            lengths,
+            surface.positions.clone(),
+            None,
+            TargetSpec::Uniform,
+        )
+    } else {
+        let s = match singularity {
+            Singularity::Vertex(v) => {
+                if v as usize >= mesh.n_vertices() || mesh.is_isolated(v) {
+                    return Err(Error::input(format!(
+                        "singular vertex {v} does not exist (the mesh has {} vertices)",
+                        mesh.n_vertices()
+                    )));
+                }
+                v
+            }
+            Singularity::Auto => (0..mesh.n_vertices() as u32)
+                .filter(|&v| !mesh.is_isolated(v))
+                .max_by(|&a, &b| mesh.valence(a).cmp(&mesh.valence(b)).then(b.cmp(&a)))
+                .ok_or_else(|| Error::input("manifold spline: empty mesh"))?,
+        };
+        let g = genus as usize;
+        let want = (4 * g + 4).max(8 * g - 2);
+        progress.report(
+            "valence",
+            None,
+            &format!("raising the valence of {s} to {want}"),
+        );
+        // Raise the valence, then grade the neighbourhood (as the cut does) so that the rings
+        // around the cone also pass the Chow–Luo check and the seam of the fill has room.
+        let mean_spoke = mesh
+            .outgoing(s)
+            .map(|h| lengths[mesh.he_edge(h) as usize])
+            .sum::<f64>()
+            / mesh.valence(s).max(1) as f64;
+        let mut rf = crate::mesh::refine::Refiner::new(
+            mesh,
+            &lengths,
+            Geometry::Euclidean,
+            Some(&surface.positions),
+        )?;
+        rf.raise_valence(s, want)?;
+        let theta = rf.cone_angle(s);
+        let radius = 1.5 * want as f64 * mean_spoke / theta.max(1e-3);
+        rf.grade_around(s, want, radius, 40 * want * want + 1000)?;
+        let r = rf.finish()?;
+        let pos = r.positions.unwrap_or_default();
+        (
+            r.mesh,
+            r.lengths,
+            pos,
+            Some(s),
+            TargetSpec::SingleCone(Some(s)),
+        )
+    };
+    let opts = FlowOptions {
+        target,
+        tolerance: 1e-11,
+        ..FlowOptions::default()
+    };
+    let flow = ricci_flow(&m, &l, &opts, progress)?;
+    if !flow.converged {
+        return Err(Error::numerical(format!(
+            "manifold spline: the Ricci flow did not converge (max |K − K̄| = {:.2e} after {} iterations)",
+            flow.max_curvature_error, flow.iterations
+        )));
+    }
+    let added = m.n_vertices() - mesh.n_vertices();
+    let charts = LocalCharts::new(
+        m,
+        flow.lengths.clone(),
+        p,
+        singular.into_iter().collect(),
+        None,
+    )?;
+    Ok(FlatDomain {
+        charts,
+        genus,
+        boundary_loops,
+        singular,
+        added_vertices: added,
+        flow_iterations: flow.iterations,
+        flow_max_curvature_error: flow.max_curvature_error,
+        flow_converged: flow.converged,
+        seconds: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// Options of [`build`].
+#[derive(Debug, Clone, Copy)]
+pub struct SplineOptions {
+    pub degree: usize,
+    /// Fairness parameter `r`, `0 ≤ r ≤ n − 1` (paper 000 eq. 14).
+    pub fairness: usize,
+    /// Fit the control points to the mesh vertices after the fairing, with this thin-plate
+    /// weight `λ` (`None`: no fit).
+    pub fit_smoothing: Option<f64>,
+    pub knots: KnotOptions,
+}
+
+impl Default for SplineOptions {
+    fn default() -> Self {
+        SplineOptions {
+            degree: 3,
+            fairness: 1,
+            fit_smoothing: None,
+            knots: KnotOptions::default(),
+        }
+    }
+}
+
+/// The spline: control points (3 per control point, all faces), the fill patches and what
+/// the construction reported.
+pub struct ManifoldSpline {
+    pub control: Vec<f64>,
+    pub holes: Vec<Hole>,
+    pub fairing: FairingReport,
+    pub fit: Option<FitReport>,
+    /// Ridge weight the fit needed (1e-9 unless the normal matrix was too ill-conditioned).
+    pub fit_ridge: Option<f64>,
+    pub seconds_fairing: f64,
+    pub seconds_fit: f64,
+    pub seconds_fill: f64,
+}
+
+/// Step 2 (module docs).
+pub fn build<A: FlatCharts + Sync + ?Sized>(
+    space: &ManifoldSpace<'_, A>,
+    opts: &SplineOptions,
+    progress: &mut dyn Progress,
+) -> Result<ManifoldSpline> {
+    let c0 = space.subdivision_control_points();
+    progress.report("fairing", None, &format!("r = {}", opts.fairness));
+    let t = Instant::now();
+    let (c1, fairing) = fair(space, &c0, 3, opts.fairness)?;
+    let seconds_fairing = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let mut fit_ridge = None;
+    let (control, fit_report) = if let Some(lam) = opts.fit_smoothing {
+        progress.report("fit", None, "least squares to the mesh vertices");
+        let charts = space.charts();
+        let mesh = charts.mesh();
+        let pos = charts.positions();
+        let mut data = Vec::new();
+        for v in 0..mesh.n_vertices() as u32 {
+            if let Some(h) = mesh.vertex_corners(v).find(|&h| space.is_active(h / 3)) {
+                let f = h / 3;
+                data.push(DataPoint {
+                    face: f,
+                    param: space.canonical_coords(f)[h as usize % 3],
+                    target: pos[v as usize].to_vec(),
+                });
+            }
+        }
+        // The normal matrix can be too ill-conditioned for the default ridge (1e-9 of the data
+        // term); retry with a stronger ridge towards the faired control points.
+        let mut result = None;
+        let mut last = None;
+        for ridge in [1e-9, 1e-7, 1e-5] {
+            match fit(
+                space,
+                &data,
+                &c1,
+                3,
+                &FitOptions {
+                    smoothing: lam,
+                    ridge,
+                },
+            ) {
+                Ok(x) => {
+                    result = Some((x, ridge));
+                    break;
+                }
+                Err(e) => last = Some(e),
+            }
+        }
+        let Some(((c, rep), ridge)) = result else {
+            return Err(last.unwrap_or_else(|| Error::numerical("fit failed")));
+        };
+        fit_ridge = Some(ridge);
+        (c, Some(rep))
+    } else {
+        (c1, None)
+    };
+    let seconds_fit = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let mut holes = Vec::new();
+    for &s in space.charts().singular_vertices() {
+        progress.report("fill", None, &format!("hole at vertex {s}"));
+        holes.push(Hole::new(space, &control, s)?);
+    }
+    Ok(ManifoldSpline {
+        control,
+        holes,
+        fairing,
+        fit: fit_report,
+        fit_ridge,
+        seconds_fairing,
+        seconds_fit,
+        seconds_fill: t.elapsed().as_secs_f64(),
+    })
+}
+
+/// Measured jumps across the interior edges of the spline domain.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ContinuityReport {
+    /// Sample points (three per interior edge between active faces).
+    pub samples: usize,
+    /// Per order `k = 0..=n`: the largest jump of a partial of order `k`, relative to the
+    /// largest such partial over all samples.
+    pub relative_jumps: Vec<f64>,
+    /// Largest `k` with all relative jumps of orders `≤ k` below `tolerance` (`C^k`).
+    pub smoothness: Option<usize>,
+    pub tolerance: f64,
+    /// Edges whose two faces have different canonical charts (sampled chart boundaries).
+    pub chart_boundary_edges: usize,
+    /// Fill patches: the seam measurements.
+    pub seams: Vec<SeamReport>,
+    /// Largest normal-angle jump along any seam (degrees).
+    pub max_seam_normal_jump_deg: f64,
+    /// `"C^k"` plus `", G^1 fill"` when there are fill patches.
+    pub class: String,
+}
+
+/// Step 3: the continuity of `control`'s spline (module docs). `tolerance` is the relative
+/// jump below which an order counts as continuous (1e-8 in the tests).
+pub fn continuity<A: FlatCharts + Sync + ?Sized>(
+    space: &ManifoldSpace<'_, A>,
+    control: &[f64],
+    holes: &[Hole],
+    tolerance: f64,
+) -> Result<ContinuityReport> {
+    use rayon::prelude::*;
+    let n = space.degree();
+    let np = n_partials(n);
+    let charts = space.charts();
+    let mesh = charts.mesh();
+    let edges: Vec<(u32, u32, u32)> = (0..mesh.n_corners() as u32)
+        .filter_map(|h| {
+            let t = mesh.he_twin(h);
+            if mesh.is_boundary_halfedge(t) || t < h {
+                return None;
+            }
+            let (g1, g2) = (h / 3, t / 3);
+            (space.is_active(g1) && space.is_active(g2)).then_some((h, g1, g2))
+        })
+        .collect();
+    let boundary_edges = edges
+        .iter()
+        .filter(|(_, a, b)| space.canonical_chart(*a) != space.canonical_chart(*b))
+        .count();
+    // Per edge sample: the two limits in g1's canonical chart.
+    let per: Vec<Vec<(Vec<f64>, Vec<f64>)>> = edges
+        .par_iter()
+        .map(|&(h, g1, g2)| -> Result<Vec<(Vec<f64>, Vec<f64>)>> {
+            let mut ws = Workspace::default();
+            let i = h as usize % 3;
+            let c1 = space.canonical_coords(g1);
+            let c2 = space.canonical_coords(g2);
+            let t = mesh.he_twin(h) as usize % 3;
+            let mut out = Vec::new();
+            for s in [0.25, 0.5, 0.75] {
+                let mut b1 = [0.0; 3];
+                b1[i] = 1.0 - s;
+                b1[(i + 1) % 3] = s;
+                let mut b2 = [0.0; 3];
+                b2[(t + 1) % 3] = 1.0 - s;
+                b2[t] = s;
+                let u1: Point = std::array::from_fn(|k| (0..3).map(|m| b1[m] * c1[m][k]).sum());
+                let u2: Point = std::array::from_fn(|k| (0..3).map(|m| b2[m] * c2[m][k]).sum());
+                let mut a = vec![0.0; np * 3];
+                evaluate(space, control, 3, g1, u1, n, &mut ws, &mut a)?;
+                let mut b = vec![0.0; np * 3];
+                evaluate(space, control, 3, g2, u2, n, &mut ws, &mut b)?;
+                // g2's canonical chart → g1's: transition on g2.
+                let (m, _) = charts
+                    .transition(space.canonical_chart(g1), space.canonical_chart(g2), g2)
+                    .ok_or_else(|| {
+                        Error::input(format!(
+                            "continuity: face {g2} is not in the canonical chart of face {g1}"
+                        ))
+                    })?;
+                debug_assert!({
+                    let w = apply(&m, u1);
+                    (w[0] - u2[0]).hypot(w[1] - u2[1]) < 1e-6 * (1.0 + u2[0].abs() + u2[1].abs())
+                });
+                // b holds partials w.r.t. g2's chart coordinates w = m(u): rotate into u.
+                let mut bt = vec![0.0; np * 3];
+                for d in 0..3 {
+                    let mut col: Vec<f64> = (0..np).map(|k| b[k * 3 + d]).collect();
+                    rotate_partials(n, m.rot, &mut col);
+                    for k in 0..np {
+                        bt[k * 3 + d] = col[k];
+                    }
+                }
+                out.push((a, bt));
+            }
+            Ok(out)
+        })
+        .collect::<Result<_>>()?;
+    let mut scale = vec![0.0f64; n + 1];
+    let mut jump = vec![0.0f64; n + 1];
+    let mut samples = 0;
+    for e in &per {
+        for (a, b) in e {
+            samples += 1;
+            for k in 0..=n {
+                for idx in n_partials(k) - (k + 1)..n_partials(k) {
+                    for d in 0..3 {
+                        let (x, y) = (a[idx * 3 + d], b[idx * 3 + d]);
+                        scale[k] = scale[k].max(x.abs()).max(y.abs());
+                        jump[k] = jump[k].max((x - y).abs());
+                    }
+                }
+            }
+        }
+    }
+    let relative_jumps: Vec<f64> = jump
+        .iter()
+        .zip(&scale)
+        .map(|(j, s)| if *s > 0.0 { j / s } else { 0.0 })
+        .collect();
+    let mut smoothness = None;
+    for (k, &j) in relative_jumps.iter().enumerate() {
+        if j <= tolerance {
+            smoothness = Some(k);
+        } else {
+            break;
+        }
+    }
+    let mut seams = Vec::new();
+    for h in holes {
+        seams.push(h.seam_normal_jump(space, control, 360)?);
+    }
+    let max_seam = seams
+        .iter()
+        .map(|s| s.max_normal_jump_deg)
+        .fold(0.0, f64::max);
+    let mut class = match smoothness {
+        Some(k) => format!("C^{k}"),
+        None => "discontinuous".to_string(),
+    };
+    if !seams.is_empty() {
+        class.push_str(", G^1 fill");
+    }
+    Ok(ContinuityReport {
+        samples,
+        relative_jumps,
+        smoothness,
+        tolerance,
+        chart_boundary_edges: boundary_edges,
+        seams,
+        max_seam_normal_jump_deg: max_seam,
+        class,
+    })
+}
+
+/// A tessellated spline surface.
+#[derive(Debug, Clone, Default)]
+pub struct Tessellation {
+    pub positions: Vec<[f64; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+    /// Domain face of each vertex (`-1` for fill-patch vertices).
+    pub vertex_face: Vec<i64>,
+    /// Canonical chart of the face (`-1` for the fill).
+    pub vertex_chart: Vec<i64>,
+    /// Triangles `0..spline_triangles` are spline, the rest fill.
+    pub spline_triangles: usize,
+    /// Patch boundaries: images of the domain edges, then the seams.
+    pub boundaries: Vec<Vec<[f64; 3]>>,
+}
+
+/// Sample every active face on a grid of `m` segments per edge; drop the sub-triangles inside
+/// a seam; add each fill patch on a polar grid. (The spline part and the fill meet at the seam
+/// but are not stitched into one mesh.)
+pub fn tessellate<A: FlatCharts + Sync + ?Sized>(
+    space: &ManifoldSpace<'_, A>,
+    spline: &ManifoldSpline,
+    m: usize,
+) -> Result<Tessellation> {
+    use rayon::prelude::*;
+    let m = m.max(1);
+    let charts = space.charts();
+    let mesh = charts.mesh();
+    let control = &spline.control;
+    let grid: Vec<(usize, usize)> = (0..=m)
+        .flat_map(|i| (0..=m - i).map(move |j| (i, j)))
+        .collect();
+    let idx = |i: usize, j: usize| -> usize { grid.iter().position(|&x| x == (i, j)).unwrap_or(0) };
+    let mut subtri = Vec::new();
+    for i in 0..m {
+        for j in 0..m - i {
+            subtri.push([idx(i, j), idx(i + 1, j), idx(i, j + 1)]);
+            if i + j + 1 < m {
+                subtri.push([idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)]);
+            }
+        }
+    }
+    let faces: Vec<u32> = (0..mesh.n_faces() as u32)
+        .filter(|&f| space.is_active(f))
+        .collect();
+    #[allow(clippy::type_complexity)]
+    let per: Vec<(Vec<[f64; 3]>, Vec<bool>)> = faces
+        .par_iter()
+        .map(|&f| -> Result<(Vec<[f64; 3]>, Vec<bool>)> {
+            let mut ws = Workspace::default();
+            let mut out = [0.0; 3];
+            let mut p = Vec::with_capacity(grid.len());
+            let mut inside = Vec::with_capacity(grid.len());
+            for &(i, j) in &grid {
+                let b = [
+                    (m - i - j) as f64 / m as f64,
+                    i as f64 / m as f64,
+                    j as f64 / m as f64,
+                ];
+                space.evaluate(control, 3, f, b, 0, &mut ws, &mut out)?;
+                p.push(out);
+                inside.push(
+                    spline
+                        .holes
+                        .iter()
+                        .any(|h| h.inside_seam(f, b).unwrap_or(false)),
+                );
+            }
+            Ok((p, inside))
+        })
+        .collect::<Result<_>>()?;
+    let mut t = Tessellation::default();
+    for (k, (p, inside)) in per.into_iter().enumerate() {
+        let f = faces[k];
+        let base = t.positions.len() as u32;
+        t.positions.extend_from_slice(&p);
+        t.vertex_face.extend(std::iter::repeat_n(f as i64, p.len()));
+        t.vertex_chart.extend(std::iter::repeat_n(
+            space.canonical_chart(f) as i64,
+            p.len(),
+        ));
+        for s in &subtri {
+            if s.iter().any(|&q| inside[q]) {
+                continue;
+            }
+            t.triangles.push(s.map(|q| base + q as u32));
+        }
+    }
+    t.spline_triangles = t.triangles.len();
+    // Domain edges as polylines (once per edge).
+    let mut ws = Workspace::default();
+    let mut out = [0.0; 3];
+    for h in 0..mesh.n_corners() as u32 {
+        let f = h / 3;
+        let tw = mesh.he_twin(h);
+        if !space.is_active(f)
+            || (!mesh.is_boundary_halfedge(tw) && space.is_active(tw / 3) && tw < h)
+        {
+            continue;
+        }
+        let i = h as usize % 3;
+        let mut line = Vec::with_capacity(m + 1);
+        for s in 0..=m {
+            let a = s as f64 / m as f64;
+            let mut b = [0.0; 3];
+            b[i] = 1.0 - a;
+            b[(i + 1) % 3] = a;
+            if spline
+                .holes
+                .iter()
+                .any(|hh| hh.inside_seam(f, b).unwrap_or(false))
+            {
+                continue;
+            }
+            space.evaluate(control, 3, f, b, 0, &mut ws, &mut out)?;
+            line.push(out);
+        }
+        if line.len() >= 2 {
+            t.boundaries.push(line);
+        }
+    }
+    // Fill patches on a polar grid.
+    for hole in &spline.holes {
+        let nt = 3 * m;
+        let npsi = 48.max(8 * m);
+        let center = t.positions.len() as u32;
+        t.positions.push(hole.center);
+        t.vertex_face.push(-1);
+        t.vertex_chart.push(-1);
+        let rows: Vec<Vec<[f64; 3]>> = (1..=nt)
+            .into_par_iter()
+            .map(|it| -> Result<Vec<[f64; 3]>> {
+                let mut ws = Workspace::default();
+                (0..npsi)
+                    .map(|j| {
+                        hole.fill_point(
+                            space,
+                            control,
+                            it as f64 / nt as f64,
+                            2.0 * std::f64::consts::PI * j as f64 / npsi as f64,
+                            &mut ws,
+                        )
+                    })
+                    .collect()
+            })
+            .collect::<Result<_>>()?;
+        let start = t.positions.len() as u32;
+        for r in &rows {
+            t.positions.extend_from_slice(r);
+            t.vertex_face.extend(std::iter::repeat_n(-1, r.len()));
+            t.vertex_chart.extend(std::iter::repeat_n(-1, r.len()));
+        }
+        let at = |it: usize, j: usize| start + (it * npsi + j % npsi) as u32;
+        for j in 0..npsi {
+            t.triangles.push([center, at(0, j), at(0, j + 1)]);
+        }
+        for it in 0..nt - 1 {
+            for j in 0..npsi {
+                t.triangles
+                    .push([at(it, j), at(it + 1, j), at(it + 1, j + 1)]);
+                t.triangles
+                    .push([at(it, j), at(it + 1, j + 1), at(it, j + 1)]);
+            }
+        }
+        let mut seam: Vec<[f64; 3]> = rows[nt - 1].clone();
+        seam.push(rows[nt - 1][0]);
+        t.boundaries.push(seam);
+    }
+    Ok(t)
+}
+
+/// Distances from points to a triangle mesh (exact point–triangle distance, uniform grid of
+/// the triangles' bounding boxes).
+pub struct MeshDistance {
+    tris: Vec<[[f64; 3]; 3]>,
+    lo: [f64; 3],
+    cell: f64,
+    dims: [usize; 3],
+    start: Vec<u32>,
+    items: Vec<u32>,
+    /// Bounding-box diagonal of the mesh.
+    pub diagonal: f64,
+}
+
+fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Distance from `p` to triangle `t` (Ericson, *Real-Time Collision Detection*, 5.1.5).
+pub fn point_triangle_distance(p: [f64; 3], t: &[[f64; 3]; 3]) -> f64 {
+    let [a, b, c] = *t;
+    let ab = sub3(b, a);
+    let ac = sub3(c, a);
+    let ap = sub3(p, a);
+    let d1 = dot3(ab, ap);
+    let d2 = dot3(ac, ap);
+    let q = if d1 <= 0.0 && d2 <= 0.0 {
+        a
+    } else {
+        let bp = sub3(p, b);
+        let d3 = dot3(ab, bp);
+        let d4 = dot3(ac, bp);
+        if d3 >= 0.0 && d4 <= d3 {
+            b
+        } else {
+            let vc = d1 * d4 - d3 * d2;
+            if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+                let v = d1 / (d1 - d3);
+                [a[0] + v * ab[0], a[1] + v * ab[1], a[2] + v * ab[2]]
+            } else {
+                let cp = sub3(p, c);
+                let d5 = dot3(ab, cp);
+                let d6 = dot3(ac, cp);
+                if d6 >= 0.0 && d5 <= d6 {
+                    c
+                } else {
+                    let vb = d5 * d2 - d1 * d6;
+                    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+                        let w = d2 / (d2 - d6);
+                        [a[0] + w * ac[0], a[1] + w * ac[1], a[2] + w * ac[2]]
+                    } else {
+                        let va = d3 * d6 - d5 * d4;
+                        if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+                            let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+                            let bc = sub3(c, b);
+                            [b[0] + w * bc[0], b[1] + w * bc[1], b[2] + w * bc[2]]
+                        } else {
+                            let denom = 1.0 / (va + vb + vc);
+                            let v = vb * denom;
+                            let w = vc * denom;
+                            [
+                                a[0] + ab[0] * v + ac[0] * w,
+                                a[1] + ab[1] * v + ac[1] * w,
+                                a[2] + ab[2] * v + ac[2] * w,
+                            ]
+                        }
+                    }
+                }
+            }
+        }
+    };
+    let d = sub3(p, q);
+    dot3(d, d).sqrt()
+}
+
+impl MeshDistance {
+    pub fn new(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> MeshDistance {
+        let tris: Vec<[[f64; 3]; 3]> = triangles
+            .iter()
+            .map(|t| t.map(|v| positions[v as usize]))
+            .collect();
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        let mut mean = 0.0;
+        for t in &tris {
+            for p in t {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+            mean += dot3(sub3(t[1], t[0]), sub3(t[1], t[0])).sqrt();
+        }
+        mean /= tris.len().max(1) as f64;
+        let diagonal = dot3(sub3(hi, lo), sub3(hi, lo)).sqrt();
+        let cell = (2.0 * mean).max(diagonal / 256.0).max(1e-300);
+        let dims: [usize; 3] =
+            std::array::from_fn(|k| (((hi[k] - lo[k]) / cell).floor() as usize + 1).min(512));
+        let cidx =
+            |p: f64, k: usize| (((p - lo[k]) / cell).floor().max(0.0) as usize).min(dims[k] - 1);
+        let ncell = dims[0] * dims[1] * dims[2];
+        let mut count = vec![0u32; ncell + 1];
+        let ranges: Vec<[usize; 6]> = tris
+            .iter()
+            .map(|t| {
+                let mut r = [0usize; 6];
+                for k in 0..3 {
+                    let a = t.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+                    let b = t.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
+                    r[2 * k] = cidx(a, k);
+                    r[2 * k + 1] = cidx(b, k);
+                }
+                r
+            })
+            .collect();
+        let cell_of = |x: usize, y: usize, z: usize| (z * dims[1] + y) * dims[0] + x;
+        for r in &ranges {
+            for z in r[4]..=r[5] {
+                for y in r[2]..=r[3] {
+                    for x in r[0]..=r[1] {
+                        count[cell_of(x, y, z) + 1] += 1;
+                    }
+                }
+            }
+        }
+        for k in 1..count.len() {
+            count[k] += count[k - 1];
+        }
+        let mut fill = count.clone();
+        let mut items = vec![0u32; count[ncell] as usize];
+        for (ti, r) in ranges.iter().enumerate() {
+            for z in r[4]..=r[5] {
+                for y in r[2]..=r[3] {
+                    for x in r[0]..=r[1] {
+                        let c = cell_of(x, y, z);
+                        items[fill[c] as usize] = ti as u32;
+                        fill[c] += 1;
+                    }
+                }
+            }
+        }
+        MeshDistance {
+            tris,
+            lo,
+            cell,
+            dims,
+            start: count,
+            items,
+            diagonal,
+        }
+    }
+
+    /// Distance from `p` to the mesh (searches growing shells of grid cells).
+    pub fn distance(&self, p: [f64; 3]) -> f64 {
+        // Start from the nearest cell of the grid (points outside the box are clamped in; the
+        // shell bound below then loses one cell, hence `r − 1`).
+        let c: [i64; 3] = std::array::from_fn(|k| {
+            (((p[k] - self.lo[k]) / self.cell).floor() as i64).clamp(0, self.dims[k] as i64 - 1)
+        });
+        let mut best = f64::INFINITY;
+        let maxr = self.dims.iter().copied().max().unwrap_or(1) as i64 + 1;
+        for r in 0..=maxr {
+            // Points outside the box: distance to the box bounds the search from below.
+            for z in c[2] - r..=c[2] + r {
+                for y in c[1] - r..=c[1] + r {
+                    for x in c[0] - r..=c[0] + r {
+                        let shell = (x - c[0]).abs().max((y - c[1]).abs()).max((z - c[2]).abs());
+                        if shell != r {
+                            continue;
+                        }
+                        if x < 0
+                            || y < 0
+                            || z < 0
+                            || x as usize >= self.dims[0]
+                            || y as usize >= self.dims[1]
+                            || z as usize >= self.dims[2]
+                        {
+                            continue;
+                        }
+                        let cell =
+                            (z as usize * self.dims[1] + y as usize) * self.dims[0] + x as usize;
+                        for &t in
+                            &self.items[self.start[cell] as usize..self.start[cell + 1] as usize]
+                        {
+                            best = best.min(point_triangle_distance(p, &self.tris[t as usize]));
+                        }
+                    }
+                }
+            }
+            // Every triangle not yet seen is at least r cells away.
+            if best <= (r as f64 - 1.0).max(0.0) * self.cell {
+                break;
+            }
+        }
+        best
+    }
+}
+
+/// RMS and maximum distance of `points` to the mesh, in percent of its bounding-box diagonal.
+pub fn error_percent(dist: &MeshDistance, points: &[[f64; 3]]) -> (f64, f64) {
+    use rayon::prelude::*;
+    let d: Vec<f64> = points.par_iter().map(|&p| dist.distance(p)).collect();
+    let rms = (d.iter().map(|x| x * x).sum::<f64>() / d.len().max(1) as f64).sqrt();
+    let max = d.iter().fold(0.0f64, |a, &b| a.max(b));
+    let s = 100.0 / dist.diagonal.max(1e-300);
+    (rms * s, max * s)
+}
+
+/// Relative jump below which [`run`] counts an order of partials as continuous: the recurrence
+/// loses accuracy on thin triangles (face.off: 5e-8 in second partials of a cubic), while the
+/// order-`n` partials of a degree-`n` spline jump by O(1).
+pub const CONTINUITY_TOLERANCE: f64 = 1e-6;
+
+/// Everything [`run`] measured, in the keys of the CLI's JSON.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SplineReport {
+    pub degree: usize,
+    pub fairness: usize,
+    pub control_points: usize,
+    pub domain_faces: usize,
+    pub active_faces: usize,
+    pub rms_error_percent: f64,
+    pub max_error_percent: f64,
+    /// Errors of the fill patches' samples alone.
+    pub fill_max_error_percent: Option<f64>,
+    pub continuity: ContinuityReport,
+    pub space: ManifoldReport,
+    pub fairing: FairingReport,
+    pub fit: Option<FitReport>,
+    pub fit_ridge: Option<f64>,
+    pub seconds_knots: f64,
+    pub seconds_fairing: f64,
+    pub seconds_fit: f64,
+    pub seconds_fill: f64,
+    /// Spline construction (knots, bases, fairing, fit, fill), without measurements.
+    pub seconds: f64,
+}
+
+/// Build the space, the spline, tessellate and measure (the CLI's work, minus files).
+pub fn run<A: FlatCharts + Sync + ?Sized>(
+    charts: &A,
+    input: &MeshDistance,
+    opts: &SplineOptions,
+    tessellation: usize,
+    progress: &mut dyn Progress,
+) -> Result<(SplineReport, Tessellation, Vec<f64>)> {
+    let t0 = Instant::now();
+    progress.report("knots", None, "knot clouds and bases");
+    let space = ManifoldSpace::new(charts, opts.degree, &opts.knots)?;
+    let seconds_knots = t0.elapsed().as_secs_f64();
+    let spline = build(&space, opts, progress)?;
+    let seconds = t0.elapsed().as_secs_f64();
+    progress.report("measure", None, "continuity, tessellation, errors");
+    let cont = continuity(&space, &spline.control, &spline.holes, CONTINUITY_TOLERANCE)?;
+    let tess = tessellate(&space, &spline, tessellation)?;
+    let (rms, max) = error_percent(input, &tess.positions);
+    let fill_pts: Vec<[f64; 3]> = tess
+        .positions
+        .iter()
+        .zip(&tess.vertex_face)
+        .filter(|(_, f)| **f < 0)
+        .map(|(p, _)| *p)
+        .collect();
+    let fill_max = (!fill_pts.is_empty()).then(|| error_percent(input, &fill_pts).1);
+    let rep = space.report();
+    Ok((
+        SplineReport {
+            degree: opts.degree,
+            fairness: opts.fairness,
+            control_points: rep.control_points,
+            domain_faces: charts.mesh().n_faces(),
+            active_faces: rep.active_faces,
+            rms_error_percent: rms,
+            max_error_percent: max,
+            fill_max_error_percent: fill_max,
+            continuity: cont,
+            space: rep,
+            fairing: spline.fairing.clone(),
+            fit: spline.fit.clone(),
+            fit_ridge: spline.fit_ridge,
+            seconds_knots,
+            seconds_fairing: spline.seconds_fairing,
+            seconds_fit: spline.seconds_fit,
+            seconds_fill: spline.seconds_fill,
+            seconds,
+        },
+        tess,
+        spline.control,
+    ))
+}

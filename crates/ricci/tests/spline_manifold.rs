@@ -1,0 +1,533 @@
+//! Manifold triangular B-splines (paper 000 §5): partition of unity on the spline domain,
+//! evaluation independent of the chart and of the chart provider, C^{n−1} across every
+//! interior edge (and not C^n, so the measurement can fail), fairing constraints, the G¹ fill
+//! patch at the extraordinary point, and the end-to-end construction on real meshes.
+//!
+//! Real-mesh tests read `RICCI_MESHES` and skip with a note when it is unset.
+
+use ricci::atlas::FlatCharts;
+use ricci::mesh::io::read_surface;
+use ricci::mesh::Surface;
+use ricci::progress::NoProgress;
+use ricci::spline::dms::{KnotOptions, Workspace};
+use ricci::spline::fit::{constraint_residuals, fair, fairness_constraints};
+use ricci::spline::hole::Hole;
+use ricci::spline::manifold::{rotate_partials, LocalCharts, ManifoldSpace};
+use ricci::spline::simplex::n_partials;
+use ricci::spline::surface::{
+    continuity, flat_domain, run, FlatDomain, MeshDistance, Singularity, SplineOptions,
+};
+use std::path::PathBuf;
+
+fn mesh_dir() -> Option<PathBuf> {
+    match std::env::var("RICCI_MESHES") {
+        Ok(d) => Some(PathBuf::from(d)),
+        Err(_) => {
+            eprintln!("note: RICCI_MESHES is not set; skipping the real-mesh spline tests");
+            None
+        }
+    }
+}
+
+fn load(name: &str) -> Option<Surface> {
+    let dir = mesh_dir()?;
+    Some(read_surface(&dir.join(name)).expect(name).0)
+}
+
+fn genus2() -> Surface {
+    ricci::mesh::generate::genus(2, 16).unwrap()
+}
+
+const SAMPLES: [[f64; 3]; 6] = [
+    [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0],
+    [0.7, 0.2, 0.1],
+    [0.05, 0.15, 0.8],
+    [1.0, 0.0, 0.0],
+    [0.0, 0.5, 0.5],
+    [0.3, 0.0, 0.7],
+];
+
+/// Σ N = 1 at sample points (vertices and edge points included) of every `stride`-th active face.
+fn check_partition_of_unity<A: FlatCharts + Sync>(space: &ManifoldSpace<'_, A>, stride: usize) {
+    let mut ws = Workspace::default();
+    let mut worst: f64 = 0.0;
+    let nf = space.charts().mesh().n_faces() as u32;
+    for f in (0..nf).step_by(stride) {
+        if !space.is_active(f) {
+            continue;
+        }
+        for b in SAMPLES {
+            let s = space.basis_sum(f, b, &mut ws).unwrap();
+            worst = worst.max((s - 1.0).abs());
+        }
+    }
+    assert!(worst < 1e-9, "partition of unity off by {worst:.2e}");
+}
+
+/// Evaluate at the same surface point in every chart containing the face: values agree to
+/// 1e-10 (relative to the bounding box) and partials up to `n − 1`, rotated by the transition
+/// into the canonical chart, agree to 1e-6 relative to the largest partial of that order at
+/// the point (measured: ≤ 2e-8; the recurrence amplifies rounding on the tiny faces near a
+/// cone, see `CONTINUITY_TOLERANCE`).
+fn check_chart_independence<A: FlatCharts + Sync>(
+    space: &ManifoldSpace<'_, A>,
+    control: &[f64],
+    stride: usize,
+) -> usize {
+    let charts = space.charts();
+    let n = space.degree();
+    let order = n - 1;
+    let np = n_partials(order);
+    let diag = Surface {
+        mesh: charts.mesh().clone(),
+        positions: charts.positions().to_vec(),
+        uvs: None,
+    }
+    .diagonal();
+    let mut ws = Workspace::default();
+    let mut compared = 0;
+    let (mut worst_v, mut worst_d): (f64, f64) = (0.0, 0.0);
+    let nf = charts.mesh().n_faces() as u32;
+    for f in (0..nf).step_by(stride) {
+        if !space.is_active(f) {
+            continue;
+        }
+        let c0 = space.canonical_chart(f);
+        for b in [SAMPLES[0], SAMPLES[2], SAMPLES[4]] {
+            let mut base = vec![0.0; np * 3];
+            space
+                .evaluate(control, 3, f, b, order, &mut ws, &mut base)
+                .unwrap();
+            let scale: Vec<f64> = (0..=order)
+                .map(|k| {
+                    (n_partials(k) - k - 1..n_partials(k))
+                        .flat_map(|i| (0..3).map(move |d| (i, d)))
+                        .map(|(i, d)| base[i * 3 + d].abs())
+                        .fold(1e-300, f64::max)
+                })
+                .collect();
+            for c in charts.charts_of_face(f) {
+                let x = charts.face_coords(c, f).unwrap();
+                let u = [
+                    b[0] * x[0][0] + b[1] * x[1][0] + b[2] * x[2][0],
+                    b[0] * x[0][1] + b[1] * x[1][1] + b[2] * x[2][1],
+                ];
+                let mut out = vec![0.0; np * 3];
+                space
+                    .evaluate_in_chart(control, 3, c, f, u, order, &mut ws, &mut out)
+                    .unwrap();
+                // Partials in chart c → canonical chart: u_c = m(u_0) with m: canon → c.
+                let (m, _) = charts.transition(c0, c, f).unwrap();
+                for d in 0..3 {
+                    let mut col: Vec<f64> = (0..np).map(|k| out[k * 3 + d]).collect();
+                    rotate_partials(order, m.rot, &mut col);
+                    for k in 0..np {
+                        out[k * 3 + d] = col[k];
+                    }
+                }
+                for d in 0..3 {
+                    worst_v = worst_v.max((out[d] - base[d]).abs() / diag);
+                }
+                for (k, sk) in scale.iter().enumerate().skip(1) {
+                    for i in n_partials(k) - k - 1..n_partials(k) {
+                        for d in 0..3 {
+                            worst_d = worst_d.max((out[i * 3 + d] - base[i * 3 + d]).abs() / sk);
+                        }
+                    }
+                }
+                compared += 1;
+            }
+        }
+    }
+    assert!(
+        worst_v <= 1e-10,
+        "values differ between charts by {worst_v:.2e}"
+    );
+    assert!(
+        worst_d <= 1e-6,
+        "partials differ between charts by {worst_d:.2e}"
+    );
+    compared
+}
+
+fn subdivided_and_faired<A: FlatCharts + Sync>(space: &ManifoldSpace<'_, A>, r: usize) -> Vec<f64> {
+    let c0 = space.subdivision_control_points();
+    fair(space, &c0, 3, r).unwrap().0
+}
+
+#[test]
+fn rotation_of_partials_matches_a_rotated_polynomial() {
+    // G(w) = w_x³ w_y − 2 w_x w_y² + w_y (degree 4), F(u) = G(rot u + t): compare all partials up
+    // to order 4 with finite-difference-free closed forms via polynomial evaluation.
+    use num_complex::Complex64 as C;
+    let rot = C::from_polar(1.0, 0.83);
+    let t = C::new(0.3, -1.2);
+    let g = |x: f64, y: f64| x.powi(3) * y - 2.0 * x * y * y + y;
+    let f = |x: f64, y: f64| {
+        let w = rot * C::new(x, y) + t;
+        g(w.re, w.im)
+    };
+    // Partials of G at w0 by exact formulas.
+    let u0 = [0.4, 0.7];
+    let w = rot * C::new(u0[0], u0[1]) + t;
+    let (x, y) = (w.re, w.im);
+    let gp = [
+        g(x, y),
+        3.0 * x * x * y - 2.0 * y * y,
+        x.powi(3) - 4.0 * x * y + 1.0,
+        6.0 * x * y,
+        3.0 * x * x - 4.0 * y,
+        -4.0 * x,
+    ];
+    let mut v = gp.to_vec();
+    rotate_partials(2, rot, &mut v);
+    // Partials of F by central differences (step 1e-4; error ~1e-7).
+    let h = 1e-4;
+    let fx = (f(u0[0] + h, u0[1]) - f(u0[0] - h, u0[1])) / (2.0 * h);
+    let fy = (f(u0[0], u0[1] + h) - f(u0[0], u0[1] - h)) / (2.0 * h);
+    let fxx = (f(u0[0] + h, u0[1]) - 2.0 * f(u0[0], u0[1]) + f(u0[0] - h, u0[1])) / (h * h);
+    let fyy = (f(u0[0], u0[1] + h) - 2.0 * f(u0[0], u0[1]) + f(u0[0], u0[1] - h)) / (h * h);
+    let fxy = (f(u0[0] + h, u0[1] + h) - f(u0[0] + h, u0[1] - h) - f(u0[0] - h, u0[1] + h)
+        + f(u0[0] - h, u0[1] - h))
+        / (4.0 * h * h);
+    let want = [f(u0[0], u0[1]), fx, fy, fxx, fxy, fyy];
+    for k in 0..6 {
+        assert!(
+            (v[k] - want[k]).abs() < 1e-5 * (1.0 + want[k].abs()),
+            "partial {k}: {} vs {}",
+            v[k],
+            want[k]
+        );
+    }
+}
+
+#[test]
+fn generated_genus2_partition_of_unity_charts_and_providers() {
+    let s = genus2();
+    let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+    let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
+    let rep = space.report();
+    assert!(rep.max_chart_residual < 1e-10, "{rep:?}");
+    check_partition_of_unity(&space, 1);
+    let control = subdivided_and_faired(&space, 1);
+    let compared = check_chart_independence(&space, &control, 3);
+    assert!(compared > 1000, "only {compared} chart comparisons");
+
+    // A second, independently placed provider (every chart moved by a random rigid motion):
+    // the same spline, values equal and partials related by the rotation between the two
+    // providers' canonical charts.
+    let charts = &dom.charts;
+    let other = LocalCharts::new(
+        charts.mesh().clone(),
+        charts.lengths().to_vec(),
+        charts.positions().to_vec(),
+        charts.singular_vertices().to_vec(),
+        Some(77),
+    )
+    .unwrap();
+    let space2 = ManifoldSpace::new(&other, 3, &KnotOptions::default()).unwrap();
+    let mut ws = Workspace::default();
+    let np = n_partials(2);
+    let mut worst: f64 = 0.0;
+    let mut worst_d: f64 = 0.0;
+    for f in 0..charts.mesh().n_faces() as u32 {
+        if !space.is_active(f) {
+            continue;
+        }
+        let a = space.canonical_coords(f);
+        let b = space2.canonical_coords(f);
+        let (m, _) = ricci::atlas::fit_rigid(&a, &b);
+        for bary in [SAMPLES[0], SAMPLES[1], SAMPLES[4]] {
+            let mut x = vec![0.0; np * 3];
+            let mut y = vec![0.0; np * 3];
+            space
+                .evaluate(&control, 3, f, bary, 2, &mut ws, &mut x)
+                .unwrap();
+            space2
+                .evaluate(&control, 3, f, bary, 2, &mut ws, &mut y)
+                .unwrap();
+            for d in 0..3 {
+                let mut col: Vec<f64> = (0..np).map(|k| y[k * 3 + d]).collect();
+                rotate_partials(2, m.rot, &mut col);
+                for k in 0..np {
+                    y[k * 3 + d] = col[k];
+                }
+            }
+            for d in 0..3 {
+                worst = worst.max((x[d] - y[d]).abs());
+            }
+            let s1 = (3..9).map(|i| x[i].abs()).fold(1e-300, f64::max);
+            worst_d = worst_d.max((3..9).map(|i| (x[i] - y[i]).abs()).fold(0.0, f64::max) / s1);
+        }
+    }
+    assert!(
+        worst < 1e-10 * s.diagonal(),
+        "providers differ by {worst:.2e}"
+    );
+    assert!(
+        worst_d < 1e-6,
+        "first partials differ between providers by {worst_d:.2e}"
+    );
+}
+
+#[test]
+fn continuity_is_c_n_minus_1_and_not_c_n() {
+    let s = genus2();
+    let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+    for n in [2usize, 3, 4] {
+        let space = ManifoldSpace::new(&dom.charts, n, &KnotOptions::default()).unwrap();
+        let control = subdivided_and_faired(&space, 1.min(n - 1));
+        let rep = continuity(&space, &control, &[], 1e-8).unwrap();
+        assert!(rep.chart_boundary_edges > 100, "{rep:?}");
+        // Orders < n − 1 to 1e-8, order n − 1 to 1e-6 (measured ≤ 6e-8 for n = 4).
+        for k in 0..n {
+            let tol = if k + 1 < n { 1e-8 } else { 1e-6 };
+            assert!(
+                rep.relative_jumps[k] <= tol,
+                "degree {n}: order {k} jumps by {:.2e}",
+                rep.relative_jumps[k]
+            );
+        }
+        // Order-n partials are piecewise constant and jump across knot lines: the
+        // measurement sees it.
+        assert!(
+            rep.relative_jumps[n] > 1e-4,
+            "degree {n}: order-{n} jump only {:.2e}",
+            rep.relative_jumps[n]
+        );
+    }
+}
+
+#[test]
+fn fairing_constraints_hold_on_the_manifold() {
+    let s = genus2();
+    let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+    let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
+    let c0 = space.subdivision_control_points();
+    let mut changes = Vec::new();
+    for r in 0..3 {
+        let (c, rep) = fair(&space, &c0, 3, r).unwrap();
+        assert!(rep.converged, "{rep:?}");
+        let cons = fairness_constraints(&space, r).unwrap();
+        let res = constraint_residuals(&space, &cons, &c, 3);
+        let scale = c.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        let worst = res.iter().fold(0.0f64, |a, b| a.max(b.abs())) / scale;
+        assert!(worst < 1e-8, "r = {r}: residual {worst:.2e}");
+        // For r ≥ 1 the initial control points violate them (otherwise the test says nothing;
+        // r = 0 only asks for shared edge control points, which the subdivision already has).
+        let res0 = constraint_residuals(&space, &cons, &c0, 3);
+        let worst0 = res0.iter().fold(0.0f64, |a, b| a.max(b.abs())) / scale;
+        if r == 0 {
+            assert!(worst0 < 1e-12, "{worst0:.2e}");
+        } else {
+            assert!(worst0 > 1e-4, "{worst0:.2e}");
+        }
+        changes.push(rep.rms_change);
+    }
+    // More constraints, more change (paper 000 Fig. 13).
+    assert!(
+        changes[0] < changes[1] && changes[1] < changes[2],
+        "{changes:?}"
+    );
+}
+
+#[test]
+fn fill_patch_meets_the_spline_g1() {
+    let s = genus2();
+    let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+    let sv = dom.singular.unwrap();
+    let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
+    let control = subdivided_and_faired(&space, 1);
+    let hole = Hole::new(&space, &control, sv).unwrap();
+    // Cone angle of 2πχ of curvature: Θ = 2π − 2πχ = 6π for genus 2.
+    assert!(
+        (hole.cone_angle - 6.0 * std::f64::consts::PI).abs() < 1e-8,
+        "{}",
+        hole.cone_angle
+    );
+    assert!(hole.min_clearance > 0.0);
+    let rep = hole.seam_normal_jump(&space, &control, 720).unwrap();
+    assert!(rep.max_normal_jump_deg <= 0.5, "{rep:?}");
+    assert!(rep.max_position_gap < 1e-12, "{rep:?}");
+    // The seam is outside the one-ring (inside active faces) and its data is the spline's.
+    let mut ws = Workspace::default();
+    for j in 0..50 {
+        let psi = 2.0 * std::f64::consts::PI * j as f64 / 50.0;
+        let phi = hole.cone_angle * psi / (2.0 * std::f64::consts::PI);
+        assert!(hole.radius(psi) > hole.r_link(phi));
+        let loc = hole.locate(hole.radius(psi), phi).unwrap();
+        assert!(space.is_active(loc.face));
+        let (c, _, _) = hole.seam_data(&space, &control, psi, &mut ws).unwrap();
+        let mut out = [0.0; 3];
+        space
+            .evaluate(&control, 3, loc.face, loc.bary, 0, &mut ws, &mut out)
+            .unwrap();
+        for k in 0..3 {
+            assert!((c[k] - out[k]).abs() < 1e-9 * s.diagonal());
+        }
+    }
+}
+
+fn end_to_end(name: &str, s: &Surface, dom: &FlatDomain, degree: usize, max_error_percent: f64) {
+    let dist = MeshDistance::new(&s.positions, s.mesh.faces());
+    let opts = SplineOptions {
+        degree,
+        ..SplineOptions::default()
+    };
+    let (rep, tess, _) = run(&dom.charts, &dist, &opts, 3, &mut NoProgress).unwrap();
+    let n = degree;
+    eprintln!(
+        "{name}: N_f {} N_c {} {} jumps {:?} seam {:.2e}° rms {:.3}% max {:.3}% ({:.2} s)",
+        rep.domain_faces,
+        rep.control_points,
+        rep.continuity.class,
+        rep.continuity.relative_jumps,
+        rep.continuity.max_seam_normal_jump_deg,
+        rep.rms_error_percent,
+        rep.max_error_percent,
+        rep.seconds
+    );
+    assert!(rep.fairing.converged);
+    assert!(rep.max_error_percent < max_error_percent, "{name}: {rep:?}");
+    assert!(tess
+        .positions
+        .iter()
+        .all(|p| p.iter().all(|x| x.is_finite())));
+    // Orders below n − 1 to 1e-8; order n − 1 to 1e-6 (rounding of the recurrence on thin
+    // triangles, see CONTINUITY_TOLERANCE); order n jumps by O(1).
+    for k in 0..n {
+        let tol = if k + 1 < n { 1e-8 } else { 1e-6 };
+        assert!(
+            rep.continuity.relative_jumps[k] <= tol,
+            "{name}: order {k} jumps by {:.2e}",
+            rep.continuity.relative_jumps[k]
+        );
+    }
+    assert!(rep.continuity.relative_jumps[n] > 1e-3, "{name}");
+    assert!(rep.continuity.max_seam_normal_jump_deg <= 0.5, "{name}");
+    assert_eq!(rep.continuity.seams.len(), dom.singular.iter().count());
+}
+
+#[test]
+fn eight_single_extraordinary_point() {
+    let Some(s) = load("eight.off") else { return };
+    let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+    assert_eq!(dom.genus, 2);
+    let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
+    check_partition_of_unity(&space, 1);
+    let control = subdivided_and_faired(&space, 1);
+    check_chart_independence(&space, &control, 7);
+    end_to_end("eight", &s, &dom, 3, 1.0);
+}
+
+#[test]
+fn open_and_genus_one_surfaces_have_no_extraordinary_point() {
+    for name in ["face.off", "eight.open.off"] {
+        let Some(s) = load(name) else { return };
+        let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+        assert!(dom.singular.is_none());
+        let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
+        assert_eq!(space.report().active_faces, s.mesh.n_faces());
+        check_partition_of_unity(&space, 3);
+        end_to_end(name, &s, &dom, 3, 1.0);
+    }
+}
+
+/// The same spline over the affine atlas and over `LocalCharts` built on the atlas's own
+/// metric: knots depend only on the metric, so the two spaces must agree (values to 1e-10 of
+/// the diagonal, first partials after the rotation between the canonical charts to 1e-8).
+fn atlas_vs_local(s: &Surface, name: &str, stride: usize) {
+    use ricci::atlas::{AffineAtlas, AtlasOptions};
+    let atlas = AffineAtlas::build(s, &AtlasOptions::default(), &mut NoProgress).unwrap();
+    let space = ManifoldSpace::new(&atlas, 3, &KnotOptions::default()).unwrap();
+    check_partition_of_unity(&space, stride);
+    let control = subdivided_and_faired(&space, 1);
+    let compared = check_chart_independence(&space, &control, stride);
+    assert!(compared > 0);
+    let local = LocalCharts::new(
+        atlas.mesh().clone(),
+        atlas.lengths().to_vec(),
+        atlas.positions().to_vec(),
+        atlas.singular_vertices().to_vec(),
+        None,
+    )
+    .unwrap();
+    let space2 = ManifoldSpace::new(&local, 3, &KnotOptions::default()).unwrap();
+    let mut ws = Workspace::default();
+    let np = n_partials(1);
+    let (mut worst, mut worst_d): (f64, f64) = (0.0, 0.0);
+    for f in (0..atlas.mesh().n_faces() as u32).step_by(stride) {
+        if !space.is_active(f) {
+            continue;
+        }
+        let (m, _) =
+            ricci::atlas::fit_rigid(&space.canonical_coords(f), &space2.canonical_coords(f));
+        for bary in [SAMPLES[0], SAMPLES[3], SAMPLES[4]] {
+            let mut x = vec![0.0; np * 3];
+            let mut y = vec![0.0; np * 3];
+            space
+                .evaluate(&control, 3, f, bary, 1, &mut ws, &mut x)
+                .unwrap();
+            space2
+                .evaluate(&control, 3, f, bary, 1, &mut ws, &mut y)
+                .unwrap();
+            for d in 0..3 {
+                let mut col: Vec<f64> = (0..np).map(|k| y[k * 3 + d]).collect();
+                rotate_partials(1, m.rot, &mut col);
+                for k in 0..np {
+                    y[k * 3 + d] = col[k];
+                }
+                worst = worst.max((x[d] - y[d]).abs());
+            }
+            let s1 = (3..9).map(|i| x[i].abs()).fold(1e-300, f64::max);
+            worst_d = worst_d.max((3..9).map(|i| (x[i] - y[i]).abs()).fold(0.0, f64::max) / s1);
+        }
+    }
+    eprintln!("{name}: atlas vs local: values {worst:.2e}, partials {worst_d:.2e}");
+    assert!(
+        worst < 1e-10 * s.diagonal(),
+        "{name}: providers differ by {worst:.2e}"
+    );
+    assert!(worst_d < 1e-6, "{name}: partials differ by {worst_d:.2e}");
+    let holes: Vec<Hole> = atlas
+        .singular_vertices()
+        .iter()
+        .map(|&v| Hole::new(&space, &control, v).unwrap())
+        .collect();
+    let rep = continuity(&space, &control, &holes, 1e-6).unwrap();
+    eprintln!(
+        "{name}: atlas jumps {:?} seam {:.2e}°",
+        rep.relative_jumps, rep.max_seam_normal_jump_deg
+    );
+    assert_eq!(rep.smoothness, Some(2), "{name}: {rep:?}");
+    assert!(rep.max_seam_normal_jump_deg <= 0.5, "{name}: {rep:?}");
+}
+
+#[test]
+fn affine_atlas_generated_genus2() {
+    atlas_vs_local(&genus2(), "genus2", 1);
+}
+
+#[test]
+fn affine_atlas_real_meshes() {
+    // 3holes.off and kitten over the atlas are not here: the fairing on the atlas's metric
+    // does not converge quickly there (minutes; see BENCHMARKS.md).
+    let Some(s) = load("eight.off") else { return };
+    atlas_vs_local(&s, "eight.off", 11);
+}
+
+#[test]
+fn local_charts_genus3_and_4_meshes() {
+    for name in ["3holes.off", "genus3.off", "fertility.off"] {
+        let Some(s) = load(name) else { return };
+        let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+        let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
+        check_partition_of_unity(&space, 13);
+        let control = subdivided_and_faired(&space, 1);
+        check_chart_independence(&space, &control, 29);
+        let hole = Hole::new(&space, &control, dom.singular.unwrap()).unwrap();
+        let rep = hole.seam_normal_jump(&space, &control, 360).unwrap();
+        eprintln!("{name}: seam {rep:?}");
+        assert!(rep.max_normal_jump_deg <= 0.5, "{name}: {rep:?}");
+    }
+}
