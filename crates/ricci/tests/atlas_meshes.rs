@@ -22,7 +22,7 @@ use std::f64::consts::PI;
 use std::path::PathBuf;
 
 fn mesh_dir() -> Option<PathBuf> {
-    let d = PathBuf::from(std::env::var("RICCI_MESHES").ok()?);
+    let d = ricci_meshes()?;
     d.is_dir().then_some(d)
 }
 
@@ -378,4 +378,16 @@ fn query_api_on_genus2() {
     bary[i] = 1.0;
     let hit = a.locate(f, bary).into_iter().find(|x| x.0 == c).unwrap();
     assert!((hit.1[0] - p[0]).hypot(hit.1[1] - p[1]) < 1e-12);
+}
+
+/// `$RICCI_MESHES` as a folder. Cargo runs test binaries in the crate's folder, so a relative
+/// path (the README's `../shared/meshes`) is taken from the workspace root when it does not
+/// exist from the current directory.
+fn ricci_meshes() -> Option<std::path::PathBuf> {
+    let d = std::path::PathBuf::from(std::env::var_os("RICCI_MESHES")?);
+    if d.is_relative() && !d.is_dir() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        return Some(root.join(d));
+    }
+    Some(d)
 }

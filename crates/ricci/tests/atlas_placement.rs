@@ -12,7 +12,7 @@ use ricci::progress::NoProgress;
 use std::path::PathBuf;
 
 fn mesh_dir() -> Option<PathBuf> {
-    let d = PathBuf::from(std::env::var("RICCI_MESHES").ok()?);
+    let d = ricci_meshes()?;
     d.is_dir().then_some(d)
 }
 
@@ -107,4 +107,16 @@ fn brute_force_every_vertex() {
         assert!(rank as f64 <= 0.05 * n as f64, "{name}: rank {rank} of {n}");
         assert!(rho > 0.8, "{name}: Spearman {rho}");
     }
+}
+
+/// `$RICCI_MESHES` as a folder. Cargo runs test binaries in the crate's folder, so a relative
+/// path (the README's `../shared/meshes`) is taken from the workspace root when it does not
+/// exist from the current directory.
+fn ricci_meshes() -> Option<std::path::PathBuf> {
+    let d = std::path::PathBuf::from(std::env::var_os("RICCI_MESHES")?);
+    if d.is_relative() && !d.is_dir() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        return Some(root.join(d));
+    }
+    Some(d)
 }

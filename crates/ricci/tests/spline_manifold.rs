@@ -20,9 +20,9 @@ use ricci::spline::surface::{
 use std::path::PathBuf;
 
 fn mesh_dir() -> Option<PathBuf> {
-    match std::env::var("RICCI_MESHES") {
-        Ok(d) => Some(PathBuf::from(d)),
-        Err(_) => {
+    match ricci_meshes() {
+        Some(d) => Some(d),
+        None => {
             eprintln!("note: RICCI_MESHES is not set; skipping the real-mesh spline tests");
             None
         }
@@ -204,7 +204,7 @@ fn rotation_of_partials_matches_a_rotated_polynomial() {
 #[test]
 fn generated_genus2_partition_of_unity_charts_and_providers() {
     let s = genus2();
-    let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+    let dom = flat_domain(&s, largest_valence(&s), &mut NoProgress).unwrap();
     let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
     let rep = space.report();
     assert!(rep.max_chart_residual < 1e-10, "{rep:?}");
@@ -273,7 +273,7 @@ fn generated_genus2_partition_of_unity_charts_and_providers() {
 #[test]
 fn continuity_is_c_n_minus_1_and_not_c_n() {
     let s = genus2();
-    let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+    let dom = flat_domain(&s, largest_valence(&s), &mut NoProgress).unwrap();
     for n in [2usize, 3, 4] {
         let space = ManifoldSpace::new(&dom.charts, n, &KnotOptions::default()).unwrap();
         let control = subdivided_and_faired(&space, 1.min(n - 1));
@@ -301,7 +301,7 @@ fn continuity_is_c_n_minus_1_and_not_c_n() {
 #[test]
 fn fairing_constraints_hold_on_the_manifold() {
     let s = genus2();
-    let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+    let dom = flat_domain(&s, largest_valence(&s), &mut NoProgress).unwrap();
     let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
     let c0 = space.subdivision_control_points();
     let mut changes = Vec::new();
@@ -334,7 +334,7 @@ fn fairing_constraints_hold_on_the_manifold() {
 #[test]
 fn fill_patch_meets_the_spline_g1() {
     let s = genus2();
-    let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+    let dom = flat_domain(&s, largest_valence(&s), &mut NoProgress).unwrap();
     let sv = dom.singular.unwrap();
     let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
     let control = subdivided_and_faired(&space, 1);
@@ -411,7 +411,7 @@ fn end_to_end(name: &str, s: &Surface, dom: &FlatDomain, degree: usize, max_erro
 #[test]
 fn eight_single_extraordinary_point() {
     let Some(s) = load("eight.off") else { return };
-    let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+    let dom = flat_domain(&s, largest_valence(&s), &mut NoProgress).unwrap();
     assert_eq!(dom.genus, 2);
     let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
     check_partition_of_unity(&space, 1);
@@ -424,7 +424,7 @@ fn eight_single_extraordinary_point() {
 fn open_and_genus_one_surfaces_have_no_extraordinary_point() {
     for name in ["face.off", "eight.open.off"] {
         let Some(s) = load(name) else { return };
-        let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+        let dom = flat_domain(&s, largest_valence(&s), &mut NoProgress).unwrap();
         assert!(dom.singular.is_none());
         let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
         assert_eq!(space.report().active_faces, s.mesh.n_faces());
@@ -520,7 +520,7 @@ fn affine_atlas_real_meshes() {
 fn local_charts_genus3_and_4_meshes() {
     for name in ["3holes.off", "genus3.off", "fertility.off"] {
         let Some(s) = load(name) else { return };
-        let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+        let dom = flat_domain(&s, largest_valence(&s), &mut NoProgress).unwrap();
         let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
         check_partition_of_unity(&space, 13);
         let control = subdivided_and_faired(&space, 1);
@@ -530,4 +530,28 @@ fn local_charts_genus3_and_4_meshes() {
         eprintln!("{name}: seam {rep:?}");
         assert!(rep.max_normal_jump_deg <= 0.5, "{name}: {rep:?}");
     }
+}
+
+/// `$RICCI_MESHES` as a folder. Cargo runs test binaries in the crate's folder, so a relative
+/// path (the README's `../shared/meshes`) is taken from the workspace root when it does not
+/// exist from the current directory.
+fn ricci_meshes() -> Option<std::path::PathBuf> {
+    let d = std::path::PathBuf::from(std::env::var_os("RICCI_MESHES")?);
+    if d.is_relative() && !d.is_dir() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        return Some(root.join(d));
+    }
+    Some(d)
+}
+
+/// The cone at the interior vertex of largest valence (smallest id among ties): a fixed,
+/// placement-independent choice for these tests (`Singularity::Auto`, least area distortion,
+/// is exercised by the CLI tests).
+fn largest_valence(s: &Surface) -> Singularity {
+    let m = &s.mesh;
+    let v = (0..m.n_vertices() as u32)
+        .filter(|&v| !m.is_isolated(v))
+        .max_by(|&a, &b| m.valence(a).cmp(&m.valence(b)).then(b.cmp(&a)))
+        .unwrap();
+    Singularity::Vertex(v)
 }

@@ -2,11 +2,14 @@
 //! [--tessellation M] [--out DIR] [--json]`: a manifold triangular B-spline surface with at most
 //! one extraordinary point (paper 000 §5).
 //!
-//! The flat metric and charts come from the affine atlas (`--charts atlas`, default:
-//! `ricci::atlas::AffineAtlas`, cone placed by least area distortion) or from the spline's own
-//! provider (`--charts local`: the flow's flat metric — genus 1 uniform, open free boundary,
-//! genus ≥ 2 one cone at the vertex of largest valence after raising its valence — developed by
-//! `ricci::spline::manifold::LocalCharts`). Then the subdivision control points, the fairing with
+//! The flat metric and charts come from the spline's own atlas (`--charts local`, default: the
+//! flow's flat metric — genus 1 uniform, open free boundary, genus ≥ 2 one cone placed by least
+//! area distortion after raising its valence and grading its neighbourhood — with one chart per
+//! face: the development of every face sharing a vertex with it,
+//! `ricci::spline::manifold::LocalCharts`) or from the paper's affine atlas (`--charts atlas`:
+//! `ricci::atlas::AffineAtlas`, central chart + cut-curve charts). Both are affine atlases of a
+//! flat cone metric with rigid transitions; the fairing over `AffineAtlas` is still slow and
+//! does not reach its tolerance on eight.off (see BENCHMARKS.md), so `local` is the default. Then the subdivision control points, the fairing with
 //! parameter `r`, optionally the least-squares fit to the mesh vertices, and the G¹ fill patch
 //! at the cone. `--out DIR` writes `surface.obj` (tessellation; the fill patch is group
 //! `fill`), `surface_vertices.json` (per tessellation vertex: domain face and chart, −1 on the
@@ -37,17 +40,19 @@ pub struct Args {
     /// Fairness parameter r (0 ≤ r ≤ n − 1; paper 000 eq. 14).
     #[arg(long, default_value_t = 1)]
     pub fairness: usize,
-    /// Singular vertex of a closed surface of genus ≥ 2: auto (largest valence) or a vertex id.
+    /// Singular vertex of a closed surface of genus ≥ 2: auto (least area distortion) or a
+    /// vertex id.
     #[arg(long, default_value = "auto")]
     pub singularity: String,
     /// After the fairing, fit the control points to the mesh vertices with this thin-plate
     /// weight (e.g. 1e-3).
     #[arg(long)]
     pub fit: Option<f64>,
-    /// Chart provider: atlas (`ricci::atlas::AffineAtlas`: cone placed by least area
-    /// distortion) or local (`LocalCharts` on the flow's flat metric, cone at the vertex of
-    /// largest valence).
-    #[arg(long, default_value = "atlas")]
+    /// Chart provider: local (`LocalCharts`: one developed chart per face on the flow's flat
+    /// metric, valence raised and graded around the cone) or atlas (`ricci::atlas::AffineAtlas`:
+    /// the paper's central + cut-curve charts; its fairing is still slow). Both place the
+    /// cone by least area distortion.
+    #[arg(long, default_value = "local")]
     pub charts: String,
     /// Segments per domain edge in the tessellation.
     #[arg(long, default_value_t = 4)]

@@ -22,7 +22,7 @@ use crate::atlas::FlatCharts;
 use crate::error::{Error, Result};
 use crate::flow::{ricci_flow, FlowOptions, TargetSpec};
 use crate::mesh::{topology, Surface};
-use crate::metric::Geometry;
+use crate::metric::{Geometry, Scheme};
 use crate::progress::Progress;
 
 use super::dms::{KnotOptions, Workspace};
@@ -34,7 +34,9 @@ use super::simplex::{n_partials, Point};
 /// Where the cone of a closed surface of genus ≥ 2 goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Singularity {
-    /// The interior vertex of largest valence (smallest id among ties).
+    /// Least area distortion, as the affine atlas chooses it
+    /// ([`crate::atlas::placement::place`]: linearized flow for every vertex, the best
+    /// confirmed by full flows).
     Auto,
     Vertex(u32),
 }
@@ -51,6 +53,8 @@ pub struct FlatDomain {
     pub flow_iterations: usize,
     pub flow_max_curvature_error: f64,
     pub flow_converged: bool,
+    /// The conformal scheme whose flow gave the metric.
+    pub scheme: Scheme,
     pub seconds: f64,
 }
 
@@ -103,10 +107,16 @@ pub fn flat_domain(
                 }
                 v
             }
-            Singularity::Auto => (0..mesh.n_vertices() as u32)
-                .filter(|&v| !mesh.is_isolated(v))
-                .max_by(|&a, &b| mesh.valence(a).cmp(&mesh.valence(b)).then(b.cmp(&a)))
-                .ok_or_else(|| Error::input("manifold spline: empty mesh"))?,
+            Singularity::Auto => {
+                progress.report("cone placement", None, "least area distortion");
+                crate::atlas::placement::place(
+                    surface,
+                    &lengths,
+                    &crate::atlas::AtlasOptions::default(),
+                    progress,
+                )?
+                .chosen
+            }
         };
         let g = genus as usize;
         let want = (4 * g + 4).max(8 * g - 2);
@@ -142,12 +152,45 @@ pub fn flat_domain(
             TargetSpec::SingleCone(Some(s)),
         )
     };
-    let opts = FlowOptions {
-        target,
-        tolerance: 1e-11,
-        ..FlowOptions::default()
+    // Thurston's packing first (the papers' scheme); where its clamped intersection angles make
+    // the target unreachable (Chow–Luo at a low-valence vertex, e.g. rocker-arm) or it does
+    // not converge, the exact schemes, which start at the input metric.
+    let mut flow = None;
+    let mut first_error = None;
+    for scheme in [
+        Scheme::Thurston,
+        Scheme::Inversive,
+        Scheme::Yamabe,
+        Scheme::Tangential,
+    ] {
+        let opts = FlowOptions {
+            target: target.clone(),
+            scheme,
+            tolerance: 1e-11,
+            ..FlowOptions::default()
+        };
+        match ricci_flow(&m, &l, &opts, progress) {
+            Ok(f) if f.converged => {
+                flow = Some((f, scheme));
+                break;
+            }
+            Ok(f) => {
+                if flow.is_none() {
+                    flow = Some((f, scheme));
+                }
+            }
+            Err(e) => {
+                if first_error.is_none() {
+                    first_error = Some(e);
+                }
+            }
+        }
+    }
+    let (flow, scheme) = match (flow, first_error) {
+        (Some(f), _) => f,
+        (None, Some(e)) => return Err(e),
+        (None, None) => return Err(Error::numerical("manifold spline: no flow ran")),
     };
-    let flow = ricci_flow(&m, &l, &opts, progress)?;
     if !flow.converged {
         return Err(Error::numerical(format!(
             "manifold spline: the Ricci flow did not converge (max |K − K̄| = {:.2e} after {} iterations)",
@@ -171,6 +214,7 @@ pub fn flat_domain(
         flow_iterations: flow.iterations,
         flow_max_curvature_error: flow.max_curvature_error,
         flow_converged: flow.converged,
+        scheme,
         seconds: t0.elapsed().as_secs_f64(),
     })
 }
