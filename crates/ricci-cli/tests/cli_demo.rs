@@ -146,7 +146,7 @@ fn every_link_of_the_page_is_a_local_non_empty_file() {
         .collect();
     assert_eq!(
         order,
-        ["surface", "flow", "cone", "loops", "layout", "spectrum", "atlas"]
+        ["surface", "flow", "cone", "loops", "layout", "spectrum", "atlas", "spline"]
     );
     let mut at = 0;
     for id in order {
@@ -624,4 +624,43 @@ fn atlas_has_one_cone_and_rigid_transitions() {
         assert!(imgs.iter().any(|t| t["src"] == want), "no picture {want}");
     }
     assert!(dir.join("atlas-overview.svg").is_file());
+}
+
+#[test]
+fn spline_is_c2_with_a_g1_fill_and_close_to_the_surface() {
+    let (dir, v) = demo();
+    let s = stage(v, "spline");
+    assert_eq!(s["degree"], 3);
+    assert!(s["singular_vertex"].is_u64(), "{s}");
+    let c = &s["continuity"];
+    // C^{n−1} = C² measured across every interior domain edge; the jump of order n is not small
+    // (the measurement can fail: a cubic spline is not C³).
+    let jumps: Vec<f64> = c["relative_jumps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(f)
+        .collect();
+    assert_eq!(jumps.len(), 4);
+    assert!(jumps[..3].iter().all(|&j| j <= 1e-6), "{c}");
+    assert!(jumps[3] > 1e-4, "{c}");
+    assert_eq!(c["seams"], 1);
+    assert!(f(&c["max_seam_normal_jump_deg"]) <= 0.5, "{c}");
+    // The spline stays near the input mesh (percent of the bounding-box diagonal).
+    assert!(
+        f(&s["rms_error_percent"]) < 1.0 && f(&s["max_error_percent"]) < 3.0,
+        "{s}"
+    );
+    assert!(s["fill_triangles"].as_u64().unwrap() > 0);
+    // The tessellation file holds what the summary says.
+    let obj = std::fs::read_to_string(dir.join("spline.obj")).unwrap();
+    let nv = obj.lines().filter(|l| l.starts_with("v ")).count() as u64;
+    let nf = obj.lines().filter(|l| l.starts_with("f ")).count() as u64;
+    assert_eq!(nv, s["tessellation_vertices"].as_u64().unwrap());
+    assert_eq!(nf, s["tessellation_triangles"].as_u64().unwrap());
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    let imgs = img_tags(&html);
+    for want in ["spline-zebra.png", "spline-patches.png"] {
+        assert!(imgs.iter().any(|t| t["src"] == want), "no picture {want}");
+    }
 }

@@ -113,17 +113,17 @@ pub const STAGES: &[Stage] = &[
         needs: &["surface"],
         run: stages::atlas,
     },
-    // ── Manifold spline goes here: Stage { id: "spline", title: "Manifold spline",
-    //    needs: &["atlas"], run: stages::spline, .. } (zebra picture, fitting errors).
+    Stage {
+        id: "spline",
+        title: "Manifold spline with one extraordinary point",
+        reference: "manifold triangular B-splines (DMS) over the affine structure, fairing, G¹ hole filling (paper 000 §5)",
+        needs: &["surface"],
+        run: stages::spline,
+    },
 ];
 
 /// Stages announced in the page but not built yet (title, sentence).
-pub const PLACEHOLDERS: &[(&str, &str)] = &[
-    (
-        "Manifold spline",
-        "the manifold triangular B-spline on the atlas, with zebra stripes (ricci spline), will appear here.",
-    ),
-];
+pub const PLACEHOLDERS: &[(&str, &str)] = &[];
 
 /// The files of a run, written into a staging folder inside the output folder and moved into
 /// place at the end.

@@ -54,8 +54,9 @@ pub struct Args {
     /// cone by least area distortion.
     #[arg(long, default_value = "local")]
     pub charts: String,
-    /// Segments per domain edge in the tessellation.
-    #[arg(long, default_value_t = 4)]
+    /// Segments per domain edge in the tessellation (8: fine enough for zebra stripes, whose
+    /// reflected normals must change less than a stripe per tessellation triangle).
+    #[arg(long, default_value_t = 8)]
     pub tessellation: usize,
     /// Output directory.
     #[arg(long)]
