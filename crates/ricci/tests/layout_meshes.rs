@@ -1,8 +1,11 @@
 //! Layouts and deck groups of the shared real meshes (`RICCI_MESHES`) with their
 //! uniformization metrics: the accuracy checks of paper 002 Table 10 / paper 001 Table II.
 
-use ricci::layout::pipeline::{cut_disk, uniformization_geometry, uniformization_metric};
-use ricci::layout::place::{align_layouts, layout};
+use ricci::layout::pipeline::{
+    cut_disk, cut_disk_polished, polish_uniformization, uniformization_geometry,
+    uniformization_metric,
+};
+use ricci::layout::place::{align_layouts, layout, layout_dd};
 use ricci::layout::{deck_group, Layout};
 use ricci::mesh::io::read_surface;
 use ricci::metric::{Geometry, Hyperbolic, Scheme};
@@ -44,10 +47,12 @@ fn accuracy(file: &str) -> Accuracy {
         "{file}: flow did not converge ({})",
         flow.max_curvature_error
     );
-    let disk = cut_disk(
+    // The metric polished to double-double (the pipeline's default for H²).
+    let polished = polish_uniformization(&s.mesh, &s.edge_lengths(), &flow).unwrap();
+    let disk = cut_disk_polished(
         &s.mesh,
-        &flow.lengths,
-        geometry,
+        &polished.lengths,
+        &polished.lengths_lo,
         Some(&s.positions),
         None,
         &mut NoProgress,
@@ -58,7 +63,8 @@ fn accuracy(file: &str) -> Accuracy {
     let mut flipped = 0;
     let mut seed_dev: f64 = 0.0;
     for seed in [None, Some(nf / 3), Some(nf - 1)] {
-        let l = layout::<Hyperbolic>(&disk.mesh, &disk.lengths, seed).unwrap();
+        let l = layout_dd::<Hyperbolic>(&disk.mesh, &disk.lengths, Some(&disk.lengths_lo), seed)
+            .unwrap();
         flipped += l.flipped_faces.len();
         if let Some(first) = layouts.first() {
             let (_, d) = align_layouts::<Hyperbolic>(first, &l).unwrap();
@@ -69,7 +75,8 @@ fn accuracy(file: &str) -> Accuracy {
     let g = deck_group::<Hyperbolic>(&layouts[0], &disk.polygon).unwrap();
     eprintln!(
         "{file}: relation {:e}, edge spread {:e} (matrices) {:e} (points), seeds {:e}, \
-         flipped {flipped}, length error {:e}, max radius {:.1}, curvature error {:e}",
+         flipped {flipped}, length error {:e}, max radius {:.1}, curvature error {:e}, \
+         polish {:?} refined polish {:?}",
         g.relation_error.unwrap(),
         g.max_edge_spread_matrix,
         g.max_edge_spread,
@@ -77,6 +84,8 @@ fn accuracy(file: &str) -> Accuracy {
         layouts[0].max_length_error,
         layouts[0].max_radius,
         flow.max_curvature_error,
+        polished.history,
+        disk.refined_polish,
     );
     Accuracy {
         relation: g.relation_error.unwrap(),

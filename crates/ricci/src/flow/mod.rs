@@ -20,6 +20,7 @@
 
 pub mod linear;
 pub mod newton;
+pub mod polish;
 pub mod sphere;
 pub mod target;
 

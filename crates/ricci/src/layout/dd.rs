@@ -460,13 +460,13 @@ impl MobiusDd {
         }
     }
     /// The frame of paper 001 §V (τ): `p ↦ 0` and `q` onto the positive real axis; also
-    /// returns `|τ(q)|` (a point near the origin, so double precision suffices for it).
-    fn frame(p: Cdd, q: Cdd) -> (MobiusDd, f64) {
+    /// returns `|τ(q)|`.
+    fn frame(p: Cdd, q: Cdd) -> (MobiusDd, Dd) {
         let t = MobiusDd::to_origin(p);
         let w = t.apply(q);
         let r = w.norm();
         if !(r.hi > 0.0) {
-            return (t, 0.0);
+            return (t, Dd::ZERO);
         }
         // Rotation z ↦ ū z (u = w/|w|) as [[c̄, 0], [0, c]] with c² = u: c = (1 + u)/|1 + u|.
         let u = Cdd {
@@ -489,7 +489,7 @@ impl MobiusDd {
             a: c.conj(),
             b: Cdd::ZERO,
         };
-        (rot.compose(&t), r.f64())
+        (rot.compose(&t), r)
     }
     /// The map taking `p0 ↦ p1` and the direction towards `q0` onto the direction towards
     /// `q1`, splitting a length mismatch evenly (same construction as
@@ -497,9 +497,20 @@ impl MobiusDd {
     pub fn from_pairs(p0: Cdd, q0: Cdd, p1: Cdd, q1: Cdd) -> MobiusDd {
         let (t0, r0) = MobiusDd::frame(p0, q0);
         let (t1, r1) = MobiusDd::frame(p1, q1);
-        let d0 = 2.0 * r0.min(1.0 - f64::EPSILON).atanh();
-        let d1 = 2.0 * r1.min(1.0 - f64::EPSILON).atanh();
-        let shift = MobiusDd::from(Mobius::real_translation(0.5 * (d1 - d0)));
+        // Half the length mismatch, atanh r1 − atanh r0 = atanh((r1 − r0)/(1 − r0 r1)), with
+        // the ratio in double-double (the mismatch is tiny when both pairs are isometric).
+        let den = Dd::ONE - r0 * r1;
+        let half = if den.hi > 0.0 {
+            ((r1 - r0) / den)
+                .f64()
+                .clamp(-1.0 + f64::EPSILON, 1.0 - f64::EPSILON)
+                .atanh()
+        } else {
+            let d0 = r0.f64().min(1.0 - f64::EPSILON).atanh();
+            let d1 = r1.f64().min(1.0 - f64::EPSILON).atanh();
+            d1 - d0
+        };
+        let shift = MobiusDd::from(Mobius::real_translation(half));
         t1.inverse().compose(&shift).compose(&t0).normalized()
     }
     /// Frobenius distance `min(|M₁ − M₂|, |M₁ + M₂|)` (±M act alike), evaluated in

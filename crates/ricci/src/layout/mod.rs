@@ -29,4 +29,4 @@ pub mod synthetic;
 
 pub use deck::{deck_group, DeckGroup, Polygon, Side, SidePairing};
 pub use isometry::{Isometry, Mobius, RigidMotion, Rotation};
-pub use place::{align, align_layouts, layout, Frame, Layout, Space};
+pub use place::{align, align_layouts, layout, layout_dd, Frame, Layout, Space};
