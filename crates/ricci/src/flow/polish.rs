@@ -184,6 +184,34 @@ fn residual_dd(mesh: &Mesh, lengths: &[Dd], residual: &mut [f64]) -> Result<()> 
     Ok(())
 }
 
+/// The curvature `K_v = 2π − Σθ` (`π − Σθ` on the boundary) of the H² metric of `structure`
+/// at the double-double variables `u + u_lo`, evaluated in double-double (see the module
+/// docs) and rounded. Only curvatures below 1e-3 in magnitude can be evaluated this way (the
+/// argument of `e^{iΣθ}` is taken near 0); larger ones are an error naming the vertex.
+pub fn curvature_dd(
+    mesh: &Mesh,
+    structure: &ConformalStructure,
+    eta_lo: Option<&[f64]>,
+    u: &[f64],
+    u_lo: &[f64],
+) -> Result<Vec<f64>> {
+    let nv = mesh.n_vertices();
+    if u.len() != nv || u_lo.len() != nv || structure.eta.len() != mesh.n_edges() {
+        return Err(Error::input(
+            "curvature_dd: the variables or the structure do not match the mesh",
+        ));
+    }
+    let ud: Vec<Dd> = u
+        .iter()
+        .zip(u_lo)
+        .map(|(&a, &b)| Dd::new(a) + Dd::new(b))
+        .collect();
+    let l = lengths_dd(mesh, structure, eta_lo, &ud)?;
+    let mut r = vec![0.0; nv];
+    residual_dd(mesh, &l, &mut r)?;
+    Ok(r.iter().map(|x| -x).collect())
+}
+
 /// Polish the hyperbolic metric of `structure` at variables `u` (a converged flow's) to
 /// double-double, for the target `K̄ = 0` on every vertex not `fixed` (see the module docs).
 /// `eta_lo` optionally gives low parts of the per-edge coefficients (vertex scaling of a
