@@ -689,10 +689,14 @@ pub(crate) fn layout_unchecked<S: Space>(
     // canonical triangles. So no direction is ever taken from the difference of two nearby
     // far-away points (in the Poincaré disk those lose ~1e-16·e^r / l of accuracy).
     let lo = |h: u32| lengths_lo.map_or(0.0, |l| l[mesh.he_edge(h) as usize]);
-    let canon = |f: u32| {
-        let [a, b, c] = mesh.face_halfedges(f);
-        S::seed_ext([len(a), len(b), len(c)], [lo(a), lo(b), lo(c)])
-    };
+    // Computed once per face (double-double transcendentals in H²).
+    let canonical: Vec<[ExtPoint<S>; 3]> = (0..nf as u32)
+        .map(|f| {
+            let [a, b, c] = mesh.face_halfedges(f);
+            S::seed_ext([len(a), len(b), len(c)], [lo(a), lo(b), lo(c)])
+        })
+        .collect();
+    let canon = |f: u32| canonical[f as usize];
     // Frames are composed in the working precision of the space (double-double in H²,
     // see [`Frame`]); the relative placements are computed near the base point in double
     // precision, where that is accurate to the last digit.
