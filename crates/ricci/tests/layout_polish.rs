@@ -55,7 +55,10 @@ fn double_double_curvature_agrees_with_the_flow_kernel_and_the_polish_converges(
         .zip(&kd)
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
-    assert!(diff < 1e-13, "f64 and double-double curvature differ by {diff:e}");
+    assert!(
+        diff < 1e-13,
+        "f64 and double-double curvature differ by {diff:e}"
+    );
     // Iterative refinement from the flow's u: the residual drops from the double-precision
     // floor to the double-double one in a few steps, and the metric hardly moves.
     let p = polish_uniformization(&s.mesh, &input, &flow).unwrap();
@@ -117,8 +120,8 @@ fn polished_metric_makes_deck_maps_from_different_edges_agree() {
     if let Some(r) = disk.refined_polish {
         assert!(r.converged, "{r:?}");
     }
-    let l = layout_dd::<Hyperbolic>(&disk.mesh, &disk.lengths, Some(&disk.lengths_lo), None)
-        .unwrap();
+    let l =
+        layout_dd::<Hyperbolic>(&disk.mesh, &disk.lengths, Some(&disk.lengths_lo), None).unwrap();
     let g = deck_group::<Hyperbolic>(&l, &disk.polygon).unwrap();
     eprintln!(
         "plain: relation {:e} spread {:e} / {:e}; polished: relation {:e} spread {:e} / {:e}",

@@ -67,7 +67,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         lengths_lo,
         report: metric_report,
         polish: mut polish_report,
-    } = polished_metric(&surface, Some(want), None, a.metric.as_ref(), true, &mut bar)?;
+    } = polished_metric(
+        &surface,
+        Some(want),
+        None,
+        a.metric.as_ref(),
+        true,
+        &mut bar,
+    )?;
     bar.0.set_message("cutting along canonical loops");
     let disk = match &lengths_lo {
         Some(lo) => {

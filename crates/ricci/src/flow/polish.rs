@@ -33,6 +33,9 @@
 //! The result reports the double-double residual before and after, the steps taken and
 //! whether it reached the tolerance (default 1e-26).
 
+// `!(x > 0.0)` is used on purpose: it is also true for NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use super::linear::SymmetricSolver;
 use crate::error::{Error, Result};
 use crate::layout::dd::{Cdd, Dd};

@@ -93,7 +93,7 @@ impl Dd {
 
 /// `ln 2` as a double-double (QD library constant).
 const LN2: Dd = Dd {
-    hi: 6.931_471_805_599_453e-1,
+    hi: std::f64::consts::LN_2,
     lo: 2.319_046_813_846_299_6e-17,
 };
 

@@ -259,13 +259,13 @@ pub fn cut_disk_polished(
     let rm = &refined.mesh;
     let nv0 = refined.original_vertices as u32;
     let mut rlo = vec![0.0; rm.n_edges()];
-    for e in 0..rm.n_edges() {
+    for (e, lo) in rlo.iter_mut().enumerate() {
         let [a, b] = rm.edge_vertices(e as u32);
         if a < nv0 && b < nv0 {
             if let Some(h) = mesh.halfedge_between(a, b) {
                 let e0 = mesh.he_edge(h) as usize;
                 if lengths[e0] == refined.lengths[e] {
-                    rlo[e] = lengths_lo[e0];
+                    *lo = lengths_lo[e0];
                 }
             }
         }

@@ -20,10 +20,15 @@
 //! **Precision.** Face frames are composed in the working precision of the space ([`Frame`]):
 //! double precision in E² and S², double-double in H² ([`super::dd`]), where a frame at
 //! distance r from the centre has entries ~e^{r/2} and a double-precision composition would
-//! perturb each step by ~1e-16·e^r. The relative placement of a face on its parent is computed
-//! at the base point in double precision (accurate to ~1e-16, like a perturbation of the input
-//! lengths at that level), positions are kept in double-double ([`Layout::positions_lo`]),
-//! and the measurements (orientation, length error, radius) use them. With the flow's metric
+//! perturb each step by ~1e-16·e^r. In E² and S² the relative placement of a face on its
+//! parent is computed at the base point in double precision; in H² the canonical triangles
+//! come from the lengths in double-double ([`Space::seed_ext`]: `tanh(l/2)` and the half-angle
+//! tangent of the cosine law) and the relative placement maps the shared edge of two
+//! canonical triangles onto each other in double-double ([`Space::relative`]). Lengths can be
+//! given to double-double precision ([`layout_dd`], `lengths_lo`; the metric polished by
+//! [`crate::flow::polish`]); [`layout`] is `layout_dd` with zero low parts. Positions are kept
+//! in double-double ([`Layout::positions_lo`]), and the measurements (orientation, length
+//! error, radius) use them. With the flow's metric
 //! at tolerance 1e-12, layouts from different seed faces agree to ≤ 2e-11 on the shared
 //! genus-2…5 meshes (fertility reaches r ≈ 25 from an off-centre seed), against 5e-5 in double
 //! precision.
@@ -334,6 +339,8 @@ impl Space for Hyperbolic {
     /// `p2 = e^{iθ} tanh(l20/2)` with `e^{iθ} = (1 − t² + 2it)/(1 + t²)` from the half-angle
     /// tangent of the cosine law ([`Background::angle`]), all in double-double from the
     /// double-double lengths.
+    // `!(x > 0.0)` is used on purpose: it is also true for NaN.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     fn seed_ext(l: [f64; 3], lo: [f64; 3]) -> [Cdd; 3] {
         use super::dd::Dd;
         let [l01, l12, l20] = [0, 1, 2].map(|m| Dd::new(l[m]) + Dd::new(lo[m]));
