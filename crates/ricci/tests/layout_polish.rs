@@ -186,3 +186,28 @@ fn polish_refuses_what_it_cannot_do() {
     .unwrap_err();
     assert!(e.to_string().contains("vertex 3"), "{e}");
 }
+
+#[test]
+fn vertex_scaling_metrics_are_polished_too() {
+    // The other H² length law: vertex scaling (sinh(l/2) = e^{(ui+uj)/2} sinh(l⁰/2)).
+    let s = generate::genus(2, 12).unwrap();
+    let flow = uniformization_metric(
+        &s.mesh,
+        &s.edge_lengths(),
+        Geometry::Hyperbolic,
+        Scheme::Yamabe,
+        1e-12,
+        &mut NoProgress,
+    )
+    .unwrap();
+    assert!(flow.converged);
+    let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &flow).unwrap();
+    assert!(p.converged && p.residual_dd <= 1e-26, "{:?}", p.history);
+    let moved = p
+        .lengths
+        .iter()
+        .zip(&flow.lengths)
+        .map(|(a, b)| ((a - b) / b).abs())
+        .fold(0.0, f64::max);
+    assert!(moved < 1e-12, "{moved:e}");
+}
