@@ -866,6 +866,47 @@ pub fn align_layouts<S: Space>(
 mod tests {
     use super::*;
 
+    /// Hyperbolic distance of two disk points, entirely in double-double.
+    fn dist_dd(p: Cdd, q: Cdd) -> super::super::dd::Dd {
+        use super::super::dd::Dd;
+        let den = (Dd::ONE - p.norm_sqr()) * (Dd::ONE - q.norm_sqr());
+        Dd::new(2.0) * ((p - q).norm() / den.sqrt()).asinh()
+    }
+
+    #[test]
+    fn double_double_seed_triangles_have_their_double_double_side_lengths() {
+        use super::super::dd::Dd;
+        // Low parts far below double precision must show up in the laid-out distances.
+        for (l, lo) in [
+            ([0.3, 0.4, 0.5], [1e-17, -2e-17, 3e-18]),
+            ([0.05, 0.0502, 0.07], [-3e-19, 1e-19, 2e-19]),
+            ([1.5, 2.0, 1.2], [4e-17, 0.0, -1e-17]),
+        ] {
+            let p = Hyperbolic::seed_ext(l, lo);
+            let want = [0, 1, 2].map(|m| Dd::new(l[m]) + Dd::new(lo[m]));
+            let got = [
+                dist_dd(p[0], p[1]),
+                dist_dd(p[1], p[2]),
+                dist_dd(p[2], p[0]),
+            ];
+            for m in 0..3 {
+                let e = ((got[m] - want[m]).f64() / l[m]).abs();
+                assert!(e < 1e-29, "side {m} of {l:?}: relative error {e:e}");
+            }
+            assert!(disk_orientation_dd(p[0], p[1], p[2]) > 0.0);
+            // Agrees with the double-precision seed to its rounding.
+            let q = Hyperbolic::seed(l[0], l[1], l[2]);
+            for m in 0..3 {
+                assert!((p[m].hi() - q[m]).norm() < 1e-15);
+            }
+            // The relative placement of a copy across edge 1 → 2 puts its corners on the
+            // edge's ends (in double-double).
+            let f = Hyperbolic::relative(&p, 1, p[2], p[1], [l[1], l[0], l[2]]);
+            let (a, b) = (f.apply(p[1]), f.apply(p[2]));
+            assert!(dist_dd(a, p[2]).f64() < 1e-29 && dist_dd(b, p[1]).f64() < 1e-29);
+        }
+    }
+
     #[test]
     fn seed_triangles_have_their_side_lengths_and_orientation() {
         fn check<S: Space>(l: [f64; 3]) {
