@@ -61,6 +61,23 @@ fn layout_json_and_files() {
     assert_eq!(v["flipped_faces"], 0);
     assert_eq!(v["deck_generators"].as_array().unwrap().len(), 4);
     assert!(v["relation_error"].as_f64().unwrap() < 1e-8);
+    // The H² metric is polished to double-double before the layout (on by default).
+    let p = &v["metric_polish"];
+    assert_eq!(p["applied"], true, "{p}");
+    assert!(p["residual_dd"].as_f64().unwrap() <= 1e-26, "{p}");
+    assert!(p["residual_start"].as_f64().unwrap() > p["residual_dd"].as_f64().unwrap());
+    let polished_spread = v["max_edge_spread_matrix"].as_f64().unwrap();
+    let out = Command::new(bin())
+        .arg("layout")
+        .arg(&mesh)
+        .args(["--no-polish", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let w: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(w["metric_polish"]["applied"], false);
+    // Without the polish the per-edge deck maps only agree to the flow's curvature error.
+    assert!(w["max_edge_spread_matrix"].as_f64().unwrap() > 100.0 * polished_spread);
     let text = std::fs::read_to_string(&obj).unwrap();
     let nvt = text.lines().filter(|l| l.starts_with("vt ")).count();
     let nf = text.lines().filter(|l| l.starts_with("f ")).count();

@@ -3,11 +3,16 @@
 //!
 //! `RICCI_MESHES=../shared/meshes cargo run --release --example bench_layout [files…]`
 //! (default: botijo.off seahorse2_100K.off). `FILE@V` cuts through base vertex `V` instead of
-//! the cut's automatic choice. Flow tolerance 1e-12 (as `tests/layout_meshes.rs`).
+//! the cut's automatic choice. Flow tolerance 1e-12 (as `tests/layout_meshes.rs`), then the
+//! metric polished to double-double (`ricci::flow::polish`, as `ricci layout` does by
+//! default; `RICCI_NO_POLISH=1` skips it), cut with the double-double lengths
+//! (`cut_disk_polished`) and `layout_dd`.
 
 use ricci::layout::deck_group;
-use ricci::layout::pipeline::{cut_disk, uniformization_metric};
-use ricci::layout::place::layout;
+use ricci::layout::pipeline::{
+    cut_disk, cut_disk_polished, polish_uniformization, uniformization_metric,
+};
+use ricci::layout::place::layout_dd;
 use ricci::mesh::io::read_surface;
 use ricci::metric::{Geometry, Hyperbolic, Scheme};
 use ricci::progress::NoProgress;
@@ -21,8 +26,9 @@ fn main() {
     if files.is_empty() {
         files = vec!["botijo.off".into(), "seahorse2_100K.off".into()];
     }
-    println!("| mesh | faces | genus | scheme | max abs(K − K̄) | flow s | cut s | layout s | deck s | flipped | max radius | relation error | edge spread (matrices) | edge spread (points) | max length error |");
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let no_polish = std::env::var_os("RICCI_NO_POLISH").is_some();
+    println!("| mesh | faces | genus | scheme | max abs(K − K̄) | flow s | polish (steps, dd residual, refined) | polish s | cut s | layout s | deck s | flipped | max radius | relation error | edge spread (matrices) | edge spread (points) | max length error |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for arg in files {
         let (f, base) = match arg.split_once('@') {
             Some((f, b)) => (f.to_string(), b.parse::<u32>().ok()),
@@ -71,29 +77,67 @@ fn main() {
             );
         }
         let t = Instant::now();
-        let disk = match cut_disk(
-            &s.mesh,
-            &flow.lengths,
-            Geometry::Hyperbolic,
-            None,
-            base,
-            &mut NoProgress,
-        ) {
+        let polished = if no_polish {
+            None
+        } else {
+            match polish_uniformization(&s.mesh, &s.edge_lengths(), &flow) {
+                Ok(p) => Some(p),
+                Err(e) => {
+                    eprintln!("{f}: polish: {e}");
+                    None
+                }
+            }
+        };
+        let t_polish = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let disk = match &polished {
+            Some(p) => cut_disk_polished(
+                &s.mesh,
+                &p.lengths,
+                &p.lengths_lo,
+                None,
+                base,
+                &mut NoProgress,
+            ),
+            None => cut_disk(
+                &s.mesh,
+                &flow.lengths,
+                Geometry::Hyperbolic,
+                None,
+                base,
+                &mut NoProgress,
+            ),
+        };
+        let disk = match disk {
             Ok(d) => d,
             Err(e) => {
                 eprintln!("{f}: cut: {e}");
                 continue;
             }
         };
+        // The cut's time includes the polish of the refined metric.
         let t_cut = t.elapsed().as_secs_f64();
+        let polish_cell = match (&polished, &disk.refined_polish) {
+            (Some(p), r) => format!(
+                "{}, {:.1e}{}",
+                p.steps,
+                p.residual_dd,
+                r.map_or(String::new(), |r| format!(
+                    "; {}, {:.1e}",
+                    r.steps, r.residual_dd
+                ))
+            ),
+            (None, _) => "off".to_string(),
+        };
         let t = Instant::now();
-        let l = layout::<Hyperbolic>(&disk.mesh, &disk.lengths, None).expect("layout");
+        let lo = (!disk.lengths_lo.is_empty()).then_some(&disk.lengths_lo[..]);
+        let l = layout_dd::<Hyperbolic>(&disk.mesh, &disk.lengths, lo, None).expect("layout");
         let t_layout = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let g = deck_group::<Hyperbolic>(&l, &disk.polygon).expect("deck group");
         let t_deck = t.elapsed().as_secs_f64();
         println!(
-            "| {arg} | {} | {genus} | {} | {:.1e} | {t_flow:.2} | {t_cut:.2} | {t_layout:.3} | {t_deck:.3} | {} | {:.1} | {:.1e} | {:.1e} | {:.1e} | {:.1e} |",
+            "| {arg} | {} | {genus} | {} | {:.1e} | {t_flow:.2} | {polish_cell} | {t_polish:.2} | {t_cut:.2} | {t_layout:.3} | {t_deck:.3} | {} | {:.1} | {:.1e} | {:.1e} | {:.1e} | {:.1e} |",
             s.mesh.n_faces(),
             scheme.name(),
             flow.max_curvature_error,

@@ -1,8 +1,11 @@
 //! Layouts and deck groups of the shared real meshes (`RICCI_MESHES`) with their
 //! uniformization metrics: the accuracy checks of paper 002 Table 10 / paper 001 Table II.
 
-use ricci::layout::pipeline::{cut_disk, uniformization_geometry, uniformization_metric};
-use ricci::layout::place::{align_layouts, layout};
+use ricci::layout::pipeline::{
+    cut_disk, cut_disk_polished, polish_uniformization, uniformization_geometry,
+    uniformization_metric,
+};
+use ricci::layout::place::{align_layouts, layout, layout_dd};
 use ricci::layout::{deck_group, Layout};
 use ricci::mesh::io::read_surface;
 use ricci::metric::{Geometry, Hyperbolic, Scheme};
@@ -44,21 +47,36 @@ fn accuracy(file: &str) -> Accuracy {
         "{file}: flow did not converge ({})",
         flow.max_curvature_error
     );
-    let disk = cut_disk(
+    // The metric polished to double-double (the pipeline's default for H²): the residual
+    // reaches the tolerance and the metric moves by no more than the flow's last step allows.
+    let polished = polish_uniformization(&s.mesh, &s.edge_lengths(), &flow).unwrap();
+    assert!(polished.converged, "{file}: polish {:?}", polished.history);
+    let moved = polished
+        .lengths
+        .iter()
+        .zip(&flow.lengths)
+        .map(|(a, b)| ((a - b) / b).abs())
+        .fold(0.0, f64::max);
+    assert!(moved < 1e-12, "{file}: polish moved a length by {moved:e}");
+    let disk = cut_disk_polished(
         &s.mesh,
-        &flow.lengths,
-        geometry,
+        &polished.lengths,
+        &polished.lengths_lo,
         Some(&s.positions),
         None,
         &mut NoProgress,
     )
     .unwrap();
+    if let Some(p) = disk.refined_polish {
+        assert!(p.converged, "{file}: refined polish {p:?}");
+    }
     let nf = disk.mesh.n_faces() as u32;
     let mut layouts: Vec<Layout<_>> = Vec::new();
     let mut flipped = 0;
     let mut seed_dev: f64 = 0.0;
     for seed in [None, Some(nf / 3), Some(nf - 1)] {
-        let l = layout::<Hyperbolic>(&disk.mesh, &disk.lengths, seed).unwrap();
+        let l = layout_dd::<Hyperbolic>(&disk.mesh, &disk.lengths, Some(&disk.lengths_lo), seed)
+            .unwrap();
         flipped += l.flipped_faces.len();
         if let Some(first) = layouts.first() {
             let (_, d) = align_layouts::<Hyperbolic>(first, &l).unwrap();
@@ -69,7 +87,8 @@ fn accuracy(file: &str) -> Accuracy {
     let g = deck_group::<Hyperbolic>(&layouts[0], &disk.polygon).unwrap();
     eprintln!(
         "{file}: relation {:e}, edge spread {:e} (matrices) {:e} (points), seeds {:e}, \
-         flipped {flipped}, length error {:e}, max radius {:.1}, curvature error {:e}",
+         flipped {flipped}, length error {:e}, max radius {:.1}, curvature error {:e}, \
+         polish {:?} refined polish {:?}",
         g.relation_error.unwrap(),
         g.max_edge_spread_matrix,
         g.max_edge_spread,
@@ -77,6 +96,8 @@ fn accuracy(file: &str) -> Accuracy {
         layouts[0].max_length_error,
         layouts[0].max_radius,
         flow.max_curvature_error,
+        polished.history,
+        disk.refined_polish,
     );
     Accuracy {
         relation: g.relation_error.unwrap(),
@@ -96,27 +117,18 @@ fn hyperbolic_layouts_are_accurate_on_real_meshes() {
     // The issue's accuracy, paper 002 Table 10 / paper 001 Table II: relation error,
     // disagreement of layouts from three seed faces (geodesic distance after one isometry)
     // and disagreement of the deck maps computed from different edges of the same side (as
-    // SU(1,1) matrices, the norm of the relation error) all ≤ 1e-9. The layout and the deck
-    // group run in double-double (`ricci::layout::dd`); in double precision genus3 and
-    // fertility reached only 7e-7 and 2e-3 (polygon corners at hyperbolic distance ~13).
-    //
-    // Not met on fertility: the per-edge deck maps. They are limited by the metric, not by
-    // rounding any more: the maps from two edges of a side differ by rotations of the size of
-    // the flow's curvature error (~5e-15 per vertex, the double-precision floor of
-    // K = 2π − Σθ; the double-double layout adds only ~1e-16 per face) about the vertices
-    // between them, and such a rotation at distance r from the centre changes the matrix by
-    // ~κ·sinh r and moves a point at distance d by ~κ·sinh d. Fertility's canonical loops
-    // are long (corners at r ≈ 13, sides up to ~18 long), so its matrix spread is ~6e-9 and
-    // its point spread (ends and middle of each side) ~2e-7; both change with the noise of
-    // the flow's last Newton step (1.5e-9 and 5e-8 after 30 steps), not with the precision
-    // of the layout. Shorter loops from the cut would fix it; the bounds below are 1e-9
-    // where the sides are short.
-    // (file, bound on the matrix spread, on the point spread).
+    // SU(1,1) matrices, the norm of the relation error, and as geodesic distances of the
+    // images of the side's ends and middle) all ≤ 1e-9. The layout and the deck group run in
+    // double-double (`ricci::layout::dd`) and the flow's metric is polished to
+    // double-double before the layout (`ricci::flow::polish`, `cut_disk_polished`). Without
+    // the polish fertility's edge maps disagreed by 6e-9 (matrices) and 2e-7 (points): the
+    // flow's curvature error ~5e-15 (the double-precision floor of K = 2π − Σθ) amplified by
+    // ~sinh r along its long canonical loops. Measured with the polish: ≤ 1e-17 on all four.
     let cases = [
         ("eight.off", 1e-9, 1e-9),
         ("3holes.off", 1e-9, 1e-9),
         ("genus3.off", 1e-9, 1e-9),
-        ("fertility.off", 2e-8, 1e-6),
+        ("fertility.off", 1e-9, 1e-9),
     ];
     let mut fails = Vec::new();
     for (file, matrix_tol, spread_tol) in cases {

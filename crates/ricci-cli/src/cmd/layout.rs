@@ -4,7 +4,10 @@
 //! given metric) in the plane, the Poincaré disk or on the sphere, and compute the deck group.
 //!
 //! Closed genus-0 surfaces go onto the sphere whole; disks are laid out as they are; every
-//! other surface is cut first (`ricci::cut`). Without `--metric` the Ricci flow of the
+//! other surface is cut first (`ricci::cut`). Hyperbolic metrics are polished to double-double
+//! before the layout (`ricci::flow::polish`; `--no-polish` turns it off): the report's
+//! `metric_polish` says what it did (`steps`, `residual_dd`, …, `applied: false` with a
+//! `reason` when it could not be applied, e.g. a metric with cone points). Without `--metric` the Ricci flow of the
 //! geometry is run (tolerance 1e-12 in H², 1e-11 otherwise). The seed face is a face id of the cut mesh (default:
 //! the face nearest the centre of the polygon). `--tiling N` draws the first N copies of the
 //! fundamental polygon (breadth first through the side pairings) instead of the polygon.
@@ -16,8 +19,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use ricci::layout::cover::{tiles_by_radius, word_string};
 use ricci::layout::export::obj_with_uv;
 use ricci::layout::isometry::{Complex, Mobius, RigidMotion};
-use ricci::layout::pipeline::{cut_disk, uniformization_geometry, CutDisk};
-use ricci::layout::place::{layout, minimax_centre, Space};
+use ricci::layout::pipeline::{cut_disk, cut_disk_polished, uniformization_geometry, CutDisk};
+use ricci::layout::place::{layout, layout_dd, minimax_centre, Space};
 use ricci::layout::svg::{fundamental_domain_svg, sphere_svg, tiling_svg};
 use ricci::layout::{deck_group, DeckGroup, Isometry, Layout, Polygon};
 use ricci::mesh::{io::read_surface, topology, Surface};
@@ -55,6 +58,10 @@ pub struct Args {
     /// Output SVG picture.
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    /// Hyperbolic metrics: lay out the flow's double-precision metric as it is, without
+    /// polishing it to double-double first.
+    #[arg(long)]
+    pub no_polish: bool,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
@@ -201,14 +208,75 @@ pub fn spinner(json: bool) -> Bar {
     Bar(bar)
 }
 
-/// The metric to use: from the file or from the flow. Returns the flow report too.
-pub fn metric(
+/// A metric with optional double-double low parts of its lengths.
+pub struct PolishedLengths {
+    pub geometry: Geometry,
+    pub lengths: Vec<f64>,
+    /// `Some` when the metric was polished to double-double.
+    pub lengths_lo: Option<Vec<f64>>,
+    /// The `metric` report.
+    pub report: Value,
+    /// The `metric_polish` report.
+    pub polish: Value,
+}
+
+/// [`metric`], then for hyperbolic metrics (when `polish`) the double-double polish
+/// (`ricci::layout::pipeline::polish_uniformization` for the flow's metric,
+/// `polish_lengths` — vertex scaling in place — for a metric file). A polish that cannot be
+/// applied (a target other than 0, a metric with cone points) is reported, not an error.
+pub fn polished_metric(
+    surface: &Surface,
+    geometry: Option<Geometry>,
+    target: Option<&str>,
+    metric_file: Option<&PathBuf>,
+    polish: bool,
+    progress: &mut dyn ricci::progress::Progress,
+) -> anyhow::Result<PolishedLengths> {
+    use ricci::layout::pipeline::{polish_lengths, polish_uniformization};
+    let (g, lengths, flow, report) =
+        metric_and_flow(surface, geometry, target, metric_file, progress)?;
+    let mut out = PolishedLengths {
+        geometry: g,
+        lengths,
+        lengths_lo: None,
+        report,
+        polish: json!({"applied": false, "reason": "not a hyperbolic metric"}),
+    };
+    if g != Geometry::Hyperbolic {
+        return Ok(out);
+    }
+    if !polish {
+        out.polish = json!({"applied": false, "reason": "--no-polish"});
+        return Ok(out);
+    }
+    progress.report("polish", None, "polishing the metric to double-double");
+    let res = match &flow {
+        Some(f) => polish_uniformization(&surface.mesh, &surface.edge_lengths(), f),
+        None => polish_lengths(&surface.mesh, &out.lengths, &vec![0.0; out.lengths.len()]),
+    };
+    match res {
+        Ok(p) => {
+            out.polish = json!({
+                "applied": true, "method": if flow.is_some() { "flow variables" } else { "vertex scaling in place" },
+                "steps": p.steps, "residual_start": p.residual_start,
+                "residual_dd": p.residual_dd, "converged": p.converged,
+            });
+            out.lengths = p.lengths;
+            out.lengths_lo = Some(p.lengths_lo);
+        }
+        Err(e) => out.polish = json!({"applied": false, "reason": e.to_string()}),
+    }
+    Ok(out)
+}
+
+/// The metric to use: from the file or from the flow (returned too, with its report).
+fn metric_and_flow(
     surface: &Surface,
     geometry: Option<Geometry>,
     target: Option<&str>,
     metric_file: Option<&PathBuf>,
     progress: &mut dyn ricci::progress::Progress,
-) -> anyhow::Result<(Geometry, Vec<f64>, Value)> {
+) -> anyhow::Result<(Geometry, Vec<f64>, Option<ricci::flow::FlowResult>, Value)> {
     if let Some(path) = metric_file {
         let (g, l) = read_metric(path, surface)?;
         if let Some(want) = geometry {
@@ -219,7 +287,7 @@ pub fn metric(
                 .into());
             }
         }
-        return Ok((g, l, json!({"source": path.display().to_string()})));
+        return Ok((g, l, None, json!({"source": path.display().to_string()})));
     }
     let g = match geometry {
         Some(g) => g,
@@ -258,7 +326,8 @@ pub fn metric(
             r.max_curvature_error
         );
     }
-    Ok((g, r.lengths, report))
+    let lengths = r.lengths.clone();
+    Ok((g, lengths, Some(r), report))
 }
 
 fn planar<S: Space<Point = Complex>>(
@@ -266,16 +335,21 @@ fn planar<S: Space<Point = Complex>>(
     surface: &Surface,
     disk: Option<&CutDisk>,
     lengths: &[f64],
+    lengths_lo: Option<&[f64]>,
     out: &mut Value,
 ) -> anyhow::Result<()>
 where
     S::Iso: JsonIso,
 {
-    let (mesh, lens) = match disk {
-        Some(d) => (&d.mesh, &d.lengths[..]),
-        None => (&surface.mesh, lengths),
+    let (mesh, lens, lo) = match disk {
+        Some(d) => (
+            &d.mesh,
+            &d.lengths[..],
+            (!d.lengths_lo.is_empty()).then_some(&d.lengths_lo[..]),
+        ),
+        None => (&surface.mesh, lengths, lengths_lo),
     };
-    let l: Layout<Complex> = layout::<S>(mesh, lens, a.seed_face)?;
+    let l: Layout<Complex> = layout_dd::<S>(mesh, lens, lo, a.seed_face)?;
     out["flipped_faces"] = json!(l.flipped_faces.len());
     out["degenerate_faces"] = json!(l.degenerate_faces.len());
     out["seed_face"] = json!(l.seed_face);
@@ -380,11 +454,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let (surface, _) = read_surface(&a.mesh)?;
     let mut bar = spinner(a.json);
-    let (geometry, lengths, metric_report) = metric(
+    let PolishedLengths {
+        geometry,
+        lengths,
+        lengths_lo,
+        report: metric_report,
+        polish: mut polish_report,
+    } = polished_metric(
         &surface,
         geometry,
         a.target.as_deref(),
         a.metric.as_ref(),
+        !a.no_polish,
         &mut bar,
     )?;
     let t = topology(&surface.mesh);
@@ -433,14 +514,28 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             None
         } else {
             bar.0.set_message("cutting along canonical loops");
-            let d = cut_disk(
-                &surface.mesh,
-                &lengths,
-                geometry,
-                Some(&surface.positions),
-                a.base,
-                &mut bar,
-            )?;
+            let d = match &lengths_lo {
+                Some(lo) => {
+                    let d = cut_disk_polished(
+                        &surface.mesh,
+                        &lengths,
+                        lo,
+                        Some(&surface.positions),
+                        a.base,
+                        &mut bar,
+                    )?;
+                    polish_report["refined"] = json!(d.refined_polish);
+                    d
+                }
+                None => cut_disk(
+                    &surface.mesh,
+                    &lengths,
+                    geometry,
+                    Some(&surface.positions),
+                    a.base,
+                    &mut bar,
+                )?,
+            };
             out["boundary_word"] = json!(d.polygon.word());
             out["base_vertex"] = json!(d.cut.base);
             out["refinement_splits"] = json!(d.cut.report.refinement_splits);
@@ -454,13 +549,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         };
         bar.0.set_message("layout and deck group");
         match geometry {
-            Geometry::Hyperbolic => {
-                planar::<Hyperbolic>(&a, &surface, disk.as_ref(), &lengths, &mut out)?
-            }
-            _ => planar::<Euclidean>(&a, &surface, disk.as_ref(), &lengths, &mut out)?,
+            Geometry::Hyperbolic => planar::<Hyperbolic>(
+                &a,
+                &surface,
+                disk.as_ref(),
+                &lengths,
+                lengths_lo.as_deref(),
+                &mut out,
+            )?,
+            _ => planar::<Euclidean>(&a, &surface, disk.as_ref(), &lengths, None, &mut out)?,
         }
     }
     bar.0.finish_and_clear();
+    out["metric_polish"] = polish_report;
     out["seconds"] = json!(t0.elapsed().as_secs_f64());
     if a.json {
         print_json(&out);

@@ -3,14 +3,15 @@
 //! genus 1, H² for genus ≥ 2; or the given metric), canonical cut, layout, deck group, then
 //! the `N` shortest free homotopy classes (unoriented, powers included), sorted. Genus 1
 //! lengths are normalized by the shortest (paper 002 Table 2); hyperbolic lengths are absolute
-//! (curvature −1, Tables 3–4) and also given normalized.
+//! (curvature −1, Tables 3–4) and also given normalized. Hyperbolic metrics are polished to
+//! double-double before the layout, as in `ricci layout` (`metric_polish` in the report).
 
-use super::layout::{metric, spinner};
+use super::layout::{polished_metric, spinner, PolishedLengths};
 use crate::util::{print_json, UsageError};
 use ricci::analysis::spectrum::{fuchsian_spectrum, lattice_spectrum};
 use ricci::layout::deck_group;
-use ricci::layout::pipeline::cut_disk;
-use ricci::layout::place::layout;
+use ricci::layout::pipeline::{cut_disk, cut_disk_polished};
+use ricci::layout::place::{layout, layout_dd};
 use ricci::mesh::{io::read_surface, topology};
 use ricci::metric::{Euclidean, Geometry, Hyperbolic};
 use serde_json::json;
@@ -60,10 +61,29 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         Geometry::Hyperbolic
     };
     let mut bar = spinner(a.json);
-    let (geometry, lengths, metric_report) =
-        metric(&surface, Some(want), None, a.metric.as_ref(), &mut bar)?;
+    let PolishedLengths {
+        geometry,
+        lengths,
+        lengths_lo,
+        report: metric_report,
+        polish: mut polish_report,
+    } = polished_metric(
+        &surface,
+        Some(want),
+        None,
+        a.metric.as_ref(),
+        true,
+        &mut bar,
+    )?;
     bar.0.set_message("cutting along canonical loops");
-    let disk = cut_disk(&surface.mesh, &lengths, geometry, None, a.base, &mut bar)?;
+    let disk = match &lengths_lo {
+        Some(lo) => {
+            let d = cut_disk_polished(&surface.mesh, &lengths, lo, None, a.base, &mut bar)?;
+            polish_report["refined"] = json!(d.refined_polish);
+            d
+        }
+        None => cut_disk(&surface.mesh, &lengths, geometry, None, a.base, &mut bar)?,
+    };
     bar.0.set_message("layout, deck group and spectrum");
     let (abs, extra) = if geometry == Geometry::Euclidean {
         let l = layout::<Euclidean>(&disk.mesh, &disk.lengths, None)?;
@@ -75,7 +95,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let sp = lattice_spectrum(gens[0].1.t, gens[1].1.t, a.count)?;
         (sp, json!({"relation_error": g.relation_error}))
     } else {
-        let l = layout::<Hyperbolic>(&disk.mesh, &disk.lengths, None)?;
+        let lo = (!disk.lengths_lo.is_empty()).then_some(&disk.lengths_lo[..]);
+        let l = layout_dd::<Hyperbolic>(&disk.mesh, &disk.lengths, lo, None)?;
         let g = deck_group::<Hyperbolic>(&l, &disk.polygon)?;
         let sp = fuchsian_spectrum(&l, &disk.polygon, &g, a.count, 2_000_000)?;
         (
@@ -100,6 +121,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "absolute_lengths": abs,
         "normalized": normalized,
         "metric": metric_report,
+        "metric_polish": polish_report,
         "details": extra,
         "boundary_word": disk.polygon.word(),
         "seconds": t0.elapsed().as_secs_f64(),

@@ -4,6 +4,8 @@
 //! [`ricci_flow`] takes connectivity and Euclidean edge lengths (never positions), builds the
 //! initial conformal structure of the chosen scheme ([`crate::metric::conformal`]), resolves and
 //! checks the target ([`target`]) and runs Newton's method or the gradient flow ([`newton`]).
+//! [`polish`] refines a converged H² metric beyond double precision (separately; the solvers
+//! do not call it).
 //! The result carries per-vertex `u`, `K`, `K̄`, per-edge final lengths, the residual history
 //! and an honest `converged` flag.
 //!
@@ -20,6 +22,7 @@
 
 pub mod linear;
 pub mod newton;
+pub mod polish;
 pub mod sphere;
 pub mod target;
 

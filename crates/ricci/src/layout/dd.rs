@@ -91,6 +91,102 @@ impl Dd {
     }
 }
 
+/// `ln 2` as a double-double (QD library constant).
+const LN2: Dd = Dd {
+    hi: std::f64::consts::LN_2,
+    lo: 2.319_046_813_846_299_6e-17,
+};
+
+/// Transcendental functions in double-double (relative accuracy ~1e-31 for the arguments
+/// the layout and the metric polish use, |x| ≲ 50; tested against known digits and identities): `exp`
+/// by argument reduction `x = k ln 2 + 2⁹ r` and a Taylor series of `e^r`, squared nine
+/// times; `ln` by one Newton step on `exp` from the double-precision logarithm (which
+/// doubles the number of correct digits); `sinh` by its Taylor series below 1/2 (no
+/// cancellation near 0) and by `(eˣ − e⁻ˣ)/2` above; `asinh` by one Newton step on `sinh`.
+impl Dd {
+    /// `eˣ` (∞ above ~709, 0 below ~−745).
+    pub fn exp(self) -> Dd {
+        if !self.hi.is_finite() {
+            return Dd::new(self.hi.exp());
+        }
+        if self.hi > 709.0 {
+            return Dd::new(f64::INFINITY);
+        }
+        if self.hi < -745.0 {
+            return Dd::ZERO;
+        }
+        let k = (self.hi / LN2.hi).round();
+        let r = self - LN2 * Dd::new(k);
+        // e^r = (e^{r/512})^512; the series of e^s with |s| < 7e-4 needs 10 terms.
+        let s = r * Dd::new(1.0 / 512.0);
+        let mut term = s;
+        let mut sum = s;
+        for n in 2..=12 {
+            term = term * s / Dd::new(n as f64);
+            sum = sum + term;
+            if term.hi.abs() < 1e-36 {
+                break;
+            }
+        }
+        // (1 + sum)^512 via squaring expm1: (1 + x)² − 1 = 2x + x².
+        for _ in 0..9 {
+            sum = sum * Dd::new(2.0) + sum.sqr();
+        }
+        let e = sum + Dd::ONE;
+        let f = 2f64.powi(k as i32);
+        Dd {
+            hi: e.hi * f,
+            lo: e.lo * f,
+        }
+    }
+    /// Natural logarithm; NaN for `x < 0`, −∞ at 0.
+    pub fn ln(self) -> Dd {
+        if !(self.hi > 0.0) || !self.hi.is_finite() {
+            return Dd::new(self.hi.ln());
+        }
+        let y = Dd::new(self.hi.ln());
+        // y + x e^{−y} − 1
+        y + self * (-y).exp() - Dd::ONE
+    }
+    /// Hyperbolic sine.
+    pub fn sinh(self) -> Dd {
+        if self.hi.abs() < 0.5 {
+            let x2 = self.sqr();
+            let mut term = self;
+            let mut sum = self;
+            for n in 1..30 {
+                term = term * x2 / Dd::new(((2 * n) * (2 * n + 1)) as f64);
+                sum = sum + term;
+                if term.hi.abs() < 1e-34 * sum.hi.abs() {
+                    break;
+                }
+            }
+            return sum;
+        }
+        let e = self.exp();
+        (e - Dd::ONE / e) * Dd::new(0.5)
+    }
+    /// Hyperbolic cosine.
+    pub fn cosh(self) -> Dd {
+        let e = self.exp();
+        (e + Dd::ONE / e) * Dd::new(0.5)
+    }
+    /// Inverse hyperbolic sine (one Newton step on [`Dd::sinh`] from the double-precision
+    /// value).
+    pub fn asinh(self) -> Dd {
+        let y = Dd::new(self.hi.asinh());
+        let c = y.cosh();
+        y + (self - y.sinh()) / c
+    }
+    /// `tanh(x)` as `sinh x / cosh x` (relative accuracy ~1e-31 also near 0).
+    pub fn tanh(self) -> Dd {
+        if self.hi.abs() > 40.0 {
+            return Dd::new(self.hi.signum());
+        }
+        self.sinh() / self.cosh()
+    }
+}
+
 impl From<f64> for Dd {
     fn from(x: f64) -> Dd {
         Dd::new(x)
@@ -364,13 +460,13 @@ impl MobiusDd {
         }
     }
     /// The frame of paper 001 §V (τ): `p ↦ 0` and `q` onto the positive real axis; also
-    /// returns `|τ(q)|` (a point near the origin, so double precision suffices for it).
-    fn frame(p: Cdd, q: Cdd) -> (MobiusDd, f64) {
+    /// returns `|τ(q)|`.
+    fn frame(p: Cdd, q: Cdd) -> (MobiusDd, Dd) {
         let t = MobiusDd::to_origin(p);
         let w = t.apply(q);
         let r = w.norm();
         if !(r.hi > 0.0) {
-            return (t, 0.0);
+            return (t, Dd::ZERO);
         }
         // Rotation z ↦ ū z (u = w/|w|) as [[c̄, 0], [0, c]] with c² = u: c = (1 + u)/|1 + u|.
         let u = Cdd {
@@ -393,7 +489,7 @@ impl MobiusDd {
             a: c.conj(),
             b: Cdd::ZERO,
         };
-        (rot.compose(&t), r.f64())
+        (rot.compose(&t), r)
     }
     /// The map taking `p0 ↦ p1` and the direction towards `q0` onto the direction towards
     /// `q1`, splitting a length mismatch evenly (same construction as
@@ -401,9 +497,20 @@ impl MobiusDd {
     pub fn from_pairs(p0: Cdd, q0: Cdd, p1: Cdd, q1: Cdd) -> MobiusDd {
         let (t0, r0) = MobiusDd::frame(p0, q0);
         let (t1, r1) = MobiusDd::frame(p1, q1);
-        let d0 = 2.0 * r0.min(1.0 - f64::EPSILON).atanh();
-        let d1 = 2.0 * r1.min(1.0 - f64::EPSILON).atanh();
-        let shift = MobiusDd::from(Mobius::real_translation(0.5 * (d1 - d0)));
+        // Half the length mismatch, atanh r1 − atanh r0 = atanh((r1 − r0)/(1 − r0 r1)), with
+        // the ratio in double-double (the mismatch is tiny when both pairs are isometric).
+        let den = Dd::ONE - r0 * r1;
+        let half = if den.hi > 0.0 {
+            ((r1 - r0) / den)
+                .f64()
+                .clamp(-1.0 + f64::EPSILON, 1.0 - f64::EPSILON)
+                .atanh()
+        } else {
+            let d0 = r0.f64().min(1.0 - f64::EPSILON).atanh();
+            let d1 = r1.f64().min(1.0 - f64::EPSILON).atanh();
+            d1 - d0
+        };
+        let shift = MobiusDd::from(Mobius::real_translation(half));
         t1.inverse().compose(&shift).compose(&t0).normalized()
     }
     /// Frobenius distance `min(|M₁ − M₂|, |M₁ + M₂|)` (±M act alike), evaluated in
@@ -538,6 +645,78 @@ mod tests {
         // The low part of 1/3 is what f64 drops: 1/3 − fl(1/3).
         let r = -(3.0f64).mul_add(1.0 / 3.0, -1.0); // 1 − 3·fl(1/3), exactly
         assert!((third.lo - r / 3.0).abs() < 1e-40);
+    }
+
+    /// A decimal string read in double-double (digit by digit; ~1e-32 relative).
+    fn parse(s: &str) -> Dd {
+        let (int, frac) = s.split_once('.').unwrap_or((s, ""));
+        let mut v = Dd::ZERO;
+        for c in int.chars().chain(frac.chars()) {
+            v = v * Dd::new(10.0) + Dd::new(c.to_digit(10).unwrap() as f64);
+        }
+        let mut p = Dd::ONE;
+        for _ in 0..frac.len() {
+            p = p * Dd::new(10.0);
+        }
+        v / p
+    }
+
+    fn rel(a: Dd, b: Dd) -> f64 {
+        ((a - b).f64() / b.f64()).abs()
+    }
+
+    #[test]
+    fn double_double_transcendentals_match_known_digits_and_identities() {
+        // Known digits (40 significant): e, ln 10, sinh 1, asinh 1 = ln(1 + √2), tanh ½.
+        let e = parse("2.718281828459045235360287471352662497757");
+        assert!(rel(Dd::ONE.exp(), e) < 1e-31, "{:e}", rel(Dd::ONE.exp(), e));
+        let ln10 = parse("2.302585092994045684017991454684364207601");
+        assert!(rel(Dd::new(10.0).ln(), ln10) < 1e-31);
+        let sinh1 = parse("1.175201193643801456882381850595600815156");
+        assert!(rel(Dd::ONE.sinh(), sinh1) < 1e-31);
+        let asinh1 = parse("0.8813735870195430252326093249797923090282");
+        assert!(rel(Dd::ONE.asinh(), asinh1) < 1e-31);
+        let tanh_half = parse("0.4621171572600097585023184836436725487302");
+        assert!(rel(Dd::new(0.5).tanh(), tanh_half) < 1e-31);
+        // Small arguments keep their relative accuracy (series, no cancellation):
+        // sinh x = x + x³/6 + x⁵/120 for x = 1e-6 to 1e-40.
+        let x = Dd::new(1e-6);
+        let want = x + x * x * x / Dd::new(6.0) + x.sqr().sqr() * x / Dd::new(120.0);
+        assert!(rel(x.sinh(), want) < 1e-31);
+        assert!(rel(x.asinh().sinh(), x) < 1e-31);
+        // Identities over a range of arguments (both branches of sinh, large and negative x).
+        for &v in &[-7.3, -0.49, -1e-3, 1e-9, 0.3, 0.5, 0.77, 2.0, 13.0, 41.5] {
+            let x = Dd::new(v) + Dd::new(v * 1e-17);
+            let (s, c) = (x.sinh(), x.cosh());
+            let one = c.sqr() - s.sqr();
+            assert!(
+                ((one - Dd::ONE).f64() / c.sqr().f64()).abs() < 1e-30,
+                "cosh² − sinh² at {v}"
+            );
+            // ln near 1 is limited by the absolute resolution of eˣ (~1e-32).
+            let err = (x.exp().ln() - x).f64().abs();
+            assert!(err < 1e-30 * v.abs().max(1.0), "ln(exp) at {v}");
+            assert!(rel(x.asinh().sinh(), x) < 1e-30, "sinh(asinh) at {v}");
+            assert!(rel(x.sinh().asinh(), x) < 1e-30, "asinh(sinh) at {v}");
+            let y = Dd::new(0.37);
+            assert!(
+                rel((x + y).exp(), x.exp() * y.exp()) < 1e-30,
+                "exp(x + y) at {v}"
+            );
+            if v.abs() < 40.0 {
+                assert!(rel(x.tanh(), s / c) < 1e-30);
+            }
+        }
+        for &v in &[1e-10, 1e-5, 0.9, 1.0, 3.5, 1e10] {
+            let x = Dd::new(v) * (Dd::ONE + Dd::new(3e-17));
+            // exp amplifies the absolute rounding of ln x (~1e-32·|ln x|).
+            let tol = 1e-31 * (1.0 + v.ln().abs());
+            assert!(
+                rel(x.ln().exp(), x) < tol,
+                "exp(ln) at {v}: {:e}",
+                rel(x.ln().exp(), x)
+            );
+        }
     }
 
     #[test]

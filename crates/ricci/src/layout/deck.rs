@@ -34,13 +34,15 @@
 //! rounded to double precision only for the result. In double precision the generators of a
 //! polygon reaching hyperbolic distance r are resolved to ~1e-16·e^r and the relation product
 //! of 4g such maps (entries ~e^{ℓ/2}) lost every digit on fertility (2e-3) and botijo (1e7).
-//! What limits the result now is the metric: the flow's curvature error κ (~5e-15 per vertex
-//! at the double-precision floor of `K = 2π − Σθ`) makes the maps from different edges of a
-//! side differ by rotations of size κ about the vertices between them, i.e. by ~κ·sinh r in
-//! the matrix norm of [`Isometry::distance`] and ~κ·sinh d at points at distance d
-//! ([`SidePairing::edge_spread`]). Measured (`tests/layout_meshes.rs`, tolerance 1e-12):
-//! relation error 1e-12…5e-10 on eight, 3holes, genus3, fertility; edge spreads ≤ 3e-10 except
-//! on fertility, whose sides are long (6e-9 as matrices, 2e-7 at points).
+//! What limited the result then was the metric: the flow's curvature error κ (~5e-15 per
+//! vertex at the double-precision floor of `K = 2π − Σθ`) makes the maps from different edges
+//! of a side differ by rotations of size κ about the vertices between them, i.e. by ~κ·sinh r
+//! in the matrix norm of [`Isometry::distance`] and ~κ·sinh d at points at distance d
+//! ([`SidePairing::edge_spread`]); fertility's long sides reached 6e-9 (matrices) and 2e-7
+//! (points). With the metric polished to double-double ([`crate::flow::polish`], the default
+//! of the layout pipeline, [`super::pipeline`]) and laid out from double-double lengths
+//! ([`super::place::layout_dd`]), measured (`tests/layout_meshes.rs`, BENCHMARKS.md): relation
+//! error and edge spreads ≤ 1e-17 on eight, 3holes, genus3, fertility, cup and botijo.
 
 use super::isometry::Isometry;
 use super::place::{ext_position, ExtPoint, Frame, Layout, Space};

@@ -12,7 +12,7 @@
 //! * [`cover`] — finite portions of the universal cover: copies of the polygon by words or by
 //!   radius.
 //! * [`pipeline`] — surface with metric → canonical cut → layout → deck group (with the
-//!   uniformization flow when no metric is given).
+//!   uniformization flow when no metric is given; H² metrics polished to double-double).
 //! * [`svg`], [`export`] — pictures of the fundamental domain and tilings; OBJ with UVs.
 //! * [`synthetic`] — closed surfaces with exact flat / hyperbolic metrics and known polygons
 //!   (flat tori, regular 4g-gons), the references of the tests.
@@ -29,4 +29,4 @@ pub mod synthetic;
 
 pub use deck::{deck_group, DeckGroup, Polygon, Side, SidePairing};
 pub use isometry::{Isometry, Mobius, RigidMotion, Rotation};
-pub use place::{align, align_layouts, layout, Frame, Layout, Space};
+pub use place::{align, align_layouts, layout, layout_dd, Frame, Layout, Space};

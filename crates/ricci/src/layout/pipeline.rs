@@ -5,13 +5,26 @@
 //! The uniformization metric itself comes from [`crate::flow`] ([`uniformization_metric`]:
 //! E² for genus 1, H² for genus ≥ 2, S² for closed genus 0; the flat free-boundary metric for
 //! disks), or from the caller.
+//!
+//! **H²: metric polished to double-double before the layout** (on by default in
+//! `ricci layout` and `ricci spectrum`): [`polish_uniformization`] refines the flow's `u` by
+//! iterative refinement with a double-double curvature residual ([`crate::flow::polish`],
+//! from ~5e-15 to ~1e-30), and [`cut_disk_polished`] carries the double-double lengths
+//! through the cut: edges of the input keep their low parts; the cut's refinement computes
+//! the lengths of split and new edges in double precision, so the refined metric is polished
+//! once more, in place, by vertex scaling (`sinh(l/2) = e^{(ui+uj)/2} sinh(l⁰/2)` from the
+//! double-double lengths, target 0 on every vertex — new vertices are flat). The cut mesh
+//! then carries `lengths_lo`, which [`super::place::layout_dd`] uses. The deck maps computed
+//! from different edges of a side then agree to the double-double layout's own accuracy
+//! instead of ~κ·sinh r with κ ≈ 5e-15 (BENCHMARKS.md, Layout).
 
 use super::deck::Polygon;
 use crate::cut::{canonical_cut, CanonicalCut, CutOptions};
 use crate::error::{Error, Result};
+use crate::flow::polish::{polish_metric, PolishSettings, PolishedMetric};
 use crate::flow::{ricci_flow, FlowOptions, FlowResult, TargetSpec};
 use crate::mesh::{topology, Mesh};
-use crate::metric::{Geometry, Scheme};
+use crate::metric::{ConformalStructure, Geometry, Scheme};
 use crate::progress::Progress;
 
 /// The geometry of the uniformization metric of a connected surface: S² for closed genus 0,
@@ -67,6 +80,11 @@ pub struct CutDisk {
     pub mesh: Mesh,
     /// Edge lengths of the cut mesh.
     pub lengths: Vec<f64>,
+    /// Low parts of the lengths (double-double metric, [`cut_disk_polished`]); empty
+    /// otherwise.
+    pub lengths_lo: Vec<f64>,
+    /// What the polish of the refined metric did ([`cut_disk_polished`]).
+    pub refined_polish: Option<PolishReport>,
     /// For every cut-mesh vertex, the vertex of the (refined) surface it is a copy of.
     pub vertex_origin: Vec<u32>,
     /// The fundamental polygon (sides read from the cut mesh).
@@ -105,8 +123,174 @@ pub fn cut_disk(
     Ok(CutDisk {
         mesh: cm,
         lengths: cl,
+        lengths_lo: Vec::new(),
+        refined_polish: None,
         vertex_origin: cut.cut_vertex_origin.clone(),
         polygon,
         cut,
     })
+}
+
+/// What a double-double polish did (for reports).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct PolishReport {
+    /// Refinement steps.
+    pub steps: usize,
+    /// Max |K − K̄| in double-double before and after.
+    pub residual_start: f64,
+    pub residual_dd: f64,
+    pub converged: bool,
+}
+
+impl From<&PolishedMetric> for PolishReport {
+    fn from(p: &PolishedMetric) -> PolishReport {
+        PolishReport {
+            steps: p.steps,
+            residual_start: p.residual_start,
+            residual_dd: p.residual_dd,
+            converged: p.converged,
+        }
+    }
+}
+
+/// Polish a hyperbolic uniformization flow (`flow`, run on `mesh` with Euclidean input
+/// `lengths`) to double-double ([`crate::flow::polish`]): the conformal structure is rebuilt
+/// from the same inputs (it is deterministic), and `u` is refined until the double-double
+/// curvature residual is ≤ 1e-26 (at most 4 steps). Errors: not H², a target other than 0
+/// (uniform / geodesic boundary), a flow that did not converge.
+pub fn polish_uniformization(
+    mesh: &Mesh,
+    lengths: &[f64],
+    flow: &FlowResult,
+) -> Result<PolishedMetric> {
+    if flow.geometry != Geometry::Hyperbolic {
+        return Err(Error::input(format!(
+            "only hyperbolic metrics are polished, this one is {}",
+            flow.geometry
+        )));
+    }
+    if !flow.converged {
+        return Err(Error::numerical(format!(
+            "the flow did not converge (max curvature error {:.3e}); nothing to polish",
+            flow.max_curvature_error
+        )));
+    }
+    let structure =
+        ConformalStructure::new(mesh, lengths, flow.geometry, flow.scheme, flow.input_scale)?;
+    polish_metric(
+        mesh,
+        &structure,
+        None,
+        &flow.u,
+        &flow.target,
+        &flow.fixed,
+        &PolishSettings::default(),
+    )
+}
+
+/// Polish a double-double hyperbolic metric with zero target curvature in place by vertex
+/// scaling (see the module docs); returns the polished lengths.
+pub fn polish_lengths(mesh: &Mesh, lengths: &[f64], lengths_lo: &[f64]) -> Result<PolishedMetric> {
+    use crate::layout::dd::Dd;
+    let ne = mesh.n_edges();
+    if lengths.len() != ne || lengths_lo.len() != ne {
+        return Err(Error::input(format!(
+            "{} lengths and {} low parts for a mesh with {ne} edges",
+            lengths.len(),
+            lengths_lo.len()
+        )));
+    }
+    let mut eta = Vec::with_capacity(ne);
+    let mut eta_lo = Vec::with_capacity(ne);
+    for e in 0..ne {
+        let x = ((Dd::new(lengths[e]) + Dd::new(lengths_lo[e])) * Dd::new(0.5)).sinh();
+        eta.push(x.hi);
+        eta_lo.push(x.lo);
+    }
+    let nv = mesh.n_vertices();
+    let structure = ConformalStructure {
+        geometry: Geometry::Hyperbolic,
+        scheme: Scheme::Yamabe,
+        eta,
+        u0: vec![0.0; nv],
+        input_scale: 1.0,
+        clamped_edges: 0,
+        initial_length_error: 0.0,
+    };
+    polish_metric(
+        mesh,
+        &structure,
+        Some(&eta_lo),
+        &vec![0.0; nv],
+        &vec![0.0; nv],
+        &vec![false; nv],
+        &PolishSettings::default(),
+    )
+}
+
+/// [`cut_disk`] for a double-double H² metric with zero target curvature (`lengths` +
+/// `lengths_lo`, e.g. from [`polish_uniformization`]): the cut runs on the leading parts;
+/// edges of the input keep their low parts, and when the cut refined the mesh, the refined
+/// metric is polished in place ([`polish_lengths`]) before it is carried to the cut mesh.
+pub fn cut_disk_polished(
+    mesh: &Mesh,
+    lengths: &[f64],
+    lengths_lo: &[f64],
+    positions: Option<&[[f64; 3]]>,
+    base: Option<u32>,
+    progress: &mut dyn Progress,
+) -> Result<CutDisk> {
+    if lengths_lo.len() != mesh.n_edges() {
+        return Err(Error::input(format!(
+            "{} low parts of lengths for a mesh with {} edges",
+            lengths_lo.len(),
+            mesh.n_edges()
+        )));
+    }
+    let mut disk = cut_disk(
+        mesh,
+        lengths,
+        Geometry::Hyperbolic,
+        positions,
+        base,
+        progress,
+    )?;
+    let refined = &disk.cut.refined;
+    let rm = &refined.mesh;
+    let nv0 = refined.original_vertices as u32;
+    let mut rlo = vec![0.0; rm.n_edges()];
+    for (e, lo) in rlo.iter_mut().enumerate() {
+        let [a, b] = rm.edge_vertices(e as u32);
+        if a < nv0 && b < nv0 {
+            if let Some(h) = mesh.halfedge_between(a, b) {
+                let e0 = mesh.he_edge(h) as usize;
+                if lengths[e0] == refined.lengths[e] {
+                    *lo = lengths_lo[e0];
+                }
+            }
+        }
+    }
+    let (rl, rlo) = if refined.splits() > 0 {
+        progress.report(
+            "polish",
+            None,
+            "polishing the refined metric in double-double",
+        );
+        let p = polish_lengths(rm, &refined.lengths, &rlo)?;
+        disk.refined_polish = Some(PolishReport::from(&p));
+        (p.lengths, p.lengths_lo)
+    } else {
+        (refined.lengths.clone(), rlo)
+    };
+    let cm = &disk.mesh;
+    let mut cl = vec![0.0; cm.n_edges()];
+    let mut cl_lo = vec![0.0; cm.n_edges()];
+    for h in 0..cm.n_corners() as u32 {
+        let e = rm.he_edge(h) as usize;
+        cl[cm.he_edge(h) as usize] = rl[e];
+        cl_lo[cm.he_edge(h) as usize] = rlo[e];
+    }
+    disk.lengths = cl;
+    disk.lengths_lo = cl_lo;
+    Ok(disk)
 }

@@ -20,10 +20,15 @@
 //! **Precision.** Face frames are composed in the working precision of the space ([`Frame`]):
 //! double precision in E² and S², double-double in H² ([`super::dd`]), where a frame at
 //! distance r from the centre has entries ~e^{r/2} and a double-precision composition would
-//! perturb each step by ~1e-16·e^r. The relative placement of a face on its parent is computed
-//! at the base point in double precision (accurate to ~1e-16, like a perturbation of the input
-//! lengths at that level), positions are kept in double-double ([`Layout::positions_lo`]),
-//! and the measurements (orientation, length error, radius) use them. With the flow's metric
+//! perturb each step by ~1e-16·e^r. In E² and S² the relative placement of a face on its
+//! parent is computed at the base point in double precision; in H² the canonical triangles
+//! come from the lengths in double-double ([`Space::seed_ext`]: `tanh(l/2)` and the half-angle
+//! tangent of the cosine law) and the relative placement maps the shared edge of two
+//! canonical triangles onto each other in double-double ([`Space::relative`]). Lengths can be
+//! given to double-double precision ([`layout_dd`], `lengths_lo`; the metric polished by
+//! [`crate::flow::polish`]); [`layout`] is `layout_dd` with zero low parts. Positions are kept
+//! in double-double ([`Layout::positions_lo`]), and the measurements (orientation, length
+//! error, radius) use them. With the flow's metric
 //! at tolerance 1e-12, layouts from different seed faces agree to ≤ 2e-11 on the shared
 //! genus-2…5 meshes (fertility reaches r ≈ 25 from an off-centre seed), against 5e-5 in double
 //! precision.
@@ -218,6 +223,39 @@ pub trait Space: Background {
     fn distance(a: Self::Point, b: Self::Point) -> f64;
     /// The point at fraction `t` of the geodesic from `a` to `b`.
     fn toward(a: Self::Point, b: Self::Point, t: f64) -> Self::Point;
+    /// [`Space::seed`] in the working precision, for side lengths `l[m] + lo[m]`
+    /// (`l = [l01, l12, l20]`). Default: the double-precision seed (low parts ignored).
+    fn seed_ext(l: [f64; 3], lo: [f64; 3]) -> [ExtPoint<Self>; 3] {
+        let _ = lo;
+        Self::seed(l[0], l[1], l[2]).map(|p| Self::Frame::ext(p, None))
+    }
+    /// The relative placement of a face `g = (i, j, k)` whose canonical triangle is `cg`
+    /// (corner of `i` at index `ti`) on its parent's canonical triangle, where the shared
+    /// edge runs from `pi` to `pj`: the isometry taking `cg[ti] ↦ pi`, `cg[ti + 1] ↦ pj`
+    /// (side lengths `l_ij`, `l_jk`, `l_ki` of `g`). Default: through the circle
+    /// intersection [`Space::third`] and [`Isometry::from_pairs`] in double precision.
+    fn relative(
+        cg: &[ExtPoint<Self>; 3],
+        ti: usize,
+        pi: ExtPoint<Self>,
+        pj: ExtPoint<Self>,
+        l: [f64; 3],
+    ) -> Self::Frame {
+        let (pi, pj) = (
+            <Self::Frame as Frame>::split(pi).0,
+            <Self::Frame as Frame>::split(pj).0,
+        );
+        let pk = Self::third(pi, pj, l[0], l[1], l[2]);
+        let q = [pi, pj, pk];
+        let mut target = [pi; 3];
+        for r in 0..3 {
+            target[(ti + r) % 3] = q[r];
+        }
+        let c0 = <Self::Frame as Frame>::split(cg[0]).0;
+        let c1 = <Self::Frame as Frame>::split(cg[1]).0;
+        let rel = Self::Iso::from_pairs(c0, c1, target[0], target[1]);
+        Self::Frame::from_iso(&rel)
+    }
 }
 
 #[inline]
@@ -296,6 +334,49 @@ impl Space for Hyperbolic {
     #[inline]
     fn distance(a: Complex, b: Complex) -> f64 {
         disk_distance(a, b)
+    }
+    /// The canonical triangle in double-double: `p0 = 0`, `p1 = tanh(l01/2)`,
+    /// `p2 = e^{iθ} tanh(l20/2)` with `e^{iθ} = (1 − t² + 2it)/(1 + t²)` from the half-angle
+    /// tangent of the cosine law ([`Background::angle`]), all in double-double from the
+    /// double-double lengths.
+    // `!(x > 0.0)` is used on purpose: it is also true for NaN.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    fn seed_ext(l: [f64; 3], lo: [f64; 3]) -> [Cdd; 3] {
+        use super::dd::Dd;
+        let [l01, l12, l20] = [0, 1, 2].map(|m| Dd::new(l[m]) + Dd::new(lo[m]));
+        let half = Dd::new(0.5);
+        let sig = (l01 + l12 + l20) * half;
+        let (sa, sb, sc) = (sig - l12, sig - l01, sig - l20);
+        let phasor = if !(sa.hi > 0.0) {
+            Cdd {
+                re: -Dd::ONE,
+                im: Dd::ZERO,
+            }
+        } else if !(sb.hi > 0.0) || !(sc.hi > 0.0) {
+            Cdd::ONE
+        } else {
+            let t2 = sb.sinh() * sc.sinh() / (sig.sinh() * sa.sinh());
+            let den = Dd::ONE + t2;
+            Cdd {
+                re: (Dd::ONE - t2) / den,
+                im: Dd::new(2.0) * t2.sqrt() / den,
+            }
+        };
+        let r1 = (l01 * half).tanh();
+        let r2 = (l20 * half).tanh();
+        [
+            Cdd::ZERO,
+            Cdd {
+                re: r1,
+                im: Dd::ZERO,
+            },
+            phasor.scale(r2),
+        ]
+    }
+    /// In double-double: [`MobiusDd::from_pairs`] on the corners of the shared edge (the two
+    /// triangles share its length exactly, so no circle intersection is needed).
+    fn relative(cg: &[Cdd; 3], ti: usize, pi: Cdd, pj: Cdd, _l: [f64; 3]) -> MobiusDd {
+        MobiusDd::from_pairs(cg[ti], cg[(ti + 1) % 3], pi, pj)
     }
     fn toward(a: Complex, b: Complex, t: f64) -> Complex {
         let m = Mobius::to_origin(a);
@@ -474,7 +555,37 @@ pub fn layout<S: Space>(
     lengths: &[f64],
     seed_face: Option<u32>,
 ) -> Result<Layout<S::Point>> {
+    layout_dd::<S>(mesh, lengths, None, seed_face)
+}
+
+/// [`layout`] for a metric given to double-double precision: edge `e` has length
+/// `lengths[e] + lengths_lo[e]` (e.g. [`super::pipeline::cut_disk_polished`]). The low parts
+/// enter the canonical triangles of the faces in the working precision of the space
+/// ([`Space::seed_ext`]: double-double in H²; E² and S² ignore them). `None` is [`layout`].
+///
+/// Errors: as [`layout`], and low parts that are not finite or not one per edge.
+pub fn layout_dd<S: Space>(
+    mesh: &Mesh,
+    lengths: &[f64],
+    lengths_lo: Option<&[f64]>,
+    seed_face: Option<u32>,
+) -> Result<Layout<S::Point>> {
     check_lengths(mesh, lengths, S::KIND)?;
+    if let Some(lo) = lengths_lo {
+        if lo.len() != mesh.n_edges() {
+            return Err(Error::input(format!(
+                "{} low parts of edge lengths given for a mesh with {} edges",
+                lo.len(),
+                mesh.n_edges()
+            )));
+        }
+        if let Some(e) = lo.iter().position(|x| !x.is_finite()) {
+            return Err(Error::input(format!(
+                "edge {e}: the low part of its length is {}",
+                lo[e]
+            )));
+        }
+    }
     let nf = mesh.n_faces();
     if nf == 0 {
         return Err(Error::input("cannot lay out a mesh without faces"));
@@ -510,7 +621,7 @@ pub fn layout<S: Space>(
         }
         None => central_face(mesh),
     };
-    let first = layout_unchecked::<S>(mesh, lengths, seed);
+    let first = layout_unchecked::<S>(mesh, lengths, lengths_lo, seed);
     if seed_face.is_some() || !mesh.has_boundary() {
         return Ok(first);
     }
@@ -528,7 +639,7 @@ pub fn layout<S: Space>(
     if best == seed {
         return Ok(first);
     }
-    Ok(layout_unchecked::<S>(mesh, lengths, best))
+    Ok(layout_unchecked::<S>(mesh, lengths, lengths_lo, best))
 }
 
 fn boundary_points<P: Copy>(mesh: &Mesh, pos: &[P]) -> Vec<P> {
@@ -561,6 +672,7 @@ pub fn minimax_centre<S: Space>(points: &[S::Point]) -> S::Point {
 pub(crate) fn layout_unchecked<S: Space>(
     mesh: &Mesh,
     lengths: &[f64],
+    lengths_lo: Option<&[f64]>,
     seed: u32,
 ) -> Layout<S::Point> {
     use std::cmp::Reverse;
@@ -583,10 +695,15 @@ pub(crate) fn layout_unchecked<S: Space>(
     // computed near the base point from the metric alone; positions are frames applied to
     // canonical triangles. So no direction is ever taken from the difference of two nearby
     // far-away points (in the Poincaré disk those lose ~1e-16·e^r / l of accuracy).
-    let canon = |f: u32| {
-        let [a, b, c] = mesh.face_halfedges(f);
-        S::seed(len(a), len(b), len(c))
-    };
+    let lo = |h: u32| lengths_lo.map_or(0.0, |l| l[mesh.he_edge(h) as usize]);
+    // Computed once per face (double-double transcendentals in H²).
+    let canonical: Vec<[ExtPoint<S>; 3]> = (0..nf as u32)
+        .map(|f| {
+            let [a, b, c] = mesh.face_halfedges(f);
+            S::seed_ext([len(a), len(b), len(c)], [lo(a), lo(b), lo(c)])
+        })
+        .collect();
+    let canon = |f: u32| canonical[f as usize];
     // Frames are composed in the working precision of the space (double-double in H²,
     // see [`Frame`]); the relative placements are computed near the base point in double
     // precision, where that is accurate to the last digit.
@@ -595,7 +712,7 @@ pub(crate) fn layout_unchecked<S: Space>(
     let tri = canon(seed);
     let fv = mesh.face(seed);
     for i in 0..3 {
-        pos[fv[i] as usize] = S::Frame::ext(tri[i], None);
+        pos[fv[i] as usize] = tri[i];
         placed[fv[i] as usize] = true;
         cost[fv[i] as usize] = 0.0;
     }
@@ -632,24 +749,18 @@ pub(crate) fn layout_unchecked<S: Space>(
         // h runs j → i: its origin (corner h % 3) is j, its tip is i.
         let (pj, pi) = (cf[(h % 3) as usize], cf[((h + 1) % 3) as usize]);
         let (tn, tp) = (mesh.he_next(t), mesh.he_prev(t));
-        // g = (i, j, k) counter-clockwise with t = i → j; place k in the parent's frame.
-        let pk = S::third(pi, pj, len(t), len(tn), len(tp));
-        // Relative placement: g's canonical triangle onto (q_i, q_j, q_k) in f's frame.
+        // g = (i, j, k) counter-clockwise with t = i → j. Relative placement: g's canonical
+        // triangle with its corners i, j onto (p_i, p_j) in f's frame.
         let cg = canon(g);
         let ti = (t % 3) as usize; // corner of i in g
-        let q = [pi, pj, pk]; // positions of g's corners ti, ti+1, ti+2
-        let mut target = [pi; 3];
-        for r in 0..3 {
-            target[(ti + r) % 3] = q[r];
-        }
-        let rel = S::Iso::from_pairs(cg[0], cg[1], target[0], target[1]);
-        let fg = ff.compose(&S::Frame::from_iso(&rel)).normalized();
+        let rel = S::relative(&cg, ti, pi, pj, [len(t), len(tn), len(tp)]);
+        let fg = ff.compose(&rel).normalized();
         frame[g as usize] = Some(fg);
         let k = mesh.he_tip(tn);
         if !placed[k as usize] {
             let i = mesh.he_origin(t);
             let j = mesh.he_tip(t);
-            pos[k as usize] = fg.apply(S::Frame::ext(cg[(ti + 2) % 3], None));
+            pos[k as usize] = fg.apply(cg[(ti + 2) % 3]);
             placed[k as usize] = true;
             let amp = len(tn).max(len(tp)) / len(t).max(f64::MIN_POSITIVE);
             cost[k as usize] = cost[i as usize].max(cost[j as usize]) + (1.0 + amp).ln();
@@ -754,6 +865,47 @@ pub fn align_layouts<S: Space>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Hyperbolic distance of two disk points, entirely in double-double.
+    fn dist_dd(p: Cdd, q: Cdd) -> super::super::dd::Dd {
+        use super::super::dd::Dd;
+        let den = (Dd::ONE - p.norm_sqr()) * (Dd::ONE - q.norm_sqr());
+        Dd::new(2.0) * ((p - q).norm() / den.sqrt()).asinh()
+    }
+
+    #[test]
+    fn double_double_seed_triangles_have_their_double_double_side_lengths() {
+        use super::super::dd::Dd;
+        // Low parts far below double precision must show up in the laid-out distances.
+        for (l, lo) in [
+            ([0.3, 0.4, 0.5], [1e-17, -2e-17, 3e-18]),
+            ([0.05, 0.0502, 0.07], [-3e-19, 1e-19, 2e-19]),
+            ([1.5, 2.0, 1.2], [4e-17, 0.0, -1e-17]),
+        ] {
+            let p = Hyperbolic::seed_ext(l, lo);
+            let want = [0, 1, 2].map(|m| Dd::new(l[m]) + Dd::new(lo[m]));
+            let got = [
+                dist_dd(p[0], p[1]),
+                dist_dd(p[1], p[2]),
+                dist_dd(p[2], p[0]),
+            ];
+            for m in 0..3 {
+                let e = ((got[m] - want[m]).f64() / l[m]).abs();
+                assert!(e < 1e-29, "side {m} of {l:?}: relative error {e:e}");
+            }
+            assert!(disk_orientation_dd(p[0], p[1], p[2]) > 0.0);
+            // Agrees with the double-precision seed to its rounding.
+            let q = Hyperbolic::seed(l[0], l[1], l[2]);
+            for m in 0..3 {
+                assert!((p[m].hi() - q[m]).norm() < 1e-15);
+            }
+            // The relative placement of a copy across edge 1 → 2 puts its corners on the
+            // edge's ends (in double-double).
+            let f = Hyperbolic::relative(&p, 1, p[2], p[1], [l[1], l[0], l[2]]);
+            let (a, b) = (f.apply(p[1]), f.apply(p[2]));
+            assert!(dist_dd(a, p[2]).f64() < 1e-29 && dist_dd(b, p[1]).f64() < 1e-29);
+        }
+    }
 
     #[test]
     fn seed_triangles_have_their_side_lengths_and_orientation() {

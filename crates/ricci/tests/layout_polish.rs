@@ -1,0 +1,213 @@
+//! The double-double metric polish (`ricci::flow::polish`) and its path through the cut and
+//! the hyperbolic layout (`cut_disk_polished`, `layout_dd`), on generated surfaces (no
+//! `RICCI_MESHES` needed).
+
+use ricci::flow::polish::{curvature_dd, polish_metric, PolishSettings};
+use ricci::layout::deck_group;
+use ricci::layout::pipeline::{
+    cut_disk, cut_disk_polished, polish_uniformization, uniformization_metric,
+};
+use ricci::layout::place::{layout, layout_dd};
+use ricci::mesh::generate;
+use ricci::metric::{ConformalStructure, Evaluator, Geometry, Hyperbolic, Scheme};
+use ricci::progress::NoProgress;
+
+#[test]
+fn double_double_curvature_agrees_with_the_flow_kernel_and_the_polish_converges() {
+    let s = generate::genus(2, 16).unwrap();
+    let input = s.edge_lengths();
+    let flow = uniformization_metric(
+        &s.mesh,
+        &input,
+        Geometry::Hyperbolic,
+        Scheme::Thurston,
+        1e-12,
+        &mut NoProgress,
+    )
+    .unwrap();
+    assert!(flow.converged);
+    let structure = ConformalStructure::new(
+        &s.mesh,
+        &input,
+        Geometry::Hyperbolic,
+        Scheme::Thurston,
+        flow.input_scale,
+    )
+    .unwrap();
+    // Same u, two implementations: the double-precision kernel of the flow and the
+    // double-double one of the polish (different length and angle code) must agree to the
+    // kernel's rounding, at a point where K is not small (u moved off the solution).
+    let u: Vec<f64> = flow
+        .u
+        .iter()
+        .enumerate()
+        .map(|(v, &x)| x + 2e-5 * (v as f64).sin())
+        .collect();
+    let mut ev = Evaluator::new(&s.mesh, structure.clone());
+    assert!(ev.evaluate(&u));
+    let kd = curvature_dd(&s.mesh, &structure, None, &u, &vec![0.0; u.len()]).unwrap();
+    let kmax = ev.ws.curvature.iter().fold(0.0f64, |m, k| m.max(k.abs()));
+    assert!(kmax > 1e-6, "the perturbation should change K ({kmax:e})");
+    let diff = ev
+        .ws
+        .curvature
+        .iter()
+        .zip(&kd)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        diff < 1e-13,
+        "f64 and double-double curvature differ by {diff:e}"
+    );
+    // Iterative refinement from the flow's u: the residual drops from the double-precision
+    // floor to the double-double one in a few steps, and the metric hardly moves.
+    let p = polish_uniformization(&s.mesh, &input, &flow).unwrap();
+    assert!(p.residual_start > 1e-17, "{:?}", p.history);
+    assert!(p.converged && p.residual_dd <= 1e-26, "{:?}", p.history);
+    assert!(p.steps <= 3, "{:?}", p.history);
+    // Recomputed from the polished u by the same double-double evaluation (u_lo included).
+    let k = curvature_dd(&s.mesh, &structure, None, &p.u, &p.u_lo).unwrap();
+    assert!(k.iter().all(|x| x.abs() <= 1e-26));
+    // Rounded to double precision, the polished u gives the flow kernel's lengths.
+    let mut ev = Evaluator::new(&s.mesh, structure.clone());
+    assert!(ev.evaluate(&p.u));
+    for (e, (&a, &b)) in ev.ws.lengths.iter().zip(&p.lengths).enumerate() {
+        assert!((a - b).abs() <= 1e-15 * b, "edge {e}: {a} vs {b}");
+    }
+    // The vertex-scaling polish of the polished double-double lengths has nothing left to
+    // do (its length law reproduces them through sinh/asinh).
+    let q = ricci::layout::pipeline::polish_lengths(&s.mesh, &p.lengths, &p.lengths_lo).unwrap();
+    assert!(q.residual_start <= 1e-26, "{:?}", q.history);
+}
+
+#[test]
+fn polished_metric_makes_deck_maps_from_different_edges_agree() {
+    // The same surface cut and laid out with the flow's metric (double precision) and with
+    // the polished one: the disagreement of the per-edge side maps, limited by the
+    // metric's curvature error, must drop by orders of magnitude.
+    let s = generate::genus(2, 16).unwrap();
+    let input = s.edge_lengths();
+    let flow = uniformization_metric(
+        &s.mesh,
+        &input,
+        Geometry::Hyperbolic,
+        Scheme::Thurston,
+        1e-12,
+        &mut NoProgress,
+    )
+    .unwrap();
+    let plain = cut_disk(
+        &s.mesh,
+        &flow.lengths,
+        Geometry::Hyperbolic,
+        None,
+        None,
+        &mut NoProgress,
+    )
+    .unwrap();
+    let lp = layout::<Hyperbolic>(&plain.mesh, &plain.lengths, None).unwrap();
+    let gp = deck_group::<Hyperbolic>(&lp, &plain.polygon).unwrap();
+    let p = polish_uniformization(&s.mesh, &input, &flow).unwrap();
+    let disk = cut_disk_polished(
+        &s.mesh,
+        &p.lengths,
+        &p.lengths_lo,
+        None,
+        None,
+        &mut NoProgress,
+    )
+    .unwrap();
+    if let Some(r) = disk.refined_polish {
+        assert!(r.converged, "{r:?}");
+    }
+    let l =
+        layout_dd::<Hyperbolic>(&disk.mesh, &disk.lengths, Some(&disk.lengths_lo), None).unwrap();
+    let g = deck_group::<Hyperbolic>(&l, &disk.polygon).unwrap();
+    eprintln!(
+        "plain: relation {:e} spread {:e} / {:e}; polished: relation {:e} spread {:e} / {:e}",
+        gp.relation_error.unwrap(),
+        gp.max_edge_spread_matrix,
+        gp.max_edge_spread,
+        g.relation_error.unwrap(),
+        g.max_edge_spread_matrix,
+        g.max_edge_spread
+    );
+    assert!(l.flipped_faces.is_empty());
+    assert!(g.relation_error.unwrap() < 1e-20);
+    assert!(g.max_edge_spread_matrix < 1e-20 && g.max_edge_spread < 1e-20);
+    assert!(g.max_edge_spread_matrix < 1e-4 * gp.max_edge_spread_matrix);
+    // With zero low parts the double-double entry point is the plain layout.
+    let z = layout_dd::<Hyperbolic>(
+        &plain.mesh,
+        &plain.lengths,
+        Some(&vec![0.0; plain.lengths.len()]),
+        None,
+    )
+    .unwrap();
+    assert_eq!(z.positions, lp.positions);
+}
+
+#[test]
+fn polish_refuses_what_it_cannot_do() {
+    let t = generate::torus(1.0, 0.4, 12).unwrap();
+    let flow = uniformization_metric(
+        &t.mesh,
+        &t.edge_lengths(),
+        Geometry::Euclidean,
+        Scheme::Thurston,
+        1e-10,
+        &mut NoProgress,
+    )
+    .unwrap();
+    let e = polish_uniformization(&t.mesh, &t.edge_lengths(), &flow).unwrap_err();
+    assert!(e.to_string().contains("hyperbolic"), "{e}");
+    // A nonzero target is refused, naming the vertex.
+    let s = generate::genus(2, 12).unwrap();
+    let st = ConformalStructure::new(
+        &s.mesh,
+        &s.edge_lengths(),
+        Geometry::Hyperbolic,
+        Scheme::Thurston,
+        0.1,
+    )
+    .unwrap();
+    let n = s.mesh.n_vertices();
+    let mut target = vec![0.0; n];
+    target[3] = 0.5;
+    let e = polish_metric(
+        &s.mesh,
+        &st,
+        None,
+        &st.u0,
+        &target,
+        &vec![false; n],
+        &PolishSettings::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("vertex 3"), "{e}");
+}
+
+#[test]
+fn vertex_scaling_metrics_are_polished_too() {
+    // The other H² length law: vertex scaling (sinh(l/2) = e^{(ui+uj)/2} sinh(l⁰/2)).
+    let s = generate::genus(2, 12).unwrap();
+    let flow = uniformization_metric(
+        &s.mesh,
+        &s.edge_lengths(),
+        Geometry::Hyperbolic,
+        Scheme::Yamabe,
+        1e-12,
+        &mut NoProgress,
+    )
+    .unwrap();
+    assert!(flow.converged);
+    let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &flow).unwrap();
+    assert!(p.converged && p.residual_dd <= 1e-26, "{:?}", p.history);
+    let moved = p
+        .lengths
+        .iter()
+        .zip(&flow.lengths)
+        .map(|(a, b)| ((a - b) / b).abs())
+        .fold(0.0, f64::max);
+    assert!(moved < 1e-12, "{moved:e}");
+}
