@@ -38,6 +38,46 @@ fn euler(s: &Surface) -> i64 {
     ricci::mesh::topology(&s.mesh).euler_characteristic()
 }
 
+/// Paper 000 §4 Step 2 (ii), recomputed from the atlas's mesh: every vertex within 3 edge
+/// rings of a cone (breadth-first over edges) has valence ≥ 6.
+fn check_ring_valence(name: &str, a: &AffineAtlas) {
+    let m = a.mesh();
+    let mut d = vec![usize::MAX; m.n_vertices()];
+    let mut q = std::collections::VecDeque::new();
+    for &c in a.singular_vertices() {
+        d[c as usize] = 0;
+        q.push_back(c);
+    }
+    let mut low = Vec::new();
+    while let Some(v) = q.pop_front() {
+        if d[v as usize] >= 1 && m.valence(v) < 6 {
+            low.push((v, d[v as usize], m.valence(v)));
+        }
+        if d[v as usize] == 3 {
+            continue;
+        }
+        for w in m.vertex_neighbors(v) {
+            if d[w as usize] == usize::MAX {
+                d[w as usize] = d[v as usize] + 1;
+                q.push_back(w);
+            }
+        }
+    }
+    let r = &a.report.refinement;
+    eprintln!(
+        "{name}: Step 2 (ii): {} low before, {} after; {} flips, {} + {} splits",
+        r.low_valence_before, r.low_valence_after, r.flips_ring, r.splits_ring, r.splits_ring_room
+    );
+    assert!(
+        low.is_empty(),
+        "{name}: {} vertices within 3 rings of a cone have valence < 6 (vertex, ring, \
+         valence): {:?}",
+        low.len(),
+        &low[..low.len().min(10)]
+    );
+    assert_eq!(r.low_valence_after, 0, "{name}: the report disagrees");
+}
+
 /// Check everything listed in the module docs; `singular` = expected number of cones.
 fn check(name: &str, s: &Surface, a: &AffineAtlas, singular: usize) {
     let m = a.mesh();
@@ -58,6 +98,9 @@ fn check(name: &str, s: &Surface, a: &AffineAtlas, singular: usize) {
         singular,
         "{name}: singular vertices"
     );
+    if singular > 0 {
+        check_ring_valence(name, a);
+    }
     assert!(r.flow_converged, "{name}: flow did not converge");
     assert_eq!(a.positions().len(), m.n_vertices());
     // Flatness, recomputed.

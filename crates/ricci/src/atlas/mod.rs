@@ -110,6 +110,10 @@ pub struct RefinementReport {
     pub splits_cut: usize,
     /// Splits that gave the cones' one-ring neighbours valence ≥ 6 after the cut.
     pub splits_ring: usize,
+    /// Step 2 (ii) within `rings` rings ([`flip_ring_valence`]): intrinsic flips, and the
+    /// splits that made room for them.
+    pub flips_ring: usize,
+    pub splits_ring_room: usize,
     /// Vertices within `rings` rings of a cone with valence < 6, before and after.
     pub low_valence_before: usize,
     pub low_valence_after: usize,
@@ -368,6 +372,15 @@ impl AffineAtlas {
             (cut.refined.clone(), 0)
         };
         rep.splits_ring = ring_splits;
+        // Step 2 (ii) within `rings` rings: intrinsic flips, and splits to make room.
+        let (refined, ring_work) = if options.rings > 0 && !cones.is_empty() {
+            let around = rings_around(&refined.mesh, &cones, options.rings).len();
+            flip_ring_valence(refined, &cones, options.rings, &on_cut, 40 * around + 1000)?
+        } else {
+            (refined, RingValenceWork::default())
+        };
+        rep.flips_ring = ring_work.flips;
+        rep.splits_ring_room = ring_work.splits;
         let rmesh = refined.mesh.clone();
         rep.vertices_after = rmesh.n_vertices();
         for (k, c) in cones.iter().enumerate() {
@@ -439,7 +452,8 @@ impl AffineAtlas {
         if cones.len() > 1 {
             add_slits(&rmesh, &lengths, &mut cut_edge, &cones[1..])?;
         }
-        let (disk, origin) = if cones.len() > 1 || ring_splits > 0 {
+        let reconnected = ring_splits + ring_work.flips + ring_work.splits > 0;
+        let (disk, origin) = if cones.len() > 1 || reconnected {
             crate::cut::slice(&rmesh, &cut_edge)?
         } else {
             (cut.cut_mesh.clone(), cut.cut_vertex_origin.clone())
@@ -997,6 +1011,157 @@ pub fn raise_ring_valence(
         refined = r.finish()?;
     }
     Ok((refined, total))
+}
+
+/// What [`flip_ring_valence`] did.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct RingValenceWork {
+    pub flips: usize,
+    pub splits: usize,
+    pub rounds: usize,
+    /// Whether every vertex within the rings reached valence ≥ 6 (false: the work bound was
+    /// reached first; the count left is in [`RefinementReport::low_valence_after`]).
+    pub complete: bool,
+}
+
+/// Paper 000 §4 Step 2 (ii): every vertex within `rings` edge-rings of a cone gets valence
+/// ≥ 6, by **intrinsic edge flips** ([`Refiner::flip`]) combined with intrinsic splits, both
+/// metric-preserving. Greedy, in rounds (distances recomputed each round, nearest vertices
+/// first): for a vertex `w` below 6, flip an edge `(a, b)` opposite `w` (face `(w, a, b)`,
+/// replaced by `(w, x)`) when that keeps `a` and `b` at valence ≥ 6 if they lie within the
+/// rings (≥ 4 otherwise), the edge is neither a `protected` edge (the cut loops) nor at a
+/// cone, `x` is not a cone, and the flip is intrinsically legal (strictly convex quad);
+/// among such flips the one leaving the most spare valence, then the shortest new edge.
+/// Otherwise split (midpoint) an edge opposite `w` to make room: the one whose endpoints are
+/// farthest from the cones (so the new valence-4 vertex lies farther out and the deficit
+/// moves outwards, leaving the rings after at most `rings` generations), then the longest.
+/// At most `max_ops` flips and splits. Vertex ids are kept (new vertices appended), so the
+/// cut loops stay edge paths: a flip never crosses an edge other than the one it removes.
+pub fn flip_ring_valence(
+    refined: crate::mesh::refine::Refined,
+    cones: &[(u32, f64)],
+    rings: usize,
+    protected: &std::collections::HashSet<(u32, u32)>,
+    max_ops: usize,
+) -> Result<(crate::mesh::refine::Refined, RingValenceWork)> {
+    let mut work = RingValenceWork::default();
+    if rings == 0 || cones.is_empty() {
+        work.complete = true;
+        return Ok((refined, work));
+    }
+    let mut r = Refiner::resume(refined, Geometry::Euclidean)?;
+    let is_cone = |x: u32| cones.iter().any(|c| c.0 == x);
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    // Splits stop at edges shorter than 1e-6 of the longest (the metric stays well resolved).
+    let min_len = 1e-6
+        * (0..r.n_faces() as u32 * 3)
+            .map(|h| r.length(h))
+            .fold(0.0, f64::max);
+    for _round in 0..4 * max_ops.max(1) {
+        let mut dist = refiner_ring_distances(&r, cones, rings + 1);
+        let mut low: Vec<u32> = (0..r.n_vertices() as u32)
+            .filter(|&w| {
+                let d = dist[w as usize];
+                d >= 1 && d <= rings && !r.is_boundary_vertex(w) && r.valence(w) < 6
+            })
+            .collect();
+        if low.is_empty() {
+            work.complete = true;
+            break;
+        }
+        if work.flips + work.splits >= max_ops {
+            break;
+        }
+        work.rounds += 1;
+        low.sort_by_key(|&w| (dist[w as usize], w));
+        for w in low {
+            if work.flips + work.splits >= max_ops {
+                break;
+            }
+            while r.valence(w) < 6 && work.flips + work.splits < max_ops {
+                let depth = |v: u32| dist.get(v as usize).copied().unwrap_or(usize::MAX);
+                let need = |v: u32| if depth(v) <= rings { 6 } else { 4 };
+                let mut best_flip: Option<((i64, f64), u32)> = None;
+                let mut best_split: Option<((usize, f64), u32)> = None;
+                for h in r.link(w) {
+                    let (a, b) = r.endpoints(h);
+                    if is_cone(a) || is_cone(b) || protected.contains(&key(a, b)) {
+                        continue;
+                    }
+                    let x = r.opposite_across(h);
+                    let l = r.length(h);
+                    // The new vertex of a split lies next to a, b, w and x.
+                    let far = depth(a)
+                        .min(depth(b))
+                        .min(x.map_or(usize::MAX, depth))
+                        .min(depth(w));
+                    if l > min_len && best_split.is_none_or(|s| (far, l) > s.0) {
+                        best_split = Some(((far, l), h));
+                    }
+                    let Some(x) = x else {
+                        continue;
+                    };
+                    if x == w || is_cone(x) || r.halfedge(w, x).is_some() {
+                        continue;
+                    }
+                    let sa = r.valence(a) as i64 - 1 - need(a);
+                    let sb = r.valence(b) as i64 - 1 - need(b);
+                    if sa < 0 || sb < 0 {
+                        continue;
+                    }
+                    let Ok(new_len) = r.flip_length(h) else {
+                        continue;
+                    };
+                    let score = (sa.min(sb), -new_len / l);
+                    if best_flip.is_none_or(|f| score > f.0) {
+                        best_flip = Some((score, h));
+                    }
+                }
+                if let Some((_, h)) = best_flip {
+                    let x = r.opposite_across(h).unwrap_or(NONE);
+                    r.flip(h)?;
+                    work.flips += 1;
+                    // The new edge (w, x) can only bring x closer.
+                    let dw = depth(w);
+                    if let Some(dx) = dist.get_mut(x as usize) {
+                        *dx = (*dx).min(dw + 1);
+                    }
+                } else if let Some(((far, _), h)) = best_split {
+                    r.split(h, 0.5);
+                    work.splits += 1;
+                    dist.push(far.saturating_add(1));
+                } else {
+                    break;
+                }
+            }
+        }
+    }
+    Ok((r.finish()?, work))
+}
+
+/// Edge-ring distance from the cones over a [`Refiner`]'s current connectivity, up to
+/// `limit` (farther vertices get `usize::MAX`).
+fn refiner_ring_distances(r: &Refiner, cones: &[(u32, f64)], limit: usize) -> Vec<usize> {
+    let mut d = vec![usize::MAX; r.n_vertices()];
+    let mut q = VecDeque::new();
+    for &(v, _) in cones {
+        if (v as usize) < d.len() {
+            d[v as usize] = 0;
+            q.push_back(v);
+        }
+    }
+    while let Some(v) = q.pop_front() {
+        if d[v as usize] >= limit {
+            continue;
+        }
+        for w in r.neighbors(v) {
+            if d[w as usize] == usize::MAX {
+                d[w as usize] = d[v as usize] + 1;
+                q.push_back(w);
+            }
+        }
+    }
+    d
 }
 
 /// Vertices within `rings` edge-rings of the cones (the cones excluded).

@@ -445,23 +445,9 @@ impl Refiner {
         (t != NONE).then(|| self.origin(Self::prev(t)))
     }
 
-    /// **Intrinsic edge flip** of the interior edge of half-edge `h` (metric-preserving).
-    ///
-    /// The edge `(a, b)` between faces `(a, b, c)` and `(b, a, d)` is replaced by `(c, d)`:
-    /// the two triangles are unfolded into the background plane (sphere, hyperbolic plane)
-    /// across `(a, b)` and `|cd|` is the side opposite the angle `θ_a = ∠cab + ∠bad` between
-    /// `|ac|` and `|ad|` (the stable half-angle form [`side`]). The flip is legal only if the
-    /// quadrilateral `a d b c` is strictly convex at `a` and at `b` intrinsically
-    /// (`∠cab + ∠bad < π` and `∠abc + ∠dba < π`, with a margin of 1e-9 rad), and `c ≠ d`
-    /// are not already joined (the result stays a simplicial complex); otherwise it is
-    /// refused with an error naming the edge and nothing changes. The cone metric is the
-    /// same (curvatures and areas unchanged up to rounding, tested to 1e-12).
-    ///
-    /// The faces keep their ids: face `f` of `h` becomes `(c, a, d)`, the twin face `g`
-    /// becomes `(d, b, c)`. Positions are unchanged. A flipped face lies in the union of the
-    /// two old faces; `face_origin` keeps, for each new face, the origin of the old face
-    /// with the same id (the one holding its whole corner at `c`, resp. `d`).
-    pub fn flip(&mut self, h: u32) -> Result<()> {
+    /// The length the new edge would have if the edge of `h` were flipped ([`Refiner::flip`]),
+    /// or the reason the flip is refused; changes nothing.
+    pub fn flip_length(&self, h: u32) -> Result<f64> {
         if h as usize >= self.len.len() {
             return Err(Error::input(format!(
                 "half-edge {h} does not exist (the mesh has {} half-edges)",
@@ -517,6 +503,39 @@ impl Refiner {
                 "flipping edge ({a}, {b}) gave the length {l_cd} for ({c}, {d})"
             )));
         }
+        Ok(l_cd)
+    }
+
+    /// **Intrinsic edge flip** of the interior edge of half-edge `h` (metric-preserving).
+    ///
+    /// The edge `(a, b)` between faces `(a, b, c)` and `(b, a, d)` is replaced by `(c, d)`:
+    /// the two triangles are unfolded into the background plane (sphere, hyperbolic plane)
+    /// across `(a, b)` and `|cd|` is the side opposite the angle `θ_a = ∠cab + ∠bad` between
+    /// `|ac|` and `|ad|` (the stable half-angle form [`side`]). The flip is legal only if the
+    /// quadrilateral `a d b c` is strictly convex at `a` and at `b` intrinsically
+    /// (`∠cab + ∠bad < π` and `∠abc + ∠dba < π`, with a margin of 1e-9 rad), and `c ≠ d`
+    /// are not already joined (the result stays a simplicial complex); otherwise it is
+    /// refused with an error naming the edge and nothing changes. The cone metric is the
+    /// same (curvatures and areas unchanged up to rounding: tested after > 1000 chained random
+    /// flips to 1e-12 in E², 1e-10 in H² and S²).
+    ///
+    /// The faces keep their ids: face `f` of `h` becomes `(c, a, d)`, the twin face `g`
+    /// becomes `(d, b, c)`. Positions are unchanged. A flipped face lies in the union of the
+    /// two old faces; `face_origin` keeps, for each new face, the origin of the old face
+    /// with the same id (the one holding its whole corner at `c`, resp. `d`).
+    pub fn flip(&mut self, h: u32) -> Result<()> {
+        let l_cd = self.flip_length(h)?;
+        let f = h / 3;
+        let i = h % 3;
+        let (h_ab, h_bc, h_ca) = (h, 3 * f + (i + 1) % 3, 3 * f + (i + 2) % 3);
+        let (a, b, c) = (self.origin(h_ab), self.origin(h_bc), self.origin(h_ca));
+        let hg = self.twin[h as usize];
+        let gf = hg / 3;
+        let j = hg % 3;
+        let (h_ad, h_db) = (3 * gf + (j + 1) % 3, 3 * gf + (j + 2) % 3);
+        let d = self.origin(h_db);
+        let (l_bc, l_ca) = (self.len[h_bc as usize], self.len[h_ca as usize]);
+        let (l_ad, l_db) = (self.len[h_ad as usize], self.len[h_db as usize]);
         let (t_bc, t_ca, t_ad, t_db) = (
             self.twin[h_bc as usize],
             self.twin[h_ca as usize],
