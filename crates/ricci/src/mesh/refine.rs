@@ -2,7 +2,7 @@
 //! of a vertex and to grade the mesh around it (paper 000, Step 2: "modify local connectivity
 //! around the singular vertex").
 //!
-//! The only operation is the **intrinsic edge split**: a point `m` is inserted on the geodesic
+//! The main operation is the **intrinsic edge split**: a point `m` is inserted on the geodesic
 //! edge `(a, b)` at the fraction `t` of its length, and joined to the opposite vertex of each
 //! adjacent face. The new lengths come from the cosine law of the background geometry: in face
 //! `(a, b, c)` with angle `θ_a` at `a`, `|mc| = side(|ac|, t·|ab|, θ_a)`. Because `m` lies on
@@ -23,6 +23,12 @@
 //!   every face at distance `r` from `x` has edges no longer than `Θ·r/n`, `Θ` the cone angle at
 //!   `x`: then every circle around `x` crosses about `n` vertices, out to the distance where the
 //!   input mesh is fine enough by itself.
+//!
+//! The other operation is the **intrinsic edge flip** ([`Refiner::flip`]): the diagonal of two
+//! faces forming a strictly convex quadrilateral (intrinsically) is replaced by the other
+//! diagonal, whose length comes from unfolding the two triangles in the background geometry.
+//! It keeps the vertices, the cone metric and the positions, and changes only connectivity;
+//! the atlas uses it for Step 2 (ii) within three rings of the cone.
 //!
 //! Faces keep their ids (a split face keeps its id for one piece, the other pieces are
 //! appended), vertices keep their ids (new ones are appended), and the provenance of every new
@@ -58,7 +64,8 @@ pub struct Refined {
     pub original_vertices: usize,
     /// Provenance of the new vertices.
     pub new_vertices: Vec<SplitVertex>,
-    /// For every refined face, the input face it lies in.
+    /// For every refined face, the input face it lies in (after [`Refiner::flip`]: one of
+    /// the two input faces it straddles).
     pub face_origin: Vec<u32>,
 }
 
