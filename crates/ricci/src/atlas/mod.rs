@@ -418,13 +418,38 @@ impl AffineAtlas {
             "uniform" => TargetSpec::Uniform,
             _ => TargetSpec::Cones(cones.clone()),
         };
-        let (flow, scheme_used, flow_notes) = flat_flow(
+        let (flow, scheme_used, flow_notes) = match flat_flow(
             &rmesh,
             &refined.lengths,
-            target,
+            target.clone(),
             options.scheme,
             options.tolerance,
-        )?;
+        ) {
+            // Thurston's Chow–Luo bound uses its clamped intersection angles φ ≤ π/2, so it
+            // can refuse at a valence-4 vertex made by the refinement (all four φ = π/2, by
+            // exactly 0) what the φ = 0 bound of inversive distance admits.
+            Err(Error::InvalidInput { message })
+                if message.contains("Chow–Luo") && options.scheme == Scheme::Thurston =>
+            {
+                let (f, s, mut n) = flat_flow(
+                    &rmesh,
+                    &refined.lengths,
+                    target,
+                    Scheme::Inversive,
+                    options.tolerance,
+                )?;
+                n.insert(
+                    0,
+                    format!(
+                        "the thurston scheme refused the target ({message}); the metric comes \
+                         from the {} scheme",
+                        s.name()
+                    ),
+                );
+                (f, s, n)
+            }
+            other => other?,
+        };
         notes.extend(flow_notes);
         if !flow.converged {
             notes.push(format!(
