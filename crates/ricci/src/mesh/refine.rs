@@ -1061,7 +1061,7 @@ mod flip_tests {
         // On a tetrahedron every edge's opposite vertices are already joined.
         let tet =
             Mesh::from_triangles(4, vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]]).unwrap();
-        let mut r = Refiner::new(&tet, &vec![1.0; 6], Geometry::Euclidean, None).unwrap();
+        let mut r = Refiner::new(&tet, &[1.0; 6], Geometry::Euclidean, None).unwrap();
         let e = r.flip(0).unwrap_err().to_string();
         assert!(e.contains("already joined"), "{e}");
     }
