@@ -496,13 +496,9 @@ fn flip_ring_valence_keeps_the_cut_and_the_metric() {
         );
     }
     let k1 = curvature(m, Geometry::Euclidean, &after.lengths);
-    for v in 0..m.n_vertices() {
+    for (v, &k) in k1.iter().enumerate() {
         let want = k0.get(v).copied().unwrap_or(0.0);
-        assert!(
-            (k1[v] - want).abs() < 1e-9,
-            "vertex {v}: K {want} → {}",
-            k1[v]
-        );
+        assert!((k - want).abs() < 1e-9, "vertex {v}: K {want} → {k}");
     }
     let a1 = total_area(m, Geometry::Euclidean, &after.lengths);
     assert!((a1 - a0).abs() < 1e-12 * a0, "area {a0} → {a1}");
