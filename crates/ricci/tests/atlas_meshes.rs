@@ -4,7 +4,8 @@
 //!
 //! * flatness: the curvature of the returned metric, recomputed from the edge lengths, is
 //!   ≤ 1e-9 at every interior non-singular vertex, the cone carries 2πχ (Gauss–Bonnet), and
-//!   the cone valence satisfies paper 000 Step 2 (i);
+//!   the cone valence satisfies paper 000 Step 2 (i), and (ii): every vertex within 3 edge
+//!   rings of a cone (breadth-first search over the atlas's mesh) has valence ≥ 6;
 //! * every chart reproduces the metric lengths, has no flipped face, and two charts holding
 //!   the same face are related there by a rigid motion to ≤ 1e-9;
 //! * the home chart of every face not at a cone holds all faces sharing a vertex with it
@@ -38,6 +39,46 @@ fn euler(s: &Surface) -> i64 {
     ricci::mesh::topology(&s.mesh).euler_characteristic()
 }
 
+/// Paper 000 §4 Step 2 (ii), recomputed from the atlas's mesh: every vertex within 3 edge
+/// rings of a cone (breadth-first over edges) has valence ≥ 6.
+fn check_ring_valence(name: &str, a: &AffineAtlas) {
+    let m = a.mesh();
+    let mut d = vec![usize::MAX; m.n_vertices()];
+    let mut q = std::collections::VecDeque::new();
+    for &c in a.singular_vertices() {
+        d[c as usize] = 0;
+        q.push_back(c);
+    }
+    let mut low = Vec::new();
+    while let Some(v) = q.pop_front() {
+        if d[v as usize] >= 1 && m.valence(v) < 6 {
+            low.push((v, d[v as usize], m.valence(v)));
+        }
+        if d[v as usize] == 3 {
+            continue;
+        }
+        for w in m.vertex_neighbors(v) {
+            if d[w as usize] == usize::MAX {
+                d[w as usize] = d[v as usize] + 1;
+                q.push_back(w);
+            }
+        }
+    }
+    let r = &a.report.refinement;
+    eprintln!(
+        "{name}: Step 2 (ii): {} low before, {} after; {} flips, {} + {} splits",
+        r.low_valence_before, r.low_valence_after, r.flips_ring, r.splits_ring, r.splits_ring_room
+    );
+    assert!(
+        low.is_empty(),
+        "{name}: {} vertices within 3 rings of a cone have valence < 6 (vertex, ring, \
+         valence): {:?}",
+        low.len(),
+        &low[..low.len().min(10)]
+    );
+    assert_eq!(r.low_valence_after, 0, "{name}: the report disagrees");
+}
+
 /// Check everything listed in the module docs; `singular` = expected number of cones.
 fn check(name: &str, s: &Surface, a: &AffineAtlas, singular: usize) {
     let m = a.mesh();
@@ -58,6 +99,9 @@ fn check(name: &str, s: &Surface, a: &AffineAtlas, singular: usize) {
         singular,
         "{name}: singular vertices"
     );
+    if singular > 0 {
+        check_ring_valence(name, a);
+    }
     assert!(r.flow_converged, "{name}: flow did not converge");
     assert_eq!(a.positions().len(), m.n_vertices());
     // Flatness, recomputed.
@@ -390,4 +434,94 @@ fn ricci_meshes() -> Option<std::path::PathBuf> {
         return Some(root.join(d));
     }
     Some(d)
+}
+
+/// `flip_ring_valence` on its own, after the valence raising and the canonical cut of a
+/// generated genus-2 surface (as in the atlas): every vertex within 3 rings of the cone gets
+/// valence ≥ 6, every cut-loop edge survives, and the metric is the same cone metric —
+/// every old vertex keeps its curvature and every new vertex is flat (to 1e-9), the total
+/// area is unchanged (to 1e-12 relative), recomputed from the returned lengths.
+#[test]
+fn flip_ring_valence_keeps_the_cut_and_the_metric() {
+    use ricci::atlas::flip_ring_valence;
+    use ricci::cut::{canonical_cut, CutOptions};
+    use ricci::mesh::refine::Refiner;
+    use ricci::metric::total_area;
+    let s = generate::genus(2, 20).unwrap();
+    let cone = 11u32;
+    let mut r = Refiner::new(
+        &s.mesh,
+        &s.edge_lengths(),
+        Geometry::Euclidean,
+        Some(&s.positions),
+    )
+    .unwrap();
+    r.raise_valence(cone, 16).unwrap();
+    let step2 = r.finish().unwrap();
+    let cut = canonical_cut(
+        &step2.mesh,
+        &step2.lengths,
+        Geometry::Euclidean,
+        step2.positions.as_deref(),
+        &CutOptions {
+            base: Some(cone),
+            ..CutOptions::default()
+        },
+        &mut NoProgress,
+    )
+    .unwrap();
+    let mut on_cut = std::collections::HashSet::new();
+    for l in &cut.loops {
+        for w in l.vertices.windows(2) {
+            on_cut.insert((w[0].min(w[1]), w[0].max(w[1])));
+        }
+    }
+    let before = cut.refined.clone();
+    let k0 = curvature(&before.mesh, Geometry::Euclidean, &before.lengths);
+    let a0 = total_area(&before.mesh, Geometry::Euclidean, &before.lengths);
+    let (after, work) = flip_ring_valence(
+        cut.refined.clone(),
+        &[(cone, -4.0 * PI)],
+        3,
+        &on_cut,
+        100_000,
+    )
+    .unwrap();
+    assert!(work.flips > 0 && work.complete, "{work:?}");
+    let m = &after.mesh;
+    for &(a, b) in &on_cut {
+        assert!(
+            m.halfedge_between(a, b).is_some(),
+            "cut edge ({a}, {b}) lost"
+        );
+    }
+    let k1 = curvature(m, Geometry::Euclidean, &after.lengths);
+    for (v, &k) in k1.iter().enumerate() {
+        let want = k0.get(v).copied().unwrap_or(0.0);
+        assert!((k - want).abs() < 1e-9, "vertex {v}: K {want} → {k}");
+    }
+    let a1 = total_area(m, Geometry::Euclidean, &after.lengths);
+    assert!((a1 - a0).abs() < 1e-12 * a0, "area {a0} → {a1}");
+    // Valence ≥ 6 within 3 rings, by breadth-first search over the returned mesh.
+    let mut d = vec![usize::MAX; m.n_vertices()];
+    d[cone as usize] = 0;
+    let mut q = std::collections::VecDeque::from([cone]);
+    while let Some(v) = q.pop_front() {
+        if d[v as usize] >= 1 {
+            assert!(
+                m.valence(v) >= 6,
+                "vertex {v} (ring {}) has valence {}",
+                d[v as usize],
+                m.valence(v)
+            );
+        }
+        if d[v as usize] < 3 {
+            for w in m.vertex_neighbors(v) {
+                if d[w as usize] == usize::MAX {
+                    d[w as usize] = d[v as usize] + 1;
+                    q.push_back(w);
+                }
+            }
+        }
+    }
 }

@@ -15,10 +15,14 @@
 //!    (the cone) so its `4g` loops fit; finally the cone's one-ring neighbours get valence
 //!    ≥ 6 by splitting their outer link edges off the cut ([`raise_ring_valence`]) — the
 //!    cut's grading leaves valence-4 neighbours, and without this the Chow–Luo condition on
-//!    the cone's closed one-ring refuses the target for genus ≥ 3. The paper's
-//!    "valence ≥ 6 within 3 rings" cannot be reached by splits alone (every link-edge split
-//!    creates a valence-4 vertex); the count of vertices within `rings` rings still below 6
-//!    is reported.
+//!    the cone's closed one-ring refuses the target for genus ≥ 3. Then Step 2 (ii) proper:
+//!    every vertex within `rings` (3) edge-rings of a cone gets valence ≥ 6 by intrinsic,
+//!    metric-preserving **edge flips** ([`crate::mesh::refine::Refiner::flip`]) that move
+//!    spare valence inwards, and splits that make room where no flip can
+//!    ([`flip_ring_valence`]); neither touches an edge of the cut loops or at a cone, so the
+//!    loops stay edge paths. All of this happens before the flow, which therefore runs on the
+//!    final connectivity. The count of vertices within `rings` rings still below 6 is
+//!    reported (`low_valence_after`, 0 on every mesh tested).
 //! 3. **Flat metric** (Step 3): Euclidean Ricci flow ([`crate::flow`]) on the refined mesh
 //!    with the cone target, from the input metric.
 //! 4. **Segmentation** (Step 4): the canonical cut through the cone ([`crate::cut`]), plus a
@@ -80,8 +84,9 @@ pub struct AtlasOptions {
     pub scheme: Scheme,
     /// Flow tolerance: max |K − K̄| (default 1e-10).
     pub tolerance: f64,
-    /// Step 2 (ii): the cones' one-ring neighbours get valence ≥ 6 unless this is 0; the
-    /// report counts the vertices within this many rings still below 6 (default 3).
+    /// Step 2 (ii): every vertex within this many edge-rings of a cone gets valence ≥ 6
+    /// (flips and splits; 0 switches it off); the report counts the vertices within this
+    /// many rings still below 6 (default 3, the paper's n).
     pub rings: usize,
     /// Options of the automatic placement.
     pub placement: PlacementOptions,
@@ -110,6 +115,10 @@ pub struct RefinementReport {
     pub splits_cut: usize,
     /// Splits that gave the cones' one-ring neighbours valence ≥ 6 after the cut.
     pub splits_ring: usize,
+    /// Step 2 (ii) within `rings` rings ([`flip_ring_valence`]): intrinsic flips, and the
+    /// splits that made room for them.
+    pub flips_ring: usize,
+    pub splits_ring_room: usize,
     /// Vertices within `rings` rings of a cone with valence < 6, before and after.
     pub low_valence_before: usize,
     pub low_valence_after: usize,
@@ -193,7 +202,8 @@ pub struct AffineAtlas {
     input_lengths: Vec<f64>,
     /// Number of vertices of the input mesh (refined vertices are appended).
     pub original_vertices: usize,
-    /// For every refined face, the input face it lies in.
+    /// For every refined face, the input face it lies in (a face made by an intrinsic flip
+    /// straddles two input faces and names one of them, see [`Refiner::flip`]).
     pub face_origin: Vec<u32>,
     pub report: AtlasReport,
 }
@@ -368,6 +378,15 @@ impl AffineAtlas {
             (cut.refined.clone(), 0)
         };
         rep.splits_ring = ring_splits;
+        // Step 2 (ii) within `rings` rings: intrinsic flips, and splits to make room.
+        let (refined, ring_work) = if options.rings > 0 && !cones.is_empty() {
+            let around = rings_around(&refined.mesh, &cones, options.rings).len();
+            flip_ring_valence(refined, &cones, options.rings, &on_cut, 40 * around + 1000)?
+        } else {
+            (refined, RingValenceWork::default())
+        };
+        rep.flips_ring = ring_work.flips;
+        rep.splits_ring_room = ring_work.splits;
         let rmesh = refined.mesh.clone();
         rep.vertices_after = rmesh.n_vertices();
         for (k, c) in cones.iter().enumerate() {
@@ -399,13 +418,38 @@ impl AffineAtlas {
             "uniform" => TargetSpec::Uniform,
             _ => TargetSpec::Cones(cones.clone()),
         };
-        let (flow, scheme_used, flow_notes) = flat_flow(
+        let (flow, scheme_used, flow_notes) = match flat_flow(
             &rmesh,
             &refined.lengths,
-            target,
+            target.clone(),
             options.scheme,
             options.tolerance,
-        )?;
+        ) {
+            // Thurston's Chow–Luo bound uses its clamped intersection angles φ ≤ π/2, so it
+            // can refuse at a valence-4 vertex made by the refinement (all four φ = π/2, by
+            // exactly 0) what the φ = 0 bound of inversive distance admits.
+            Err(Error::InvalidInput { message })
+                if message.contains("Chow–Luo") && options.scheme == Scheme::Thurston =>
+            {
+                let (f, s, mut n) = flat_flow(
+                    &rmesh,
+                    &refined.lengths,
+                    target,
+                    Scheme::Inversive,
+                    options.tolerance,
+                )?;
+                n.insert(
+                    0,
+                    format!(
+                        "the thurston scheme refused the target ({message}); the metric comes \
+                         from the {} scheme",
+                        s.name()
+                    ),
+                );
+                (f, s, n)
+            }
+            other => other?,
+        };
         notes.extend(flow_notes);
         if !flow.converged {
             notes.push(format!(
@@ -439,7 +483,8 @@ impl AffineAtlas {
         if cones.len() > 1 {
             add_slits(&rmesh, &lengths, &mut cut_edge, &cones[1..])?;
         }
-        let (disk, origin) = if cones.len() > 1 || ring_splits > 0 {
+        let reconnected = ring_splits + ring_work.flips + ring_work.splits > 0;
+        let (disk, origin) = if cones.len() > 1 || reconnected {
             crate::cut::slice(&rmesh, &cut_edge)?
         } else {
             (cut.cut_mesh.clone(), cut.cut_vertex_origin.clone())
@@ -997,6 +1042,181 @@ pub fn raise_ring_valence(
         refined = r.finish()?;
     }
     Ok((refined, total))
+}
+
+/// What [`flip_ring_valence`] did.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct RingValenceWork {
+    pub flips: usize,
+    pub splits: usize,
+    pub rounds: usize,
+    /// Whether every vertex within the rings reached valence ≥ 6 (false: the work bound was
+    /// reached, or no flip or split applied; the count left is in
+    /// [`RefinementReport::low_valence_after`]).
+    pub complete: bool,
+}
+
+/// Paper 000 §4 Step 2 (ii): every vertex within `rings` edge-rings of a cone gets valence
+/// ≥ 6, by **intrinsic edge flips** ([`Refiner::flip`]) combined with intrinsic splits, both
+/// metric-preserving. Greedy, in rounds (ring distances recomputed each round, kept up to
+/// date within it; nearest vertices first): for a vertex `w` below 6, flip an edge `(a, b)`
+/// opposite `w` (face `(w, a, b)`, replaced by `(w, x)`) when that keeps `a` and `b` at
+/// valence ≥ 6 if they lie within the rings (≥ 5 otherwise), the edge is neither a
+/// `protected` edge (the cut loops) nor at a cone, `x` is not a cone, and the flip is
+/// intrinsically legal (strictly convex quad); among such flips the one leaving the most
+/// spare valence, then the shortest new edge. Otherwise split (midpoint) an edge opposite
+/// `w` to make room: the one whose endpoints and far vertex `x` lie farthest from the cones,
+/// then the longest, so that the new valence-4 vertex lies outside the rings when `w` is on
+/// the last ring and the deficit moves outwards otherwise. The new vertices just outside the
+/// rings are then raised to valence 5 by flips where one is allowed (no splits there).
+///
+/// Why 5 and not 4 outside the rings: a valence-4 vertex whose four Thurston intersection
+/// angles are clamped to π/2 fails the Chow–Luo condition (paper 000 eq. 7) of a flat target
+/// by exactly 0, and the flat flow then refuses the target; the split vertices just outside
+/// the rings are such vertices. Splits stop at edges shorter than 1e-6 of the longest.
+///
+/// At most `max_ops` flips and splits; a round that changes nothing ends the search.
+/// Vertex ids are kept (new vertices appended), so the cut loops stay edge paths: a flip
+/// never crosses an edge other than the one it removes, and protected edges are never split.
+pub fn flip_ring_valence(
+    refined: crate::mesh::refine::Refined,
+    cones: &[(u32, f64)],
+    rings: usize,
+    protected: &std::collections::HashSet<(u32, u32)>,
+    max_ops: usize,
+) -> Result<(crate::mesh::refine::Refined, RingValenceWork)> {
+    let mut work = RingValenceWork::default();
+    if rings == 0 || cones.is_empty() {
+        work.complete = true;
+        return Ok((refined, work));
+    }
+    let n0 = refined.mesh.n_vertices() as u32;
+    let mut r = Refiner::resume(refined, Geometry::Euclidean)?;
+    let is_cone = |x: u32| cones.iter().any(|c| c.0 == x);
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    // Splits stop at edges shorter than 1e-6 of the longest (the metric stays well resolved).
+    let min_len = 1e-6
+        * (0..r.n_faces() as u32 * 3)
+            .map(|h| r.length(h))
+            .fold(0.0, f64::max);
+    for _round in 0..4 * max_ops.max(1) {
+        let mut dist = refiner_ring_distances(&r, cones, rings + 1);
+        let mut low: Vec<u32> = (0..r.n_vertices() as u32)
+            .filter(|&w| {
+                let d = dist[w as usize];
+                let target = if d <= rings { 6 } else { 5 };
+                d >= 1
+                    && (d <= rings || (d == rings + 1 && w >= n0))
+                    && !r.is_boundary_vertex(w)
+                    && r.valence(w) < target
+            })
+            .collect();
+        if low.is_empty() {
+            break;
+        }
+        if work.flips + work.splits >= max_ops {
+            break;
+        }
+        work.rounds += 1;
+        let ops_before = work.flips + work.splits;
+        low.sort_by_key(|&w| (dist[w as usize], w));
+        for w in low {
+            if work.flips + work.splits >= max_ops {
+                break;
+            }
+            let inside = dist[w as usize] <= rings;
+            let target = if inside { 6 } else { 5 };
+            while r.valence(w) < target && work.flips + work.splits < max_ops {
+                let depth = |v: u32| dist.get(v as usize).copied().unwrap_or(usize::MAX);
+                let need = |v: u32| if depth(v) <= rings { 6 } else { 5 };
+                let mut best_flip: Option<((i64, f64), u32)> = None;
+                let mut best_split: Option<((usize, f64), u32)> = None;
+                for h in r.link(w) {
+                    let (a, b) = r.endpoints(h);
+                    if is_cone(a) || is_cone(b) || protected.contains(&key(a, b)) {
+                        continue;
+                    }
+                    let x = r.opposite_across(h);
+                    let l = r.length(h);
+                    // The new vertex of a split lies next to a, b, w and x; prefer a, b, x
+                    // far out, where its valence 4 can later be raised by a flip.
+                    let far = depth(a).min(depth(b)).min(x.map_or(usize::MAX, depth));
+                    if l > min_len && best_split.is_none_or(|s| (far, l) > s.0) {
+                        best_split = Some(((far, l), h));
+                    }
+                    let Some(x) = x else {
+                        continue;
+                    };
+                    if x == w || is_cone(x) || r.halfedge(w, x).is_some() {
+                        continue;
+                    }
+                    let sa = r.valence(a) as i64 - 1 - need(a);
+                    let sb = r.valence(b) as i64 - 1 - need(b);
+                    if sa < 0 || sb < 0 {
+                        continue;
+                    }
+                    let Ok(new_len) = r.flip_length(h) else {
+                        continue;
+                    };
+                    let score = (sa.min(sb), -new_len / l);
+                    if best_flip.is_none_or(|f| score > f.0) {
+                        best_flip = Some((score, h));
+                    }
+                }
+                if let Some((_, h)) = best_flip {
+                    let x = r.opposite_across(h).unwrap_or(NONE);
+                    r.flip(h)?;
+                    work.flips += 1;
+                    // The new edge (w, x) can only bring x closer.
+                    let dw = depth(w);
+                    if let Some(dx) = dist.get_mut(x as usize) {
+                        *dx = (*dx).min(dw + 1);
+                    }
+                } else if let Some(((far, _), h)) = best_split.filter(|_| inside) {
+                    r.split(h, 0.5);
+                    work.splits += 1;
+                    dist.push(far.min(depth(w)).saturating_add(1));
+                } else {
+                    break;
+                }
+            }
+        }
+        if work.flips + work.splits == ops_before {
+            // Nothing more can be done (every remaining vertex is stuck).
+            break;
+        }
+    }
+    let dist = refiner_ring_distances(&r, cones, rings);
+    work.complete = (0..r.n_vertices() as u32).all(|w| {
+        let d = dist[w as usize];
+        d == 0 || d > rings || r.is_boundary_vertex(w) || r.valence(w) >= 6
+    });
+    Ok((r.finish()?, work))
+}
+
+/// Edge-ring distance from the cones over a [`Refiner`]'s current connectivity, up to
+/// `limit` (farther vertices get `usize::MAX`).
+fn refiner_ring_distances(r: &Refiner, cones: &[(u32, f64)], limit: usize) -> Vec<usize> {
+    let mut d = vec![usize::MAX; r.n_vertices()];
+    let mut q = VecDeque::new();
+    for &(v, _) in cones {
+        if (v as usize) < d.len() {
+            d[v as usize] = 0;
+            q.push_back(v);
+        }
+    }
+    while let Some(v) = q.pop_front() {
+        if d[v as usize] >= limit {
+            continue;
+        }
+        for w in r.neighbors(v) {
+            if d[w as usize] == usize::MAX {
+                d[w as usize] = d[v as usize] + 1;
+                q.push_back(w);
+            }
+        }
+    }
+    d
 }
 
 /// Vertices within `rings` edge-rings of the cones (the cones excluded).

@@ -1364,11 +1364,16 @@ pub fn atlas(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
             (
                 "refinement",
                 format!(
-                    "{} → {} vertices ({} + {} splits)",
+                    "{} → {} vertices ({} + {} + {} + {} splits, {} flips; {} vertices \
+                     within 3 rings below valence 6)",
                     r.refinement.vertices_before,
                     r.refinement.vertices_after,
+                    r.refinement.splits_step2,
                     r.refinement.splits_cut,
-                    r.refinement.splits_ring
+                    r.refinement.splits_ring,
+                    r.refinement.splits_ring_room,
+                    r.refinement.flips_ring,
+                    r.refinement.low_valence_after
                 ),
             ),
             (
