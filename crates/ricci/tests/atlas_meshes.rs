@@ -424,17 +424,8 @@ fn query_api_on_genus2() {
     assert!((hit.1[0] - p[0]).hypot(hit.1[1] - p[1]) < 1e-12);
 }
 
-/// `$RICCI_MESHES` as a folder. Cargo runs test binaries in the crate's folder, so a relative
-/// path (the README's `../shared/meshes`) is taken from the workspace root when it does not
-/// exist from the current directory.
-fn ricci_meshes() -> Option<std::path::PathBuf> {
-    let d = std::path::PathBuf::from(std::env::var_os("RICCI_MESHES")?);
-    if d.is_relative() && !d.is_dir() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        return Some(root.join(d));
-    }
-    Some(d)
-}
+mod ricci_meshes;
+use ricci_meshes::ricci_meshes;
 
 /// `flip_ring_valence` on its own, after the valence raising and the canonical cut of a
 /// generated genus-2 surface (as in the atlas): every vertex within 3 rings of the cone gets

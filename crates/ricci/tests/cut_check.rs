@@ -212,14 +212,6 @@ pub fn verify(c: &CanonicalCut, g: usize, nb: usize, what: &str) {
     assert_eq!(j, symplectic(g), "{what}: intersection matrix");
 }
 
-/// `$RICCI_MESHES` as a folder. Cargo runs test binaries in the crate's folder, so a relative
-/// path (the README's `../shared/meshes`) is taken from the workspace root when it does not
-/// exist from the current directory.
-fn ricci_meshes() -> Option<std::path::PathBuf> {
-    let d = std::path::PathBuf::from(std::env::var_os("RICCI_MESHES")?);
-    if d.is_relative() && !d.is_dir() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        return Some(root.join(d));
-    }
-    Some(d)
-}
+#[path = "ricci_meshes/mod.rs"]
+mod ricci_meshes;
+use ricci_meshes::ricci_meshes;

@@ -261,14 +261,5 @@ fn no_flipped_faces_on_the_flow_list() {
     assert!(fails.is_empty(), "{fails:#?}");
 }
 
-/// `$RICCI_MESHES` as a folder. Cargo runs test binaries in the crate's folder, so a relative
-/// path (the README's `../shared/meshes`) is taken from the workspace root when it does not
-/// exist from the current directory.
-fn ricci_meshes() -> Option<std::path::PathBuf> {
-    let d = std::path::PathBuf::from(std::env::var_os("RICCI_MESHES")?);
-    if d.is_relative() && !d.is_dir() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        return Some(root.join(d));
-    }
-    Some(d)
-}
+mod ricci_meshes;
+use ricci_meshes::ricci_meshes;
