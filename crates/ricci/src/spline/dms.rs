@@ -1080,32 +1080,7 @@ impl DmsSpace {
         ws: &mut Workspace,
         out: &mut [f64],
     ) -> Result<()> {
-        let np = n_partials(order);
-        if control.len() != self.n_control_points() * dim || out.len() < np * dim {
-            return Err(Error::input(format!(
-                "spline evaluation: {} control numbers for {} control points of dimension {dim}, output of {} for {} numbers",
-                control.len(),
-                self.n_control_points(),
-                out.len(),
-                np * dim
-            )));
-        }
-        out[..np * dim].fill(0.0);
-        let m = self.basis_at(face, u, order, ws)?;
-        for i in 0..m {
-            let g = ws.indices[i] as usize;
-            let vals = &ws.values[i * np..(i + 1) * np];
-            let c = &control[g * dim..(g + 1) * dim];
-            for k in 0..np {
-                let v = vals[k];
-                if v != 0.0 {
-                    for d in 0..dim {
-                        out[k * dim + d] += v * c[d];
-                    }
-                }
-            }
-        }
-        Ok(())
+        crate::spline::fit::evaluate(self, control, dim, face, u, order, ws, out)
     }
 
     /// Control points (`dim` = 1) of a polynomial of degree `≤ n` by blossoming: the spline
