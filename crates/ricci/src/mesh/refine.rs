@@ -601,10 +601,16 @@ impl Refiner {
     /// Returns the number of splits.
     pub fn raise_valence(&mut self, x: u32, min_valence: usize) -> Result<usize> {
         self.check_interior(x)?;
+        self.split_link_until(x, min_valence)
+    }
+
+    /// Split the longest link edge of `x` (the edge opposite `x` in one of its faces) at its
+    /// midpoint until `x` has at least `min_corners` corners (faces); the number of splits.
+    fn split_link_until(&mut self, x: u32, min_corners: usize) -> Result<usize> {
         let mut n = 0;
         loop {
             let (fan, _) = self.fan(x);
-            if fan.len() >= min_valence {
+            if fan.len() >= min_corners {
                 return Ok(n);
             }
             // Link half-edge of corner c at x: next(c).
@@ -636,34 +642,16 @@ impl Refiner {
                 self.n_vertices()
             )));
         }
-        let mut n = 0;
-        loop {
-            let (fan, closed) = self.fan(x);
-            if closed {
-                return Err(Error::input(format!(
-                    "vertex {x} is interior; widen_boundary_vertex needs a boundary vertex"
-                )));
-            }
-            if fan.is_empty() {
-                return Err(Error::input(format!("vertex {x} is isolated")));
-            }
-            if fan.len() >= min_faces {
-                return Ok(n);
-            }
-            let best = fan
-                .iter()
-                .map(|&c| Self::next(c))
-                .max_by(|&p, &q| self.len[p as usize].total_cmp(&self.len[q as usize]))
-                .unwrap_or(NONE);
-            let opp = self.twin[best as usize];
-            if opp != NONE && self.origin(Self::prev(opp)) == x {
-                return Err(Error::invalid_mesh(format!(
-                    "vertex {x} appears twice around one of its link edges"
-                )));
-            }
-            self.split(best, 0.5);
-            n += 1;
+        let (fan, closed) = self.fan(x);
+        if closed {
+            return Err(Error::input(format!(
+                "vertex {x} is interior; widen_boundary_vertex needs a boundary vertex"
+            )));
         }
+        if fan.is_empty() {
+            return Err(Error::input(format!("vertex {x} is isolated")));
+        }
+        self.split_link_until(x, min_faces)
     }
 
     /// Cone angle at interior vertex `x` (sum of its corner angles).
