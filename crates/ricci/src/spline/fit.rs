@@ -610,11 +610,10 @@ impl Blocks {
     }
 }
 
-/// Thin-plate quadrature: midpoint subdivision into 4, 3-point rule (points at 1/6, 1/6, 2/3)
-/// in each sub-triangle. Returns `(face, point, weight)`.
-fn quadrature(space: &DmsSpace) -> Vec<(u32, Point, f64)> {
-    let dom = space.domain();
-    let mut q = Vec::with_capacity(dom.n_faces() * 12);
+/// The thin-plate quadrature rule of one triangle: midpoint subdivision into 4, 3-point rule
+/// (points at 1/6, 1/6, 2/3) in each sub-triangle — 12 barycentric points, each of weight
+/// 1/12 of the triangle's area.
+pub fn quadrature_barycentric() -> [[f64; 3]; 12] {
     let subs: [[[f64; 3]; 3]; 4] = [
         [[1.0, 0.0, 0.0], [0.5, 0.5, 0.0], [0.5, 0.0, 0.5]],
         [[0.0, 1.0, 0.0], [0.0, 0.5, 0.5], [0.5, 0.5, 0.0]],
@@ -626,17 +625,28 @@ fn quadrature(space: &DmsSpace) -> Vec<(u32, Point, f64)> {
         [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
         [1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0],
     ];
+    let mut out = [[0.0; 3]; 12];
+    for (i, s) in subs.iter().enumerate() {
+        for (j, r) in rule.iter().enumerate() {
+            for k in 0..3 {
+                out[3 * i + j][k] = r[0] * s[0][k] + r[1] * s[1][k] + r[2] * s[2][k];
+            }
+        }
+    }
+    out
+}
+
+/// Thin-plate quadrature ([`quadrature_barycentric`] on every face). Returns
+/// `(face, point, weight)`.
+fn quadrature(space: &DmsSpace) -> Vec<(u32, Point, f64)> {
+    let dom = space.domain();
+    let rule = quadrature_barycentric();
+    let mut q = Vec::with_capacity(dom.n_faces() * rule.len());
     for f in 0..dom.n_faces() as u32 {
         let [a, b, c] = dom.face_points(f);
         let area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
-        for s in &subs {
-            for r in &rule {
-                let mut bary = [0.0; 3];
-                for k in 0..3 {
-                    bary[k] = r[0] * s[0][k] + r[1] * s[1][k] + r[2] * s[2][k];
-                }
-                q.push((f, dom.point_in_face(f, bary), area / 12.0));
-            }
+        for &bary in &rule {
+            q.push((f, dom.point_in_face(f, bary), area / 12.0));
         }
     }
     q

@@ -967,14 +967,7 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         ws.indices.clear();
         ws.values.clear();
         let c = self.canon_coords[g as usize];
-        let cen = [
-            (c[0][0] + c[1][0] + c[2][0]) / 3.0,
-            (c[0][1] + c[1][1] + c[2][1]) / 3.0,
-        ];
-        let mut dir = [cen[0] - u[0], cen[1] - u[1]];
-        if dir == [0.0, 0.0] {
-            dir = [1.0, 0.0];
-        }
+        let dir = inward_direction(&c, u);
         let (a, b) = (
             self.cand_start[g as usize] as usize,
             self.cand_start[g as usize + 1] as usize,
@@ -1015,14 +1008,7 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         })?;
         ws.indices.clear();
         ws.values.clear();
-        let cen = [
-            (c[0][0] + c[1][0] + c[2][0]) / 3.0,
-            (c[0][1] + c[1][1] + c[2][1]) / 3.0,
-        ];
-        let mut dir = [cen[0] - u[0], cen[1] - u[1]];
-        if dir == [0.0, 0.0] {
-            dir = [1.0, 0.0];
-        }
+        let dir = inward_direction(&c, u);
         let (a, b) = (
             self.cand_start[g as usize] as usize,
             self.cand_start[g as usize + 1] as usize,
@@ -1180,17 +1166,7 @@ impl<A: FlatCharts + Sync + ?Sized> SplineSpace for ManifoldSpace<'_, A> {
         self.basis_at_point(face, param, order, ws)
     }
     fn quadrature(&self) -> Vec<(u32, Point, f64)> {
-        let subs: [[[f64; 3]; 3]; 4] = [
-            [[1.0, 0.0, 0.0], [0.5, 0.5, 0.0], [0.5, 0.0, 0.5]],
-            [[0.0, 1.0, 0.0], [0.0, 0.5, 0.5], [0.5, 0.5, 0.0]],
-            [[0.0, 0.0, 1.0], [0.5, 0.0, 0.5], [0.0, 0.5, 0.5]],
-            [[0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]],
-        ];
-        let rule = [
-            [2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0],
-            [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
-            [1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0],
-        ];
+        let rule = super::fit::quadrature_barycentric();
         let mut q = Vec::new();
         let (hbar, _) = self.domain_scale();
         let mesh = self.charts.mesh();
@@ -1204,14 +1180,8 @@ impl<A: FlatCharts + Sync + ?Sized> SplineSpace for ManifoldSpace<'_, A> {
             let l = face_side_lengths(mesh, lengths, f);
             let hf = (l[0] + l[1] + l[2]) / 3.0;
             let area = 0.5 * det3(a, b, c) * (hf / hbar).powi(2);
-            for s in &subs {
-                for r in &rule {
-                    let mut bary = [0.0; 3];
-                    for k in 0..3 {
-                        bary[k] = r[0] * s[0][k] + r[1] * s[1][k] + r[2] * s[2][k];
-                    }
-                    q.push((f, self.face_point(f, bary), area / 12.0));
-                }
+            for &bary in &rule {
+                q.push((f, self.face_point(f, bary), area / 12.0));
             }
         }
         q
@@ -1227,5 +1197,20 @@ impl<A: FlatCharts + Sync + ?Sized> SplineSpace for ManifoldSpace<'_, A> {
             })
             .sum();
         (mean, area)
+    }
+}
+
+/// Direction from `u` towards the centroid of the triangle `c`: the side from which values at
+/// `u` are taken as limits from inside the face (any direction at the centroid itself).
+fn inward_direction(c: &[Point; 3], u: Point) -> Point {
+    let cen = [
+        (c[0][0] + c[1][0] + c[2][0]) / 3.0,
+        (c[0][1] + c[1][1] + c[2][1]) / 3.0,
+    ];
+    let dir = [cen[0] - u[0], cen[1] - u[1]];
+    if dir == [0.0, 0.0] {
+        [1.0, 0.0]
+    } else {
+        dir
     }
 }
