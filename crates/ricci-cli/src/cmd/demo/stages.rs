@@ -1439,33 +1439,13 @@ pub fn atlas(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "gauss_bonnet_error": r.gauss_bonnet_error,
         "flow_converged": r.flow_converged,
         "faces_without_home": r.faces_without_home,
-        "cone_curvature": cone.map(|v| 2.0 * PI - vertex_angle_sum(&atlas, v)),
+        "cone_curvature": cone.map(|v| {
+            ricci::metric::curvature(atlas.mesh(), Geometry::Euclidean, atlas.lengths())[v as usize]
+        }),
         "refined_vertices": r.refinement.vertices_after,
     });
     ctx.atlas = Some(atlas);
     Ok(sec)
-}
-
-/// Sum of the corner angles at interior vertex `v` from the atlas's flat edge lengths
-/// (recomputed here with the Euclidean cosine law, independently of the flow's report).
-fn vertex_angle_sum(atlas: &AffineAtlas, v: u32) -> f64 {
-    let m = atlas.mesh();
-    let l = atlas.lengths();
-    let mut sum = 0.0;
-    for f in m.vertex_faces(v) {
-        let t = m.face(f);
-        let e = m.face_edges_opposite(f);
-        let i = t.iter().position(|&w| w == v).unwrap_or(0);
-        let (a, b, c) = (
-            l[e[i] as usize],
-            l[e[(i + 1) % 3] as usize],
-            l[e[(i + 2) % 3] as usize],
-        );
-        sum += ((b * b + c * c - a * a) / (2.0 * b * c))
-            .clamp(-1.0, 1.0)
-            .acos();
-    }
-    sum
 }
 
 // ---------------------------------------------------------------------------------------------
