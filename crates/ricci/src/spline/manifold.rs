@@ -1165,8 +1165,7 @@ impl<A: FlatCharts + Sync + ?Sized> SplineSpace for ManifoldSpace<'_, A> {
     fn basis_at(&self, face: u32, param: Point, order: usize, ws: &mut Workspace) -> Result<usize> {
         self.basis_at_point(face, param, order, ws)
     }
-    fn quadrature(&self) -> Vec<(u32, Point, f64)> {
-        let rule = super::fit::quadrature_barycentric();
+    fn quadrature_with(&self, rule: &[([f64; 3], f64)]) -> Vec<(u32, Point, f64)> {
         let mut q = Vec::new();
         let (hbar, _) = self.domain_scale();
         let mesh = self.charts.mesh();
@@ -1180,8 +1179,8 @@ impl<A: FlatCharts + Sync + ?Sized> SplineSpace for ManifoldSpace<'_, A> {
             let l = face_side_lengths(mesh, lengths, f);
             let hf = (l[0] + l[1] + l[2]) / 3.0;
             let area = 0.5 * det3(a, b, c) * (hf / hbar).powi(2);
-            for &bary in &rule {
-                q.push((f, self.face_point(f, bary), area / 12.0));
+            for &(bary, w) in rule {
+                q.push((f, self.face_point(f, bary), area * w));
             }
         }
         q

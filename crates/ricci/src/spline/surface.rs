@@ -16,6 +16,7 @@
 //!    transformed into one), [`tessellate`] and [`MeshDistance`] (errors of spline samples
 //!    against the input mesh as a percentage of the bounding-box diagonal).
 
+use std::collections::HashMap;
 use std::time::Instant;
 
 use crate::atlas::FlatCharts;
@@ -503,9 +504,44 @@ pub struct Tessellation {
     pub boundaries: Vec<Vec<[f64; 3]>>,
 }
 
+/// A grid point of the tessellation that several faces share: a domain vertex, or the `k`-th
+/// of the `m − 1` inner points of a domain edge counted from the origin of its lower-numbered
+/// half-edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum GridKey {
+    Vertex(u32),
+    Edge(u32, usize),
+}
+
+/// The shared key of the grid point with integer barycentric weights `w` (summing to `m`) in
+/// face `f`, or `None` for a point inside the face.
+fn grid_key(mesh: &crate::mesh::Mesh, f: u32, w: [usize; 3]) -> Option<GridKey> {
+    let zeros = w.iter().filter(|&&x| x == 0).count();
+    if zeros == 2 {
+        let c = (0..3).find(|&c| w[c] != 0)?;
+        return Some(GridKey::Vertex(mesh.face(f)[c]));
+    }
+    if zeros != 1 {
+        return None;
+    }
+    let z = (0..3).find(|&c| w[c] == 0)?;
+    // The edge opposite corner z runs from corner a = z + 1 to corner b = z + 2 (half-edge
+    // 3f + a goes from corner a to corner a + 1).
+    let (a, b) = ((z + 1) % 3, (z + 2) % 3);
+    let h = 3 * f + a as u32;
+    let tw = mesh.he_twin(h);
+    let k = if mesh.is_boundary_halfedge(tw) || h < tw {
+        w[b]
+    } else {
+        w[a]
+    };
+    Some(GridKey::Edge(mesh.he_edge(h), k))
+}
+
 /// Sample every active face on a grid of `m` segments per edge; drop the sub-triangles inside
-/// a seam; add each fill patch on a polar grid. (The spline part and the fill meet at the seam
-/// but are not stitched into one mesh.)
+/// a seam; add each fill patch on a polar grid. The spline part is one welded mesh (grid points
+/// on domain vertices and edges are shared between the faces that meet there); the spline
+/// part and the fill meet at the seam but are not stitched into one mesh.
 pub fn tessellate<A: FlatCharts + Sync + ?Sized>(
     space: &ManifoldSpace<'_, A>,
     spline: &ManifoldSpline,
@@ -558,21 +594,35 @@ pub fn tessellate<A: FlatCharts + Sync + ?Sized>(
             Ok((p, inside))
         })
         .collect::<Result<_>>()?;
+    // Weld: a grid point on a domain vertex or edge is one vertex of the tessellation, shared
+    // by the faces around it (the spline is continuous there; its value is taken from the
+    // first face that reaches the point), so the spline part is one connected mesh and vertex
+    // normals average across patch boundaries instead of stopping at them.
     let mut t = Tessellation::default();
+    let mut shared: HashMap<GridKey, u32> = HashMap::new();
+    let mut local = vec![0u32; grid.len()];
     for (k, (p, inside)) in per.into_iter().enumerate() {
         let f = faces[k];
-        let base = t.positions.len() as u32;
-        t.positions.extend_from_slice(&p);
-        t.vertex_face.extend(std::iter::repeat_n(f as i64, p.len()));
-        t.vertex_chart.extend(std::iter::repeat_n(
-            space.canonical_chart(f) as i64,
-            p.len(),
-        ));
+        let chart = space.canonical_chart(f) as i64;
+        for (q, &(i, j)) in grid.iter().enumerate() {
+            let key = grid_key(mesh, f, [m - i - j, i, j]);
+            let next = t.positions.len() as u32;
+            let id = match key {
+                Some(key) => *shared.entry(key).or_insert(next),
+                None => next,
+            };
+            if id == next {
+                t.positions.push(p[q]);
+                t.vertex_face.push(f as i64);
+                t.vertex_chart.push(chart);
+            }
+            local[q] = id;
+        }
         for s in &subtri {
             if s.iter().any(|&q| inside[q]) {
                 continue;
             }
-            t.triangles.push(s.map(|q| base + q as u32));
+            t.triangles.push(s.map(|q| local[q]));
         }
     }
     t.spline_triangles = t.triangles.len();
