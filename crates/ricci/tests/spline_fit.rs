@@ -114,3 +114,38 @@ fn fit_is_resolved_by_its_quadrature_and_smoother_than_the_faired_spline() {
         "distance to the mesh {fitted:?}"
     );
 }
+
+/// The tessellation's spline part is one welded surface: every edge inside it is shared by
+/// two triangles, its only boundary is the seam around the fill patch, and its Euler
+/// characteristic is that of the surface minus a disk (`2 − 2g − 1`).
+#[test]
+fn tessellation_is_welded_along_domain_edges() {
+    let Some(dir) = ricci_meshes() else {
+        eprintln!("note: RICCI_MESHES is not set; skipping the tessellation test");
+        return;
+    };
+    let s = read_surface(&dir.join("eight.off")).expect("eight.off").0;
+    let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+    let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
+    let sp = build(&space, &SplineOptions::default(), &mut NoProgress).unwrap();
+    let t = tessellate(&space, &sp, 4).unwrap();
+    let tris = &t.triangles[..t.spline_triangles];
+    let mut used = vec![u32::MAX; t.positions.len()];
+    let mut n = 0;
+    let faces: Vec<[u32; 3]> = tris
+        .iter()
+        .map(|f| {
+            f.map(|v| {
+                if used[v as usize] == u32::MAX {
+                    used[v as usize] = n;
+                    n += 1;
+                }
+                used[v as usize]
+            })
+        })
+        .collect();
+    let mesh = ricci::mesh::Mesh::from_triangles(n as usize, faces).expect("a manifold mesh");
+    let chi = mesh.n_vertices() as i64 - mesh.n_edges() as i64 + mesh.n_faces() as i64;
+    assert_eq!(mesh.boundary_loops().len(), 1, "only the seam is open");
+    assert_eq!(chi, 2 - 2 * 2 - 1);
+}
