@@ -159,72 +159,11 @@ fn flat_octagon_with_one_cone_has_rigid_motion_generators() {
     }
 }
 
-fn icosphere(levels: usize) -> (Mesh, Vec<[f64; 3]>) {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut p: Vec<[f64; 3]> = vec![
-        [-1., t, 0.],
-        [1., t, 0.],
-        [-1., -t, 0.],
-        [1., -t, 0.],
-        [0., -1., t],
-        [0., 1., t],
-        [0., -1., -t],
-        [0., 1., -t],
-        [t, 0., -1.],
-        [t, 0., 1.],
-        [-t, 0., -1.],
-        [-t, 0., 1.],
-    ];
-    let mut f: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    let norm = |a: [f64; 3]| {
-        let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
-        [a[0] / n, a[1] / n, a[2] / n]
-    };
-    for x in p.iter_mut() {
-        *x = norm(*x);
-    }
-    for _ in 0..levels {
-        let mut mid = std::collections::HashMap::new();
-        let mut nf = Vec::new();
-        for tri in &f {
-            let mut m = [0u32; 3];
-            for i in 0..3 {
-                let (a, b) = (tri[i].min(tri[(i + 1) % 3]), tri[i].max(tri[(i + 1) % 3]));
-                m[i] = *mid.entry((a, b)).or_insert_with(|| {
-                    let (pa, pb) = (p[a as usize], p[b as usize]);
-                    p.push(norm([pa[0] + pb[0], pa[1] + pb[1], pa[2] + pb[2]]));
-                    (p.len() - 1) as u32
-                });
-            }
-            nf.push([tri[0], m[0], m[2]]);
-            nf.push([tri[1], m[1], m[0]]);
-            nf.push([tri[2], m[2], m[1]]);
-            nf.push([m[0], m[1], m[2]]);
-        }
-        f = nf;
-    }
-    (Mesh::from_triangles(p.len(), f).unwrap(), p)
+/// The library's icosphere (unit sphere, `levels` 4-to-1 subdivisions) as connectivity and
+/// positions.
+fn icosphere(levels: u32) -> (Mesh, Vec<[f64; 3]>) {
+    let s = ricci::mesh::generate::icosphere(levels).unwrap();
+    (s.mesh, s.positions)
 }
 
 #[test]

@@ -8,74 +8,10 @@ use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
-/// Subdivided icosahedron on the unit sphere (`level` 4-to-1 subdivisions).
+/// Subdivided icosahedron on the unit sphere (`level` 4-to-1 subdivisions): the library's
+/// generator.
 pub fn icosphere(level: usize) -> Surface {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut p: Vec<[f64; 3]> = vec![
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ];
-    let mut f: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for q in p.iter_mut() {
-        let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
-        *q = [q[0] / n, q[1] / n, q[2] / n];
-    }
-    for _ in 0..level {
-        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut nf = Vec::with_capacity(4 * f.len());
-        let mut m = |a: u32, b: u32, p: &mut Vec<[f64; 3]>| -> u32 {
-            let k = (a.min(b), a.max(b));
-            *mid.entry(k).or_insert_with(|| {
-                let (x, y) = (p[a as usize], p[b as usize]);
-                let c = [x[0] + y[0], x[1] + y[1], x[2] + y[2]];
-                let n = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
-                p.push([c[0] / n, c[1] / n, c[2] / n]);
-                (p.len() - 1) as u32
-            })
-        };
-        for t in &f {
-            let a = m(t[0], t[1], &mut p);
-            let b = m(t[1], t[2], &mut p);
-            let c = m(t[2], t[0], &mut p);
-            nf.push([t[0], a, c]);
-            nf.push([t[1], b, a]);
-            nf.push([t[2], c, b]);
-            nf.push([a, b, c]);
-        }
-        f = nf;
-    }
-    Surface::new(p, f).unwrap()
+    ricci::mesh::generate::icosphere(level as u32).unwrap()
 }
 
 /// Torus of revolution with radii `(big_r, r)`, `n` segments around the axis and `m` around
