@@ -20,12 +20,14 @@
 
 #![allow(clippy::needless_range_loop)]
 
+pub mod adaptive;
 pub mod linear;
 pub mod newton;
 pub mod polish;
 pub mod sphere;
 pub mod target;
 
+pub use adaptive::ricci_flow_refined;
 pub use target::{separated_vertices, Target, TargetSpec};
 
 use crate::error::{Error, Result};

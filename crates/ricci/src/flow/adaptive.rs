@@ -1,0 +1,92 @@
+//! Ricci flow with adaptive, metric-preserving refinement of the faces where the discrete
+//! conformal metric does not exist on the given triangulation (DESIGN.md §3; the splits of
+//! [`crate::mesh::refine`]).
+//!
+//! A discrete conformal class on a fixed triangulation can miss a target: with vertex scaling
+//! the convex (extended) energy then has its minimum at a "metric" whose faces violate the
+//! triangle inequality (paper 001 §IV admits the same for circle packings). A boundary that
+//! zig-zags (turning angles of ±2 rad at neighbouring vertices, as on scanned disks) asks the
+//! conformal factor to change by orders of magnitude within one ring, which a fixed coarse
+//! triangulation cannot follow. Refinement resolves the factor: [`ricci_flow_refined`] runs
+//! the flow, bisects (longest-edge bisection, [`Refiner::bisect`], in the *input* metric, so
+//! the surface and its metric are unchanged and input vertices keep their ids and positions)
+//! every face whose final metric is under-resolved — a triangle inequality fails, or a corner
+//! angle is below [`MIN_ANGLE`] or above π − [`MAX_ANGLE_GAP`] — and flows again, until the
+//! flow converges with no such face or the round limit is reached. The result says how many
+//! rounds and splits it took; a flow that still fails is reported as not converged.
+
+use super::{ricci_flow, FlowOptions, FlowResult};
+use crate::error::Result;
+use crate::mesh::refine::{Refined, Refiner};
+use crate::mesh::Mesh;
+use crate::metric::Geometry;
+use crate::progress::Progress;
+use std::f64::consts::PI;
+
+/// Corner angles below this (radians) mark a face as under-resolved.
+pub const MIN_ANGLE: f64 = 1e-3;
+/// Corner angles above π minus this (radians) mark a face as under-resolved.
+pub const MAX_ANGLE_GAP: f64 = 0.02;
+
+/// Faces of `mesh` whose Euclidean `lengths` (by edge id) violate a triangle inequality or
+/// have a corner angle below [`MIN_ANGLE`] or above `π − MAX_ANGLE_GAP`.
+pub fn under_resolved_faces(mesh: &Mesh, lengths: &[f64]) -> Vec<u32> {
+    (0..mesh.n_faces() as u32)
+        .filter(|&f| {
+            let e = mesh.face_edges_opposite(f);
+            let l = e.map(|e| lengths[e as usize]);
+            if (0..3).any(|i| l[i] >= l[(i + 1) % 3] + l[(i + 2) % 3]) {
+                return true;
+            }
+            (0..3).any(|i| {
+                let a = Geometry::Euclidean.angle(l[i], l[(i + 1) % 3], l[(i + 2) % 3]);
+                !(a >= MIN_ANGLE && a <= PI - MAX_ANGLE_GAP)
+            })
+        })
+        .collect()
+}
+
+/// Run [`ricci_flow`] on `refined` (Euclidean input lengths; start with
+/// [`Refined::identity`] or the output of another refinement), bisecting under-resolved faces
+/// and flowing again up to `max_rounds` times. Returns the final refinement and the flow on
+/// it; the flow's notes say how many rounds and splits were needed, and `converged` is true
+/// only if the last flow converged with no under-resolved face.
+pub fn ricci_flow_refined(
+    mut refined: Refined,
+    options: &FlowOptions,
+    max_rounds: usize,
+    progress: &mut dyn Progress,
+) -> Result<(Refined, FlowResult)> {
+    let splits0 = refined.splits();
+    let mut round = 0;
+    loop {
+        let mut r = ricci_flow(&refined.mesh, &refined.lengths, options, progress)?;
+        let bad = under_resolved_faces(&refined.mesh, &r.lengths);
+        if (r.converged && bad.is_empty()) || round >= max_rounds {
+            let added = refined.splits() - splits0;
+            if round > 0 {
+                r.notes.push(format!(
+                    "adaptive refinement: {round} round(s) of longest-edge bisection of the \
+                     faces where the metric degenerated added {added} vertices ({} faces now)",
+                    refined.mesh.n_faces()
+                ));
+            }
+            if !bad.is_empty() {
+                r.converged = false;
+                r.notes.push(format!(
+                    "{} faces are still under-resolved (triangle inequality violated, or an \
+                     angle below {MIN_ANGLE} rad or above π − {MAX_ANGLE_GAP} rad) after \
+                     {round} refinement round(s)",
+                    bad.len()
+                ));
+            }
+            return Ok((refined, r));
+        }
+        round += 1;
+        let mut rf = Refiner::resume(refined, Geometry::Euclidean)?;
+        for f in bad {
+            rf.bisect(f)?;
+        }
+        refined = rf.finish()?;
+    }
+}
