@@ -49,14 +49,16 @@ pub fn under_resolved_faces(mesh: &Mesh, lengths: &[f64]) -> Vec<u32> {
 /// Run [`ricci_flow`] on `refined` (Euclidean input lengths; start with
 /// [`Refined::identity`] or the output of another refinement), bisecting under-resolved faces
 /// and flowing again up to `max_rounds` times. Returns the final refinement and the flow on
-/// it; the flow's notes say how many rounds and splits were needed, and `converged` is true
-/// only if the last flow converged with no under-resolved face.
+/// it; the flow's notes say how many rounds and splits were needed, `seconds` is the time of
+/// all rounds, and `converged` is true only if the last flow converged with no under-resolved
+/// face (its `iterations` and `history` are those of the last flow).
 pub fn ricci_flow_refined(
     mut refined: Refined,
     options: &FlowOptions,
     max_rounds: usize,
     progress: &mut dyn Progress,
 ) -> Result<(Refined, FlowResult)> {
+    let t0 = std::time::Instant::now();
     let splits0 = refined.splits();
     let mut round = 0;
     loop {
@@ -67,10 +69,14 @@ pub fn ricci_flow_refined(
             if round > 0 {
                 r.notes.push(format!(
                     "adaptive refinement: {round} round(s) of longest-edge bisection of the \
-                     faces where the metric degenerated added {added} vertices ({} faces now)",
-                    refined.mesh.n_faces()
+                     faces where the metric degenerated added {added} vertices ({} faces now); \
+                     the last flow took {:.3} s, all rounds {:.3} s (`seconds`)",
+                    refined.mesh.n_faces(),
+                    r.seconds,
+                    t0.elapsed().as_secs_f64()
                 ));
             }
+            r.seconds = t0.elapsed().as_secs_f64();
             if !bad.is_empty() {
                 r.converged = false;
                 r.notes.push(format!(

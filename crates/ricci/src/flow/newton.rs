@@ -704,3 +704,88 @@ pub fn gradient_flow(
         notes,
     })
 }
+
+#[cfg(test)]
+mod round_jacobian_tests {
+    use super::*;
+    use crate::metric::{ConformalStructure, Geometry, Scheme};
+
+    /// The exact round-boundary step solves `J δ = r` with the true Jacobian of
+    /// `F(u) = K(u) − K̄(u)` on the free vertices: the central difference of `F` along `δ`
+    /// reproduces `r` (every scheme; a disk and an annulus, whose hole has `T = −2π`).
+    #[test]
+    fn exact_round_step_inverts_the_jacobian() {
+        let disk = crate::mesh::generate::disk(40).unwrap();
+        let annulus = crate::mesh::generate::annulus(0.5, 1.0, 40).unwrap();
+        for s in [disk, annulus] {
+            let lengths = s.edge_lengths();
+            for scheme in [
+                Scheme::Thurston,
+                Scheme::Tangential,
+                Scheme::Inversive,
+                Scheme::Yamabe,
+            ] {
+                let st =
+                    ConformalStructure::new(&s.mesh, &lengths, Geometry::Euclidean, scheme, 1.0)
+                        .unwrap();
+                let mut ev = Evaluator::new(&s.mesh, st);
+                let mut target = crate::flow::target::resolve(
+                    &s.mesh,
+                    Geometry::Euclidean,
+                    &crate::flow::TargetSpec::RoundBoundary,
+                )
+                .unwrap();
+                let n = s.mesh.n_vertices();
+                // A generic point: u0 plus a smooth perturbation.
+                let u: Vec<f64> = (0..n)
+                    .map(|i| ev.structure.u0[i] + 0.05 * ((i as f64) * 0.7).sin())
+                    .collect();
+                assert!(ev.evaluate(&u));
+                crate::flow::target::set_round_totals(
+                    &mut target,
+                    &ev.ws.lengths,
+                    &ev.ws.dlengths,
+                    &ev.data.edges,
+                );
+                let mut held = target.fixed.clone();
+                let pin = (0..n as u32)
+                    .find(|&v| !s.mesh.is_boundary_vertex(v))
+                    .unwrap();
+                held[pin as usize] = true;
+                let pattern = HessianPattern::new(&ev.data, &held);
+                let mut values = vec![0.0; pattern.nnz()];
+                assert!(ev.evaluate_with_hessian(&u, &pattern, &mut values));
+                target.update_round(&ev.ws.lengths, &ev.ws.dlengths, &ev.data.edges);
+                let nf = pattern.n();
+                let r: Vec<f64> = (0..nf).map(|c| ((c as f64) * 1.3).cos()).collect();
+                let d = exact_round_step(&ev, &target, &pattern, &values, &r)
+                    .unwrap_or_else(|| panic!("{scheme} {n}"));
+                let dmax = d.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                let h = 1e-5 / dmax;
+                let mut f = |sign: f64| -> Vec<f64> {
+                    let mut uu = u.clone();
+                    for (c, &v) in pattern.free_vertex.iter().enumerate() {
+                        uu[v as usize] += sign * h * d[c];
+                    }
+                    assert!(ev.evaluate(&uu));
+                    target.update_round(&ev.ws.lengths, &ev.ws.dlengths, &ev.data.edges);
+                    pattern
+                        .free_vertex
+                        .iter()
+                        .map(|&v| ev.ws.curvature[v as usize] - target.curvature[v as usize])
+                        .collect()
+                };
+                let (fp, fm) = (f(1.0), f(-1.0));
+                let rmax = r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                let worst = (0..nf)
+                    .map(|c| ((fp[c] - fm[c]) / (2.0 * h) - r[c]).abs())
+                    .fold(0.0, f64::max);
+                assert!(
+                    worst <= 1e-6 * rmax,
+                    "{scheme}, {} vertices: J δ differs from r by {worst:e}",
+                    n
+                );
+            }
+        }
+    }
+}

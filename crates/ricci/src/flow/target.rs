@@ -705,3 +705,41 @@ pub fn separated_vertices(mesh: &Mesh, count: usize, min_valence: usize) -> Vec<
     }
     chosen
 }
+
+#[cfg(test)]
+mod circle_tests {
+    use super::*;
+
+    /// Closed forms: a regular n-gon with side l has circumradius l / (2 sin(π/n)); a polygon
+    /// built on a circle of radius R from unequal central angles gives back R; the central
+    /// angles sum to the total turning.
+    #[test]
+    fn circle_radius_of_cyclic_polygons() {
+        for n in [3usize, 4, 7, 100, 1000] {
+            let l = vec![0.37; n];
+            let want = 0.37 / (2.0 * (PI / n as f64).sin());
+            let r = circle_radius(&l, 2.0 * PI);
+            assert!((r / want - 1.0).abs() < 1e-13, "n = {n}: {r} vs {want}");
+        }
+        // Unequal central angles (summing to 2π), sides 2R sin(α/2).
+        let weights: Vec<f64> = (0..57).map(|k| 1.0 + ((k * 7919) % 13) as f64).collect();
+        let wsum: f64 = weights.iter().sum();
+        let radius = 2.5;
+        let alpha: Vec<f64> = weights.iter().map(|w| 2.0 * PI * w / wsum).collect();
+        let l: Vec<f64> = alpha
+            .iter()
+            .map(|a| 2.0 * radius * (0.5 * a).sin())
+            .collect();
+        let c = CircleLoop::new(&l, -2.0 * PI);
+        assert!((c.radius / radius - 1.0).abs() < 1e-13, "{}", c.radius);
+        assert_eq!(c.sign, -1.0);
+        for (a, b) in c.alpha.iter().zip(&alpha) {
+            assert!((a - b).abs() < 1e-12);
+        }
+        assert!((c.alpha.iter().sum::<f64>() - 2.0 * PI).abs() < 1e-12);
+        // An arc of total turning π on the same circle (half the angles doubled up).
+        let half: Vec<f64> = l[..l.len() / 2].to_vec();
+        let t: f64 = alpha[..alpha.len() / 2].iter().sum();
+        assert!((circle_radius(&half, t) / radius - 1.0).abs() < 1e-13);
+    }
+}
