@@ -147,6 +147,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut lengths = surface.edge_lengths();
     let mut surface = surface;
     let mut refinement = serde_json::Value::Null;
+    let mut widen_splits = 0;
     if let Some(n) = a.widen_boundary {
         let r = ricci::mesh::refine::widen_boundary(
             &surface.mesh,
@@ -156,6 +157,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             n,
         )
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?;
+        widen_splits = r.splits();
         refinement = json!({
             "min_faces": n,
             "splits": r.splits(),
@@ -180,6 +182,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             refinement = json!({
                 "min_faces": a.widen_boundary,
                 "refine_degenerate": rounds,
+                "splits": widen_splits + rf.splits(),
                 "vertices": rf.mesh.n_vertices(),
                 "faces": rf.mesh.n_faces(),
                 "refined_out": a.refined_out.as_ref().map(|p| p.display().to_string()),

@@ -143,6 +143,7 @@ pub fn newton(
     let mut rejected_exact = 0usize;
     let mut mass = vec![0.0; n];
     let dynamic = target.is_dynamic();
+    let mut lu_symbolic = None;
     loop {
         if !ev.evaluate_with_hessian(&u, &pattern, &mut values) {
             notes.push("the metric left the domain of the scheme".into());
@@ -214,7 +215,7 @@ pub fn newton(
         // LU ([`exact_round_step`]); if that fails, take a chord step instead.
         let mut exact_delta = None;
         if dynamic && exact {
-            match exact_round_step(ev, target, &pattern, &values, &r0) {
+            match exact_round_step(ev, target, &pattern, &values, &r0, &mut lu_symbolic) {
                 Some(d) => exact_delta = Some(d),
                 None => {
                     exact_failed = true;
@@ -445,6 +446,7 @@ fn exact_round_step(
     pattern: &HessianPattern,
     values: &[f64],
     r: &[f64],
+    symbolic: &mut Option<faer::sparse::linalg::solvers::SymbolicLu<u32>>,
 ) -> Option<Vec<f64>> {
     use faer::linalg::solvers::SolveCore;
     use faer::sparse::{SparseColMat, Triplet};
@@ -501,7 +503,14 @@ fn exact_round_step(
         terms.push((p, q, 0.5 * c.sign / c.s));
     }
     let a = SparseColMat::<u32, f64>::try_new_from_triplets(nf, nf, &trip).ok()?;
-    let lu = a.sp_lu().ok()?;
+    // The triplets come in the same order with the same pattern at every step, so the
+    // symbolic factorization (ordering, elimination structure) is computed once.
+    if symbolic.is_none() {
+        *symbolic = faer::sparse::linalg::solvers::SymbolicLu::try_new(a.symbolic()).ok();
+    }
+    let lu =
+        faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(symbolic.clone()?, a.as_ref())
+            .ok()?;
     let mut solve = |x: &mut [f64]| {
         let n = x.len();
         lu.solve_in_place_with_conj(
@@ -758,7 +767,7 @@ mod round_jacobian_tests {
                 target.update_round(&ev.ws.lengths, &ev.ws.dlengths, &ev.data.edges);
                 let nf = pattern.n();
                 let r: Vec<f64> = (0..nf).map(|c| ((c as f64) * 1.3).cos()).collect();
-                let d = exact_round_step(&ev, &target, &pattern, &values, &r)
+                let d = exact_round_step(&ev, &target, &pattern, &values, &r, &mut None)
                     .unwrap_or_else(|| panic!("{scheme} {n}"));
                 let dmax = d.iter().fold(0.0f64, |m, x| m.max(x.abs()));
                 let h = 1e-5 / dmax;
