@@ -40,7 +40,7 @@ pub fn under_resolved_faces(mesh: &Mesh, lengths: &[f64]) -> Vec<u32> {
             }
             (0..3).any(|i| {
                 let a = Geometry::Euclidean.angle(l[i], l[(i + 1) % 3], l[(i + 2) % 3]);
-                !(a >= MIN_ANGLE && a <= PI - MAX_ANGLE_GAP)
+                !(MIN_ANGLE..=PI - MAX_ANGLE_GAP).contains(&a)
             })
         })
         .collect()

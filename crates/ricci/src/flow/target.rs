@@ -285,7 +285,7 @@ pub fn circle_radius(l: &[f64], t: f64) -> f64 {
             hi = r;
         }
         let mut next = r - v / d;
-        if !(next > lo && next < hi) || !next.is_finite() {
+        if !(next > lo && next < hi && next.is_finite()) {
             next = 0.5 * (lo + hi);
         }
         if (next - r).abs() <= 1e-15 * r || hi - lo <= 1e-15 * hi {

@@ -1,7 +1,7 @@
 //! Small procedural surfaces and a minimal mesh reader for the flow and metric tests (the
 //! library's own generators and readers live in other modules; these keep the tests
 //! self-contained).
-#![allow(dead_code)]
+#![allow(dead_code, clippy::needless_range_loop)]
 
 use ricci::mesh::Surface;
 use std::collections::HashMap;
