@@ -15,8 +15,9 @@
 //!   next to its thin boundary triangles (angles down to 4.6°) then violate Chow–Luo for
 //!   Thurston, and vertex scaling's convex energy has its minimum at a "metric" with degenerate
 //!   faces (no discrete conformal metric on that triangulation). Widening plus adaptive
-//!   bisection of the degenerate faces (`ricci::flow::ricci_flow_refined`) makes vertex scaling
-//!   and inversive distance converge: `face_round_boundary_after_adaptive_refinement`.
+//!   bisection of the degenerate faces (`ricci::flow::ricci_flow_refined`) makes Thurston
+//!   (11 Newton steps), tangential, inversive distance and vertex scaling converge:
+//!   `face_round_boundary_after_adaptive_refinement`.
 //!
 //! Round boundaries are checked to be circles in an independent layout
 //! (`round_boundaries_are_circles`, and the face test).
@@ -427,15 +428,14 @@ fn round_boundaries_are_circles() {
 /// face.off (a scanned disk whose boundary zig-zags: 114 of its 359 boundary vertices turn by
 /// more than 1 rad, 82 are ears) to a round disk. On its own triangulation no scheme can:
 /// vertex scaling's convex energy has its minimum at a "metric" with 77 faces violating the
-/// triangle inequality (checked above: stuck, and refused by Thurston). Metric-preserving
+/// triangle inequality, and Thurston is refused by Chow–Luo (checked above). Metric-preserving
 /// refinement makes the discrete conformal metric exist: boundary widening (every boundary
 /// vertex ≥ 3 faces), then adaptive longest-edge bisection of the faces where the flow's
-/// metric degenerates (`ricci::flow::ricci_flow_refined`). Asserted: vertex scaling (Yamabe)
-/// meets the bar of issue 3 on the refined mesh, the laid-out boundary is a circle, the
-/// refinement kept the input vertices (ids, positions, curvature of the input metric) and
-/// made every new vertex flat, and no face of the final metric is degenerate. (Thurston's
-/// packing is still refused on the refined mesh by Chow–Luo at new valence-4 vertices whose
-/// initial intersection angles clamp to π/2.)
+/// metric degenerates (`ricci::flow::ricci_flow_refined`; while Thurston is refused, a
+/// vertex-scaling probe finds the faces). Asserted for the default scheme (Thurston) and for
+/// vertex scaling: the bar of issue 3 on the refined mesh, the laid-out boundary is a circle,
+/// the refinement kept the input vertices (ids, positions, curvature of the input metric) and
+/// made every new vertex flat, and no face of the final metric is degenerate.
 #[test]
 fn face_round_boundary_after_adaptive_refinement() {
     let Some(dir) = flow_support::meshes_dir() else {
@@ -443,41 +443,54 @@ fn face_round_boundary_after_adaptive_refinement() {
     };
     let s = flow_support::read_mesh(&dir.join("face.off"));
     let l0 = s.edge_lengths();
+    for scheme in [Scheme::Thurston, Scheme::Yamabe] {
+        let widened = ricci::mesh::refine::widen_boundary(
+            &s.mesh,
+            &l0,
+            Geometry::Euclidean,
+            Some(&s.positions),
+            3,
+        )
+        .unwrap();
+        let options = FlowOptions {
+            scheme,
+            target: TargetSpec::RoundBoundary,
+            ..FlowOptions::default()
+        };
+        let (refined, r) =
+            ricci::flow::ricci_flow_refined(widened, &options, 40, &mut NoProgress).unwrap();
+        eprintln!(
+            "face.off round-boundary {scheme}: {} → {} faces, {} Newton steps, max |K − K̄| \
+             {:.2e}, GB {:.1e}, {:.2} s; {:?}",
+            s.mesh.n_faces(),
+            refined.mesh.n_faces(),
+            r.iterations,
+            r.max_curvature_error,
+            r.gauss_bonnet_error,
+            r.seconds,
+            r.notes
+        );
+        check_refined_face(&s, &refined, &r);
+    }
+}
+
+/// The assertions of `face_round_boundary_after_adaptive_refinement` for one flow.
+fn check_refined_face(s: &Surface, refined: &ricci::mesh::refine::Refined, r: &FlowResult) {
+    let l0 = s.edge_lengths();
     let n0 = s.mesh.n_vertices();
-    let widened = ricci::mesh::refine::widen_boundary(
-        &s.mesh,
-        &l0,
-        Geometry::Euclidean,
-        Some(&s.positions),
-        3,
-    )
-    .unwrap();
-    let options = FlowOptions {
-        scheme: Scheme::Yamabe,
-        target: TargetSpec::RoundBoundary,
-        ..FlowOptions::default()
-    };
-    let (refined, r) =
-        ricci::flow::ricci_flow_refined(widened, &options, 40, &mut NoProgress).unwrap();
-    eprintln!(
-        "face.off round-boundary yamabe: {} → {} faces, {} Newton steps, max |K − K̄| {:.2e}, \
-         GB {:.1e}, {:.2} s; {:?}",
-        s.mesh.n_faces(),
-        refined.mesh.n_faces(),
-        r.iterations,
-        r.max_curvature_error,
-        r.gauss_bonnet_error,
-        r.seconds,
-        r.notes
-    );
     let surf = Surface {
         mesh: refined.mesh.clone(),
         positions: refined.positions.clone().unwrap(),
         uvs: None,
     };
-    meets_bar(&surf, &r).unwrap();
+    meets_bar(&surf, r).unwrap();
     assert_eq!(r.degenerate_faces, 0);
-    assert!(ricci::flow::adaptive::under_resolved_faces(&refined.mesh, &r.lengths).is_empty());
+    assert!(ricci::flow::adaptive::under_resolved_faces(
+        &refined.mesh,
+        Geometry::Euclidean,
+        &r.lengths
+    )
+    .is_empty());
     // The boundary is round.
     let spread = flow_support::boundary_circle_spread(&refined.mesh, &r.lengths);
     eprintln!("face.off: boundary radius spread {spread:.2e}");

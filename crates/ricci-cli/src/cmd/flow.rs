@@ -63,10 +63,10 @@ pub struct Args {
     pub widen_boundary: Option<usize>,
     /// Adaptive refinement, up to N rounds: after a flow, bisect (longest-edge bisection, in
     /// the input metric) every face whose final metric violates a triangle inequality or has
-    /// an angle near 0 or π, and flow again — for targets the triangulation cannot reach
-    /// as it is (e.g. a zig-zag boundary made round: face.off needs 18 rounds with
-    /// --scheme yamabe --widen-boundary 3). Needs --refined-out: the metric is on the
-    /// refined mesh.
+    /// an angle near 0 or π, and flow again (while a circle packing is refused by Chow–Luo,
+    /// a vertex-scaling flow finds the faces) — for targets the triangulation cannot reach
+    /// as it is (e.g. a zig-zag boundary made round: face.off needs 13 rounds after
+    /// --widen-boundary 3). Needs --refined-out: the metric is on the refined mesh.
     #[arg(long, value_name = "N", requires = "refined_out")]
     pub refine_degenerate: Option<usize>,
     /// Where to write the refined mesh of --widen-boundary / --refine-degenerate (input

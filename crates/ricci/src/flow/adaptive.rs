@@ -19,7 +19,7 @@ use super::{ricci_flow, FlowOptions, FlowResult};
 use crate::error::Result;
 use crate::mesh::refine::{Refined, Refiner};
 use crate::mesh::Mesh;
-use crate::metric::Geometry;
+use crate::metric::{Geometry, Scheme};
 use crate::progress::Progress;
 use std::f64::consts::PI;
 
@@ -28,9 +28,10 @@ pub const MIN_ANGLE: f64 = 1e-3;
 /// Corner angles above π minus this (radians) mark a face as under-resolved.
 pub const MAX_ANGLE_GAP: f64 = 0.02;
 
-/// Faces of `mesh` whose Euclidean `lengths` (by edge id) violate a triangle inequality or
-/// have a corner angle below [`MIN_ANGLE`] or above `π − MAX_ANGLE_GAP`.
-pub fn under_resolved_faces(mesh: &Mesh, lengths: &[f64]) -> Vec<u32> {
+/// Faces of `mesh` whose `lengths` (by edge id, in the background `geometry`) violate a
+/// triangle inequality or have a corner angle below [`MIN_ANGLE`] or above
+/// `π − MAX_ANGLE_GAP`.
+pub fn under_resolved_faces(mesh: &Mesh, geometry: Geometry, lengths: &[f64]) -> Vec<u32> {
     (0..mesh.n_faces() as u32)
         .filter(|&f| {
             let e = mesh.face_edges_opposite(f);
@@ -39,19 +40,27 @@ pub fn under_resolved_faces(mesh: &Mesh, lengths: &[f64]) -> Vec<u32> {
                 return true;
             }
             (0..3).any(|i| {
-                let a = Geometry::Euclidean.angle(l[i], l[(i + 1) % 3], l[(i + 2) % 3]);
+                let a = geometry.angle(l[i], l[(i + 1) % 3], l[(i + 2) % 3]);
                 !(MIN_ANGLE..=PI - MAX_ANGLE_GAP).contains(&a)
             })
         })
         .collect()
 }
 
-/// Run [`ricci_flow`] on `refined` (Euclidean input lengths; start with
-/// [`Refined::identity`] or the output of another refinement), bisecting under-resolved faces
-/// and flowing again up to `max_rounds` times. Returns the final refinement and the flow on
-/// it; the flow's notes say how many rounds and splits were needed, `seconds` is the time of
-/// all rounds, and `converged` is true only if the last flow converged with no under-resolved
-/// face (its `iterations` and `history` are those of the last flow).
+/// Run [`ricci_flow`] on `refined` (Euclidean input lengths, any background geometry of
+/// `options`; start with [`Refined::identity`] or the output of another refinement),
+/// bisecting under-resolved faces and flowing again up to `max_rounds` times. Returns the
+/// final refinement and the flow on it; the flow's notes say how many rounds and splits were
+/// needed, `seconds` is the time of all rounds, and `converged` is true only if the last flow
+/// converged with no under-resolved face (its `iterations` and `history` are those of the
+/// last flow).
+///
+/// The faces to bisect come from the requested scheme's flow; when that flow is refused (a
+/// circle packing failing Chow–Luo, whose intersection angles come from the triangulation)
+/// or stops without a degenerate face, from a vertex-scaling flow with the same target (the
+/// *probe*: its convex energy has its minimum at a degenerate metric exactly when no discrete
+/// conformal metric exists on the triangulation). A refusal that persists after `max_rounds`
+/// is returned as the error.
 pub fn ricci_flow_refined(
     mut refined: Refined,
     options: &FlowOptions,
@@ -61,16 +70,27 @@ pub fn ricci_flow_refined(
     let t0 = std::time::Instant::now();
     let splits0 = refined.splits();
     let mut round = 0;
+    let mut probes = 0;
+    let probe_options = FlowOptions {
+        scheme: Scheme::Yamabe,
+        ..options.clone()
+    };
     loop {
-        let mut r = ricci_flow(&refined.mesh, &refined.lengths, options, progress)?;
-        let bad = under_resolved_faces(&refined.mesh, &r.lengths);
-        if (r.converged && bad.is_empty()) || round >= max_rounds {
+        let attempt = ricci_flow(&refined.mesh, &refined.lengths, options, progress);
+        let bad = match &attempt {
+            Ok(r) => under_resolved_faces(&refined.mesh, r.geometry, &r.lengths),
+            Err(_) => Vec::new(),
+        };
+        let done = matches!(&attempt, Ok(r) if r.converged && bad.is_empty());
+        if done || round >= max_rounds {
+            let mut r = attempt?;
             let added = refined.splits() - splits0;
             if round > 0 {
                 r.notes.push(format!(
                     "adaptive refinement: {round} round(s) of longest-edge bisection of the \
-                     faces where the metric degenerated added {added} vertices ({} faces now); \
-                     the last flow took {:.3} s, all rounds {:.3} s (`seconds`)",
+                     faces where the metric degenerated added {added} vertices ({} faces now; \
+                     {probes} round(s) found the faces with a vertex-scaling probe); the last \
+                     flow took {:.3} s, all rounds {:.3} s (`seconds`)",
                     refined.mesh.n_faces(),
                     r.seconds,
                     t0.elapsed().as_secs_f64()
@@ -86,6 +106,25 @@ pub fn ricci_flow_refined(
                     bad.len()
                 ));
             }
+            return Ok((refined, r));
+        }
+        let bad = if bad.is_empty() && options.scheme != Scheme::Yamabe {
+            probes += 1;
+            match ricci_flow(&refined.mesh, &refined.lengths, &probe_options, progress) {
+                Ok(p) => under_resolved_faces(&refined.mesh, p.geometry, &p.lengths),
+                Err(_) => Vec::new(),
+            }
+        } else {
+            bad
+        };
+        if bad.is_empty() {
+            // Nothing to refine: report the flow as it is.
+            let mut r = attempt?;
+            r.seconds = t0.elapsed().as_secs_f64();
+            r.notes.push(format!(
+                "adaptive refinement stopped after {round} round(s): no degenerate face to \
+                 bisect (neither in this flow nor in a vertex-scaling probe)"
+            ));
             return Ok((refined, r));
         }
         round += 1;
