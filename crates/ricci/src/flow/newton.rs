@@ -23,14 +23,13 @@
 //! along the Möbius near-kernel and vanishes at the solution (superlinear convergence).
 //!
 //! **Round boundaries.** The target depends on the metric (boundary vertices on a circle,
-//! see [`super::target`]). Newton steps use the Jacobian `J = H − ∂K̄/∂u` of the full system:
-//! its sparse part (boundary rows) is factorized by LDLᵀ with `H`, its rank-one part (the
-//! circle's radius) is applied with Woodbury's identity. The step is exact for vertex scaling
-//! (symmetric `J`) and quasi-Newton for circle packings (the antisymmetric part of `J`, O(l/R)
-//! in the boundary rows, is dropped). An exact step the residual line search rejects is
-//! replaced by a chord step: the target frozen, the convex energy minimized. (Chord steps
-//! from the start, as before, took 25 of 30 steps on face.off and did not converge; exact
-//! steps from the start converge in 22.)
+//! see [`super::target`]). Newton steps solve with the Jacobian `J = H − ∂K̄/∂u` of the full
+//! system ([`exact_round_step`]): its sparse part by sparse LU (for circle packings `J` is not
+//! symmetric; the symbolic factorization is computed once), its rank-one parts (one per loop:
+//! the circle's radius) by Woodbury's identity. An exact step the residual line search rejects
+//! is replaced by a chord step: the target frozen, the convex energy minimized. (Chord steps
+//! while far from the solution, as before, took 25 of 30 steps on refined face.off and did not
+//! converge; exact steps from the start converge in 22.)
 //!
 //! **Gradient flow** (reference): `u += ε (K̄ − K)`, with `ε` halved whenever a step leaves the
 //! domain or increases the largest error tenfold; in E² without fixed vertices the mean of `u`
@@ -180,8 +179,8 @@ pub fn newton(
             break;
         }
         it += 1;
-        // Round boundaries: frozen-target (chord) steps on the convex energy while far from the
-        // solution, exact Newton steps on the full Jacobian once close (or when chords stall).
+        // Round boundaries: exact Newton steps on the full Jacobian; a frozen-target (chord)
+        // step on the convex energy after an exact step was rejected.
         let exact = !dynamic || !exact_failed;
         exact_failed = false;
         let line_search = if dynamic && !exact {
