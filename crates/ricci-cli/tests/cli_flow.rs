@@ -236,3 +236,59 @@ fn widen_boundary_writes_the_refined_mesh() {
     );
     assert_eq!(j["converged"], true);
 }
+
+/// `--refine-degenerate N` also needs `--refined-out` (exit 2 without); with it, the mesh
+/// the metric lives on is written, input vertices first and unmoved.
+#[test]
+fn refine_degenerate_writes_the_refined_mesh() {
+    let mesh = generate("disk", "disk-rd.off");
+    let o = ricci()
+        .arg("flow")
+        .arg(&mesh)
+        .args(["--refine-degenerate", "5"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let refined = scratch("disk-rd-refined.off");
+    let metric_file = scratch("disk-rd-metric.json");
+    let o = ricci()
+        .arg("flow")
+        .arg(&mesh)
+        .args([
+            "--target",
+            "round-boundary",
+            "--scheme",
+            "yamabe",
+            "--widen-boundary",
+            "3",
+            "--refine-degenerate",
+            "5",
+            "--json",
+            "--refined-out",
+        ])
+        .arg(&refined)
+        .arg("--out")
+        .arg(&metric_file)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["converged"], true);
+    let (r, _) = read_surface(&refined).unwrap();
+    let (s, _) = read_surface(&mesh).unwrap();
+    assert_eq!(
+        r.mesh.n_vertices(),
+        s.mesh.n_vertices() + j["refinement"]["splits"].as_u64().unwrap() as usize
+    );
+    for v in 0..s.mesh.n_vertices() {
+        for i in 0..3 {
+            assert!((r.positions[v][i] - s.positions[v][i]).abs() <= 1e-9);
+        }
+    }
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&metric_file).unwrap()).unwrap();
+    assert_eq!(
+        m["vertices"].as_u64().unwrap() as usize,
+        r.mesh.n_vertices()
+    );
+}

@@ -7,13 +7,20 @@
 //! * rocker-arm (E² uniform): a valence-3 vertex whose Thurston angles φ are near π/2 cannot be
 //!   flat (Chow–Luo); tangential packing converges;
 //! * face (E² round-boundary): 82 boundary "ears" (boundary vertices with one face) cannot be
-//!   straightened by any scheme without changing the connectivity;
+//!   straightened by any scheme without changing the connectivity (refused / stuck here);
 //! * beetle (H² geodesic-boundary): 10 ears and, for Thurston, boundary vertices with two faces
 //!   and φ = π/2; refused as it is, and converges (Thurston, 6 Newton steps) once every boundary
 //!   vertex has three faces (`mesh::refine::widen_boundary`, metric-preserving splits).
-//! * face (E² round-boundary) still fails after widening its boundary: interior one-rings next
-//!   to its thin boundary triangles (angles down to 4.6°) then violate Chow–Luo for Thurston, and
-//!   inversive / vertex scaling stall at max |K − K̄| ≈ 3.
+//! * face (E² round-boundary) still fails after widening its boundary alone: interior one-rings
+//!   next to its thin boundary triangles (angles down to 4.6°) then violate Chow–Luo for
+//!   Thurston, and vertex scaling's convex energy has its minimum at a "metric" with degenerate
+//!   faces (no discrete conformal metric on that triangulation). Widening plus adaptive
+//!   bisection of the degenerate faces (`ricci::flow::ricci_flow_refined`) makes Thurston
+//!   (11 Newton steps), tangential, inversive distance and vertex scaling converge:
+//!   `face_round_boundary_after_adaptive_refinement`.
+//!
+//! Round boundaries are checked to be circles in an independent layout
+//! (`round_boundaries_are_circles`, and the face test).
 
 #![allow(clippy::needless_range_loop)]
 
@@ -393,4 +400,129 @@ fn beetle_converges_after_widening_the_boundary() {
         f.max_curvature_error
     );
     meets_bar(&refined, &f).unwrap();
+}
+
+/// The round boundaries of the convergence list are circles: laid out independently, the
+/// boundary vertices of camelhead and hemisphere (Thurston) lie on one circle.
+#[test]
+fn round_boundaries_are_circles() {
+    let Some(dir) = flow_support::meshes_dir() else {
+        return;
+    };
+    for m in ["camelhead.off", "hemisphere.obj"] {
+        let s = flow_support::read_mesh(&dir.join(m));
+        let r = flow(
+            &s,
+            Geometry::Euclidean,
+            Scheme::Thurston,
+            TargetSpec::RoundBoundary,
+        )
+        .unwrap();
+        meets_bar(&s, &r).unwrap();
+        let spread = flow_support::boundary_circle_spread(&s.mesh, &r.lengths);
+        eprintln!("{m} round-boundary (Thurston): boundary radius spread {spread:.2e}");
+        assert!(spread <= 1e-8, "{m}: radius spread {spread:e}");
+    }
+}
+
+/// face.off (a scanned disk whose boundary zig-zags: 114 of its 359 boundary vertices turn by
+/// more than 1 rad, 82 are ears) to a round disk. On its own triangulation no scheme can:
+/// vertex scaling's convex energy has its minimum at a "metric" with 77 faces violating the
+/// triangle inequality, and Thurston is refused by Chow–Luo (checked above). Metric-preserving
+/// refinement makes the discrete conformal metric exist: boundary widening (every boundary
+/// vertex ≥ 3 faces), then adaptive longest-edge bisection of the faces where the flow's
+/// metric degenerates (`ricci::flow::ricci_flow_refined`; while Thurston is refused, a
+/// vertex-scaling probe finds the faces). Asserted for the default scheme (Thurston) and for
+/// vertex scaling: the bar of issue 3 on the refined mesh, the laid-out boundary is a circle,
+/// the refinement kept the input vertices (ids, positions, curvature of the input metric) and
+/// made every new vertex flat, and no face of the final metric is degenerate.
+#[test]
+fn face_round_boundary_after_adaptive_refinement() {
+    let Some(dir) = flow_support::meshes_dir() else {
+        return;
+    };
+    let s = flow_support::read_mesh(&dir.join("face.off"));
+    let l0 = s.edge_lengths();
+    for scheme in [Scheme::Thurston, Scheme::Yamabe] {
+        let widened = ricci::mesh::refine::widen_boundary(
+            &s.mesh,
+            &l0,
+            Geometry::Euclidean,
+            Some(&s.positions),
+            3,
+        )
+        .unwrap();
+        let options = FlowOptions {
+            scheme,
+            target: TargetSpec::RoundBoundary,
+            ..FlowOptions::default()
+        };
+        let (refined, r) =
+            ricci::flow::ricci_flow_refined(widened, &options, 40, &mut NoProgress).unwrap();
+        eprintln!(
+            "face.off round-boundary {scheme}: {} → {} faces, {} Newton steps, max |K − K̄| \
+             {:.2e}, GB {:.1e}, {:.2} s; {:?}",
+            s.mesh.n_faces(),
+            refined.mesh.n_faces(),
+            r.iterations,
+            r.max_curvature_error,
+            r.gauss_bonnet_error,
+            r.seconds,
+            r.notes
+        );
+        check_refined_face(&s, &refined, &r);
+    }
+}
+
+/// The assertions of `face_round_boundary_after_adaptive_refinement` for one flow.
+fn check_refined_face(s: &Surface, refined: &ricci::mesh::refine::Refined, r: &FlowResult) {
+    let l0 = s.edge_lengths();
+    let n0 = s.mesh.n_vertices();
+    let surf = Surface {
+        mesh: refined.mesh.clone(),
+        positions: refined.positions.clone().unwrap(),
+        uvs: None,
+    };
+    meets_bar(&surf, r).unwrap();
+    assert_eq!(r.degenerate_faces, 0);
+    assert!(ricci::flow::adaptive::under_resolved_faces(
+        &refined.mesh,
+        Geometry::Euclidean,
+        &r.lengths
+    )
+    .is_empty());
+    // The boundary is round.
+    let spread = flow_support::boundary_circle_spread(&refined.mesh, &r.lengths);
+    eprintln!("face.off: boundary radius spread {spread:.2e}");
+    assert!(spread <= 1e-8, "radius spread {spread:e}");
+    // The refinement kept the input: ids and positions of the input vertices, boundary
+    // vertices on the boundary, new vertices on input edges (at their interpolated position).
+    let p = refined.positions.as_ref().unwrap();
+    assert_eq!(refined.original_vertices, n0);
+    assert_eq!(&p[..n0], &s.positions[..]);
+    for v in 0..n0 as u32 {
+        assert_eq!(
+            s.mesh.is_boundary_vertex(v),
+            refined.mesh.is_boundary_vertex(v),
+            "vertex {v}"
+        );
+    }
+    for (k, sv) in refined.new_vertices.iter().enumerate() {
+        let q = p[n0 + k];
+        let (a, b) = (p[sv.a as usize], p[sv.b as usize]);
+        let lerp = [0, 1, 2].map(|i| (1.0 - sv.t) * a[i] + sv.t * b[i]);
+        assert!((0..3).all(|i| (q[i] - lerp[i]).abs() <= 1e-12 * (1.0 + lerp[i].abs())));
+    }
+    // The same metric: curvature of the input vertices unchanged, new vertices flat.
+    let k0 = metric::curvature(&s.mesh, Geometry::Euclidean, &l0);
+    let k1 = metric::curvature(&refined.mesh, Geometry::Euclidean, &refined.lengths);
+    let worst_old = (0..n0).map(|v| (k0[v] - k1[v]).abs()).fold(0.0, f64::max);
+    let worst_new = k1[n0..].iter().map(|k| k.abs()).fold(0.0, f64::max);
+    assert!(
+        worst_old < 1e-9 && worst_new < 1e-9,
+        "{worst_old:e} {worst_new:e}"
+    );
+    let a0 = metric::total_area(&s.mesh, Geometry::Euclidean, &l0);
+    let a1 = metric::total_area(&refined.mesh, Geometry::Euclidean, &refined.lengths);
+    assert!((a0 - a1).abs() <= 1e-10 * a0);
 }

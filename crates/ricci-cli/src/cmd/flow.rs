@@ -1,5 +1,7 @@
 //! `ricci flow MESH --geometry … --scheme … --target … --solver … --tolerance T
-//! [--max-iterations N] [--out METRIC.json] [--json]`: discrete Ricci flow (`ricci::flow`).
+//! [--max-iterations N] [--widen-boundary N] [--refine-degenerate N --refined-out MESH]
+//! [--out METRIC.json] [--json]`: discrete Ricci flow (`ricci::flow`), optionally on a
+//! metric-preserving refinement of the input (`ricci::mesh::refine`, `ricci::flow::adaptive`).
 //!
 //! METRIC.json holds the final discrete metric: geometry, scheme, per-vertex `u`, `curvature`
 //! and `target_curvature` (null where the vertex was held fixed), and per-edge `lengths` with
@@ -59,9 +61,17 @@ pub struct Args {
     /// vertices with two faces). Needs --refined-out: the metric is on the refined mesh.
     #[arg(long, value_name = "N", requires = "refined_out")]
     pub widen_boundary: Option<usize>,
-    /// Where to write the refined mesh of --widen-boundary (input vertices keep their ids,
-    /// new vertices are appended).
-    #[arg(long, value_name = "MESH", requires = "widen_boundary")]
+    /// Adaptive refinement, up to N rounds: after a flow, bisect (longest-edge bisection, in
+    /// the input metric) every face whose final metric violates a triangle inequality or has
+    /// an angle near 0 or π, and flow again (while a circle packing is refused by Chow–Luo,
+    /// a vertex-scaling flow finds the faces) — for targets the triangulation cannot reach
+    /// as it is (e.g. a zig-zag boundary made round: face.off needs 13 rounds after
+    /// --widen-boundary 3). Needs --refined-out: the metric is on the refined mesh.
+    #[arg(long, value_name = "N", requires = "refined_out")]
+    pub refine_degenerate: Option<usize>,
+    /// Where to write the refined mesh of --widen-boundary / --refine-degenerate (input
+    /// vertices keep their ids and positions, new vertices are appended).
+    #[arg(long, value_name = "MESH")]
     pub refined_out: Option<PathBuf>,
     /// Write the final metric (per-vertex u, K, K̄; per-edge lengths) to this JSON file.
     #[arg(long, short = 'o')]
@@ -137,6 +147,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut lengths = surface.edge_lengths();
     let mut surface = surface;
     let mut refinement = serde_json::Value::Null;
+    let mut widen_splits = 0;
     if let Some(n) = a.widen_boundary {
         let r = ricci::mesh::refine::widen_boundary(
             &surface.mesh,
@@ -146,6 +157,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             n,
         )
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?;
+        widen_splits = r.splits();
         refinement = json!({
             "min_faces": n,
             "splits": r.splits(),
@@ -160,7 +172,31 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             uvs: None,
         };
     }
-    let result = ricci_flow(&surface.mesh, &lengths, &options, &mut progress);
+    let result = if let Some(rounds) = a.refine_degenerate {
+        let start = ricci::mesh::refine::Refined::identity(
+            &surface.mesh,
+            &lengths,
+            Some(&surface.positions),
+        );
+        ricci::flow::ricci_flow_refined(start, &options, rounds, &mut progress).map(|(rf, r)| {
+            refinement = json!({
+                "min_faces": a.widen_boundary,
+                "refine_degenerate": rounds,
+                "splits": widen_splits + rf.splits(),
+                "vertices": rf.mesh.n_vertices(),
+                "faces": rf.mesh.n_faces(),
+                "refined_out": a.refined_out.as_ref().map(|p| p.display().to_string()),
+            });
+            surface = ricci::mesh::Surface {
+                mesh: rf.mesh,
+                positions: rf.positions.unwrap_or_default(),
+                uvs: None,
+            };
+            r
+        })
+    } else {
+        ricci_flow(&surface.mesh, &lengths, &options, &mut progress)
+    };
     bar.finish_and_clear();
     let r = result.map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?;
     let source = a.mesh.display().to_string();

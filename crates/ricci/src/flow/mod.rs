@@ -5,7 +5,8 @@
 //! initial conformal structure of the chosen scheme ([`crate::metric::conformal`]), resolves and
 //! checks the target ([`target`]) and runs Newton's method or the gradient flow ([`newton`]).
 //! [`polish`] refines a converged H² metric beyond double precision (separately; the solvers
-//! do not call it).
+//! do not call it). [`adaptive`] reruns the flow on metric-preserving refinements of the mesh
+//! where its metric degenerates (targets the given triangulation cannot reach).
 //! The result carries per-vertex `u`, `K`, `K̄`, per-edge final lengths, the residual history
 //! and an honest `converged` flag.
 //!
@@ -20,12 +21,14 @@
 
 #![allow(clippy::needless_range_loop)]
 
+pub mod adaptive;
 pub mod linear;
 pub mod newton;
 pub mod polish;
 pub mod sphere;
 pub mod target;
 
+pub use adaptive::ricci_flow_refined;
 pub use target::{separated_vertices, Target, TargetSpec};
 
 use crate::error::{Error, Result};

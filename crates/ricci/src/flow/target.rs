@@ -10,15 +10,15 @@
 //! * `single-cone:V` — all of `2πχ` at `V` (the automatic choice comes with the atlas);
 //! * `free-boundary` — `K̄ = 0` inside, `u` fixed at its initial value on the boundary (the
 //!   boundary keeps its lengths: least area distortion near the boundary);
-//! * `round-boundary` — `K̄ = 0` inside; on each boundary loop the geodesic curvature is
-//!   constant: `K̄_i = T_loop · w_i / L_loop` with `L_loop` the loop's current length and
-//!   `w_i = ∂L_loop/∂u_i` the vertex's share of it — exactly the dual boundary length
-//!   `(l_{i−1,i} + l_{i,i+1})/2` for vertex scaling, and its circle-packing analogue
-//!   (`≈ 2γ_i` for nearly tangent circles) otherwise — re-evaluated as the metric changes.
-//!   With this choice the targets are the gradient of `T log L`, so the problem stays
-//!   variational (energy `E − Σ T log L`, symmetric Jacobian). Totals `T`: for genus 0 the
-//!   longest loop (input lengths) gets `+2π` and every other loop `−2π` (a disk with round
-//!   holes); for genus ≥ 1 every loop gets `2πχ/b` (constant geodesic curvature per loop, all
+//! * `round-boundary` — `K̄ = 0` inside; the vertices of each boundary loop lie on a circle
+//!   (constant geodesic curvature `1/R`): with the loop's current edge lengths `l_k`, edge `k`
+//!   subtends `α_k = 2 asin(l_k/2R)`, `R` chosen so that `Σ α_k = |T|`, and a boundary vertex
+//!   between edges `a`, `b` gets the turning angle `K̄_i = sign(T)(α_a + α_b)/2` —
+//!   re-evaluated as the metric changes ([`Target::update_round`]). (To first order
+//!   `K̄_i ≈ T (l_a + l_b)/2L`, the dual-length share of `T`; the exact rule is what puts the
+//!   laid-out vertices on one circle, to rounding.) Totals `T`: for genus 0 the longest loop
+//!   (input lengths) gets `+2π` and every other loop `−2π` (a disk with round holes); for
+//!   genus ≥ 1 every loop gets `2πχ/b` (vertices on arcs of constant geodesic curvature, all
 //!   loops alike). Euclidean only;
 //! * `geodesic-boundary` — `K̄ = 0` everywhere including the boundary (hyperbolic metrics with
 //!   geodesic boundaries);
@@ -167,30 +167,27 @@ pub struct Target {
 }
 
 impl Target {
-    /// Recompute the round loops' boundary targets `K̄_i = T w_i / L` from the current lengths
-    /// and their derivatives (`dlengths[e]` = `[∂l_e/∂u_a, ∂l_e/∂u_b]` for
-    /// `[a, b] = edge_vertices[e]`).
+    /// Recompute the round loops' boundary targets from the current lengths: the boundary
+    /// vertices of a loop with total curvature `T` lie on a circle of radius `R` (a curve of
+    /// constant geodesic curvature `1/R`) when each boundary edge `k` subtends the central
+    /// angle `α_k = 2 asin(l_k / 2R)` with `Σ_k α_k = |T|`, and the turning angle at a vertex
+    /// between edges `a` and `b` is `K̄_i = sign(T) (α_a + α_b)/2` (the base angles of the
+    /// isosceles triangles over the edges). `R` is solved for per loop ([`circle_radius`]).
+    /// `dlengths` and `edge_vertices` are not needed by this rule (kept for the callers'
+    /// convenience: the Jacobian in [`super::newton`] uses them).
     pub fn update_round(
         &mut self,
         lengths: &[f64],
-        dlengths: &[[f64; 2]],
-        edge_vertices: &[[u32; 2]],
+        _dlengths: &[[f64; 2]],
+        _edge_vertices: &[[u32; 2]],
     ) {
         for lp in &self.round_loops {
             let n = lp.vertices.len();
-            let total_len: f64 = lp.edges.iter().map(|&e| lengths[e as usize]).sum();
+            let l: Vec<f64> = lp.edges.iter().map(|&e| lengths[e as usize]).collect();
+            let c = CircleLoop::new(&l, lp.total);
             for k in 0..n {
                 let v = lp.vertices[k];
-                let mut w = 0.0;
-                for e in [lp.edges[(k + n - 1) % n], lp.edges[k]] {
-                    let d = dlengths[e as usize];
-                    w += if edge_vertices[e as usize][0] == v {
-                        d[0]
-                    } else {
-                        d[1]
-                    };
-                }
-                self.curvature[v as usize] = lp.total * w / total_len;
+                self.curvature[v as usize] = c.sign * 0.5 * (c.alpha[(k + n - 1) % n] + c.alpha[k]);
             }
         }
     }
@@ -198,6 +195,105 @@ impl Target {
     pub fn is_dynamic(&self) -> bool {
         !self.round_loops.is_empty()
     }
+}
+
+/// The circle through the vertices of one boundary loop with edge lengths `l_k` and total
+/// turning `T` (see [`Target::update_round`]): radius `R`, central angles `α_k`, and the
+/// derivative data of Newton's method, `c_k = ∂α_k/∂l_k = 1/(R cos(α_k/2))` and
+/// `S = Σ l_k c_k` (then `∂R/∂l_k = R c_k / S` along `Σ α_k = |T|`).
+#[derive(Debug, Clone)]
+pub struct CircleLoop {
+    pub radius: f64,
+    pub alpha: Vec<f64>,
+    pub dalpha: Vec<f64>,
+    pub s: f64,
+    /// `sign(T)`: +1 for a loop bounding a disk on its left, −1 for a hole; 0 when `T = 0`.
+    pub sign: f64,
+}
+
+impl CircleLoop {
+    pub fn new(l: &[f64], total: f64) -> CircleLoop {
+        let n = l.len();
+        let t = total.abs();
+        let sign = if total > 0.0 {
+            1.0
+        } else if total < 0.0 {
+            -1.0
+        } else {
+            0.0
+        };
+        if t == 0.0 || n == 0 {
+            return CircleLoop {
+                radius: f64::INFINITY,
+                alpha: vec![0.0; n],
+                dalpha: vec![0.0; n],
+                s: 1.0,
+                sign,
+            };
+        }
+        let radius = circle_radius(l, t);
+        let mut alpha = Vec::with_capacity(n);
+        let mut dalpha = Vec::with_capacity(n);
+        let mut s = 0.0;
+        for &x in l {
+            let q = (x / (2.0 * radius)).min(1.0);
+            alpha.push(2.0 * q.asin());
+            let c = 1.0 / (radius * (1.0 - q * q).sqrt().max(1e-12));
+            dalpha.push(c);
+            s += x * c;
+        }
+        CircleLoop {
+            radius,
+            alpha,
+            dalpha,
+            s,
+            sign,
+        }
+    }
+}
+
+/// The radius `R` with `Σ_k 2 asin(l_k / 2R) = t` (`t > 0`): the circle on which a polygon
+/// with sides `l_k` has its vertices while its sides turn by `t` in total (`t = 2π`: an
+/// inscribed polygon around the centre). The left side decreases in `R`; the root lies in
+/// `[max(L/t, l_max/2), πL/(2t)]` (from `x ≤ asin x ≤ πx/2`) and is found by Newton's method
+/// safeguarded by bisection, to relative accuracy 1e-15. If even `R = l_max/2` turns by less
+/// than `t` (one side longer than the rest can close), `R = l_max/2` is returned.
+pub fn circle_radius(l: &[f64], t: f64) -> f64 {
+    let total: f64 = l.iter().sum();
+    let lmax = l.iter().cloned().fold(0.0, f64::max);
+    let f = |r: f64| -> (f64, f64) {
+        let mut v = -t;
+        let mut d = 0.0;
+        for &x in l {
+            let q = (x / (2.0 * r)).min(1.0);
+            v += 2.0 * q.asin();
+            d -= x / (r * r * (1.0 - q * q).sqrt().max(1e-300));
+        }
+        (v, d)
+    };
+    let mut lo = (total / t).max(0.5 * lmax);
+    let mut hi = (0.5 * PI * total / t).max(lo);
+    if f(lo).0 <= 0.0 {
+        return lo;
+    }
+    let mut r = lo.max(total / t);
+    for _ in 0..200 {
+        let (v, d) = f(r);
+        if v > 0.0 {
+            lo = r;
+        } else {
+            hi = r;
+        }
+        let mut next = r - v / d;
+        if !(next > lo && next < hi && next.is_finite()) {
+            next = 0.5 * (lo + hi);
+        }
+        if (next - r).abs() <= 1e-15 * r || hi - lo <= 1e-15 * hi {
+            return next;
+        }
+        r = next;
+    }
+    r
 }
 
 fn read_target_file(path: &Path, n: usize) -> Result<Vec<f64>> {
@@ -608,4 +704,42 @@ pub fn separated_vertices(mesh: &Mesh, count: usize, min_valence: usize) -> Vec<
         }
     }
     chosen
+}
+
+#[cfg(test)]
+mod circle_tests {
+    use super::*;
+
+    /// Closed forms: a regular n-gon with side l has circumradius l / (2 sin(π/n)); a polygon
+    /// built on a circle of radius R from unequal central angles gives back R; the central
+    /// angles sum to the total turning.
+    #[test]
+    fn circle_radius_of_cyclic_polygons() {
+        for n in [3usize, 4, 7, 100, 1000] {
+            let l = vec![0.37; n];
+            let want = 0.37 / (2.0 * (PI / n as f64).sin());
+            let r = circle_radius(&l, 2.0 * PI);
+            assert!((r / want - 1.0).abs() < 1e-13, "n = {n}: {r} vs {want}");
+        }
+        // Unequal central angles (summing to 2π), sides 2R sin(α/2).
+        let weights: Vec<f64> = (0..57).map(|k| 1.0 + ((k * 7919) % 13) as f64).collect();
+        let wsum: f64 = weights.iter().sum();
+        let radius = 2.5;
+        let alpha: Vec<f64> = weights.iter().map(|w| 2.0 * PI * w / wsum).collect();
+        let l: Vec<f64> = alpha
+            .iter()
+            .map(|a| 2.0 * radius * (0.5 * a).sin())
+            .collect();
+        let c = CircleLoop::new(&l, -2.0 * PI);
+        assert!((c.radius / radius - 1.0).abs() < 1e-13, "{}", c.radius);
+        assert_eq!(c.sign, -1.0);
+        for (a, b) in c.alpha.iter().zip(&alpha) {
+            assert!((a - b).abs() < 1e-12);
+        }
+        assert!((c.alpha.iter().sum::<f64>() - 2.0 * PI).abs() < 1e-12);
+        // An arc of total turning π on the same circle (half the angles doubled up).
+        let half: Vec<f64> = l[..l.len() / 2].to_vec();
+        let t: f64 = alpha[..alpha.len() / 2].iter().sum();
+        assert!((circle_radius(&half, t) / radius - 1.0).abs() < 1e-13);
+    }
 }

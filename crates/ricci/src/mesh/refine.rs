@@ -727,9 +727,9 @@ impl Refiner {
         best
     }
 
-    /// One step of Rivara's longest-edge propagation path from face `f`: follow the longest
-    /// edges until an edge is the longest of both its faces (or on the boundary) and split it.
-    fn lepp_step(&mut self, f: u32, x: u32, dist: &mut Vec<f64>) -> u32 {
+    /// The terminal edge of Rivara's longest-edge propagation path from face `f`: follow the
+    /// longest edges until an edge is the longest of both its faces (or on the boundary).
+    fn lepp_edge(&self, f: u32, x: u32) -> u32 {
         let mut h = self.refinement_edge(f, x);
         for _ in 0..64 {
             let t = self.twin[h as usize];
@@ -742,6 +742,29 @@ impl Refiner {
             }
             h = r;
         }
+        h
+    }
+
+    /// **Longest-edge bisection** (Rivara's LEPP) started at face `f`: split the terminal
+    /// edge of the longest-edge propagation path from `f` at its midpoint (metric-preserving,
+    /// like [`Refiner::split`]); returns the new vertex. Repeated bisection of a face keeps
+    /// the smallest angle of the refined faces above half the smallest input angle (Rivara),
+    /// so refining a region never creates slivers there.
+    pub fn bisect(&mut self, f: u32) -> Result<u32> {
+        if f as usize >= self.faces.len() {
+            return Err(Error::input(format!(
+                "face {f} does not exist (the mesh has {} faces)",
+                self.faces.len()
+            )));
+        }
+        let h = self.lepp_edge(f, NONE);
+        Ok(self.split(h, 0.5))
+    }
+
+    /// One LEPP step from face `f` (faces at `x` split across their link edge only), keeping
+    /// the distances from `x` up to date.
+    fn lepp_step(&mut self, f: u32, x: u32, dist: &mut Vec<f64>) -> u32 {
+        let h = self.lepp_edge(f, x);
         let m = self.split(h, 0.5);
         // Distance of the new vertex: the best over its neighbours.
         let (fan, closed) = self.fan(m);

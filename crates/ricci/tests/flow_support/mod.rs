@@ -1,7 +1,7 @@
 //! Small procedural surfaces and a minimal mesh reader for the flow and metric tests (the
 //! library's own generators and readers live in other modules; these keep the tests
 //! self-contained).
-#![allow(dead_code)]
+#![allow(dead_code, clippy::needless_range_loop)]
 
 use ricci::mesh::Surface;
 use std::collections::HashMap;
@@ -196,3 +196,65 @@ pub fn hemisphere(rings: usize) -> Surface {
 #[path = "../ricci_meshes/mod.rs"]
 mod ricci_meshes;
 use ricci_meshes::ricci_meshes;
+
+/// Spread `(max r − min r)/max r` of the distances of each boundary loop's vertices from the
+/// least-squares (Kåsa) circle through them, in an independent E² layout of `lengths`
+/// (`ricci::layout`); the worst over the loops.
+pub fn boundary_circle_spread(mesh: &ricci::mesh::Mesh, lengths: &[f64]) -> f64 {
+    use ricci::metric::geometry::Euclidean;
+    let lay = ricci::layout::layout::<Euclidean>(mesh, lengths, None).unwrap();
+    assert!(lay.flipped_faces.is_empty() && lay.degenerate_faces.is_empty());
+    let mut worst = 0.0f64;
+    for lp in mesh.boundary_loops() {
+        let pts: Vec<[f64; 2]> = lp
+            .iter()
+            .map(|&v| {
+                let z = lay.positions[v as usize];
+                [z.re, z.im]
+            })
+            .collect();
+        let n = pts.len() as f64;
+        let c0 = pts
+            .iter()
+            .fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
+        // Kåsa fit: x² + y² + a x + b y + c = 0 in least squares (exact for concyclic points).
+        let mut m = [[0.0f64; 3]; 3];
+        let mut r = [0.0f64; 3];
+        for p in &pts {
+            let (x, y) = (p[0] - c0[0], p[1] - c0[1]);
+            let row = [x, y, 1.0];
+            for i in 0..3 {
+                for j in 0..3 {
+                    m[i][j] += row[i] * row[j];
+                }
+                r[i] -= row[i] * (x * x + y * y);
+            }
+        }
+        for c in 0..3 {
+            for i in c + 1..3 {
+                let f = m[i][c] / m[c][c];
+                for j in 0..3 {
+                    m[i][j] -= f * m[c][j];
+                }
+                r[i] -= f * r[c];
+            }
+        }
+        let mut s = [0.0; 3];
+        for i in (0..3).rev() {
+            let mut a = r[i];
+            for j in i + 1..3 {
+                a -= m[i][j] * s[j];
+            }
+            s[i] = a / m[i][i];
+        }
+        let centre = [c0[0] - 0.5 * s[0], c0[1] - 0.5 * s[1]];
+        let radii: Vec<f64> = pts
+            .iter()
+            .map(|p| ((p[0] - centre[0]).powi(2) + (p[1] - centre[1]).powi(2)).sqrt())
+            .collect();
+        let rmax = radii.iter().cloned().fold(0.0, f64::max);
+        let rmin = radii.iter().cloned().fold(f64::INFINITY, f64::min);
+        worst = worst.max((rmax - rmin) / rmax);
+    }
+    worst
+}
