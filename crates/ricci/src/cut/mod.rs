@@ -50,6 +50,7 @@
 
 pub mod homology;
 pub mod paths;
+mod schema;
 pub mod slice;
 pub mod system;
 
@@ -280,6 +281,21 @@ pub fn canonical_cut(
         s / valence_before.max(1) as f64
     };
 
+    if nb == 0 && genus >= 1 {
+        return cut_and_paste(
+            mesh,
+            lengths,
+            geometry,
+            positions,
+            base,
+            automatic,
+            genus,
+            min_valence,
+            mean_spoke,
+            progress,
+            t0,
+        );
+    }
     let mut failed = Vec::new();
     let mut attempt = 0;
     progress.report(
@@ -400,6 +416,82 @@ pub fn canonical_cut(
         search: stats,
         seconds: t0.elapsed().as_secs_f64(),
     };
+    progress.report("cut", Some(1.0), "done");
+    Ok(out)
+}
+
+/// Closed surfaces of genus `g ≥ 1`: the construction of [`schema`] (disjoint loops with
+/// independent classes, then cut-and-paste moves on the polygon), which does not fail.
+#[allow(clippy::too_many_arguments)]
+fn cut_and_paste(
+    mesh: &Mesh,
+    lengths: &[f64],
+    geometry: Geometry,
+    positions: Option<&[[f64; 3]]>,
+    base: u32,
+    automatic: bool,
+    genus: usize,
+    min_valence: usize,
+    mean_spoke: f64,
+    progress: &mut dyn Progress,
+    t0: std::time::Instant,
+) -> Result<CanonicalCut> {
+    let valence_before = mesh.valence(base);
+    progress.report(
+        "cut",
+        Some(0.0),
+        &format!("refining around vertex {base} to valence {min_valence}"),
+    );
+    let refined = grade_base(
+        mesh,
+        lengths,
+        geometry,
+        positions,
+        base,
+        min_valence,
+        4 * genus,
+        mean_spoke,
+    )?;
+    let coh = Cohomology::new(&refined.mesh)?;
+    if coh.dim != 2 * genus {
+        return Err(Error::topology(format!(
+            "the first Z2 homology has dimension {} but a closed surface of genus {genus} needs {}",
+            coh.dim,
+            2 * genus
+        )));
+    }
+    let omega = schema::Schema::halfedge_cocycles(&refined.mesh, &coh);
+    let words = coh.words;
+    drop(coh);
+    let r = Refiner::resume(refined, geometry)?;
+    progress.report(
+        "cut",
+        Some(0.2),
+        &format!("{} loops with independent classes, then cut-and-paste", 2 * genus),
+    );
+    let mut sch = schema::Schema::new(r, omega, words, base);
+    let raw = sch.build(genus)?;
+    let stats = sch.stats.clone();
+    let moves = sch.moves;
+    let refined = sch.into_refiner().finish()?;
+    progress.report("cut", Some(0.9), "slicing");
+    let mut out = assemble(refined, raw, base, genus, 0, geometry)?;
+    out.report = CutReport {
+        base_vertex: base,
+        base_automatic: automatic,
+        valence_before,
+        valence_after: out.refined.mesh.valence(base),
+        min_valence,
+        refinement_splits: out.refined.splits(),
+        attempts: 1,
+        failed_attempts: Vec::new(),
+        search: SearchStats {
+            attempts: 1,
+            ..stats
+        },
+        seconds: t0.elapsed().as_secs_f64(),
+    };
+    let _ = moves;
     progress.report("cut", Some(1.0), "done");
     Ok(out)
 }
