@@ -452,7 +452,14 @@ fn cut_and_paste(
         4 * genus,
         mean_spoke,
     )?;
+    let tm = |s: &str| {
+        if std::env::var_os("RICCI_CUT_TIMING").is_some() {
+            eprintln!("  {s}: {:.3} s", t0.elapsed().as_secs_f64());
+        }
+    };
+    tm("graded");
     let coh = Cohomology::new(&refined.mesh)?;
+    tm("cohomology");
     if coh.dim != 2 * genus {
         return Err(Error::topology(format!(
             "the first Z2 homology has dimension {} but a closed surface of genus {genus} needs {}",
@@ -470,12 +477,16 @@ fn cut_and_paste(
         &format!("{} loops with independent classes, then cut-and-paste", 2 * genus),
     );
     let mut sch = schema::Schema::new(r, omega, words, base);
+    tm("resumed");
     let raw = sch.build(genus)?;
+    tm("built");
     let stats = sch.stats.clone();
     let moves = sch.moves;
     let refined = sch.into_refiner().finish()?;
+    tm("finished");
     progress.report("cut", Some(0.9), "slicing");
     let mut out = assemble(refined, raw, base, genus, 0, geometry)?;
+    tm("assembled");
     out.report = CutReport {
         base_vertex: base,
         base_automatic: automatic,

@@ -50,7 +50,6 @@ use std::collections::BinaryHeap;
 /// Loops and their bookkeeping on a mutable refinement.
 struct Loops {
     verts: Vec<u32>,
-    class: Vec<u64>,
 }
 
 /// The construction state: the refinement being split, the cocycles per half-edge, the loops.
@@ -75,6 +74,8 @@ pub(crate) struct Schema {
     branch: Vec<u32>,
     parity: Vec<u64>,
     heap: BinaryHeap<MinItem>,
+    /// Scratch list of outgoing half-edges.
+    buf: Vec<u32>,
     pub stats: SearchStats,
     /// Cut-and-paste moves made in phase 2.
     pub moves: usize,
@@ -124,6 +125,7 @@ impl Schema {
             branch: Vec::new(),
             parity: Vec::new(),
             heap: BinaryHeap::new(),
+            buf: Vec::new(),
             stats: SearchStats {
                 attempts: 1,
                 ..SearchStats::default()
@@ -290,7 +292,7 @@ impl Schema {
         }
     }
 
-    fn mark(&mut self, verts: Vec<u32>, class: Vec<u64>) -> usize {
+    fn mark(&mut self, verts: Vec<u32>) -> usize {
         let id = self.loops.len();
         for (k, &v) in verts.iter().enumerate() {
             if v != self.x {
@@ -298,7 +300,7 @@ impl Schema {
                 self.pos[v as usize] = k as u32;
             }
         }
-        self.loops.push(Some(Loops { verts, class }));
+        self.loops.push(Some(Loops { verts }));
         id
     }
 
@@ -337,7 +339,19 @@ impl Schema {
     }
 
     fn independent(&self, c: &[u64]) -> bool {
-        self.reduce(c.to_vec()).iter().any(|&w| w != 0)
+        if c.len() > 8 {
+            return self.reduce(c.to_vec()).iter().any(|&w| w != 0);
+        }
+        let mut t = [0u64; 8];
+        t[..c.len()].copy_from_slice(c);
+        for (pb, b) in &self.basis {
+            if t[pb / 64] >> (pb % 64) & 1 == 1 {
+                for (p, q) in t.iter_mut().zip(b) {
+                    *p ^= q;
+                }
+            }
+        }
+        t.iter().any(|&w| w != 0)
     }
 
     fn add_to_basis(&mut self, c: &[u64]) {
@@ -450,7 +464,10 @@ impl Schema {
                         self.parity[u as usize * wd + k] ^ self.omega[hp as usize * wd + k];
                 }
             }
-            for h in self.outgoing(v) {
+            let mut buf = std::mem::take(&mut self.buf);
+            buf.clear();
+            self.for_outgoing(v, |h| buf.push(h));
+            for &h in &buf {
                 let w = self.r.he_tip(h);
                 let l = self.r.length(h);
                 if w == x {
@@ -496,6 +513,7 @@ impl Schema {
                     self.offer(w, d + l, h);
                 }
             }
+            self.buf = buf;
         }
         if let Some((_, v, w)) = best {
             let mut verts = self.trace(v);
@@ -531,7 +549,7 @@ impl Schema {
             Error::numerical("internal error: a loop of the cut uses a missing edge")
         })?;
         self.add_to_basis(&class);
-        let id = self.mark(verts, class);
+        let id = self.mark(verts);
         self.depinch(id);
         Ok(())
     }
@@ -553,7 +571,7 @@ impl Schema {
         if a.iter().skip(1).any(|&v| !self.free(v)) {
             return Ok(false);
         }
-        let tmp = self.mark(a.clone(), Vec::new());
+        let tmp = self.mark(a.clone());
         self.depinch(tmp);
         let mut xn = Vec::new();
         for h in self.outgoing(x) {
@@ -573,13 +591,17 @@ impl Schema {
                 end = Some(v);
                 break;
             }
-            for h in self.outgoing(v) {
+            let mut buf = std::mem::take(&mut self.buf);
+            buf.clear();
+            self.for_outgoing(v, |h| buf.push(h));
+            for &h in &buf {
                 let z = self.r.he_tip(h);
                 if self.free(z) && !self.settled(z) {
                     let l = self.r.length(h);
                     self.offer(z, self.dist[v as usize] + l, h);
                 }
             }
+            self.buf = buf;
         }
         self.unmark(tmp);
         self.loops.pop();
@@ -706,13 +728,17 @@ impl Schema {
                     best_v = v;
                 }
             }
-            for h in self.outgoing(v) {
+            let mut buf = std::mem::take(&mut self.buf);
+            buf.clear();
+            self.for_outgoing(v, |h| buf.push(h));
+            for &h in &buf {
                 let z = self.r.he_tip(h);
                 if self.free(z) && !self.settled(z) {
                     let l = self.r.length(h);
                     self.offer(z, d + l, h);
                 }
             }
+            self.buf = buf;
         }
         if best_v == NONE {
             return None;
@@ -728,6 +754,13 @@ impl Schema {
         self.ensure();
         for _ in 0..2 * genus {
             self.independent_loop()?;
+        }
+        if std::env::var_os("RICCI_CUT_TIMING").is_some() {
+            eprintln!(
+                "  phase 1 done ({} searches, {} vertices)",
+                self.stats.searches,
+                self.r.n_vertices()
+            );
         }
         let x = self.x;
         let max_moves = 4 * genus + 8;
@@ -778,8 +811,7 @@ impl Schema {
             })?;
             let removed = (s.unsigned_abs() - 1) as usize;
             self.unmark(removed);
-            let class = self.path_class(&c).unwrap_or_default();
-            let id = self.mark(c, class);
+            let id = self.mark(c);
             self.depinch(id);
             self.moves += 1;
         }
@@ -867,6 +899,43 @@ fn plan(w: &[i64]) -> Option<(usize, usize, i64)> {
         }
     }
     let (a, b, ia) = pair?;
+    // A move that completes a block for any linked pair first (the second move of a plan
+    // made earlier), then the first move of a two-move plan for the first pair.
+    for (a2, b2, i2) in linked_pairs(w, &done) {
+        if let Some(m) = plan_pair(w, a2, b2, i2, false) {
+            return Some(m);
+        }
+    }
+    plan_pair(w, a, b, ia, true)
+}
+
+/// All linked pairs `(a, b, first index of a)` of letters outside blocks.
+fn linked_pairs(w: &[i64], done: &dyn Fn(i64) -> bool) -> Vec<(i64, i64, usize)> {
+    let n = w.len();
+    let at = |l: i64| (0..n).find(|&k| w[k] == l).unwrap_or(0);
+    let mut out = Vec::new();
+    for k in 0..n {
+        let a = w[k];
+        if a < 0 || done(a) {
+            continue;
+        }
+        let (ia, ja) = (at(a), at(-a));
+        for &b in w {
+            if b < 0 || b == a || done(b) {
+                continue;
+            }
+            let inside = |t: usize| (t + n - ia) % n < (ja + n - ia) % n;
+            if inside(at(b)) != inside(at(-b)) {
+                out.push((a, b, ia));
+            }
+        }
+    }
+    out
+}
+
+/// A move for the pair `(a, b)` that makes a block now, or (with `two`) the first of two.
+fn plan_pair(w: &[i64], a: i64, b: i64, ia: usize, two: bool) -> Option<(usize, usize, i64)> {
+    let n = w.len();
     // Compress from `a`'s first occurrence.
     let mut toks: Vec<i64> = Vec::new();
     let mut start: Vec<usize> = Vec::new();
@@ -897,6 +966,9 @@ fn plan(w: &[i64]) -> Option<(usize, usize, i64)> {
             }
         }
     }
+    if !two {
+        return None;
+    }
     for p in 0..m {
         for q in 0..m {
             for s in [a, b] {
@@ -926,7 +998,44 @@ fn plan(w: &[i64]) -> Option<(usize, usize, i64)> {
 mod tests {
     use super::*;
 
+    /// Number of vertices of the polygon schema (corners identified by the side pairing).
+    fn vertices(w: &[i64]) -> usize {
+        let n = w.len();
+        let ends = |l: i64| {
+            let k = 2 * (l.unsigned_abs() as usize);
+            if l > 0 { (k, k + 1) } else { (k + 1, k) }
+        };
+        let top = w.iter().map(|l| l.unsigned_abs() as usize).max().unwrap_or(0);
+        let mut parent: Vec<usize> = (0..2 * top + 2).collect();
+        fn find(p: &mut Vec<usize>, mut i: usize) -> usize {
+            while p[i] != i {
+                p[i] = p[p[i]];
+                i = p[i];
+            }
+            i
+        }
+        for k in 0..n {
+            let (_, head) = ends(w[k]);
+            let (tail, _) = ends(w[(k + 1) % n]);
+            let (r1, r2) = (find(&mut parent, head), find(&mut parent, tail));
+            parent[r1] = r2;
+            let _ = n;
+        }
+        let mut roots: Vec<usize> = w
+            .iter()
+            .flat_map(|&l| {
+                let (t, h) = ends(l);
+                [t, h]
+            })
+            .map(|i| find(&mut parent, i))
+            .collect();
+        roots.sort_unstable();
+        roots.dedup();
+        roots.len()
+    }
+
     fn is_canonical_after(mut w: Vec<i64>, genus: usize) -> usize {
+        assert_eq!(vertices(&w), 1, "{w:?} is not a one-vertex schema");
         // Apply planned moves symbolically until the word is canonical; the number of moves.
         let mut next = 100;
         for moves in 0..4 * genus + 8 {
@@ -935,6 +1044,7 @@ mod tests {
             }
             let (p, q, s) = plan(&w).expect("a move");
             w = paste(&w, p, q, s, next).expect("a valid move");
+            assert_eq!(vertices(&w), 1, "the move made {w:?}");
             next += 1;
         }
         panic!("not canonical: {w:?}");
@@ -942,14 +1052,36 @@ mod tests {
 
     #[test]
     fn planned_moves_reach_the_canonical_word_in_two_moves_per_handle() {
-        // a b a⁻¹ b⁻¹ is canonical; the word of two linked pairs "a c b a⁻¹ d c⁻¹ b⁻¹ d⁻¹"
-        // (genus 2, one vertex) and the "hyperelliptic" word a b c d a⁻¹ b⁻¹ c⁻¹ d⁻¹.
         assert_eq!(is_canonical_after(vec![1, 2, -1, -2], 1), 0);
-        assert!(is_canonical_after(vec![1, 2, -1, -2, 3, 4, -3, -4], 2) == 0);
-        assert!(is_canonical_after(vec![1, 2, 3, 4, -1, -2, -3, -4], 2) <= 4);
-        assert!(is_canonical_after(vec![1, 3, 2, -1, 4, -3, -2, -4], 2) <= 4);
-        // Genus 4 "a b c … a⁻¹ b⁻¹ c⁻¹ …".
-        let w: Vec<i64> = (1..=8).chain((1..=8).map(|k| -k)).collect();
-        assert!(is_canonical_after(w, 4) <= 8);
+        assert_eq!(is_canonical_after(vec![1, 2, -1, -2, 3, 4, -3, -4], 2), 0);
+        // The standard 4g-gon x₁ … x_2g x₁⁻¹ … x_2g⁻¹ (one vertex).
+        for g in 1..=8i64 {
+            let w: Vec<i64> = (1..=2 * g).chain((1..=2 * g).map(|k| -k)).collect();
+            assert!(is_canonical_after(w, g as usize) <= 2 * g as usize);
+        }
+        // Random one-vertex words: random cut-and-paste moves applied to canonical words.
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut rnd = |n: usize| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % n as u64) as usize
+        };
+        for trial in 0..200 {
+            let g = 1 + trial % 6;
+            let mut w: Vec<i64> = (0..g as i64)
+                .flat_map(|k| [2 * k + 1, 2 * k + 2, -(2 * k + 1), -(2 * k + 2)])
+                .collect();
+            let mut next = 1000;
+            for _ in 0..3 * g {
+                let n = w.len();
+                let (p, q, s) = (rnd(n), rnd(n), w[rnd(n)]);
+                if let Some(w2) = paste(&w, p, q, s, next) {
+                    w = w2;
+                    next += 1;
+                }
+            }
+            assert!(is_canonical_after(w, g) <= 2 * g);
+        }
     }
 }
