@@ -265,22 +265,33 @@ impl Schema {
         Some(m)
     }
 
-    /// Split every chord edge (uncut, both ends cut) at a vertex of loop `l`.
-    fn depinch(&mut self, l: usize) {
+    /// Whether the uncut edge `v → w` (half-edge `h`) has an *ear* on one side: a triangle
+    /// whose two other edges are cut. An ear is a leaf of the dual graph of the cut surface,
+    /// so its chord edge does not disconnect the free vertices and is left alone (splitting it
+    /// would halve the angle at the ear's apex, possibly `x`, for nothing); a sector of `x`
+    /// that is a single ear is split when a chord has to start there ([`Schema::chord`]).
+    fn is_ear_chord(&self, h: u32) -> bool {
+        let t = self.r.he_twin(h);
+        [h, t].into_iter().filter(|&g| g != NONE).any(|g| {
+            let (v, w) = (self.r.he_origin(g), self.r.he_tip(g));
+            let c = self.r.he_origin(Refiner::he_prev(g));
+            self.is_cut_edge(w, c) && self.is_cut_edge(c, v)
+        })
+    }
+
+    /// Split (at the midpoint) every chord edge at the given
+    /// vertices: uncut, both ends cut (`x` included), and not the chord of an ear.
+    fn depinch_at(&mut self, verts: &[u32]) {
         let x = self.x;
-        let verts = match &self.loops[l] {
-            Some(lp) => lp.verts.clone(),
-            None => return,
-        };
         let mut pairs = Vec::new();
-        for &v in &verts {
-            if v == x {
+        for &v in verts {
+            if v == x || self.loop_of[v as usize] == NONE {
                 continue;
             }
             self.for_outgoing(v, |h| {
                 let w = self.r.he_tip(h);
                 let cut = w == x || self.loop_of[w as usize] != NONE;
-                if cut && !self.is_cut_edge(v, w) {
+                if cut && !self.is_cut_edge(v, w) && !self.is_ear_chord(h) {
                     pairs.push((v.min(w), v.max(w)));
                 }
             });
@@ -290,6 +301,34 @@ impl Schema {
         for (a, b) in pairs {
             self.split_edge(a, b);
         }
+    }
+
+    /// Split the chord edges at the vertices of loop `l` (see the module docs).
+    fn depinch(&mut self, l: usize) {
+        let verts = match &self.loops[l] {
+            Some(lp) => lp.verts.clone(),
+            None => return,
+        };
+        self.depinch_at(&verts);
+    }
+
+    /// Remove loop `l`; the ears it made disappear, so their chord edges may now pinch: they
+    /// are split.
+    fn remove(&mut self, l: usize) {
+        let verts = match &self.loops[l] {
+            Some(lp) => lp.verts.clone(),
+            None => return,
+        };
+        self.unmark(l);
+        let mut around = Vec::new();
+        for &v in &verts {
+            if v != self.x {
+                self.for_outgoing(v, |h| around.push(self.r.he_tip(h)));
+            }
+        }
+        around.sort_unstable();
+        around.dedup();
+        self.depinch_at(&around);
     }
 
     fn mark(&mut self, verts: Vec<u32>) -> usize {
@@ -650,10 +689,17 @@ impl Schema {
             }
         }
         let ne = ends.len();
+        // Number from a fixed end (the start of the loop with the smallest id), so that the
+        // numbering does not depend on where the fan of `x` starts (splits move it).
+        let r = (0..ne)
+            .filter(|&k| ends[k].1)
+            .min_by_key(|&k| ends[k].0)
+            .unwrap_or(0);
+        let ends: Vec<(u32, bool)> = ends[r..].iter().chain(&ends[..r]).copied().collect();
         // Neighbours before the first end lie in the last sector.
         let free_nbrs = free_nbrs
             .into_iter()
-            .map(|(n, k)| (n, (k + ne - 1) % ne.max(1)))
+            .map(|(n, k)| (n, (k + 2 * ne - 1 - r) % ne.max(1)))
             .collect();
         (ends, free_nbrs)
     }
@@ -691,10 +737,45 @@ impl Schema {
         out
     }
 
+    /// Sector `j` of `x` without a free neighbour is one ear `(x, n_j, n_{j+1})`: split its
+    /// chord edge; the new vertex is joined to the free vertex across it.
+    fn open_sector(&mut self, j: usize) {
+        let x = self.x;
+        let (ends, _) = self.rotation();
+        let ne = ends.len();
+        let mut tips = Vec::new();
+        for h in self.outgoing(x) {
+            let n = self.r.he_tip(h);
+            if !self.free(n) && self.is_spoke(n) {
+                tips.push(n);
+            }
+        }
+        if tips.len() != ne || ne == 0 {
+            return;
+        }
+        // The same numbering as `rotation`.
+        let first = tips
+            .iter()
+            .position(|&n| {
+                let l = self.loop_of[n as usize];
+                (l, self.pos[n as usize] == 1) == ends[0]
+            })
+            .unwrap_or(0);
+        tips.rotate_left(first);
+        let (a, b) = (tips[j], tips[(j + 1) % ne]);
+        self.split_edge(a, b);
+    }
+
     /// Shortest chord of the disk from a free neighbour of `x` in sector `p` to one in sector
     /// `q`, as a loop `[x, …, x]`.
     fn chord(&mut self, p: usize, q: usize) -> Option<Vec<u32>> {
         let x = self.x;
+        for sector in [p, q] {
+            let (_, nbrs) = self.rotation();
+            if nbrs.iter().all(|&(_, s)| s != sector) {
+                self.open_sector(sector);
+            }
+        }
         let (_, nbrs) = self.rotation();
         let mut target_len = std::collections::HashMap::new();
         let spokes: Vec<(u32, f64)> = self
@@ -753,14 +834,18 @@ impl Schema {
     pub(crate) fn build(&mut self, genus: usize) -> Result<Vec<RawPath>> {
         self.ensure();
         for _ in 0..2 * genus {
-            self.independent_loop()?;
-        }
-        if std::env::var_os("RICCI_CUT_TIMING").is_some() {
-            eprintln!(
-                "  phase 1 done ({} searches, {} vertices)",
-                self.stats.searches,
-                self.r.n_vertices()
-            );
+            // The loop may have to start in a sector that is a single ear: then every such
+            // sector is opened (each split halves an angle at `x`) and the search repeated.
+            if self.independent_loop().is_err() {
+                let (ends, _) = self.rotation();
+                for j in 0..ends.len() {
+                    let (_, nbrs) = self.rotation();
+                    if nbrs.iter().all(|&(_, s)| s != j) {
+                        self.open_sector(j);
+                    }
+                }
+                self.independent_loop()?;
+            }
         }
         let x = self.x;
         let max_moves = 4 * genus + 8;
@@ -809,9 +894,10 @@ impl Schema {
                     "internal error: no chord of the cut disk joins sectors {p} and {q} at vertex {x}"
                 ))
             })?;
+            // Mark the chord first: the splits after removing `s` must keep it an edge path.
             let removed = (s.unsigned_abs() - 1) as usize;
-            self.unmark(removed);
             let id = self.mark(c);
+            self.remove(removed);
             self.depinch(id);
             self.moves += 1;
         }
