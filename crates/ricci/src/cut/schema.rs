@@ -25,20 +25,32 @@
 //! loop `s` by the loop `c`. Every linked pair `a … b … a⁻¹ … b⁻¹` (one always exists among the
 //! letters not yet in a commutator block of a one-vertex orientable word) becomes a block
 //! `c d c⁻¹ d⁻¹` in two moves; the moves are planned on the word with the other letters grouped
-//! into unsplittable blocks (a search over at most `8²·2 · 9²·3` move pairs), and the word is read
-//! again from the mesh after every move. `2g` handles take at most `4g` moves.
+//! into unsplittable blocks (a search over at most `8²·2 · 9²·3` move pairs), a move that
+//! completes a block for any linked pair is preferred, and the word is read again from the mesh
+//! after every move (sectors are numbered from a fixed loop end, so splits at `x` do not shift
+//! them). `g` handles take at most `2g` moves (unit test on random one-vertex words).
 //!
 //! **Why it does not fail: no pinches.** A chord between two corners exists topologically; in
 //! the mesh it is a path through *free* vertices (not on a loop), which exists if the free
-//! vertices of the disk are connected and every sector of `x` has a free neighbour. Both hold
-//! when no *chord edge* is left, i.e. no uncut edge joins two cut vertices (`x` included): then
-//! every triangle of the disk has a free vertex and two triangles sharing an edge share a free
-//! vertex, so the free vertices are connected through the connected dual graph; and a sector
-//! without a free neighbour would contain such an edge. After every new loop, every chord edge
-//! at one of its vertices is split at its midpoint, in place ([`Refiner::split`]: intrinsic and
-//! metric-preserving; the new vertex is free, so no new chord edge appears), and the cocycles
-//! are carried over to the new edges. A loop through the same vertices needs no rebuild of the
-//! mesh, only `O(length)` local splits.
+//! vertices of the disk are connected and the two sectors of `x` have free neighbours. Call a
+//! *chord edge* an uncut edge joining two cut vertices (`x` included), and an *ear* a triangle
+//! with two cut edges (a leaf of the dual graph of the cut surface). If every chord edge is
+//! the chord of an ear, the free vertices are connected: remove the ears (leaves) from the
+//! connected dual graph; every remaining triangle has a free vertex (a triangle with three cut
+//! vertices and no two cut edges has a chord edge that is not an ear's), and two remaining
+//! triangles sharing an edge share a free vertex. So after every new loop each chord edge at
+//! one of its vertices that is not an ear's is split at its midpoint, in place
+//! ([`Refiner::split`]: intrinsic and metric-preserving; the new vertex is free, so no new
+//! chord edge appears), and the cocycles are carried over to the new edges; when a loop is
+//! removed, the chord edges of the ears it made are split. Ears are left alone because the
+//! split halves the angle at the ear's apex (often `x`); a sector of `x` that is a single ear
+//! is opened (its chord split, the new vertex joined to the free vertex across it) only when a
+//! loop or a chord must start there. Only `O(length)` local splits per loop, no mesh rebuild.
+//! (Intrinsic flips after the splits would restore angles, but the atlas develops the refined
+//! mesh from its split provenance and positions, which flips make inconsistent; none are made.)
+//!
+//! If the shortest-path search of phase 1 finds no loop with a new class (its start must lie in
+//! a sector that is an ear), every such sector is opened and the search repeated once.
 
 use super::homology::Cohomology;
 use super::system::{RawKind, RawPath, SearchStats};
