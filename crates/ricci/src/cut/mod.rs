@@ -464,7 +464,10 @@ fn cut_and_paste(
     progress.report(
         "cut",
         Some(0.2),
-        &format!("{} loops with independent classes, then cut-and-paste", 2 * genus),
+        &format!(
+            "{} loops with independent classes, then cut-and-paste",
+            2 * genus
+        ),
     );
     let mut sch = schema::Schema::new(r, omega, words, base);
     let raw = sch.build(genus)?;

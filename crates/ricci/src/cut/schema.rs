@@ -104,6 +104,9 @@ struct SideRef {
 
 const OPAQUE: i64 = 1 << 40;
 
+/// Loop ends around `x` (loop, is its start) and free neighbours of `x` with their sectors.
+type Rotation = (Vec<(u32, bool)>, Vec<(u32, usize)>);
+
 impl Schema {
     /// Start from the refined mesh (its half-edge ids are the refiner's) with its cocycles.
     /// The cocycles of `coh` per interior half-edge of `mesh` (the half-edge ids of a
@@ -224,7 +227,8 @@ impl Schema {
 
     /// Split the edge `v → w` at its midpoint, carrying the cocycles over; the new vertex.
     fn split_edge(&mut self, v: u32, w: u32) -> Option<u32> {
-        let h = self.outgoing(v)
+        let h = self
+            .outgoing(v)
             .into_iter()
             .find(|&h| self.r.he_tip(h) == w)?;
         let wd = self.words;
@@ -250,7 +254,8 @@ impl Schema {
         let m = self.r.split(h, 0.5);
         self.omega.resize(self.r.n_halfedges() * wd, 0);
         let zero = vec![0u64; wd];
-        let xor = |a: &[u64], b: &[u64]| -> Vec<u64> { a.iter().zip(b).map(|(p, q)| p ^ q).collect() };
+        let xor =
+            |a: &[u64], b: &[u64]| -> Vec<u64> { a.iter().zip(b).map(|(p, q)| p ^ q).collect() };
         let mut set = |he: u32, val: &[u64]| {
             self.omega[he as usize * wd..(he as usize + 1) * wd].copy_from_slice(val);
         };
@@ -368,7 +373,8 @@ impl Schema {
     fn path_class(&self, verts: &[u32]) -> Option<Vec<u64>> {
         let mut c = vec![0u64; self.words];
         for w in verts.windows(2) {
-            let h = self.outgoing(w[0])
+            let h = self
+                .outgoing(w[0])
                 .into_iter()
                 .find(|&h| self.r.he_tip(h) == w[1])?;
             for (a, b) in c.iter_mut().zip(self.om(h)) {
@@ -525,8 +531,8 @@ impl Schema {
                     if self.r.he_twin(h) == hp {
                         continue;
                     }
-                    for k in 0..wd {
-                        cls[k] = self.parity[vi * wd + k] ^ self.omega[h as usize * wd + k];
+                    for (k, c) in cls.iter_mut().enumerate() {
+                        *c = self.parity[vi * wd + k] ^ self.omega[h as usize * wd + k];
                     }
                     self.stats.candidates_tried += 1;
                     if self.independent(&cls) && best.is_none_or(|b| d + l < b.0) {
@@ -542,8 +548,8 @@ impl Schema {
                         continue;
                     }
                     let wi = w as usize;
-                    for k in 0..wd {
-                        cls[k] = self.parity[vi * wd + k]
+                    for (k, c) in cls.iter_mut().enumerate() {
+                        *c = self.parity[vi * wd + k]
                             ^ self.parity[wi * wd + k]
                             ^ self.omega[h as usize * wd + k];
                     }
@@ -684,7 +690,7 @@ impl Schema {
 
     /// Loop ends around `x` counter-clockwise (loop, is its start), and the sector of every
     /// free neighbour of `x` (sector `j` lies between ends `j` and `j + 1`).
-    fn rotation(&self) -> (Vec<(u32, bool)>, Vec<(u32, usize)>) {
+    fn rotation(&self) -> Rotation {
         let x = self.x;
         let mut ends = Vec::new();
         let mut free_nbrs = Vec::new();
@@ -874,7 +880,13 @@ impl Schema {
             let word = &faces[0];
             let letters: Vec<i64> = word
                 .iter()
-                .map(|s| if s.fwd { s.lp as i64 + 1 } else { -(s.lp as i64 + 1) })
+                .map(|s| {
+                    if s.fwd {
+                        s.lp as i64 + 1
+                    } else {
+                        -(s.lp as i64 + 1)
+                    }
+                })
                 .collect();
             let blocks = blocks(&letters);
             if blocks.len() == genus {
@@ -883,7 +895,9 @@ impl Schema {
                     for (which, l) in [(0u8, d), (1u8, e)] {
                         let lp = self.loops[(l.unsigned_abs() - 1) as usize]
                             .as_ref()
-                            .ok_or_else(|| Error::numerical("internal error: a removed loop is in the word"))?;
+                            .ok_or_else(|| {
+                                Error::numerical("internal error: a removed loop is in the word")
+                            })?;
                         out.push(RawPath {
                             kind: RawKind::Handle { handle: k, which },
                             vertices: lp.verts.clone(),
@@ -897,9 +911,13 @@ impl Schema {
                     "the cut-and-paste normalization did not reach a canonical word in {max_moves} moves"
                 )));
             }
-            let (pc, qc, s) = plan(&letters).ok_or_else(|| {
-                Error::numerical("internal error: no cut-and-paste move makes a new handle")
-            })?;
+            let moves = plan(&letters).unwrap_or_default();
+            if moves.is_empty() {
+                return Err(Error::numerical(
+                    "internal error: no cut-and-paste move makes a new handle",
+                ));
+            }
+            let (pc, qc, s) = moves[0];
             let (p, q) = (word[pc].leave_end, word[qc].leave_end);
             let c = self.chord(p, q).ok_or_else(|| {
                 Error::numerical(format!(
@@ -929,7 +947,10 @@ fn blocks(w: &[i64]) -> Vec<(i64, i64)> {
         if d.abs() >= OPAQUE || e.abs() >= OPAQUE || d.abs() == e.abs() {
             continue;
         }
-        let used = |l: i64| out.iter().any(|&(a, b): &(i64, i64)| a.abs() == l.abs() || b.abs() == l.abs());
+        let used = |l: i64| {
+            out.iter()
+                .any(|&(a, b): &(i64, i64)| a.abs() == l.abs() || b.abs() == l.abs())
+        };
         if d2 == -d && e2 == -e && !used(d) && !used(e) {
             out.push((d, e));
         }
@@ -968,43 +989,30 @@ fn paste(w: &[i64], p: usize, q: usize, s: i64, c: i64) -> Option<Vec<i64>> {
     Some(out)
 }
 
-/// The first move `(corner p, corner q, letter s)` of at most two that turns a linked pair of
-/// letters outside the commutator blocks into a new block (the other letters are grouped into
-/// unsplittable opaque letters for the search).
-fn plan(w: &[i64]) -> Option<(usize, usize, i64)> {
-    let n = w.len();
+/// The candidate moves `(corner p, corner q, letter s)`: each is the first of at most two that
+/// turn a linked pair of letters outside the commutator blocks into a new block (the other
+/// letters are grouped into unsplittable opaque letters for the search).
+fn plan(w: &[i64]) -> Option<Vec<(usize, usize, i64)>> {
     let bl = blocks(w);
-    let done = |l: i64| bl.iter().any(|&(d, e)| d.abs() == l.abs() || e.abs() == l.abs());
-    let at = |l: i64| (0..n).find(|&k| w[k] == l);
+    let done = |l: i64| {
+        bl.iter()
+            .any(|&(d, e)| d.abs() == l.abs() || e.abs() == l.abs())
+    };
     // A linked pair (a, b) of letters not in blocks.
-    let mut pair = None;
-    'outer: for k in 0..n {
-        let a = w[k];
-        if a < 0 || done(a) {
-            continue;
-        }
-        let (ia, ja) = (at(a)?, at(-a)?);
-        for m in 0..n {
-            let b = w[m];
-            if b < 0 || b == a || done(b) {
-                continue;
-            }
-            let inside = |t: usize| (t + n - ia) % n < (ja + n - ia) % n;
-            if inside(at(b)?) != inside(at(-b)?) {
-                pair = Some((a, b, ia));
-                break 'outer;
-            }
-        }
-    }
+    let pair = linked_pairs(w, &done).first().copied();
     let (a, b, ia) = pair?;
-    // A move that completes a block for any linked pair first (the second move of a plan
-    // made earlier), then the first move of a two-move plan for the first pair.
+    // The moves that complete a block for some linked pair (the second move of a plan made
+    // earlier), or else the first moves of two-move plans for the first pair.
+    let mut out = Vec::new();
     for (a2, b2, i2) in linked_pairs(w, &done) {
-        if let Some(m) = plan_pair(w, a2, b2, i2, false) {
-            return Some(m);
-        }
+        out.extend(plan_pair(w, a2, b2, i2, false));
     }
-    plan_pair(w, a, b, ia, true)
+    if out.is_empty() {
+        out = plan_pair(w, a, b, ia, true);
+    }
+    out.sort_unstable();
+    out.dedup();
+    Some(out)
 }
 
 /// All linked pairs `(a, b, first index of a)` of letters outside blocks.
@@ -1032,7 +1040,7 @@ fn linked_pairs(w: &[i64], done: &dyn Fn(i64) -> bool) -> Vec<(i64, i64, usize)>
 }
 
 /// A move for the pair `(a, b)` that makes a block now, or (with `two`) the first of two.
-fn plan_pair(w: &[i64], a: i64, b: i64, ia: usize, two: bool) -> Option<(usize, usize, i64)> {
+fn plan_pair(w: &[i64], a: i64, b: i64, ia: usize, two: bool) -> Vec<(usize, usize, i64)> {
     let n = w.len();
     // Compress from `a`'s first occurrence.
     let mut toks: Vec<i64> = Vec::new();
@@ -1053,19 +1061,20 @@ fn plan_pair(w: &[i64], a: i64, b: i64, ia: usize, two: bool) -> Option<(usize, 
     let m = toks.len();
     let (c, d) = (OPAQUE / 2, OPAQUE / 2 + 1);
     let gain = |v: &[i64]| !blocks(v).is_empty();
+    let mut out = Vec::new();
     for p in 0..m {
         for q in 0..m {
             for s in [a, b] {
                 if let Some(w1) = paste(&toks, p, q, s, c) {
                     if gain(&w1) {
-                        return Some((start[p], start[q], s));
+                        out.push((start[p], start[q], s));
                     }
                 }
             }
         }
     }
-    if !two {
-        return None;
+    if !two || !out.is_empty() {
+        return out;
     }
     for p in 0..m {
         for q in 0..m {
@@ -1075,12 +1084,13 @@ fn plan_pair(w: &[i64], a: i64, b: i64, ia: usize, two: bool) -> Option<(usize, 
                 };
                 let other = if s == a { b } else { a };
                 let m1 = w1.len();
-                for p2 in 0..m1 {
+                'second: for p2 in 0..m1 {
                     for q2 in 0..m1 {
                         for s2 in [other, c] {
                             if let Some(w2) = paste(&w1, p2, q2, s2, d) {
                                 if gain(&w2) {
-                                    return Some((start[p], start[q], s));
+                                    out.push((start[p], start[q], s));
+                                    break 'second;
                                 }
                             }
                         }
@@ -1089,7 +1099,7 @@ fn plan_pair(w: &[i64], a: i64, b: i64, ia: usize, two: bool) -> Option<(usize, 
             }
         }
     }
-    None
+    out
 }
 
 #[cfg(test)]
@@ -1101,11 +1111,19 @@ mod tests {
         let n = w.len();
         let ends = |l: i64| {
             let k = 2 * (l.unsigned_abs() as usize);
-            if l > 0 { (k, k + 1) } else { (k + 1, k) }
+            if l > 0 {
+                (k, k + 1)
+            } else {
+                (k + 1, k)
+            }
         };
-        let top = w.iter().map(|l| l.unsigned_abs() as usize).max().unwrap_or(0);
+        let top = w
+            .iter()
+            .map(|l| l.unsigned_abs() as usize)
+            .max()
+            .unwrap_or(0);
         let mut parent: Vec<usize> = (0..2 * top + 2).collect();
-        fn find(p: &mut Vec<usize>, mut i: usize) -> usize {
+        fn find(p: &mut [usize], mut i: usize) -> usize {
             while p[i] != i {
                 p[i] = p[p[i]];
                 i = p[i];
@@ -1135,15 +1153,13 @@ mod tests {
     fn is_canonical_after(mut w: Vec<i64>, genus: usize) -> usize {
         assert_eq!(vertices(&w), 1, "{w:?} is not a one-vertex schema");
         // Apply planned moves symbolically until the word is canonical; the number of moves.
-        let mut next = 100;
-        for moves in 0..4 * genus + 8 {
+        for (moves, next) in (0..4 * genus + 8).zip(100..) {
             if blocks(&w).len() == genus {
                 return moves;
             }
-            let (p, q, s) = plan(&w).expect("a move");
+            let (p, q, s) = plan(&w).and_then(|m| m.first().copied()).expect("a move");
             w = paste(&w, p, q, s, next).expect("a valid move");
             assert_eq!(vertices(&w), 1, "the move made {w:?}");
-            next += 1;
         }
         panic!("not canonical: {w:?}");
     }
