@@ -989,9 +989,10 @@ fn paste(w: &[i64], p: usize, q: usize, s: i64, c: i64) -> Option<Vec<i64>> {
     Some(out)
 }
 
-/// The candidate moves `(corner p, corner q, letter s)`: each is the first of at most two that
-/// turn a linked pair of letters outside the commutator blocks into a new block (the other
-/// letters are grouped into unsplittable opaque letters for the search).
+/// The candidate moves `(corner p, corner q, letter s)` in the order found (the caller takes the
+/// first): each is the first of at most two that turn a linked pair of letters outside the
+/// commutator blocks into a new block (the other letters are grouped into unsplittable opaque
+/// letters for the search).
 fn plan(w: &[i64]) -> Option<Vec<(usize, usize, i64)>> {
     let bl = blocks(w);
     let done = |l: i64| {
@@ -1010,8 +1011,6 @@ fn plan(w: &[i64]) -> Option<Vec<(usize, usize, i64)>> {
     if out.is_empty() {
         out = plan_pair(w, a, b, ia, true);
     }
-    out.sort_unstable();
-    out.dedup();
     Some(out)
 }
 
