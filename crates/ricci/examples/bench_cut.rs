@@ -1,5 +1,6 @@
 //! Benchmark of `ricci::cut::canonical_cut` (refinement around the base vertex, tree–cotree,
-//! the canonical loops, slicing and the checks), on the shared meshes.
+//! the canonical loops — cut-and-paste on closed surfaces, the greedy with boundary —, slicing
+//! and the checks), on the shared meshes.
 //!
 //! ```sh
 //! cargo run --release -p ricci --example bench_cut [-- MESH...]
@@ -80,7 +81,7 @@ fn main() {
                 }
                 let total: f64 = c.loops.iter().map(|l| l.length).sum();
                 println!(
-                    "{name}: F={} genus={} base={} valence {}→{} splits={} attempts={} searches={} rejected={:?} sides={} \
+                    "{name}: F={} genus={} base={} valence {}→{} splits={} attempts={} searches={} moves={} rejected={:?} sides={} \
                      loops total length {:.4} (bbox diag {:.4}) | median {:.3} s, min {:.3} s over {runs} runs",
                     s.mesh.n_faces(),
                     c.genus,
@@ -90,6 +91,7 @@ fn main() {
                     c.report.refinement_splits,
                     c.report.attempts,
                     c.report.search.searches,
+                    c.report.search.moves,
                     c.report.search.rejected,
                     c.polygon.len(),
                     total,

@@ -16,40 +16,36 @@
 //! symplectic matrix (`a_i·b_i = +1`).
 //!
 //! Steps: (1) raise the valence of `x` and grade its neighbourhood by intrinsic,
-//! metric-preserving edge splits ([`crate::mesh::refine`]) so that `4g + b` disjoint paths fit
-//! around it; (2) a Z₂ cohomology basis by tree–cotree ([`homology`]); (3) the loops, handle by
-//! handle, as short non-separating loops through the free edges of `x` ([`system`]); when a
-//! handle does not fit, the loops found so far are kept, a free row of vertices is split in
-//! along them and the search resumes; after [`CutOptions::max_attempts`] such attempts the
-//! construction restarts from the input with 3.5×, then 5× the valence at `x` (and a graded
-//! neighbourhood to match); (4) slicing ([`mod@slice`]) and reading the polygon.
+//! metric-preserving edge splits ([`crate::mesh::refine`]); (2) a Z₂ cohomology basis by
+//! tree–cotree ([`homology`]); (3) the loops; (4) slicing ([`mod@slice`]) and reading the
+//! polygon.
 //!
-//! **Why attempts fail.** A canonical system through `x` always exists topologically; the
-//! failures are discrete. The greedy commits to each handle before the next and must put all
-//! four ends of the next handle into one corner between two earlier handles; the shortest
-//! loops from there run alongside the earlier loops (all loops leave `x` towards the same
-//! nearby handles), so the strip where `b_i` would have to pass is pinched — two cut vertices
-//! joined by an uncut edge (a chord of the cut disk) separate it although the surface is not
-//! separated. Splitting edges along the loops removes the pinches found, but the later handles
-//! meet new ones; more edges at `x` and a wider graded neighbourhood give the room back, which
-//! is why the restart with a larger valence succeeds where the resumed attempts do not. A
-//! construction that cannot fail topologically — any `2g` loops with independent Z₂ classes,
-//! then the cut-and-paste moves of the classification of surfaces on the polygon (two per
-//! handle) — needs a free path between two corners of the current disk for every move, and
-//! stays exposed to the same pinches unless a free row is split in after every loop (a full
-//! mesh rebuild, ~60–75 ms at 100k faces, with the present [`Refiner`]); it is not used.
+//! **Closed surfaces of genus `g ≥ 1`: cut-and-paste ([`schema`]).** `2g` shortest simple
+//! loops through `x`, pairwise disjoint except at `x`, with linearly independent Z₂ classes
+//! (their complement is then a disk), followed by the cut-and-paste moves of the
+//! classification of surfaces on the polygon (a chord of the disk between two corners
+//! replaces one loop; two moves per handle). Every chord exists topologically; in the mesh it
+//! exists because every *chord edge* (an uncut edge joining two cut vertices, the discrete
+//! pinch) is split in place right after each new loop, which keeps the free vertices of the
+//! disk connected and gives every sector at `x` a free neighbour. This construction does not
+//! fail from any base vertex; it makes one attempt ([`CutOptions::max_attempts`] is not used).
 //!
-//! This follows the lead's design with three changes found necessary on the shared meshes:
-//! the neighbourhood of `x` is *graded* (valence alone leaves only ~12 vertices in the second
-//! ring, too few for `4g` disjoint paths); a lasso-shaped odd cycle is turned into a simple
-//! loop by rerouting its return strand; and failures resume from the handles already found
-//! after refining along them instead of restarting with a higher valence.
+//! **Surfaces with boundary: the greedy of [`system`].** Handle by handle, short
+//! non-separating loops through the free edges of `x` whose four ends are placed in one gap
+//! between earlier handles, then the paths `c_k` to the boundary loops; when a handle does not
+//! fit, the loops found so far are kept, a free row of vertices is split in along them and the
+//! search resumes; after [`CutOptions::max_attempts`] such attempts the construction restarts
+//! from the input with 3.5×, then 5× the valence at `x` (and a graded neighbourhood to match).
+//! Its attempts fail for discrete reasons (the strip where `b_i` would pass is pinched by
+//! earlier loops running alongside) — the reason the closed case moved to cut-and-paste; the
+//! bordered shared meshes cut at the first attempt.
 //!
 //! Genus 0: a closed surface is slit along a path of two edges (word `c₁ c₁⁻¹`); a disk is
 //! already cut (word `d₁`); with `b ≥ 2` boundary loops, `b` paths join them to `x`.
 
 pub mod homology;
 pub mod paths;
+pub mod schema;
 pub mod slice;
 pub mod system;
 
@@ -79,9 +75,11 @@ pub struct CutOptions {
     /// `max(4g + 4, 8g − 4) + b` (paper 000, Step 2: `8g − 4` lets the single-cone flat metric
     /// exist; `4g + b` edges are needed by the cut itself).
     pub min_valence: Option<usize>,
-    /// Attempts per round (each refining along the loops found so far) when the loops do not
-    /// fit (default 4). After a round fails, the construction restarts from the input with the
-    /// valence at the base vertex scaled by 3.5, then by 5 (three rounds in all).
+    /// Surfaces with boundary (the greedy construction of [`system`]): attempts per round (each
+    /// refining along the loops found so far) when the loops do not fit (default 4). After a
+    /// round fails, the construction restarts from the input with the valence at the base
+    /// vertex scaled by 3.5, then by 5 (three rounds in all). Closed surfaces are cut by
+    /// cut-and-paste ([`schema`]) in one attempt and ignore it.
     pub max_attempts: Option<usize>,
 }
 
@@ -280,6 +278,21 @@ pub fn canonical_cut(
         s / valence_before.max(1) as f64
     };
 
+    if nb == 0 && genus >= 1 {
+        return cut_and_paste(
+            mesh,
+            lengths,
+            geometry,
+            positions,
+            base,
+            automatic,
+            genus,
+            min_valence,
+            mean_spoke,
+            progress,
+            t0,
+        );
+    }
     let mut failed = Vec::new();
     let mut attempt = 0;
     progress.report(
@@ -398,6 +411,86 @@ pub fn canonical_cut(
         attempts: attempt,
         failed_attempts: failed,
         search: stats,
+        seconds: t0.elapsed().as_secs_f64(),
+    };
+    progress.report("cut", Some(1.0), "done");
+    Ok(out)
+}
+
+/// Closed surfaces of genus `g ≥ 1`: the construction of [`schema`] (disjoint loops with
+/// independent classes, then cut-and-paste moves on the polygon), which does not fail.
+#[allow(clippy::too_many_arguments)]
+fn cut_and_paste(
+    mesh: &Mesh,
+    lengths: &[f64],
+    geometry: Geometry,
+    positions: Option<&[[f64; 3]]>,
+    base: u32,
+    automatic: bool,
+    genus: usize,
+    min_valence: usize,
+    mean_spoke: f64,
+    progress: &mut dyn Progress,
+    t0: std::time::Instant,
+) -> Result<CanonicalCut> {
+    let valence_before = mesh.valence(base);
+    progress.report(
+        "cut",
+        Some(0.0),
+        &format!("refining around vertex {base} to valence {min_valence}"),
+    );
+    let refined = grade_base(
+        mesh,
+        lengths,
+        geometry,
+        positions,
+        base,
+        min_valence,
+        4 * genus,
+        mean_spoke,
+    )?;
+    let coh = Cohomology::new(&refined.mesh)?;
+    if coh.dim != 2 * genus {
+        return Err(Error::topology(format!(
+            "the first Z2 homology has dimension {} but a closed surface of genus {genus} needs {}",
+            coh.dim,
+            2 * genus
+        )));
+    }
+    let omega = schema::Schema::halfedge_cocycles(&refined.mesh, &coh);
+    let words = coh.words;
+    drop(coh);
+    let r = Refiner::resume(refined, geometry)?;
+    progress.report(
+        "cut",
+        Some(0.2),
+        &format!(
+            "{} loops with independent classes, then cut-and-paste",
+            2 * genus
+        ),
+    );
+    let mut sch = schema::Schema::new(r, omega, words, base);
+    let raw = sch.build(genus)?;
+    let stats = SearchStats {
+        moves: sch.moves,
+        ..sch.stats.clone()
+    };
+    let refined = sch.into_refiner().finish()?;
+    progress.report("cut", Some(0.9), "slicing");
+    let mut out = assemble(refined, raw, base, genus, 0, geometry)?;
+    out.report = CutReport {
+        base_vertex: base,
+        base_automatic: automatic,
+        valence_before,
+        valence_after: out.refined.mesh.valence(base),
+        min_valence,
+        refinement_splits: out.refined.splits(),
+        attempts: 1,
+        failed_attempts: Vec::new(),
+        search: SearchStats {
+            attempts: 1,
+            ..stats
+        },
         seconds: t0.elapsed().as_secs_f64(),
     };
     progress.report("cut", Some(1.0), "done");

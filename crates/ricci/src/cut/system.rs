@@ -1,6 +1,8 @@
 //! Greedy construction of a canonical system of loops through the base vertex `x`, handle by
 //! handle, as vertex-disjoint simple edge paths meeting only at `x` (paper 001 App. A,
 //! 002 §6.2.2.1; the loops themselves are shortest-path loops as in Erickson–Whittlesey).
+//! Used for surfaces with boundary and genus 0; closed surfaces of genus ≥ 1 are cut by the
+//! cut-and-paste construction of [`super::schema`], which cannot run out of room.
 //!
 //! **Why the loops must be disjoint and how their ends are placed.** Cutting along `2g` simple
 //! loops that meet only at `x` gives a disk iff the complement is connected; the word of the
@@ -89,6 +91,8 @@ pub struct SearchStats {
     /// separating, ends adjacent at the base vertex, no free edge on one side, over the slot
     /// budget, no admissible end for the second loop, no second loop.
     pub rejected: [usize; 7],
+    /// Cut-and-paste moves on the polygon (cut-and-paste construction).
+    pub moves: usize,
 }
 
 /// Why a construction attempt failed (the caller refines more and retries).
@@ -313,6 +317,7 @@ impl SearchStats {
         for k in 0..self.rejected.len() {
             self.rejected[k] += o.rejected[k];
         }
+        self.moves += o.moves;
     }
 }
 

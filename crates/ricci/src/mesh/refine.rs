@@ -391,6 +391,36 @@ impl Refiner {
         m
     }
 
+    /// Origin of half-edge `h` (`3f + i` starts at corner `i` of face `f`).
+    #[inline]
+    pub(crate) fn he_origin(&self, h: u32) -> u32 {
+        self.origin(h)
+    }
+    /// Tip of half-edge `h`.
+    #[inline]
+    pub(crate) fn he_tip(&self, h: u32) -> u32 {
+        self.origin(Self::next(h))
+    }
+    /// Twin of half-edge `h` (`NONE` on the boundary).
+    #[inline]
+    pub(crate) fn he_twin(&self, h: u32) -> u32 {
+        self.twin[h as usize]
+    }
+    /// The previous half-edge in the face of `h`.
+    #[inline]
+    pub(crate) fn he_prev(h: u32) -> u32 {
+        Self::prev(h)
+    }
+    /// One outgoing half-edge of `v` (`NONE` for an isolated vertex).
+    #[inline]
+    pub(crate) fn vertex_corner(&self, v: u32) -> u32 {
+        self.vertex_corner[v as usize]
+    }
+    /// Number of half-edges (three per face).
+    pub(crate) fn n_halfedges(&self) -> usize {
+        self.len.len()
+    }
+
     /// The two endpoints `(origin, tip)` of half-edge `h`.
     pub fn endpoints(&self, h: u32) -> (u32, u32) {
         (self.origin(h), self.origin(Self::next(h)))
