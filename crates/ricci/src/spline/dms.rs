@@ -737,6 +737,30 @@ impl TriangleBasis {
         }
     }
 
+    /// The centroid of the knots: the origin of [`Self::eval_offset`].
+    pub fn origin(&self) -> Point {
+        self.family.origin()
+    }
+
+    /// [`Self::eval`] at `origin() + x`, the point given by its offset from the knots'
+    /// centroid (see [`SimplexFamily::eval_offset`]).
+    pub fn eval_offset(
+        &self,
+        x: Point,
+        dir: Point,
+        order: usize,
+        work: &mut Vec<f64>,
+        out: &mut [f64],
+    ) {
+        let np = n_partials(order);
+        self.family.eval_offset(x, dir, order, work, out);
+        for (b, s) in self.scale.iter().enumerate() {
+            for v in &mut out[b * np..(b + 1) * np] {
+                *v *= s;
+            }
+        }
+    }
+
     /// The arguments `t_{0,0..β_0−1}, t_{1,0..β_1−1}, t_{2,0..β_2−1}` at which the blossom gives
     /// the control point of β.
     pub fn blossom_args(&self, beta: [usize; 3]) -> Vec<Point> {
