@@ -65,7 +65,7 @@ use crate::layout::RigidMotion;
 use crate::mesh::Mesh;
 
 use super::dms::{
-    general_position_involving, hash64, multi_indices, patch_quality, per_triangle, unit,
+    general_position_involving, hash64, multi_indices, needs_shrink, per_triangle, unit,
     KnotOptions, TriangleBasis, Workspace, MAX_DEGREE,
 };
 use super::fit::SplineSpace;
@@ -688,8 +688,7 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
                     continue;
                 }
                 pl.face_knots(&knots, f, &mut arr);
-                let (o, w) = patch_quality(n, &arr);
-                if o < 0.05 || w < 0.1 {
+                if needs_shrink(n, &arr) {
                     for &v in &mesh.face(f) {
                         dirty[v as usize] = true;
                     }
