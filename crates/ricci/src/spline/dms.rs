@@ -822,6 +822,46 @@ impl TriangleBasis {
     }
 }
 
+/// [`TriangleBasis::blossom_weights`] for the knot array `knots` (`[m * (n+1) + k] = t_{m,k}`)
+/// given directly, in any coordinate system: the barycentric coordinates of each argument in
+/// `Δ_γ` are formed from differences to the argument, so a frame local to the triangle keeps
+/// them to rounding of the triangle's size.
+pub(crate) fn blossom_weights_of(n: usize, knots: &[Point], args: &[Point], out: &mut [f64]) {
+    let t = |m: usize, k: usize| knots[m * (n + 1) + k];
+    let w = n + 1;
+    let mut cur = vec![0.0; w * w];
+    let mut next = vec![0.0; w * w];
+    cur[0] = 1.0;
+    for (s, x) in args.iter().enumerate() {
+        next.fill(0.0);
+        for g in multi_indices(s) {
+            let wt = cur[g[0] * w + g[1]];
+            if wt == 0.0 {
+                continue;
+            }
+            let d = [
+                sub(t(0, g[0]), *x),
+                sub(t(1, g[1]), *x),
+                sub(t(2, g[2]), *x),
+            ];
+            let det = det3(t(0, g[0]), t(1, g[1]), t(2, g[2]));
+            let cr = |a: Point, b: Point| a[0] * b[1] - a[1] * b[0];
+            let lam = [
+                cr(d[1], d[2]) / det,
+                cr(d[2], d[0]) / det,
+                cr(d[0], d[1]) / det,
+            ];
+            next[(g[0] + 1) * w + g[1]] += wt * lam[0];
+            next[g[0] * w + g[1] + 1] += wt * lam[1];
+            next[g[0] * w + g[1]] += wt * lam[2];
+        }
+        std::mem::swap(&mut cur, &mut next);
+    }
+    for (b, beta) in multi_indices(n).iter().enumerate() {
+        out[b] = cur[beta[0] * w + beta[1]];
+    }
+}
+
 /// Uniform grid of the triangles' support boxes, for finding the basis functions that may be
 /// non-zero at a point.
 #[derive(Debug, Clone)]
