@@ -548,11 +548,17 @@ fn clip_left(poly: &[Point], a: Point, b: Point) -> Vec<Point> {
     out
 }
 
+/// Signed area of a polygon, by the shoelace formula relative to its first vertex: in
+/// absolute coordinates the terms are `|x|²` and a polygon of size `h ≪ |x|` loses its area
+/// to cancellation (a 1e-8 face in a unit-size affine-atlas chart of 3holes.off measured
+/// `Ω_I` empty, 0 against 0.25 in a local frame).
 fn polygon_area(poly: &[Point]) -> f64 {
+    let Some(&o) = poly.first() else {
+        return 0.0;
+    };
     let mut s = 0.0;
-    for i in 0..poly.len() {
-        s +=
-            poly[i][0] * poly[(i + 1) % poly.len()][1] - poly[(i + 1) % poly.len()][0] * poly[i][1];
+    for i in 1..poly.len().saturating_sub(1) {
+        s += det3(o, poly[i], poly[i + 1]);
     }
     0.5 * s
 }
