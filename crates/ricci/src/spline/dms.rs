@@ -215,8 +215,9 @@ impl KnotClouds {
     /// `seed`); every vertex keeps the best of 32 candidates for the measure
     /// [`general_position`] over its triangles (a second sweep for clouds still below 0.05),
     /// because nearly collinear knots amplify rounding errors of the recurrence. Clouds of
-    /// triangles whose `Δ_β` come out thin (relative area < 0.05) or whose `Ω_I` is small
-    /// (< 10 % of the triangle) are shrunk by 0.7 and re-optimised.
+    /// triangles whose `Δ_β` come out thin (relative area below `min(0.05, ½ ×` the
+    /// triangle's own, see `needs_shrink`) or whose `Ω_I` is small (< 10 % of the triangle)
+    /// are shrunk by 0.7 and re-optimised.
     pub fn place(domain: &Domain, degree: usize, opts: &KnotOptions) -> Result<KnotClouds> {
         if !(1..=MAX_DEGREE).contains(&degree) {
             return Err(Error::input(format!(

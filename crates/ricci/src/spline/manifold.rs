@@ -19,8 +19,10 @@
 //! domain (the mesh boundary or a hole's link) inside the wedge outside both boundary edges, so
 //! the DMS boundary condition holds and the basis is a **partition of unity on every active
 //! face, up to the hole's link** (asserted by the tests); candidates keep the best worst-triple
-//! [`crate::spline::dms::general_position`], and clouds of triangles with thin `Δ_β` or small
-//! `Ω_I` are shrunk.
+//! [`crate::spline::dms::general_position`], and clouds of triangles with thin `Δ_β` (thinner
+//! than `min(0.05, ½ ×` the triangle's own relative area) or small `Ω_I` are shrunk — the
+//! floor relative to the triangle, so that a cap triangle (rocker-arm.off) does not collapse
+//! its vertices' clouds to 10⁻⁴ of the face.
 //!
 //! **Basis.** The DMS basis of an active triangle `I` is built by
 //! [`TriangleBasis::new`] in `I`'s home chart ([`FlatCharts::home_chart`]) from the three
@@ -28,8 +30,9 @@
 //! the stars of `I`'s vertices, which the home chart contains.
 //!
 //! **Evaluation** at a point of face `g`: every active triangle `I` sharing a vertex with `g`
-//! contributes, evaluated in `I`'s home chart after mapping the point by the transition on `g`;
-//! partials are rotated back into the chart the point was given in. Values therefore do not
+//! contributes, evaluated in `I`'s home chart at the point with the same barycentric
+//! coordinates in `g` (the transition on `g`, as an affine map of `g`'s corners; see
+//! *Conditioning*); partials are rotated back into the chart the point was given in. Values therefore do not
 //! depend on the chart (to rounding), and partials transform by the rotation of the transition
 //! ([`rotate_partials`]). Limits are taken from inside `g` (direction towards its centroid).
 //!
