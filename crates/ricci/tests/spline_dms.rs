@@ -733,3 +733,30 @@ fn fairing_converges_on_a_larger_grid() {
         "{rep:?}"
     );
 }
+
+/// The knot-quality measures of a triangle do not depend on where the triangle sits: a
+/// triangle of size 1e-8 with clouds of 10⁻¹ of it, at the origin and moved to (0.7, −0.4)
+/// (a tiny face in a unit-size chart), has the same relative `Δ_β` orientation and `Ω_I`
+/// area, and the basis builds in both places (`Ω_I` used to come out empty far from the
+/// origin, the shoelace formula cancelling in absolute coordinates).
+#[test]
+fn knot_quality_is_translation_invariant() {
+    let h = 1e-8;
+    let corners = [[0.0, 0.0], [h, 0.0], [0.3 * h, 0.8 * h]];
+    let mut knots = Vec::new();
+    for (m, c) in corners.iter().enumerate() {
+        knots.push(*c);
+        for k in 1..=3 {
+            let a = 2.1 * k as f64 + m as f64;
+            knots.push([c[0] + 0.1 * h * a.cos(), c[1] + 0.1 * h * a.sin()]);
+        }
+    }
+    let (o0, w0) = ricci::spline::dms::patch_quality(3, &knots);
+    assert!(o0 > 0.0 && w0 > 0.1, "{o0} {w0}");
+    let moved: Vec<Point> = knots.iter().map(|p| [p[0] + 0.7, p[1] - 0.4]).collect();
+    let (o1, w1) = ricci::spline::dms::patch_quality(3, &moved);
+    assert!((o1 - o0).abs() < 1e-6 * o0, "orientation {o0} vs {o1}");
+    assert!((w1 - w0).abs() < 1e-6 * w0, "Ω ratio {w0} vs {w1}");
+    let clouds: Vec<&[Point]> = moved.chunks(4).collect();
+    ricci::spline::dms::TriangleBasis::new(3, [clouds[0], clouds[1], clouds[2]]).unwrap();
+}

@@ -64,15 +64,55 @@ fn check_partition_of_unity<A: FlatCharts + Sync>(space: &ManifoldSpace<'_, A>, 
     assert!(worst < 1e-9, "partition of unity off by {worst:.2e}");
 }
 
+/// What [`check_chart_independence`] asserts: partials at face centroids relative to the
+/// largest partial of that order there, partials anywhere relative to the size of the terms of
+/// the sum (`A_k`, see below), and partials anywhere relative to the largest partial.
+#[derive(Clone, Copy)]
+struct ChartTolerances {
+    centroid: f64,
+    terms: f64,
+    anywhere: f64,
+}
+
+/// genus2:16 and eight.off, over `LocalCharts` and over the affine atlas: the 1e-10.
+const TIGHT: ChartTolerances = ChartTolerances {
+    centroid: 1e-10,
+    terms: 1e-10,
+    anywhere: 1e-8,
+};
+
+/// 3holes, genus3, fertility (`LocalCharts`): their graded cone neighbourhoods (faces down to
+/// 1e-7 of the mean edge) put knot clouds of radius 1.5e-2 of a neighbouring face's size into
+/// its basis, and the recurrence's rounding grows with that ratio (measured: 7.7e-10 at
+/// centroids, 1.1e-8 of the terms, 2.1e-7 of the partial on fertility).
+const GRADED: ChartTolerances = ChartTolerances {
+    centroid: 2e-9,
+    terms: 3e-8,
+    anywhere: 1e-6,
+};
+
 /// Evaluate at the same surface point in every chart containing the face: values agree to
-/// 1e-10 (relative to the bounding box) and partials up to `n − 1`, rotated by the transition
-/// into the canonical chart, agree to 1e-6 relative to the largest partial of that order at
-/// the point (measured: ≤ 2e-8; the recurrence amplifies rounding on the tiny faces near a
-/// cone, see `CONTINUITY_TOLERANCE`).
+/// 1e-10 of the bounding-box diagonal; partials up to `n − 1`, rotated by the transition into
+/// the canonical chart, agree to `tol` ([`ChartTolerances`]):
+/// - at face centroids, relative to the largest partial of that order at the point;
+/// - everywhere (edge midpoints and points near vertices included) relative to the size of
+///   the terms of the sum, `A_k = max_d Σ_β |c_{β,d} − F_d| max_{|α|=k} |∂^α N_β|`
+///   (`Σ_β ∂^α N_β = 0` lets `F` be subtracted), and relative to the largest partial.
+///
+/// Why not 1e-10 relative to the partial everywhere: at edge midpoints and near vertices the
+/// basis functions of knot sets drawn from one or two clouds (supported in thin lenses along
+/// the edges) have order-2 partials up to 10³× those of `F` and carry the recurrence's
+/// rounding; moving the point by one ulp *in the same chart* changes `∂²F` by as much as
+/// changing the chart does (~1e-8 on genus2:16), while the charts place the point
+/// consistently to ≤ 2e-15 of the face size. It is the rounding floor of the DMS evaluation,
+/// not the charts. (Over the affine atlas, whose charts are up to 5·10³ face sizes across, the
+/// charts did matter — 1.5e-6 — until points were placed by barycentric offsets; see the
+/// module docs of `spline::manifold`, *Conditioning*.)
 fn check_chart_independence<A: FlatCharts + Sync>(
     space: &ManifoldSpace<'_, A>,
     control: &[f64],
     stride: usize,
+    tol: ChartTolerances,
 ) -> usize {
     let charts = space.charts();
     let n = space.degree();
@@ -87,17 +127,39 @@ fn check_chart_independence<A: FlatCharts + Sync>(
     let mut ws = Workspace::default();
     let mut compared = 0;
     let (mut worst_v, mut worst_d): (f64, f64) = (0.0, 0.0);
+    let (mut worst_terms, mut worst_centroid): (f64, f64) = (0.0, 0.0);
     let nf = charts.mesh().n_faces() as u32;
     for f in (0..nf).step_by(stride) {
         if !space.is_active(f) {
             continue;
         }
         let c0 = space.canonical_chart(f);
-        for b in [SAMPLES[0], SAMPLES[2], SAMPLES[4]] {
+        for (si, b) in [SAMPLES[0], SAMPLES[2], SAMPLES[4]].into_iter().enumerate() {
             let mut base = vec![0.0; np * 3];
             space
                 .evaluate(control, 3, f, b, order, &mut ws, &mut base)
                 .unwrap();
+            // A_k (see the doc comment) from the basis at the point.
+            let m = space
+                .basis_at_point(f, space.face_point(f, b), order, &mut ws)
+                .unwrap();
+            let terms: Vec<f64> = (0..=order)
+                .map(|k| {
+                    (0..3)
+                        .map(|d| {
+                            (0..m)
+                                .map(|j| {
+                                    let g = ws.indices[j] as usize;
+                                    let dn = (n_partials(k) - k - 1..n_partials(k))
+                                        .map(|i| ws.values[j * np + i].abs())
+                                        .fold(0.0, f64::max);
+                                    (control[g * 3 + d] - base[d]).abs() * dn
+                                })
+                                .sum::<f64>()
+                        })
+                        .fold(1e-300, f64::max)
+                })
+                .collect();
             let scale: Vec<f64> = (0..=order)
                 .map(|k| {
                     (n_partials(k) - k - 1..n_partials(k))
@@ -131,7 +193,12 @@ fn check_chart_independence<A: FlatCharts + Sync>(
                 for (k, sk) in scale.iter().enumerate().skip(1) {
                     for i in n_partials(k) - k - 1..n_partials(k) {
                         for d in 0..3 {
-                            worst_d = worst_d.max((out[i * 3 + d] - base[i * 3 + d]).abs() / sk);
+                            let e = (out[i * 3 + d] - base[i * 3 + d]).abs();
+                            worst_d = worst_d.max(e / sk);
+                            worst_terms = worst_terms.max(e / terms[k]);
+                            if si == 0 {
+                                worst_centroid = worst_centroid.max(e / sk);
+                            }
                         }
                     }
                 }
@@ -143,8 +210,19 @@ fn check_chart_independence<A: FlatCharts + Sync>(
         worst_v <= 1e-10,
         "values differ between charts by {worst_v:.2e}"
     );
+    eprintln!(
+        "chart independence ({compared} comparisons): values {worst_v:.1e} of the diagonal; partials {worst_d:.1e} of the partial, {worst_centroid:.1e} at centroids, {worst_terms:.1e} of the terms"
+    );
     assert!(
-        worst_d <= 1e-6,
+        worst_centroid <= tol.centroid,
+        "partials at centroids differ between charts by {worst_centroid:.2e}"
+    );
+    assert!(
+        worst_terms <= tol.terms,
+        "partials differ between charts by {worst_terms:.2e} of the size of the terms"
+    );
+    assert!(
+        worst_d <= tol.anywhere,
         "partials differ between charts by {worst_d:.2e}"
     );
     compared
@@ -210,7 +288,7 @@ fn generated_genus2_partition_of_unity_charts_and_providers() {
     assert!(rep.max_chart_residual < 1e-10, "{rep:?}");
     check_partition_of_unity(&space, 1);
     let control = subdivided_and_faired(&space, 1);
-    let compared = check_chart_independence(&space, &control, 3);
+    let compared = check_chart_independence(&space, &control, 3, TIGHT);
     assert!(compared > 1000, "only {compared} chart comparisons");
 
     // A second, independently placed provider (every chart moved by a random rigid motion):
@@ -278,10 +356,12 @@ fn continuity_is_c_n_minus_1_and_not_c_n() {
         let space = ManifoldSpace::new(&dom.charts, n, &KnotOptions::default()).unwrap();
         let control = subdivided_and_faired(&space, 1.min(n - 1));
         let rep = continuity(&space, &control, &[], 1e-8).unwrap();
+        eprintln!("degree {n}: relative jumps {:?}", rep.relative_jumps);
         assert!(rep.chart_boundary_edges > 100, "{rep:?}");
-        // Orders < n − 1 to 1e-8, order n − 1 to 1e-6 (measured ≤ 6e-8 for n = 4).
+        // Orders < n − 1 to 1e-8, order n − 1 to 1e-7 (measured 6.5e-12, 8.1e-10 and 4.5e-8
+        // for n = 2, 3, 4).
         for k in 0..n {
-            let tol = if k + 1 < n { 1e-8 } else { 1e-6 };
+            let tol = if k + 1 < n { 1e-8 } else { 1e-7 };
             assert!(
                 rep.relative_jumps[k] <= tol,
                 "degree {n}: order {k} jumps by {:.2e}",
@@ -416,7 +496,7 @@ fn eight_single_extraordinary_point() {
     let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
     check_partition_of_unity(&space, 1);
     let control = subdivided_and_faired(&space, 1);
-    check_chart_independence(&space, &control, 7);
+    check_chart_independence(&space, &control, 7, TIGHT);
     end_to_end("eight", &s, &dom, 3, 1.0);
 }
 
@@ -441,8 +521,12 @@ fn atlas_vs_local(s: &Surface, name: &str, stride: usize) {
     let atlas = AffineAtlas::build(s, &AtlasOptions::default(), &mut NoProgress).unwrap();
     let space = ManifoldSpace::new(&atlas, 3, &KnotOptions::default()).unwrap();
     check_partition_of_unity(&space, stride);
-    let control = subdivided_and_faired(&space, 1);
-    let compared = check_chart_independence(&space, &control, stride);
+    // The fairing reaches its tolerance over the atlas's charts as over `LocalCharts` (its
+    // constraints are formed in vertex frames; from the home charts, eight.off stalled at a
+    // residual of 1.3e-4 after 21 s).
+    let (control, fairing) = fair(&space, &space.subdivision_control_points(), 3, 1).unwrap();
+    assert!(fairing.converged, "{name}: {fairing:?}");
+    let compared = check_chart_independence(&space, &control, stride, TIGHT);
     assert!(compared > 0);
     let local = LocalCharts::new(
         atlas.mesh().clone(),
@@ -453,6 +537,18 @@ fn atlas_vs_local(s: &Surface, name: &str, stride: usize) {
     )
     .unwrap();
     let space2 = ManifoldSpace::new(&local, 3, &KnotOptions::default()).unwrap();
+    // Same metric, same knots, same constraints: the same faired control points.
+    let (control2, _) = fair(&space2, &space2.subdivision_control_points(), 3, 1).unwrap();
+    let diag = s.diagonal();
+    let moved = control
+        .iter()
+        .zip(&control2)
+        .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()))
+        / diag;
+    assert!(
+        moved < 1e-9,
+        "{name}: faired control points differ by {moved:.2e}"
+    );
     let mut ws = Workspace::default();
     let np = n_partials(1);
     let (mut worst, mut worst_d): (f64, f64) = (0.0, 0.0);
@@ -510,8 +606,8 @@ fn affine_atlas_generated_genus2() {
 
 #[test]
 fn affine_atlas_real_meshes() {
-    // 3holes.off and kitten over the atlas are not here: the fairing on the atlas's metric
-    // does not converge quickly there (minutes; see BENCHMARKS.md).
+    // 3holes.off and kitten over the atlas are left to the benchmark (the atlas itself takes
+    // seconds to build there).
     let Some(s) = load("eight.off") else { return };
     atlas_vs_local(&s, "eight.off", 11);
 }
@@ -524,7 +620,7 @@ fn local_charts_genus3_and_4_meshes() {
         let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
         check_partition_of_unity(&space, 13);
         let control = subdivided_and_faired(&space, 1);
-        check_chart_independence(&space, &control, 29);
+        check_chart_independence(&space, &control, 29, GRADED);
         let hole = Hole::new(&space, &control, dom.singular.unwrap()).unwrap();
         let rep = hole.seam_normal_jump(&space, &control, 360).unwrap();
         eprintln!("{name}: seam {rep:?}");
@@ -545,4 +641,64 @@ fn largest_valence(s: &Surface) -> Singularity {
         .max_by(|&a, &b| m.valence(a).cmp(&m.valence(b)).then(b.cmp(&a)))
         .unwrap();
     Singularity::Vertex(v)
+}
+
+/// rocker-arm.off (genus 1, a flat torus: no extraordinary point) has 176° cap triangles in
+/// its flat metric. Their vertices' knot clouds used to be shrunk in every placement round (a
+/// fixed relative-area floor that the triangle itself fails), to 10⁻⁴ of the face size, and
+/// the spline measured only C⁰ (order-1 / order-2 jumps 1.2e-5 / 6.0e-3). Now C² with order-2
+/// jumps at kitten's level (≤ 1e-7), and no cloud at a cap triangle is below 1e-3 of the
+/// triangle's longest side.
+#[test]
+fn rocker_arm_flat_torus_is_c2() {
+    let Some(s) = load("rocker-arm.off") else {
+        return;
+    };
+    let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+    assert_eq!(dom.genus, 1);
+    assert!(dom.singular.is_none());
+    let charts = &dom.charts;
+    let space = ManifoldSpace::new(charts, 3, &KnotOptions::default()).unwrap();
+    // The caps are there (largest flat angle > 170°) and their clouds are not collapsed.
+    let mesh = charts.mesh();
+    let mut caps = 0;
+    let mut worst_cloud = f64::INFINITY;
+    for f in 0..mesh.n_faces() as u32 {
+        let l = ricci::spline::manifold::face_side_lengths(mesh, charts.lengths(), f);
+        let longest = l[0].max(l[1]).max(l[2]);
+        let (i, _) = l
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .unwrap();
+        let (b, c) = (l[(i + 1) % 3], l[(i + 2) % 3]);
+        let cos = (b * b + c * c - longest * longest) / (2.0 * b * c);
+        if cos.clamp(-1.0, 1.0).acos().to_degrees() > 170.0 {
+            caps += 1;
+            for v in mesh.face(f) {
+                let r = space
+                    .cloud(v)
+                    .iter()
+                    .map(|p| p[0].hypot(p[1]))
+                    .fold(0.0, f64::max);
+                worst_cloud = worst_cloud.min(r / longest);
+            }
+        }
+    }
+    assert!(caps > 0, "no cap triangle in the flat metric");
+    assert!(
+        worst_cloud > 1e-3,
+        "a cap's cloud is {worst_cloud:.1e} of its side"
+    );
+    let (control, fairing) = fair(&space, &space.subdivision_control_points(), 3, 1).unwrap();
+    assert!(fairing.converged, "{fairing:?}");
+    let rep = continuity(&space, &control, &[], 1e-7).unwrap();
+    eprintln!(
+        "rocker-arm: {caps} caps, smallest cap cloud {worst_cloud:.1e} of the side; jumps {:?}",
+        rep.relative_jumps
+    );
+    let j = &rep.relative_jumps;
+    assert!(j[0] <= 1e-8 && j[1] <= 1e-8 && j[2] <= 1e-7, "{j:?}");
+    assert!(j[3] > 1e-3, "{j:?}");
+    assert_eq!(rep.smoothness, Some(2));
 }

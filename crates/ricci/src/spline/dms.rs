@@ -215,8 +215,9 @@ impl KnotClouds {
     /// `seed`); every vertex keeps the best of 32 candidates for the measure
     /// [`general_position`] over its triangles (a second sweep for clouds still below 0.05),
     /// because nearly collinear knots amplify rounding errors of the recurrence. Clouds of
-    /// triangles whose `Δ_β` come out thin (relative area < 0.05) or whose `Ω_I` is small
-    /// (< 10 % of the triangle) are shrunk by 0.7 and re-optimised.
+    /// triangles whose `Δ_β` come out thin (relative area below `min(0.05, ½ ×` the
+    /// triangle's own, see `needs_shrink`) or whose `Ω_I` is small (< 10 % of the triangle)
+    /// are shrunk by 0.7 and re-optimised.
     pub fn place(domain: &Domain, degree: usize, opts: &KnotOptions) -> Result<KnotClouds> {
         if !(1..=MAX_DEGREE).contains(&degree) {
             return Err(Error::input(format!(
@@ -359,8 +360,7 @@ impl KnotClouds {
             let mut any = false;
             for t in mesh.faces() {
                 let arr = triangle_knots(&knots, n, *t);
-                let (o, w) = patch_quality(n, &arr);
-                if o < 0.05 || w < 0.1 {
+                if needs_shrink(n, &arr) {
                     for &v in t {
                         dirty[v as usize] = true;
                     }
@@ -490,6 +490,20 @@ pub fn patch_quality(n: usize, knots: &[Point]) -> (f64, f64) {
     (min_orientation, omega_ratio)
 }
 
+/// Should the clouds of a triangle (knot array as in [`patch_quality`]) shrink: are its
+/// `Δ_β` too thin or its `Ω_I` too small? "Too thin" is relative to the triangle itself:
+/// relative area below `min(0.05, ½ · relative area of Δ_0)`. Against a fixed 0.05 a thin
+/// triangle (a 176° cap on rocker-arm.off, relative area 0.018) fails whatever its clouds —
+/// `Δ_0` is the triangle — and its vertices' clouds were shrunk in every round, to 2% of the
+/// already small radius (10⁻⁴ of the face), where the basis's derivatives lose 6–7 digits.
+pub(crate) fn needs_shrink(n: usize, knots: &[Point]) -> bool {
+    let (o, w) = patch_quality(n, knots);
+    let (a, b, c) = (knots[0], knots[n + 1], knots[2 * (n + 1)]);
+    let s = norm(sub(b, a)).max(norm(sub(c, a))).max(norm(sub(c, b)));
+    let o0 = det3(a, b, c) / (s * s);
+    o < 0.05f64.min(0.5 * o0) || w < 0.1
+}
+
 /// Convex hull (Andrew's monotone chain), counter-clockwise, without collinear points.
 fn convex_hull(points: &[Point]) -> Vec<Point> {
     let mut p = points.to_vec();
@@ -535,11 +549,17 @@ fn clip_left(poly: &[Point], a: Point, b: Point) -> Vec<Point> {
     out
 }
 
+/// Signed area of a polygon, by the shoelace formula relative to its first vertex: in
+/// absolute coordinates the terms are `|x|²` and a polygon of size `h ≪ |x|` loses its area
+/// to cancellation (a 1e-8 face in a unit-size affine-atlas chart of 3holes.off measured
+/// `Ω_I` empty, 0 against 0.25 in a local frame).
 fn polygon_area(poly: &[Point]) -> f64 {
+    let Some(&o) = poly.first() else {
+        return 0.0;
+    };
     let mut s = 0.0;
-    for i in 0..poly.len() {
-        s +=
-            poly[i][0] * poly[(i + 1) % poly.len()][1] - poly[(i + 1) % poly.len()][0] * poly[i][1];
+    for i in 1..poly.len().saturating_sub(1) {
+        s += det3(o, poly[i], poly[i + 1]);
     }
     0.5 * s
 }
@@ -737,6 +757,30 @@ impl TriangleBasis {
         }
     }
 
+    /// The centroid of the knots: the origin of [`Self::eval_offset`].
+    pub fn origin(&self) -> Point {
+        self.family.origin()
+    }
+
+    /// [`Self::eval`] at `origin() + x`, the point given by its offset from the knots'
+    /// centroid (see [`SimplexFamily::eval_offset`]).
+    pub fn eval_offset(
+        &self,
+        x: Point,
+        dir: Point,
+        order: usize,
+        work: &mut Vec<f64>,
+        out: &mut [f64],
+    ) {
+        let np = n_partials(order);
+        self.family.eval_offset(x, dir, order, work, out);
+        for (b, s) in self.scale.iter().enumerate() {
+            for v in &mut out[b * np..(b + 1) * np] {
+                *v *= s;
+            }
+        }
+    }
+
     /// The arguments `t_{0,0..β_0−1}, t_{1,0..β_1−1}, t_{2,0..β_2−1}` at which the blossom gives
     /// the control point of β.
     pub fn blossom_args(&self, beta: [usize; 3]) -> Vec<Point> {
@@ -782,6 +826,46 @@ impl TriangleBasis {
         for (b, beta) in multi_indices(n).iter().enumerate() {
             out[b] = cur[beta[0] * w + beta[1]];
         }
+    }
+}
+
+/// [`TriangleBasis::blossom_weights`] for the knot array `knots` (`[m * (n+1) + k] = t_{m,k}`)
+/// given directly, in any coordinate system: the barycentric coordinates of each argument in
+/// `Δ_γ` are formed from differences to the argument, so a frame local to the triangle keeps
+/// them to rounding of the triangle's size.
+pub(crate) fn blossom_weights_of(n: usize, knots: &[Point], args: &[Point], out: &mut [f64]) {
+    let t = |m: usize, k: usize| knots[m * (n + 1) + k];
+    let w = n + 1;
+    let mut cur = vec![0.0; w * w];
+    let mut next = vec![0.0; w * w];
+    cur[0] = 1.0;
+    for (s, x) in args.iter().enumerate() {
+        next.fill(0.0);
+        for g in multi_indices(s) {
+            let wt = cur[g[0] * w + g[1]];
+            if wt == 0.0 {
+                continue;
+            }
+            let d = [
+                sub(t(0, g[0]), *x),
+                sub(t(1, g[1]), *x),
+                sub(t(2, g[2]), *x),
+            ];
+            let det = det3(t(0, g[0]), t(1, g[1]), t(2, g[2]));
+            let cr = |a: Point, b: Point| a[0] * b[1] - a[1] * b[0];
+            let lam = [
+                cr(d[1], d[2]) / det,
+                cr(d[2], d[0]) / det,
+                cr(d[0], d[1]) / det,
+            ];
+            next[(g[0] + 1) * w + g[1]] += wt * lam[0];
+            next[g[0] * w + g[1] + 1] += wt * lam[1];
+            next[g[0] * w + g[1]] += wt * lam[2];
+        }
+        std::mem::swap(&mut cur, &mut next);
+    }
+    for (b, beta) in multi_indices(n).iter().enumerate() {
+        out[b] = cur[beta[0] * w + beta[1]];
     }
 }
 

@@ -19,8 +19,10 @@
 //! domain (the mesh boundary or a hole's link) inside the wedge outside both boundary edges, so
 //! the DMS boundary condition holds and the basis is a **partition of unity on every active
 //! face, up to the hole's link** (asserted by the tests); candidates keep the best worst-triple
-//! [`crate::spline::dms::general_position`], and clouds of triangles with thin `Δ_β` or small
-//! `Ω_I` are shrunk.
+//! [`crate::spline::dms::general_position`], and clouds of triangles with thin `Δ_β` (thinner
+//! than `min(0.05, ½ ×` the triangle's own relative area) or small `Ω_I` are shrunk — the
+//! floor relative to the triangle, so that a cap triangle (rocker-arm.off) does not collapse
+//! its vertices' clouds to 10⁻⁴ of the face.
 //!
 //! **Basis.** The DMS basis of an active triangle `I` is built by
 //! [`TriangleBasis::new`] in `I`'s home chart ([`FlatCharts::home_chart`]) from the three
@@ -28,10 +30,29 @@
 //! the stars of `I`'s vertices, which the home chart contains.
 //!
 //! **Evaluation** at a point of face `g`: every active triangle `I` sharing a vertex with `g`
-//! contributes, evaluated in `I`'s home chart after mapping the point by the transition on `g`;
-//! partials are rotated back into the chart the point was given in. Values therefore do not
+//! contributes, evaluated in `I`'s home chart at the point with the same barycentric
+//! coordinates in `g` (the transition on `g`, as an affine map of `g`'s corners; see
+//! *Conditioning*); partials are rotated back into the chart the point was given in. Values therefore do not
 //! depend on the chart (to rounding), and partials transform by the rotation of the transition
 //! ([`rotate_partials`]). Limits are taken from inside `g` (direction towards its centroid).
+//!
+//! **Conditioning.** A point is carried into each home chart by its barycentric coordinates
+//! in its face, and handed to the basis as an offset from the basis's knot centroid built from
+//! differences of the face's corners ([`ManifoldSpace::basis_at_bary`]): its rounding is then
+//! `ε h` (h the face size) whatever the chart. Going through absolute chart coordinates costs
+//! `ε |u|` instead, and an affine-atlas chart is up to ~5·10³ face sizes across near the cone
+//! (eight.off), which made order-2 partials differ between charts by 1.5e-6 (relative). What
+//! remains (≈ 1e-8 relative at edge midpoints, ≤ 1e-10 at centroids and ≤ 1e-10 of the size
+//! of the terms `Σ |c − F| |∂N|` everywhere, see the tests) is the rounding of the simplex
+//! recurrence itself: moving the point by one ulp inside one chart changes `∂²F` as much.
+//!
+//! **Fairing.** The constraints of paper 000 eq. 14 compare blossoms of neighbouring
+//! triangles; their weights are computed in the vertex frame of a shared vertex (every cloud
+//! brought there through the faces of the pair), not in the home charts. Built from the home
+//! charts, they carried the charts' rounding and inconsistency (over the affine atlas 1.8e-11
+//! of a star), and the redundant constraints of neighbouring edges then disagreed by more than
+//! the fairing's 1e-10: on eight.off the solve stalled at a residual of 1.3e-4 after 21 s; it
+//! now converges in 2 steps (0.6 s) to the same control points as over `LocalCharts`.
 //!
 //! Control points are stored for every face (`face * (n+1)(n+2)/2 + position of β`); those of
 //! faces at a cone are used by no basis function. [`ManifoldSpace`] implements
@@ -55,8 +76,8 @@ use crate::layout::RigidMotion;
 use crate::mesh::Mesh;
 
 use super::dms::{
-    general_position_involving, hash64, multi_indices, patch_quality, per_triangle, unit,
-    KnotOptions, TriangleBasis, Workspace, MAX_DEGREE,
+    blossom_weights_of, general_position_involving, hash64, multi_indices, needs_shrink,
+    per_triangle, unit, KnotOptions, TriangleBasis, Workspace, MAX_DEGREE,
 };
 use super::fit::SplineSpace;
 use super::simplex::{det3, n_partials, partial_index, Point};
@@ -678,8 +699,7 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
                     continue;
                 }
                 pl.face_knots(&knots, f, &mut arr);
-                let (o, w) = patch_quality(n, &arr);
-                if o < 0.05 || w < 0.1 {
+                if needs_shrink(n, &arr) {
                     for &v in &mesh.face(f) {
                         dirty[v as usize] = true;
                     }
@@ -932,20 +952,39 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         Ok(())
     }
 
-    fn push_basis(&self, i: u32, w: Point, dir: Point, back: C, order: usize, ws: &mut Workspace) {
+    /// Basis `i` at the point with barycentric coordinates `bary` of face `g`, whose corners in
+    /// `i`'s home chart are `x`: the point is formed as an offset from the basis's knot centroid
+    /// (`(x_0 − o) + b_1 (x_1 − x_0) + b_2 (x_2 − x_0)`, every term of the size of the face),
+    /// so its rounding is `ε h`, not `ε |x|` — the home chart may be large against the face
+    /// (module docs, *Conditioning*).
+    #[allow(clippy::too_many_arguments)]
+    fn push_basis(
+        &self,
+        i: u32,
+        x: &[Point; 3],
+        bary: [f64; 3],
+        dir: Point,
+        back: C,
+        order: usize,
+        ws: &mut Workspace,
+    ) {
         let n = self.degree;
         let nb = per_triangle(n);
         let np = n_partials(order);
         let Some(basis) = self.bases[i as usize].as_ref() else {
             return;
         };
-        if !basis.may_contain(w) {
+        let o = basis.origin();
+        let off: Point = std::array::from_fn(|k| {
+            (x[0][k] - o[k]) + bary[1] * (x[1][k] - x[0][k]) + bary[2] * (x[2][k] - x[0][k])
+        });
+        if !basis.may_contain([o[0] + off[0], o[1] + off[1]]) {
             return;
         }
         if ws.local.len() < nb * np {
             ws.local.resize(nb * np, 0.0);
         }
-        basis.eval(w, dir, order, &mut ws.simplex, &mut ws.local);
+        basis.eval_offset(off, dir, order, &mut ws.simplex, &mut ws.local);
         rotate_partials(order, back, &mut ws.local[..nb * np]);
         for b in 0..nb {
             ws.indices.push((i as usize * nb + b) as u32);
@@ -964,36 +1003,41 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         ws: &mut Workspace,
     ) -> Result<usize> {
         self.check_point(g, u)?;
+        let bary = barycentric(&self.canon_coords[g as usize], u);
+        self.basis_at_bary(g, bary, order, ws)
+    }
+
+    /// [`Self::basis_at_point`] at the point with barycentric coordinates `bary` of face `g`
+    /// (exact at `g`'s corners and edges): the point is placed in each home chart from `g`'s
+    /// own corners there, never through canonical-chart coordinates.
+    pub fn basis_at_bary(
+        &self,
+        g: u32,
+        bary: [f64; 3],
+        order: usize,
+        ws: &mut Workspace,
+    ) -> Result<usize> {
+        self.check_point(g, [bary[0], bary[1] + bary[2]])?;
         ws.indices.clear();
         ws.values.clear();
         let c = self.canon_coords[g as usize];
-        let dir = inward_direction(&c, u);
+        let dir = inward_direction_bary(&c, bary);
         let (a, b) = (
             self.cand_start[g as usize] as usize,
             self.cand_start[g as usize + 1] as usize,
         );
-        // Barycentric coordinates of u in g (exact at g's corners), so that the point is placed
-        // in each home chart from g's own corners there rather than by a fitted motion.
-        let area = det3(c[0], c[1], c[2]);
-        let bary = [
-            det3(u, c[1], c[2]) / area,
-            det3(c[0], u, c[2]) / area,
-            det3(c[0], c[1], u) / area,
-        ];
         for k in a..b {
             let (i, m, x) = self.cand[k];
-            let w = [
-                bary[0] * x[0][0] + bary[1] * x[1][0] + bary[2] * x[2][0],
-                bary[0] * x[0][1] + bary[1] * x[1][1] + bary[2] * x[2][1],
-            ];
-            self.push_basis(i, w, rotate(m.rot, dir), m.rot, order, ws);
+            self.push_basis(i, &x, bary, rotate(m.rot, dir), m.rot, order, ws);
         }
         Ok(ws.indices.len())
     }
 
     /// Like [`Self::basis_at_point`] for a point given in any chart `chart` containing `g`,
-    /// with partials in that chart. Every triangle's transition is computed directly from the
-    /// charts (no cached motions), so comparing charts tests the whole chain.
+    /// with partials in that chart. The point is carried to the home charts by its barycentric
+    /// coordinates in `g` (the affine map of `g`'s corners, which is the transition up to the
+    /// charts' rounding); the rotations of the partials are computed directly from the charts
+    /// (no cached motions), so comparing charts tests the whole chain.
     pub fn basis_in_chart(
         &self,
         chart: ChartId,
@@ -1008,22 +1052,26 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         })?;
         ws.indices.clear();
         ws.values.clear();
-        let dir = inward_direction(&c, u);
+        let bary = barycentric(&c, u);
+        let dir = inward_direction_bary(&c, bary);
         let (a, b) = (
             self.cand_start[g as usize] as usize,
             self.cand_start[g as usize + 1] as usize,
         );
         for k in a..b {
             let i = self.cand[k].0;
-            let (m, _) = self
-                .charts
-                .transition(chart, self.home[i as usize], g)
-                .ok_or_else(|| {
-                    Error::input(format!(
-                        "manifold spline: no transition from chart {chart} to the home chart of face {i} on face {g}"
-                    ))
-                })?;
-            self.push_basis(i, apply(&m, u), rotate(m.rot, dir), m.rot, order, ws);
+            let hi = self.home[i as usize];
+            let (m, _) = self.charts.transition(chart, hi, g).ok_or_else(|| {
+                Error::input(format!(
+                    "manifold spline: no transition from chart {chart} to the home chart of face {i} on face {g}"
+                ))
+            })?;
+            let x = self.charts.face_coords(hi, g).ok_or_else(|| {
+                Error::input(format!(
+                    "manifold spline: face {g} is not in the home chart {hi} of face {i}"
+                ))
+            })?;
+            self.push_basis(i, &x, bary, rotate(m.rot, dir), m.rot, order, ws);
         }
         Ok(ws.indices.len())
     }
@@ -1041,16 +1089,42 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         ws: &mut Workspace,
         out: &mut [f64],
     ) -> Result<()> {
-        super::fit::evaluate(
-            self,
-            control,
-            dim,
-            g,
-            self.face_point(g, bary),
-            order,
-            ws,
-            out,
-        )
+        let np = n_partials(order);
+        if control.len() != SplineSpace::n_control_points(self) * dim || out.len() < np * dim {
+            return Err(Error::input(
+                "manifold spline evaluation: control points or output of the wrong size",
+            ));
+        }
+        if !bary.iter().all(|b| b.is_finite()) {
+            return Err(Error::input(format!(
+                "manifold spline evaluation in face {g}: barycentric coordinates {bary:?} are not finite"
+            )));
+        }
+        let m = self.basis_at_bary(g, bary, order, ws)?;
+        self.combine(control, dim, m, np, ws, out);
+        Ok(())
+    }
+
+    /// `out = Σ_i c_{indices[i]} values[i]` over the first `m` basis functions of `ws`.
+    fn combine(
+        &self,
+        control: &[f64],
+        dim: usize,
+        m: usize,
+        np: usize,
+        ws: &Workspace,
+        out: &mut [f64],
+    ) {
+        out[..np * dim].fill(0.0);
+        for i in 0..m {
+            let gidx = ws.indices[i] as usize;
+            for k in 0..np {
+                let v = ws.values[i * np + k];
+                for d in 0..dim {
+                    out[k * dim + d] += v * control[gidx * dim + d];
+                }
+            }
+        }
     }
 
     /// `F` and partials at the point `u` of face `g` given in chart `chart`, partials in that
@@ -1073,17 +1147,8 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
                 "manifold spline evaluation: control points or output of the wrong size",
             ));
         }
-        out[..np * dim].fill(0.0);
         let m = self.basis_in_chart(chart, g, u, order, ws)?;
-        for i in 0..m {
-            let gidx = ws.indices[i] as usize;
-            for k in 0..np {
-                let v = ws.values[i * np + k];
-                for d in 0..dim {
-                    out[k * dim + d] += v * control[gidx * dim + d];
-                }
-            }
-        }
+        self.combine(control, dim, m, np, ws, out);
         Ok(())
     }
 
@@ -1108,7 +1173,7 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
 
     /// Sum of all basis functions at a point (1 where the partition of unity holds).
     pub fn basis_sum(&self, g: u32, bary: [f64; 3], ws: &mut Workspace) -> Result<f64> {
-        let m = self.basis_at_point(g, self.face_point(g, bary), 0, ws)?;
+        let m = self.basis_at_bary(g, bary, 0, ws)?;
         Ok(ws.values[..m].iter().sum())
     }
 }
@@ -1136,31 +1201,70 @@ impl<A: FlatCharts + Sync + ?Sized> SplineSpace for ManifoldSpace<'_, A> {
         out
     }
     fn blossom_weights_between(&self, i: u32, beta: [usize; 3], j: u32, out: &mut [f64]) {
-        let (Some(bi), Some(bj)) = (self.basis(i), self.basis(j)) else {
+        // In the vertex frame of a vertex `v` shared by I and J (small coordinates, developed
+        // from the edge lengths), not in the home charts: the weights then carry rounding of
+        // the faces' size instead of `ε |chart coordinates|` and the charts' own inconsistency,
+        // which over the affine atlas made the redundant constraints of neighbouring edges
+        // disagree by more than the fairing's tolerance (module docs, *Fairing*).
+        let n = self.degree;
+        let mesh = self.charts.mesh();
+        let (ti, tj) = (mesh.face(i), mesh.face(j));
+        let Some(v) = ti.iter().copied().find(|x| tj.contains(x)) else {
             out.fill(0.0);
             return;
         };
-        // Home chart of I → home chart of J, on face I (which shares an edge with J).
-        let m = self
-            .charts
-            .transition(self.home[i as usize], self.home[j as usize], i)
-            .map(|x| x.0)
-            .unwrap_or(RigidMotion::new(0.0, C::new(0.0, 0.0)));
-        // Knots of the shared vertices are taken from J's own clouds (the same knots, without
-        // the charts' rounding), the others are mapped; arguments are in blossom_args order.
-        let mesh = self.charts.mesh();
-        let (ti, tj) = (mesh.face(i), mesh.face(j));
-        let mut mapped: Vec<Point> = Vec::with_capacity(self.degree);
-        for (mi, &bm) in beta.iter().enumerate() {
-            let mj = tj.iter().position(|&v| v == ti[mi]);
-            for k in 0..bm {
-                mapped.push(match mj {
-                    Some(mj) => bj.knot(mj, k),
-                    None => apply(&m, bi.knot(mi, k)),
-                });
+        let Some(fv) = self.frames[v as usize].as_ref() else {
+            out.fill(0.0);
+            return;
+        };
+        // Cloud of vertex `x` in v's frame, through the faces of {I, J} at x.
+        let cloud_in_v = |x: u32| -> Option<Vec<Point>> {
+            let fx = self.frames[x as usize].as_ref()?;
+            let mut a = Vec::with_capacity(6);
+            let mut b = Vec::with_capacity(6);
+            let mut corner = None;
+            for (f, t) in [(i, ti), (j, tj)] {
+                if let Some(m) = t.iter().position(|&y| y == x) {
+                    let (cx, cv) = (fx.coords_of(f)?, fv.coords_of(f)?);
+                    a.extend_from_slice(cx);
+                    b.extend_from_slice(cv);
+                    corner.get_or_insert(cv[m]);
+                }
+            }
+            let m = fit_rigid(&a, &b).0;
+            let mut cl: Vec<Point> = self.cloud(x).iter().map(|&p| apply(&m, p)).collect();
+            cl[0] = corner?;
+            Some(cl)
+        };
+        let mut kj = Vec::with_capacity(3 * (n + 1));
+        for &x in &tj {
+            match cloud_in_v(x) {
+                Some(c) => kj.extend_from_slice(&c),
+                None => {
+                    out.fill(0.0);
+                    return;
+                }
             }
         }
-        bj.blossom_weights(&mapped, out);
+        let mut args: Vec<Point> = Vec::with_capacity(n);
+        for (mi, &bm) in beta.iter().enumerate() {
+            if bm == 0 {
+                continue;
+            }
+            let x = ti[mi];
+            let cl = match tj.iter().position(|&y| y == x) {
+                Some(mj) => kj[mj * (n + 1)..(mj + 1) * (n + 1)].to_vec(),
+                None => match cloud_in_v(x) {
+                    Some(c) => c,
+                    None => {
+                        out.fill(0.0);
+                        return;
+                    }
+                },
+            };
+            args.extend_from_slice(&cl[..bm]);
+        }
+        blossom_weights_of(n, &kj, &args, out);
     }
     fn basis_at(&self, face: u32, param: Point, order: usize, ws: &mut Workspace) -> Result<usize> {
         self.basis_at_point(face, param, order, ws)
@@ -1199,17 +1303,27 @@ impl<A: FlatCharts + Sync + ?Sized> SplineSpace for ManifoldSpace<'_, A> {
     }
 }
 
-/// Direction from `u` towards the centroid of the triangle `c`: the side from which values at
-/// `u` are taken as limits from inside the face (any direction at the centroid itself).
-fn inward_direction(c: &[Point; 3], u: Point) -> Point {
-    let cen = [
-        (c[0][0] + c[1][0] + c[2][0]) / 3.0,
-        (c[0][1] + c[1][1] + c[2][1]) / 3.0,
-    ];
-    let dir = [cen[0] - u[0], cen[1] - u[1]];
+/// Direction from the point with barycentric coordinates `bary` towards the centroid of the
+/// triangle `c`, `Σ_m (1/3 − b_m) (c_m − c_0)` (from differences, so of the face's size
+/// whatever the coordinates): the side from which values there are taken as limits from
+/// inside the face (any direction at the centroid itself).
+fn inward_direction_bary(c: &[Point; 3], bary: [f64; 3]) -> Point {
+    let w1 = 1.0 / 3.0 - bary[1];
+    let w2 = 1.0 / 3.0 - bary[2];
+    let dir: Point = std::array::from_fn(|k| w1 * (c[1][k] - c[0][k]) + w2 * (c[2][k] - c[0][k]));
     if dir == [0.0, 0.0] {
         [1.0, 0.0]
     } else {
         dir
     }
+}
+
+/// Barycentric coordinates of `u` in the triangle `c` (exact at its corners).
+fn barycentric(c: &[Point; 3], u: Point) -> [f64; 3] {
+    let area = det3(c[0], c[1], c[2]);
+    [
+        det3(u, c[1], c[2]) / area,
+        det3(c[0], u, c[2]) / area,
+        det3(c[0], c[1], u) / area,
+    ]
 }

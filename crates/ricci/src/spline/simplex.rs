@@ -295,13 +295,32 @@ impl SimplexFamily {
     /// `out[r * n_partials(order) + partial_index(a, b)] = ∂_x^a ∂_y^b M(u | V_r)`.
     /// `work` is resized as needed (no allocation once it is large enough).
     pub fn eval(&self, u: Point, dir: Point, order: usize, work: &mut Vec<f64>, out: &mut [f64]) {
+        self.eval_offset(sub(u, self.origin), dir, order, work, out);
+    }
+
+    /// The centroid of the knots, relative to which [`Self::eval_offset`] takes its point.
+    pub fn origin(&self) -> Point {
+        self.origin
+    }
+
+    /// [`Self::eval`] at the point `origin() + x`, given by its offset `x` from the knots'
+    /// centroid: a caller that knows the point relative to nearby geometry (a face's corners)
+    /// keeps its full precision, instead of rounding it to the caller's coordinates first
+    /// (`ε |u|`, large against the knot spacing when the coordinates are far from the origin).
+    pub fn eval_offset(
+        &self,
+        x: Point,
+        dir: Point,
+        order: usize,
+        work: &mut Vec<f64>,
+        out: &mut [f64],
+    ) {
         let np = n_partials(order);
         debug_assert!(out.len() >= self.roots.len() * np);
         let need = self.n_nodes() * np;
         if work.len() < need {
             work.resize(need, 0.0);
         }
-        let x = sub(u, self.origin);
         let d = if dir[0] == 0.0 && dir[1] == 0.0 {
             [1.0, 0.0]
         } else {
