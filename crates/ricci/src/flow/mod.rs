@@ -384,6 +384,17 @@ pub fn ricci_flow(
             "after rescaling, max |K − K̄| = {max_err:.3e} exceeds the tolerance"
         ));
     }
+    // A curvature reached with faces that violate the triangle inequality (their angles
+    // extended by 0, 0, π) is not a polyhedral metric on this triangulation: not converged.
+    let degenerate = ev.ws.degenerate_faces;
+    let converged = converged && degenerate == 0;
+    if degenerate > 0 {
+        notes.push(format!(
+            "{degenerate} face(s) violate the triangle inequality in the final metric: no \
+             discrete conformal metric with this target on this triangulation (try \
+             --refine-degenerate N with --refined-out, or another scheme)"
+        ));
+    }
     Ok(FlowResult {
         geometry,
         scheme: options.scheme,
