@@ -12,7 +12,7 @@
 //! (attempts per round), `BENCH_VALENCE` (minimum valence at the base vertex). Failed attempts
 //! are printed above each result line.
 
-use ricci::cut::{canonical_cut, CutOptions};
+use ricci::cut::{canonical_cut, Construction, CutOptions};
 use ricci::mesh::io::read_surface;
 use ricci::metric::Geometry;
 use ricci::progress::NoProgress;
@@ -37,6 +37,12 @@ fn main() {
     let base: Option<u32> = std::env::var("BENCH_BASE")
         .ok()
         .and_then(|r| r.parse().ok());
+    // BENCH_CONSTRUCTION: cut-and-paste (default), greedy, greedy-then-cut-and-paste.
+    let construction = match std::env::var("BENCH_CONSTRUCTION").as_deref() {
+        Ok("greedy") => Construction::Greedy,
+        Ok("greedy-then-cut-and-paste") => Construction::GreedyThenCutAndPaste,
+        _ => Construction::CutAndPaste,
+    };
     for f in files {
         let (s, _) = match read_surface(&f) {
             Ok(x) => x,
@@ -63,6 +69,7 @@ fn main() {
                     min_valence: std::env::var("BENCH_VALENCE")
                         .ok()
                         .and_then(|r| r.parse().ok()),
+                    construction,
                 },
                 &mut NoProgress,
             );

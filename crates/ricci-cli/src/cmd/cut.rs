@@ -274,6 +274,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         base: a.base,
         min_valence: a.min_valence,
         max_attempts: None,
+        ..CutOptions::default()
     };
     let c = canonical_cut(
         &s.mesh,

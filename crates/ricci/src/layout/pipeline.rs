@@ -19,7 +19,7 @@
 //! instead of ~κ·sinh r with κ ≈ 5e-15 (BENCHMARKS.md, Layout).
 
 use super::deck::Polygon;
-use crate::cut::{canonical_cut, CanonicalCut, CutOptions};
+use crate::cut::{canonical_cut, CanonicalCut, Construction, CutOptions};
 use crate::error::{Error, Result};
 use crate::flow::polish::{polish_metric, PolishSettings, PolishedMetric};
 use crate::flow::{ricci_flow, FlowOptions, FlowResult, TargetSpec};
@@ -103,8 +103,11 @@ pub fn cut_disk(
     base: Option<u32>,
     progress: &mut dyn Progress,
 ) -> Result<CutDisk> {
+    // Short loops keep the hyperbolic fundamental polygon compact (see
+    // `Construction::GreedyThenCutAndPaste`).
     let opts = CutOptions {
         base,
+        construction: Construction::GreedyThenCutAndPaste,
         ..CutOptions::default()
     };
     let cut = canonical_cut(mesh, lengths, geometry, positions, &opts, progress)?;
