@@ -6,7 +6,7 @@
 mod cut_check;
 
 use cut_check::{meshes_dir, verify};
-use ricci::cut::{canonical_cut, CutOptions};
+use ricci::cut::{canonical_cut, Construction, CutOptions};
 use ricci::mesh::io::read_surface;
 use ricci::metric::Geometry;
 use ricci::progress::NoProgress;
@@ -21,9 +21,21 @@ fn run(file: &str, g: usize, nb: usize, base: Option<u32>) {
 }
 
 fn run_surface(s: &ricci::mesh::Surface, file: &str, g: usize, nb: usize, base: Option<u32>) {
+    run_construction(s, file, g, nb, base, Construction::default());
+}
+
+fn run_construction(
+    s: &ricci::mesh::Surface,
+    file: &str,
+    g: usize,
+    nb: usize,
+    base: Option<u32>,
+    construction: Construction,
+) -> ricci::cut::CanonicalCut {
     let lengths = s.edge_lengths();
     let opts = CutOptions {
         base,
+        construction,
         ..CutOptions::default()
     };
     let c = canonical_cut(
@@ -40,6 +52,7 @@ fn run_surface(s: &ricci::mesh::Surface, file: &str, g: usize, nb: usize, base: 
     for l in &c.loops {
         assert!(l.length > 0.0 && l.length.is_finite());
     }
+    c
 }
 
 #[test]
@@ -102,6 +115,42 @@ fn hard_and_random_base_vertices_on_botijo_and_seahorse() {
             run_surface(&s, f, g, 0, Some(v));
         }
     }
+}
+
+/// The layout's construction: the greedy, then cut-and-paste when the greedy fails. From
+/// seahorse2_100K's vertex 10000 all 12 greedy attempts fail; the fallback must still give a
+/// canonical system (checked independently), and a mesh where the greedy succeeds keeps the
+/// greedy's loops (no cut-and-paste moves).
+#[test]
+fn greedy_then_cut_and_paste_falls_back_when_the_greedy_fails() {
+    let Some(dir) = meshes_dir() else {
+        eprintln!("RICCI_MESHES not set: skipping the fallback test");
+        return;
+    };
+    let (s, _) = read_surface(&dir.join("seahorse2_100K.off")).unwrap();
+    let c = run_construction(
+        &s,
+        "seahorse2_100K.off",
+        8,
+        0,
+        Some(10000),
+        Construction::GreedyThenCutAndPaste,
+    );
+    assert!(!c.report.failed_attempts.is_empty(), "{:?}", c.report);
+    assert!(
+        c.report.search.moves > 0,
+        "the loops come from cut-and-paste"
+    );
+    let (s, _) = read_surface(&dir.join("genus3.off")).unwrap();
+    let c = run_construction(
+        &s,
+        "genus3.off",
+        3,
+        0,
+        None,
+        Construction::GreedyThenCutAndPaste,
+    );
+    assert_eq!(c.report.search.moves, 0, "the greedy's loops, no moves");
 }
 
 #[test]
