@@ -759,7 +759,14 @@ proptest! {
         assert_topology(&d, 0, 1, "disk");
         assert_planar_cover(&d, polygon_area(n as usize, 1.0), "disk");
         let r_in = r_in * r_out;
-        let a = annulus(r_in, r_out, n).unwrap();
+        let a = annulus(r_in, r_out, n);
+        if r_in / r_out > annulus_max_ratio(n) {
+            // Too thin for n segments: refused with a sentence that says so.
+            let e = a.err().expect("a too thin annulus is refused").to_string();
+            prop_assert!(e.contains("too thin"), "{}", e);
+            return Ok(());
+        }
+        let a = a.unwrap();
         assert_topology(&a, 0, 2, "annulus");
         let sizes = boundary_circles(&a, &[([0.0, 0.0], r_out), ([0.0, 0.0], r_in)], "annulus");
         let area = polygon_area(sizes[0], r_out) - polygon_area(sizes[1], r_in);
@@ -779,5 +786,23 @@ proptest! {
         assert_topology(&s, g as i64, 0, "genus");
         let (_, v) = area_volume(&s);
         prop_assert!(v > 0.0, "not oriented outward");
+    }
+}
+
+/// Just inside `annulus_max_ratio` every resolution triangulates to an annulus; just outside,
+/// the generator refuses with a sentence instead of failing inside the mesh builder (it used
+/// to report "non-manifold vertex 0: two boundary fans meet there" for e.g. n = 8, 0.85).
+#[test]
+fn thin_annuli_triangulate_or_are_refused() {
+    for n in [8u32, 10, 12, 14, 16, 20, 24, 32, 48, 64] {
+        let max = annulus_max_ratio(n);
+        for q in [max - 0.002, max - 0.02, max - 0.06] {
+            let a = annulus(q * 0.5, 0.5, n).unwrap_or_else(|e| panic!("n = {n}, ratio {q}: {e}"));
+            assert_topology(&a, 0, 2, "thin annulus");
+        }
+        let e = annulus((max + 0.002).min(0.999) * 0.5, 0.5, n)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("too thin"), "n = {n}: {e}");
     }
 }

@@ -119,6 +119,14 @@ pub fn annulus(r_in: f64, r_out: f64, resolution: u32) -> Result<Surface> {
         )));
     }
     check_resolution("annulus", resolution, 8)?;
+    let max_ratio = annulus_max_ratio(resolution);
+    if ratio > max_ratio {
+        return Err(Error::input(format!(
+            "annulus: inner / outer = {ratio:.4} is too thin for {resolution} segments (at most \
+             {max_ratio:.4}: the inner circle must stay a fifth of a segment inside the outer \
+             polygon); use more segments or a smaller inner radius"
+        )));
+    }
     check_planar_size("annulus", PI * (1.0 - ratio * ratio), 1.0, resolution)?;
     let mut s = planar::mesh_domain(
         "annulus",
@@ -133,6 +141,16 @@ pub fn annulus(r_in: f64, r_out: f64, resolution: u32) -> Result<Surface> {
         p[1] *= r_out;
     }
     Ok(s)
+}
+
+/// Largest inner / outer radius ratio [`annulus`] accepts with `resolution` segments on the
+/// outer circle: the inner circle must stay clear of the outer polygon's edges (at distance
+/// `cos(π/n)` from the centre) by a fifth of a segment (`2 sin(π/n)`). Thinner annuli could not
+/// be triangulated (a boundary vertex shared by two boundary fans); measured on a grid of
+/// ratios for n = 8…64, the first failure was at 0.035–0.123 of a segment.
+pub fn annulus_max_ratio(resolution: u32) -> f64 {
+    let t = PI / resolution.max(3) as f64;
+    t.cos() - 0.2 * 2.0 * t.sin()
 }
 
 /// Radius and centres of the two holes of [`pair_of_pants`].
