@@ -762,7 +762,7 @@ proptest! {
         let a = annulus(r_in, r_out, n);
         if r_in / r_out > annulus_max_ratio(n) {
             // Too thin for n segments: refused with a sentence that says so.
-            let e = a.err().expect("a too thin annulus is refused").to_string();
+            let e = a.expect_err("a too thin annulus is refused").to_string();
             prop_assert!(e.contains("too thin"), "{}", e);
             return Ok(());
         }
