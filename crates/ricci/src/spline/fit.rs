@@ -796,27 +796,32 @@ fn energy_gram<S: SplineSpace + ?Sized>(space: &S, blocks: &mut Blocks) -> Resul
             let mut ws = Workspace::default();
             let mut groups: Vec<u32> = Vec::new();
             let mut local: HashMap<u32, usize> = HashMap::new();
-            let mut points: Vec<(Vec<u32>, Vec<f64>, f64)> = Vec::with_capacity(b - a);
-            for &(f, u, w) in &quad[a..b] {
+            // One entry per (point, basis function): its local column and its scaled second
+            // partials √w·(∂xx, √2 ∂xy, ∂yy), so that VᵀV sums w(∂xx² + 2∂xy² + ∂yy²).
+            let mut entries: Vec<(usize, usize, [f64; 3])> = Vec::new();
+            for (r, &(f, u, w)) in quad[a..b].iter().enumerate() {
                 let m = space.basis_at(f, u, 2, &mut ws)?;
-                for g in ws.indices[..m].chunks(nb) {
+                let sw = [w.sqrt(), (2.0 * w).sqrt(), w.sqrt()];
+                for (gi, g) in ws.indices[..m].chunks(nb).enumerate() {
                     let t = g[0] / nb as u32;
-                    local.entry(t).or_insert_with(|| {
+                    let lg = *local.entry(t).or_insert_with(|| {
                         groups.push(t);
                         groups.len() - 1
                     });
-                }
-                points.push((ws.indices[..m].to_vec(), ws.values[..m * np2].to_vec(), w));
-            }
-            let cols = groups.len() * nb;
-            let mut v = Mat::<f64>::zeros(3 * points.len(), cols);
-            for (r, (idx, vals, w)) in points.iter().enumerate() {
-                let sw = [w.sqrt(), (2.0 * w).sqrt(), w.sqrt()];
-                for (i, &g) in idx.iter().enumerate() {
-                    let col = local[&(g / nb as u32)] * nb + g as usize % nb;
-                    for c in 0..3 {
-                        v[(3 * r + c, col)] += sw[c] * vals[i * np2 + 3 + c];
+                    for (p, &gp) in g.iter().enumerate() {
+                        let vals = &ws.values[(gi * nb + p) * np2..];
+                        entries.push((
+                            r,
+                            lg * nb + gp as usize % nb,
+                            [sw[0] * vals[3], sw[1] * vals[4], sw[2] * vals[5]],
+                        ));
                     }
+                }
+            }
+            let mut v = Mat::<f64>::zeros(3 * (b - a), groups.len() * nb);
+            for &(r, col, d) in &entries {
+                for (c, dc) in d.iter().enumerate() {
+                    v[(3 * r + c, col)] += dc;
                 }
             }
             Ok((groups, v.transpose() * &v))
