@@ -301,20 +301,14 @@ pub fn canonical_cut(
     };
 
     let closed = nb == 0 && genus >= 1;
+    let cut_and_paste_from = |valence: usize, progress: &mut dyn Progress| {
+        cut_and_paste(
+            mesh, lengths, geometry, positions, base, automatic, genus, valence, mean_spoke,
+            progress, t0,
+        )
+    };
     if closed && options.construction == Construction::CutAndPaste {
-        return cut_and_paste(
-            mesh,
-            lengths,
-            geometry,
-            positions,
-            base,
-            automatic,
-            genus,
-            min_valence,
-            mean_spoke,
-            progress,
-            t0,
-        );
+        return cut_and_paste_from(min_valence, progress);
     }
     let mut failed = Vec::new();
     let mut attempt = 0;
@@ -390,19 +384,7 @@ pub fn canonical_cut(
                     && options.construction == Construction::GreedyThenCutAndPaste
                 {
                     drop(refined);
-                    let mut out = cut_and_paste(
-                        mesh,
-                        lengths,
-                        geometry,
-                        positions,
-                        base,
-                        automatic,
-                        genus,
-                        round_valence[0],
-                        mean_spoke,
-                        progress,
-                        t0,
-                    )?;
+                    let mut out = cut_and_paste_from(round_valence[0], progress)?;
                     out.report.attempts += attempt;
                     out.report.search.attempts += attempt;
                     failed.append(&mut out.report.failed_attempts);
