@@ -41,10 +41,19 @@
 //! differences of the face's corners ([`ManifoldSpace::basis_at_bary`]): its rounding is then
 //! `ε h` (h the face size) whatever the chart. Going through absolute chart coordinates costs
 //! `ε |u|` instead, and an affine-atlas chart is up to ~5·10³ face sizes across near the cone
-//! (eight.off), which made order-2 partials differ between charts by 1.5e-6 (relative). What
-//! remains (≈ 1e-8 relative at edge midpoints, ≤ 1e-10 at centroids and ≤ 1e-10 of the size
-//! of the terms `Σ |c − F| |∂N|` everywhere, see the tests) is the rounding of the simplex
-//! recurrence itself: moving the point by one ulp inside one chart changes `∂²F` as much.
+//! (eight.off), which made order-2 partials differ between charts by 1.5e-6 (relative).
+//! That is not enough for partials: at edge midpoints and near vertices the thin basis
+//! functions (knot sets from one or two clouds) have order-2 partials up to 10³ × and order-3
+//! partials up to 10⁸ × those of `F` (relative to the face), and their sum cancels. Three
+//! roundings each moved `∂²F` by 1e-9 … 2e-7 of itself (as much as moving the point by one
+//! ulp in one chart): the simplex recurrence's, each basis's own rounding of the point's offset
+//! (the point then differs from basis to basis by `ε h`, and the third partials make that
+//! noise), and that of `Σ c N` with `|c|` the distance from the origin. With the default
+//! [`Precision::Extended`] the offset and the recurrence are double-double
+//! ([`crate::spline::simplex::SimplexFamily::eval_offset_extended`]) and the sum is formed as
+//! `c_0 + Σ (c − c_0) N`; partials then agree between charts to ≤ 6e-12 of the largest partial
+//! of their order and jump across edges by ≤ 1e-10 (3holes, genus3, fertility, eight, a
+//! generated genus-2 surface; see the tests). Values alone are computed in double.
 //!
 //! **Fairing.** The constraints of paper 000 eq. 14 compare blossoms of neighbouring
 //! triangles; their weights are computed in the vertex frame of a shared vertex (every cloud
@@ -72,12 +81,13 @@ use rayon::prelude::*;
 
 use crate::atlas::{fit_rigid, ChartId, FlatCharts};
 use crate::error::{Error, Result};
+use crate::layout::dd::Dd;
 use crate::layout::RigidMotion;
 use crate::mesh::Mesh;
 
 use super::dms::{
     blossom_weights_of, general_position_involving, hash64, multi_indices, needs_shrink,
-    per_triangle, unit, KnotOptions, TriangleBasis, Workspace, MAX_DEGREE,
+    per_triangle, unit, KnotOptions, Precision, TriangleBasis, Workspace, MAX_DEGREE,
 };
 use super::fit::SplineSpace;
 use super::simplex::{det3, n_partials, partial_index, Point};
@@ -984,7 +994,23 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         if ws.local.len() < nb * np {
             ws.local.resize(nb * np, 0.0);
         }
-        basis.eval_offset(off, dir, order, &mut ws.simplex, &mut ws.local);
+        match ws.precision {
+            // Values alone are well conditioned (a convex combination): double suffices.
+            Precision::Extended if order > 0 => {
+                // The offset in double-double too: rounded in double, each basis would see
+                // the point moved by its own `ε h`, and the thin bases' third partials
+                // (10⁵ × those of `F` relative to the face) turn that into noise in `∂²F`.
+                let (b1, b2) = (Dd::new(bary[1]), Dd::new(bary[2]));
+                let offd: [Dd; 2] = std::array::from_fn(|k| {
+                    let x0 = Dd::new(x[0][k]);
+                    (x0 - Dd::new(o[k]))
+                        + b1 * (Dd::new(x[1][k]) - x0)
+                        + b2 * (Dd::new(x[2][k]) - x0)
+                });
+                basis.eval_offset_extended(offd, dir, order, &mut ws.simplex_dd, &mut ws.local)
+            }
+            _ => basis.eval_offset(off, dir, order, &mut ws.simplex, &mut ws.local),
+        }
         rotate_partials(order, back, &mut ws.local[..nb * np]);
         for b in 0..nb {
             ws.indices.push((i as usize * nb + b) as u32);
@@ -1105,7 +1131,13 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         Ok(())
     }
 
-    /// `out = Σ_i c_{indices[i]} values[i]` over the first `m` basis functions of `ws`.
+    /// `out = Σ_i c_{indices[i]} values[i]` over the first `m` basis functions of `ws`,
+    /// summed as `c_0 + Σ_i (c_i − c_0) values[i]` (partials: without the `c_0` term) with
+    /// `c_0` the first function's control point: equal by the partition of unity
+    /// (`Σ N = 1`, `Σ ∂^α N = 0`), but the terms are of the size of the spline's support
+    /// instead of its distance from the origin. A face's second partials are sums of terms
+    /// up to 10⁶ × their result; in the plain form their rounding (`ε |c|`) alone reached
+    /// 1e-10 of `∂²F`.
     fn combine(
         &self,
         control: &[f64],
@@ -1116,14 +1148,22 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         out: &mut [f64],
     ) {
         out[..np * dim].fill(0.0);
+        if m == 0 {
+            return;
+        }
+        let g0 = ws.indices[0] as usize;
+        let c0 = &control[g0 * dim..(g0 + 1) * dim];
         for i in 0..m {
             let gidx = ws.indices[i] as usize;
             for k in 0..np {
                 let v = ws.values[i * np + k];
                 for d in 0..dim {
-                    out[k * dim + d] += v * control[gidx * dim + d];
+                    out[k * dim + d] += v * (control[gidx * dim + d] - c0[d]);
                 }
             }
+        }
+        for d in 0..dim {
+            out[d] += c0[d];
         }
     }
 
