@@ -394,7 +394,11 @@ impl SimplexFamily {
                 v.child[2] as usize * np,
             ];
             me[0] = lam[0] * done[c[0]] + lam[1] * done[c[1]] + lam[2] * done[c[2]];
-            for ord in 1..=order {
+            // A simplex spline of degree p is piecewise of degree p: partials of higher order
+            // vanish (and are not computed).
+            let top = order.min(nd.degree as usize);
+            me[n_partials(top)..].fill(0.0);
+            for ord in 1..=top {
                 for b in 0..=ord {
                     let a = ord - b;
                     let idx = partial_index(a, b);
@@ -494,7 +498,9 @@ impl SimplexFamily {
                 }
             }
             me[0] = acc;
-            for ord in 1..=order {
+            let top = order.min(nd.degree as usize);
+            me[n_partials(top)..].fill(Dd::ZERO);
+            for ord in 1..=top {
                 for b in 0..=ord {
                     let a = ord - b;
                     let idx = partial_index(a, b);
