@@ -187,6 +187,8 @@ pub struct AtlasReport {
     /// Largest conditioning ([`AffineAtlas::conditioning`]) of a face in its home chart:
     /// `ε ×` this is the relative rounding of the face's neighbourhood there.
     pub max_home_conditioning: f64,
+    /// Time spent on the local charts (part of `seconds`).
+    pub seconds_local_charts: f64,
     /// Non-singular faces without a home chart (0 when the atlas is complete).
     pub faces_without_home: usize,
     pub boundary_word: String,
@@ -564,6 +566,7 @@ impl AffineAtlas {
                 max_relative_transition_error: 0.0,
                 local_charts: 0,
                 max_home_conditioning: 0.0,
+                seconds_local_charts: 0.0,
                 faces_without_home: 0,
                 boundary_word: cut.boundary_word.clone(),
                 seconds: 0.0,
@@ -784,6 +787,7 @@ impl AffineAtlas {
     /// and conditions it within the bound; a seed left over gets a chart of its own
     /// neighbourhood alone (kept when it is better conditioned than the old home).
     fn add_local_charts(&mut self, progress: &mut dyn Progress) {
+        let t0 = Instant::now();
         let nf = self.mesh.n_faces();
         let mut todo: Vec<bool> = (0..nf as u32)
             .map(|f| {
@@ -836,6 +840,7 @@ impl AffineAtlas {
             .iter()
             .filter(|c| c.kind == "local")
             .count();
+        self.report.seconds_local_charts = t0.elapsed().as_secs_f64();
     }
 
     /// One local chart for `cluster` seeded at `seed` ([`Self::add_local_charts`]); `strict`:
