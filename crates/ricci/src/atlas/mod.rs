@@ -840,6 +840,22 @@ impl AffineAtlas {
             .iter()
             .filter(|c| c.kind == "local")
             .count();
+        let (mut left, mut worst) = (0usize, 0.0f64);
+        for &f in &list {
+            let c = self.conditioning(self.home[f as usize], f);
+            if c > LOCAL_CHART_CONDITIONING {
+                left += 1;
+                worst = worst.max(c);
+            }
+        }
+        if left > 0 {
+            self.report.notes.push(format!(
+                "{left} faces keep a home chart more than {LOCAL_CHART_CONDITIONING:.0e} of \
+                 their size across (worst {worst:.2e}): no local chart conditioned them \
+                 better; their coordinates there are accurate to ~{:.0e} of the face",
+                worst * f64::EPSILON
+            ));
+        }
         self.report.seconds_local_charts = t0.elapsed().as_secs_f64();
     }
 
