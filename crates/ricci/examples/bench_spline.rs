@@ -3,10 +3,13 @@
 //! jump.
 //!
 //! `RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_spline [-- [--degree N] [--fairness R] [--fit] [--atlas] files…]`
-//! (`--atlas`: charts of `ricci::atlas::AffineAtlas` instead of `LocalCharts`)
+//! (`--atlas`: charts of `ricci::atlas::AffineAtlas` instead of `LocalCharts`; the row names
+//! the atlas's charts and how many of them are local charts of the cone's graded
+//! neighbourhood)
 //! (default: eight.off 3holes.off fertility.off kitten.nf20k.off face.off; `genus2:RES` is
 //! a generated genus-2 surface).
 
+use ricci::atlas::FlatCharts;
 use ricci::mesh::io::read_surface;
 use ricci::progress::NoProgress;
 use ricci::spline::surface::{flat_domain, run, MeshDistance, Singularity, SplineOptions};
@@ -90,7 +93,10 @@ fn main() {
                 Ok((rep, _, _)) => {
                     let n = rep.degree;
                     println!(
-                        "| {f} (atlas) | {} | {} | {} | {:.2} | {:.3} | {} | {} | {} | {:.1e} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} |",
+                        "| {f} (atlas, {} charts, {} local in {:.3} s) | {} | {} | {} | {:.2} | {:.3} | {} | {} | {} | {:.1e} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} |",
+                        atlas.n_charts(),
+                        atlas.report.local_charts,
+                        atlas.report.seconds_local_charts,
                         atlas.report.genus,
                         rep.domain_faces,
                         rep.control_points,
