@@ -219,8 +219,10 @@ fn check(s: &Surface, name: &str, stride: usize) {
         sci(&cont2.relative_jumps),
         cont.chart_boundary_edges
     );
+    // Measured (double-double recurrence) ≤ 9.8e-12 over the atlas, ≤ 8.3e-11 over
+    // `LocalCharts`; the issue's planar bound is 1e-8.
     for k in 0..3 {
-        let bound = 1e-8f64.max(1.5 * cont2.relative_jumps[k]);
+        let bound = 1e-9f64.max(1.5 * cont2.relative_jumps[k]);
         assert!(
             cont.relative_jumps[k] <= bound,
             "{name}: order-{k} jump {:.2e} over the atlas (LocalCharts {:.2e})",
@@ -239,15 +241,16 @@ fn check(s: &Surface, name: &str, stride: usize) {
     );
     assert!(compared > 0);
     assert!(val[0] <= 1e-10, "{name}: values differ by {:.2e}", val[0]);
-    // Charts within the bound: `LocalCharts`' level (≤ 1e-8, spline_manifold.rs `TIGHT`);
-    // measured 1.1e-10 (eight.off), 1.5e-10 (genus2:16), 1.4e-9 (3holes.off).
+    // Charts within the bound: the issue's 1e-10 (spline_manifold.rs `ISSUE`); measured
+    // 3.5e-12 (genus2:16), 3.3e-13 (eight.off), 5.5e-13 (3holes.off).
     assert!(
-        par[1] <= 1e-8,
+        par[1] <= 1e-10,
         "{name}: partials differ by {:.2e} between well-conditioned charts",
         par[1]
     );
     // Any chart, including the central chart at the cone's smallest faces (stored there to
-    // 1.1e-8 of the face on 3holes.off): measured 1.8e-9 / 3.9e-10 / 2.4e-8.
+    // 1.1e-8 of the face on 3holes.off, so the point itself is known only to that): measured
+    // 6.9e-12 / 2.8e-10 / 2.4e-8.
     assert!(par[0] <= 1e-6, "{name}: partials differ by {:.2e}", par[0]);
 }
 
