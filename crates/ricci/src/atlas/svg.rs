@@ -1,5 +1,5 @@
 //! SVG pictures of the charts of an [`AffineAtlas`]: one picture per chart with its faces
-//! filled (home faces of the chart darker than faces it only overlaps), or all cut charts
+//! filled (home faces of the chart darker than faces it only overlaps), or all cut and local charts
 //! over the central chart after mapping them into it by their transition on a common face.
 //! Plain text output, no dependencies.
 
@@ -86,7 +86,7 @@ pub fn chart_svg(atlas: &AffineAtlas, c: ChartId, size: f64) -> Option<String> {
     Some(out)
 }
 
-/// The central chart with every cut chart's home faces mapped into it (by the transition on
+/// The central chart with every other (cut or local) chart's home faces mapped into it (by the transition on
 /// the chart's first face that also lies in the central chart), coloured by chart.
 pub fn overview_svg(atlas: &AffineAtlas, size: f64) -> String {
     let Some((faces0, coords0)) = atlas.chart_faces(0) else {
@@ -128,7 +128,7 @@ pub fn overview_svg(atlas: &AffineAtlas, size: f64) -> String {
     }
     let _ = writeln!(
         out,
-        "<text x=\"8\" y=\"20\" font-family=\"sans-serif\" font-size=\"14\">{} charts: central chart (blue); each cut chart's home faces (colours) placed by its transition on one face — across the cut they appear displaced by the deck motion</text>\n</svg>",
+        "<text x=\"8\" y=\"20\" font-family=\"sans-serif\" font-size=\"14\">{} charts: central chart (blue); each cut or local chart's home faces (colours) placed by its transition on one face — across the cut they appear displaced by the deck motion</text>\n</svg>",
         atlas.n_charts()
     );
     out
