@@ -605,19 +605,29 @@ pub fn place(
         }
         let last_msg = match (confirmed.last(), rejected.last()) {
             (Some(c), _) if c.vertex == v => format!(
-                "vertex {v} confirmed: distortion {:.4} ({}, {} iterations)",
-                c.measured, c.scheme, c.iterations
+                "candidate {} (vertex {v}) converged: distortion {:.4} ({} scheme{}, {} \
+                 iterations, {:.1} s)",
+                i + 1,
+                c.measured,
+                c.scheme,
+                if c.graded { ", graded mesh" } else { "" },
+                c.iterations,
+                c.seconds
             ),
             (_, Some(r)) => format!(
-                "vertex {v} rejected: best max |K − K̄| {} after {} iterations",
+                "candidate {} (vertex {v}) did not converge: best max |K − K̄| {} after {} \
+                 iterations ({:.1} s)",
+                i + 1,
                 r.best_error
                     .map_or("none".to_string(), |e| format!("{e:.3e}")),
-                r.iterations
+                r.iterations,
+                r.seconds
             ),
             _ => String::new(),
         };
+        // One line per candidate, under its own stage name (the CLI prints these lines).
         progress.report(
-            "placement",
+            "placement candidate",
             Some(confirmed.len() as f64 / k as f64),
             &last_msg,
         );
