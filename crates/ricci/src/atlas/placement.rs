@@ -58,8 +58,8 @@ pub struct PlacementOptions {
     /// Newton work of all candidate flows together, in vertex-iterations (iterations times
     /// the number of input vertices, so that the budget bounds time whatever the mesh size;
     /// at least `candidate_iterations` iterations). When it is spent no further flow is run
-    /// (default 6·10⁶: about 20 s of CPU on a 2-core EPYC VM, 146 iterations on botijo's
-    /// 41k vertices, 1335 on fertility's 4.5k).
+    /// (default 6·10⁶: 145 iterations on botijo's 41k vertices, about 16 s of CPU on a 2-core
+    /// Xeon VM; 1335 on fertility's 4.5k).
     pub confirm_budget: usize,
     /// Confirm a candidate on the graded mesh when no scheme converges on the ungraded one
     /// ([`candidate_mesh`]; default true).
