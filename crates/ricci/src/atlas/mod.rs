@@ -6,8 +6,9 @@
 //! 1. **Singularity** ([`placement`]): closed surfaces of genus ≥ 2 get one cone carrying all
 //!    of `2πχ`, at a vertex given by the user or chosen automatically by least area
 //!    distortion `Σ_f (log S_f − log s_f)² / n` (linearized flow ranking, confirmed by full
-//!    flows). Genus 1 gets none (uniform flat metric); open surfaces none (free boundary:
-//!    the curvature is pushed to the boundary, `u` keeps its initial value there);
+//!    flows on a budget, on a mesh graded around the candidate when needed). Genus 1 gets
+//!    none (uniform flat metric); open surfaces none (free boundary: the curvature is pushed
+//!    to the boundary, `u` keeps its initial value there);
 //!    `k` user cones (`cones`) on closed surfaces.
 //! 2. **Connectivity modification** (Step 2): intrinsic, metric-preserving edge splits
 //!    ([`crate::mesh::refine`]) raise the valence of every cone `v` to at least

@@ -22,7 +22,12 @@
 //!   the differences between vertices — it gave negative variances on a 10k-vertex mesh.)
 //! * The best `confirm` candidates are confirmed by full flows (valence raised to
 //!   `4 − 2κ/π` by splits, Newton to 1e-9) and the one with the least measured distortion
-//!   is chosen.
+//!   is chosen. A candidate whose flows fail with every scheme is flowed again on a mesh
+//!   graded around the cone ([`candidate_mesh`]: a cone of angle `2π(1 + m)` needs a
+//!   conformal factor growing like `m log r`, which the input's first rings do not resolve
+//!   for large genus — botijo, genus 5). The flows run on a budget (iterations per scheme,
+//!   candidates, Newton work in all; [`PlacementOptions`]), so a mesh where no candidate
+//!   converges is refused in bounded time with one sentence saying what was tried.
 
 use super::AtlasOptions;
 use crate::error::{Error, Result};
