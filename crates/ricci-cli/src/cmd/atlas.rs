@@ -4,7 +4,9 @@
 //!
 //! DIR receives `atlas.json` (the JSON report below plus every chart's faces and corner
 //! coordinates), `overview.svg` (the central chart with the cut charts mapped into it) and
-//! `chart-K.svg` for every chart. Every file is written atomically.
+//! `chart-K.svg` for every chart. Every file is written atomically. With `--singularity auto`
+//! every candidate flow of the placement prints one line on stderr (vertex, converged or not,
+//! distortion or best residual, iterations, seconds).
 
 use crate::util::{print_json, write_atomic, UsageError};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -95,6 +97,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let mut progress = |stage: &str, f: Option<f64>, msg: &str| {
+        // The automatic placement reports one line per candidate flow: keep those on stderr.
+        if stage == "placement candidate" {
+            let line = format!("placement: {msg}");
+            if bar.is_hidden() {
+                eprintln!("{line}");
+            } else {
+                bar.println(line);
+            }
+            return;
+        }
         bar.set_prefix(stage.to_string());
         if let Some(f) = f {
             bar.set_position((100.0 * f.clamp(0.0, 1.0)) as u64);

@@ -6,8 +6,9 @@
 //! 1. **Singularity** ([`placement`]): closed surfaces of genus ≥ 2 get one cone carrying all
 //!    of `2πχ`, at a vertex given by the user or chosen automatically by least area
 //!    distortion `Σ_f (log S_f − log s_f)² / n` (linearized flow ranking, confirmed by full
-//!    flows). Genus 1 gets none (uniform flat metric); open surfaces none (free boundary:
-//!    the curvature is pushed to the boundary, `u` keeps its initial value there);
+//!    flows on a budget, on a mesh graded around the candidate when needed). Genus 1 gets
+//!    none (uniform flat metric); open surfaces none (free boundary: the curvature is pushed
+//!    to the boundary, `u` keeps its initial value there);
 //!    `k` user cones (`cones`) on closed surfaces.
 //! 2. **Connectivity modification** (Step 2): intrinsic, metric-preserving edge splits
 //!    ([`crate::mesh::refine`]) raise the valence of every cone `v` to at least
@@ -1149,6 +1150,46 @@ pub fn flat_flow(
     scheme: Scheme,
     tolerance: f64,
 ) -> Result<(crate::flow::FlowResult, Scheme, Vec<String>)> {
+    let mut unlimited = usize::MAX;
+    let f = flat_flow_limited(
+        mesh,
+        lengths,
+        target,
+        scheme,
+        tolerance,
+        400,
+        &mut unlimited,
+    )?;
+    Ok((f.result, f.scheme, f.notes))
+}
+
+/// What [`flat_flow_limited`] produced.
+#[derive(Debug, Clone)]
+pub struct FlatFlow {
+    /// The converged flow, or the last one that ran when none converged.
+    pub result: crate::flow::FlowResult,
+    /// The scheme of `result`.
+    pub scheme: Scheme,
+    pub notes: Vec<String>,
+    /// Newton iterations of all the schemes tried together.
+    pub iterations: usize,
+    /// The smallest max |K − K̄| any scheme reached.
+    pub best_error: f64,
+}
+
+/// [`flat_flow`] with at most `max_iterations` Newton iterations per scheme and `budget`
+/// iterations in all (the spent ones are subtracted; no further scheme is tried once it is
+/// 0). The candidate flows of the automatic placement run with such a budget
+/// ([`placement::PlacementOptions`]).
+pub fn flat_flow_limited(
+    mesh: &Mesh,
+    lengths: &[f64],
+    target: TargetSpec,
+    scheme: Scheme,
+    tolerance: f64,
+    max_iterations: usize,
+    budget: &mut usize,
+) -> Result<FlatFlow> {
     let mut notes = Vec::new();
     let mut schemes = vec![scheme];
     for s in [Scheme::Inversive, Scheme::Tangential] {
@@ -1157,7 +1198,16 @@ pub fn flat_flow(
         }
     }
     let mut last = None;
+    let mut iterations = 0;
+    let mut best_error = f64::INFINITY;
     for (k, &s) in schemes.iter().enumerate() {
+        if *budget == 0 {
+            notes.push(format!(
+                "the iteration budget was spent before the {} scheme could run",
+                s.name()
+            ));
+            break;
+        }
         let run = ricci_flow(
             mesh,
             lengths,
@@ -1166,11 +1216,14 @@ pub fn flat_flow(
                 scheme: s,
                 target: target.clone(),
                 tolerance,
-                max_iterations: Some(400),
+                max_iterations: Some(max_iterations.min(*budget).max(1)),
                 ..FlowOptions::default()
             },
             &mut crate::progress::NoProgress,
         );
+        if let Ok(f) = &run {
+            *budget = budget.saturating_sub(f.iterations.max(1));
+        }
         match run {
             Ok(f) if f.converged => {
                 if k > 0 {
@@ -1181,7 +1234,15 @@ pub fn flat_flow(
                     ));
                 }
                 notes.extend(f.notes.iter().cloned());
-                return Ok((f, s, notes));
+                iterations += f.iterations;
+                best_error = best_error.min(f.max_curvature_error);
+                return Ok(FlatFlow {
+                    result: f,
+                    scheme: s,
+                    notes,
+                    iterations,
+                    best_error,
+                });
             }
             Ok(f) => {
                 notes.push(format!(
@@ -1190,6 +1251,10 @@ pub fn flat_flow(
                     f.max_curvature_error,
                     f.iterations
                 ));
+                iterations += f.iterations;
+                if f.max_curvature_error.is_finite() {
+                    best_error = best_error.min(f.max_curvature_error);
+                }
                 last = Some(Ok((f, s)));
             }
             Err(e) => {
@@ -1209,7 +1274,13 @@ pub fn flat_flow(
     match last {
         Some(Ok((f, s))) => {
             notes.extend(f.notes.iter().cloned());
-            Ok((f, s, notes))
+            Ok(FlatFlow {
+                result: f,
+                scheme: s,
+                notes,
+                iterations,
+                best_error,
+            })
         }
         Some(Err(e)) => Err(e),
         None => Err(Error::numerical("no flow was run")),
