@@ -15,6 +15,13 @@
 //!    interior edge, the two one-sided limits evaluated in their own canonical charts and
 //!    transformed into one), [`tessellate`] and [`MeshDistance`] (errors of spline samples
 //!    against the input mesh as a percentage of the bounding-box diagonal).
+//!
+//! The tessellation is one welded, consistently oriented mesh, closed for a closed input: the
+//! spline part is trimmed exactly at each seam (the crossings of the grid with the seam curve
+//! are computed on the seam in (face, barycentric) coordinates through the hole's unrolled
+//! cone coordinates) and the fill patch is triangulated on rings whose outer ring is exactly
+//! those seam vertices, so there is no gap and no T-junction and vertex normals average
+//! across the seam (`tests/spline_seam.rs`).
 
 use std::collections::HashMap;
 use std::time::Instant;
@@ -973,17 +980,18 @@ pub fn tessellate<A: FlatCharts + Sync + ?Sized>(
             let lv = level_at(f, b);
             if let Some((pb, pl)) = prev {
                 if inside(pl) != inside(lv) {
+                    // The edge enters or leaves a seam between two samples: end or start the
+                    // polyline on the seam.
                     let hh = pl.or(lv).map(|x| x.0).unwrap_or(0);
                     if let Some((_, bc, _)) = holes[hh].seam_crossing(f, pb, b) {
                         space.evaluate(control, 3, f, bc, 0, &mut ws, &mut out)?;
                         line.push(out);
                     }
-                    if inside(lv) && line.len() >= 2 {
-                        lines.push(std::mem::take(&mut line));
-                    }
-                    line.clear();
-                    if !inside(lv) {
-                        line.push(out);
+                    if inside(lv) {
+                        if line.len() >= 2 {
+                            lines.push(std::mem::take(&mut line));
+                        }
+                        line.clear();
                     }
                 }
             }
@@ -1026,10 +1034,14 @@ fn min_angle(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
 }
 
 /// Triangulate the fill patch of `seam.hole` inside its seam loop (already vertices of `t`):
-/// the centre, rings `t = k/n_t` (`k = 1..n_t`) of the patch's disk with about as many points as
-/// the seam has at that radius, placed at equal steps of the seam's arc length, and the seam
-/// itself as ring `n_t`; `n_t` makes the rings about as far apart as the seam's vertices.
-/// Consecutive rings are zipped by arc-length order; orientation is the spline's.
+/// the seam is the ring `t = 1` of the patch's disk; the regular ring step `1/n_t` makes rings
+/// about as far apart as the seam's vertices. Next to the seam the steps start at
+/// [`FILL_GRADING`]`/n_t` and grow by [`FILL_GROWTH`] (the patch bends more than the spline
+/// there, and the spline's trimmed triangles are small), and those rings keep the seam's own
+/// `ψ` (a quad strip along radial lines, which cannot fold however thin). The regular rings
+/// inside have `max(5, round(n t))` points at equal steps of the seam's arc length, and the
+/// centre closes the disk. Consecutive rings are zipped by arc-length order; orientation is
+/// the spline's.
 fn fill_patch<A: FlatCharts + Sync + ?Sized>(
     space: &ManifoldSpace<'_, A>,
     spline: &ManifoldSpline,
