@@ -163,10 +163,14 @@ fn check(name: &str, s: &Surface, m: usize) -> (f64, f64, f64, f64) {
         "{name}: a seam vertex is {worst_fill:e} off the fill patch"
     );
 
-    // Dihedral angles: spline–spline edges vs the seam edges (one spline and one fill
-    // triangle), and the smallest angles.
+    // Dihedral angles: the spline part's grid (edges between triangles with no vertex on the
+    // seam) vs the seam edges (one spline and one fill triangle), the spline triangles cut by
+    // the seam, and the fill.
+    let seam_set: std::collections::HashSet<u32> = seam.vertices.iter().copied().collect();
+    let on_seam = |f: &[u32; 3]| f.iter().any(|v| seam_set.contains(v));
     let mut owner: HashMap<(u32, u32), usize> = HashMap::new();
-    let mut spline_angles = Vec::new();
+    let mut grid_angles = Vec::new();
+    let mut trimmed_angles = Vec::new();
     let mut seam_angles = Vec::new();
     let mut fill_angles = Vec::new();
     for (i, f) in t.triangles.iter().enumerate() {
@@ -174,12 +178,11 @@ fn check(name: &str, s: &Surface, m: usize) -> (f64, f64, f64, f64) {
             let (a, b) = (f[e], f[(e + 1) % 3]);
             let key = (a.min(b), a.max(b));
             if let Some(&j) = owner.get(&key) {
-                let d = angle_deg(
-                    unit_normal(&t.positions, *f),
-                    unit_normal(&t.positions, t.triangles[j]),
-                );
+                let g = &t.triangles[j];
+                let d = angle_deg(unit_normal(&t.positions, *f), unit_normal(&t.positions, *g));
                 match (i < t.spline_triangles, j < t.spline_triangles) {
-                    (true, true) => spline_angles.push(d),
+                    (true, true) if on_seam(f) || on_seam(g) => trimmed_angles.push(d),
+                    (true, true) => grid_angles.push(d),
                     (false, false) => fill_angles.push(d),
                     _ => seam_angles.push(d),
                 }
@@ -191,33 +194,33 @@ fn check(name: &str, s: &Surface, m: usize) -> (f64, f64, f64, f64) {
     assert_eq!(seam_angles.len(), n, "{name}: every seam edge is shared");
     let seam_max = seam_angles.iter().copied().fold(0.0, f64::max);
     let (med, q90, max) = (
-        quantile(spline_angles.clone(), 0.5),
-        quantile(spline_angles.clone(), 0.9),
-        quantile(spline_angles, 1.0),
+        quantile(grid_angles.clone(), 0.5),
+        quantile(grid_angles.clone(), 0.9),
+        quantile(grid_angles, 1.0),
     );
+    let trimmed_max = trimmed_angles.iter().copied().fold(0.0, f64::max);
     let fill_max = fill_angles.iter().copied().fold(0.0, f64::max);
     let seam_q90 = quantile(seam_angles.clone(), 0.9);
-    let seam_set: std::collections::HashSet<u32> = seam.vertices.iter().copied().collect();
-    let touches_seam = |f: &[u32; 3]| f.iter().any(|v| seam_set.contains(v));
     let spline_tris = &t.triangles[..t.spline_triangles];
     let min_of = |it: &mut dyn Iterator<Item = &[u32; 3]>| {
         it.map(|&f| min_angle_deg(&t.positions, f))
             .fold(180.0, f64::min)
     };
-    let min_grid = min_of(&mut spline_tris.iter().filter(|f| !touches_seam(f)));
-    let min_trimmed = min_of(&mut spline_tris.iter().filter(|f| touches_seam(f)));
+    let min_grid = min_of(&mut spline_tris.iter().filter(|f| !on_seam(f)));
+    let min_trimmed = min_of(&mut spline_tris.iter().filter(|f| on_seam(f)));
     let min_fill = min_of(&mut t.triangles[t.spline_triangles..].iter());
     eprintln!(
         "{name} m={m}: {nv} vertices, {} triangles ({} fill), seam {n} vertices ({} snapped); \
-         dihedral spline median {med:.2}° 90% {q90:.2}° max {max:.2}° | seam 90% {seam_q90:.2}° \
-         max {seam_max:.2}° | fill max {fill_max:.2}°; min angle grid {min_grid:.1}° trimmed \
+         dihedral grid median {med:.2}° 90% {q90:.2}° max {max:.2}° | seam 90% {seam_q90:.2}° \
+         max {seam_max:.2}° | trimmed max {trimmed_max:.2}° | fill max {fill_max:.2}°; min angle grid {min_grid:.1}° trimmed \
          {min_trimmed:.1}° fill {min_fill:.1}°; seam off spline {worst_spline:.1e}, off fill \
          {worst_fill:.1e} (diag {diag:.3})",
         t.triangles.len(),
         t.triangles.len() - t.spline_triangles,
         seam.snapped
     );
-    // No kink at the seam: its dihedral angles are within those of the spline part.
+    // No kink at the seam and no fold where the grid is cut: their dihedral angles are within
+    // those of the spline's grid.
     assert!(
         seam_q90 <= q90,
         "{name} m={m}: 90th percentile dihedral across the seam {seam_q90:.2}° > spline {q90:.2}°"
@@ -225,6 +228,10 @@ fn check(name: &str, s: &Surface, m: usize) -> (f64, f64, f64, f64) {
     assert!(
         seam_max <= max,
         "{name} m={m}: largest dihedral across the seam {seam_max:.2}° > spline {max:.2}°"
+    );
+    assert!(
+        trimmed_max <= max,
+        "{name} m={m}: largest dihedral at the cut triangles {trimmed_max:.2}° > grid {max:.2}°"
     );
     // No slivers: trimming keeps half the grid's smallest angle, the fill above 1°.
     assert!(

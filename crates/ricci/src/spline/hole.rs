@@ -18,16 +18,12 @@
 //!
 //! **Fill.** Over the unit disk `(t, ψ)` a radial cubic Hermite patch
 //! `F(t, ψ) = h₀₀(t) P₀ + h₁₀(t) T(ψ) + h₀₁(t) C(ψ) + h₁₁(t) D(ψ)` with the seam data
-//! `C(ψ) = S(R, φ)` taken from the spline `S` itself and `D(ψ)` the vector from the seam's
-//! mean `C̄` to `C(ψ)` projected onto the spline's tangent plane at `C(ψ)`; `P₀` is the mean of
+//! `C(ψ) = S(R, φ)` and `D(ψ) = R ∂S/∂ρ` taken from the spline `S` itself, `P₀` the mean of
 //! `C − D` and `T(ψ) = a cos ψ + b sin ψ` the first Fourier mode of `D` (so a plane is
 //! reproduced exactly and the patch has a tangent plane at its centre). At `t = 1` the patch
 //! has the spline's value and its tangents `∂F/∂t = D`, `∂F/∂ψ = dC/dψ` lie in the spline's
-//! tangent plane: the join is G¹ (measured by [`Hole::seam_normal_jump`]). (`D = R ∂S/∂ρ`, the
-//! cone's radial derivative, would do as well for G¹, but the flat metric of a strong cone
-//! varies by orders of magnitude around the seam and so does that `D`: the patch rippled in
-//! `ψ`, as zebra stripes showed.) This is not the paper's planar triangular B-spline fill; it
-//! is a single smooth patch, C¹ at its centre.
+//! tangent plane: the join is G¹ (measured by [`Hole::seam_normal_jump`]). This is not the
+//! paper's planar triangular B-spline fill; it is a single smooth patch, C¹ at its centre.
 
 use std::f64::consts::PI;
 
@@ -73,8 +69,6 @@ pub struct Hole {
     shift: f64,
     /// Centre of the fill and its tangent directions (3 coordinates each).
     pub center: [f64; 3],
-    /// Mean of the seam curve `C(ψ)` (the fill's radial tangents point away from it).
-    seam_centroid: [f64; 3],
     tangent_a: [f64; 3],
     tangent_b: [f64; 3],
     /// Smallest `R(ψ) / r_link(ψ) − 1` over the checked samples.
@@ -231,7 +225,6 @@ impl Hole {
             fourier: Vec::new(),
             shift: 0.0,
             center: [0.0; 3],
-            seam_centroid: [0.0; 3],
             tangent_a: [0.0; 3],
             tangent_b: [0.0; 3],
             min_clearance: 0.0,
@@ -291,19 +284,9 @@ impl Hole {
         let mut p0 = [0.0; 3];
         let (mut ta, mut tb) = ([0.0; 3], [0.0; 3]);
         let mut ws = Workspace::default();
-        let mut centroid = [0.0; 3];
         for j in 0..ns {
             let psi = 2.0 * PI * j as f64 / ns as f64;
-            let (c, _, _) = hole.seam_data(space, control, psi, &mut ws)?;
-            for k in 0..3 {
-                centroid[k] += c[k] / ns as f64;
-            }
-        }
-        hole.seam_centroid = centroid;
-        for j in 0..ns {
-            let psi = 2.0 * PI * j as f64 / ns as f64;
-            let (c, _, [sx, sy]) = hole.seam_data(space, control, psi, &mut ws)?;
-            let dd = hole.radial_tangent(c, sx, sy);
+            let (c, dd, _) = hole.seam_data(space, control, psi, &mut ws)?;
             for k in 0..3 {
                 p0[k] += (c[k] - dd[k]) / ns as f64;
                 ta[k] += 2.0 * dd[k] * psi.cos() / ns as f64;
@@ -470,9 +453,8 @@ impl Hole {
         Some((s, bary, self.psi_of_phi(phi)))
     }
 
-    /// The seam point at `ψ`: spline value `C(ψ)`, the cone's radial derivative `R ∂S/∂ρ`
-    /// (not the fill's `D`, see the module docs), and the spline's partials `(S_X, S_Y)` in the
-    /// unrolled frame.
+    /// The seam point at `ψ`: spline value `C(ψ)`, `D(ψ) = R ∂S/∂ρ`, and the spline's partials
+    /// `(S_X, S_Y)` in the unrolled frame.
     pub fn seam_data<A: FlatCharts + Sync + ?Sized>(
         &self,
         space: &ManifoldSpace<'_, A>,
@@ -509,24 +491,6 @@ impl Hole {
         Ok((c, dd, [sx, sy]))
     }
 
-    /// The fill's radial derivative `∂F/∂t` at the seam point `c` where the spline has partials
-    /// `(S_X, S_Y)`: `c − c̄` (`c̄` the seam's mean) projected onto the spline's tangent plane.
-    fn radial_tangent(&self, c: [f64; 3], sx: [f64; 3], sy: [f64; 3]) -> [f64; 3] {
-        let n = [
-            sx[1] * sy[2] - sx[2] * sy[1],
-            sx[2] * sy[0] - sx[0] * sy[2],
-            sx[0] * sy[1] - sx[1] * sy[0],
-        ];
-        let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-        let v: [f64; 3] = std::array::from_fn(|k| c[k] - self.seam_centroid[k]);
-        let vn = if nn > 0.0 {
-            (v[0] * n[0] + v[1] * n[1] + v[2] * n[2]) / nn
-        } else {
-            0.0
-        };
-        std::array::from_fn(|k| v[k] - vn * n[k])
-    }
-
     /// The fill patch at `(t, ψ)`, `t ∈ [0, 1]` (module docs).
     pub fn fill_point<A: FlatCharts + Sync + ?Sized>(
         &self,
@@ -536,8 +500,7 @@ impl Hole {
         psi: f64,
         ws: &mut Workspace,
     ) -> Result<[f64; 3]> {
-        let (c, _, [sx, sy]) = self.seam_data(space, control, psi, ws)?;
-        let dd = self.radial_tangent(c, sx, sy);
+        let (c, dd, _) = self.seam_data(space, control, psi, ws)?;
         let (t2, t3) = (t * t, t * t * t);
         let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
         let h10 = t3 - 2.0 * t2 + t;
