@@ -47,6 +47,10 @@ pub struct Located {
     pub motion: RigidMotion,
 }
 
+/// A candidate face of a sector: id, unrolled corners, motion to its canonical chart, unrolled
+/// angle of its centroid.
+type Candidate = (u32, [Point; 3], RigidMotion, f64);
+
 /// Seam data at one `ψ`: `C(ψ)`, `D(ψ)` and the spline's partials `(S_X, S_Y)`.
 pub type SeamData = ([f64; 3], [f64; 3], [[f64; 3]; 2]);
 
@@ -63,7 +67,7 @@ pub struct Hole {
     /// Candidate active faces per sector: id, unrolled coordinates, motion to the canonical
     /// chart, and the unrolled angle `φ` of the centroid (tracked through the development, so
     /// it is not ambiguous by multiples of 2π where the cone angle exceeds 2π).
-    sector_faces: Vec<Vec<(u32, [Point; 3], RigidMotion, f64)>>,
+    sector_faces: Vec<Vec<Candidate>>,
     /// Seam radius: `ln R(ψ) = a₀ + Σ a_k cos kψ + b_k sin kψ + shift`.
     fourier: Vec<(f64, f64)>,
     shift: f64,
@@ -138,7 +142,7 @@ impl Hole {
         };
         let mut sector_faces = Vec::with_capacity(d);
         for k in 0..d as isize {
-            let mut list: Vec<(u32, [Point; 3], RigidMotion, f64)> = Vec::new();
+            let mut list: Vec<Candidate> = Vec::new();
             for j in [k - 1, k, k + 1] {
                 let jj = j.rem_euclid(d as isize) as usize;
                 let fj = sf.faces[jj].0;

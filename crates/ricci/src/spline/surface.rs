@@ -579,6 +579,10 @@ fn grid_key(mesh: &crate::mesh::Mesh, f: u32, w: [usize; 3]) -> Option<GridKey> 
     Some(GridKey::Edge(mesh.he_edge(h), k))
 }
 
+/// Seam level of a point: the hole whose two-ring holds it and `ln ρ − ln R` (negative inside);
+/// `None` away from every hole.
+type SeamLevel = Option<(usize, f64)>;
+
 /// Where a grid edge of the tessellation crosses a seam.
 #[derive(Debug, Clone, Copy)]
 struct Crossing {
@@ -639,16 +643,16 @@ pub fn tessellate<A: FlatCharts + Sync + ?Sized>(
         .filter(|&f| space.is_active(f))
         .collect();
     // Seam level of a point: (hole, ln ρ − ln R), negative inside.
-    let level_at = |f: u32, b: [f64; 3]| -> Option<(usize, f64)> {
+    let level_at = |f: u32, b: [f64; 3]| -> SeamLevel {
         holes
             .iter()
             .enumerate()
             .find_map(|(h, hole)| hole.seam_level(f, b).map(|l| (h, l)))
     };
     #[allow(clippy::type_complexity)]
-    let per: Vec<(Vec<[f64; 3]>, Vec<Option<(usize, f64)>>)> = faces
+    let per: Vec<(Vec<[f64; 3]>, Vec<SeamLevel>)> = faces
         .par_iter()
-        .map(|&f| -> Result<(Vec<[f64; 3]>, Vec<Option<(usize, f64)>>)> {
+        .map(|&f| -> Result<(Vec<[f64; 3]>, Vec<SeamLevel>)> {
             let mut ws = Workspace::default();
             let mut out = [0.0; 3];
             let mut p = Vec::with_capacity(grid.len());
@@ -667,7 +671,7 @@ pub fn tessellate<A: FlatCharts + Sync + ?Sized>(
     // reaches it), so the spline part is one connected mesh and vertex normals average across
     // patch boundaries instead of stopping at them.
     let mut t = Tessellation::default();
-    let mut level: Vec<Option<(usize, f64)>> = Vec::new();
+    let mut level: Vec<SeamLevel> = Vec::new();
     let mut shared: HashMap<GridKey, u32> = HashMap::new();
     let mut ids: Vec<Vec<u32>> = Vec::with_capacity(faces.len());
     for (k, (p, lv)) in per.into_iter().enumerate() {
@@ -692,7 +696,7 @@ pub fn tessellate<A: FlatCharts + Sync + ?Sized>(
         }
         ids.push(local);
     }
-    let inside = |l: Option<(usize, f64)>| l.is_some_and(|(_, x)| x < 0.0);
+    let inside = |l: SeamLevel| l.is_some_and(|(_, x)| x < 0.0);
     // Grid edges that cross a seam, keyed by their (lower, higher) vertex ids.
     let mut crossings: BTreeMap<(u32, u32), Crossing> = BTreeMap::new();
     for (k, &f) in faces.iter().enumerate() {
@@ -971,7 +975,7 @@ pub fn tessellate<A: FlatCharts + Sync + ?Sized>(
         }
         let i = h as usize % 3;
         let mut line: Vec<[f64; 3]> = Vec::with_capacity(m + 1);
-        let mut prev: Option<([f64; 3], Option<(usize, f64)>)> = None;
+        let mut prev: Option<([f64; 3], SeamLevel)> = None;
         for s in 0..=m {
             let a = s as f64 / m as f64;
             let mut b = [0.0; 3];
