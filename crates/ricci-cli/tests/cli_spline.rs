@@ -78,6 +78,39 @@ fn genus2_writes_the_surface_net_boundaries_and_report() {
         .unwrap();
         assert_eq!(side["face"].as_array().unwrap().len(), nv);
         assert_eq!(side["chart"].as_array().unwrap().len(), nv);
+        // One closed mesh: every edge in two triangles. Spline triangles use vertices of
+        // the spline (face and chart ≥ 0); the fill's own vertices are −1 and only in the fill.
+        let (mut group, mut edges) = ("", std::collections::HashMap::new());
+        let mut in_spline = vec![false; nv];
+        for l in obj.lines() {
+            if let Some(g) = l.strip_prefix("g ") {
+                group = if g == "fill" { "fill" } else { "spline" };
+            } else if let Some(f) = l.strip_prefix("f ") {
+                let f: Vec<usize> = f
+                    .split(' ')
+                    .map(|x| x.parse::<usize>().unwrap() - 1)
+                    .collect();
+                for k in 0..3 {
+                    let (a, b) = (f[k], f[(k + 1) % 3]);
+                    *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+                    if group == "spline" {
+                        in_spline[a] = true;
+                    }
+                }
+            }
+        }
+        assert!(
+            edges.values().all(|&c| c == 2),
+            "{charts}: the surface is not closed"
+        );
+        for (v, &s) in in_spline.iter().enumerate() {
+            let (f, c) = (
+                side["face"][v].as_i64().unwrap(),
+                side["chart"][v].as_i64().unwrap(),
+            );
+            assert_eq!(s, f >= 0, "{charts}: vertex {v} face {f}");
+            assert_eq!(f >= 0, c >= 0, "{charts}: vertex {v} face {f} chart {c}");
+        }
         let net = std::fs::read_to_string(out.join("control_net.obj")).unwrap();
         assert_eq!(
             net.lines().filter(|l| l.starts_with("v ")).count() as u64,

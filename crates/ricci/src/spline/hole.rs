@@ -47,6 +47,10 @@ pub struct Located {
     pub motion: RigidMotion,
 }
 
+/// A candidate face of a sector: id, unrolled corners, motion to its canonical chart, unrolled
+/// angle of its centroid.
+type Candidate = (u32, [Point; 3], RigidMotion, f64);
+
 /// Seam data at one `ψ`: `C(ψ)`, `D(ψ)` and the spline's partials `(S_X, S_Y)`.
 pub type SeamData = ([f64; 3], [f64; 3], [[f64; 3]; 2]);
 
@@ -60,8 +64,10 @@ pub struct Hole {
     sector_start: Vec<f64>,
     /// Link vertices' unrolled positions, `link[k]` = first link vertex of sector `k`.
     link: Vec<Point>,
-    /// Candidate active faces per sector, with unrolled coordinates.
-    sector_faces: Vec<Vec<(u32, [Point; 3], RigidMotion)>>,
+    /// Candidate active faces per sector: id, unrolled coordinates, motion to the canonical
+    /// chart, and the unrolled angle `φ` of the centroid (tracked through the development, so
+    /// it is not ambiguous by multiples of 2π where the cone angle exceeds 2π).
+    sector_faces: Vec<Vec<Candidate>>,
     /// Seam radius: `ln R(ψ) = a₀ + Σ a_k cos kψ + b_k sin kψ + shift`.
     fourier: Vec<(f64, f64)>,
     shift: f64,
@@ -123,17 +129,35 @@ impl Hole {
             let r = C::from_polar(1.0, turns * theta);
             sf.faces[k].1.map(|p| super::manifold::pt(r * cz(p)))
         };
+        let centroid = |c: &[Point; 3]| {
+            cz([
+                (c[0][0] + c[1][0] + c[2][0]) / 3.0,
+                (c[0][1] + c[1][1] + c[2][1]) / 3.0,
+            ])
+        };
+        // Angle of the centroid of `cg` from that of `cf` (angle `phi_f`) through their common
+        // vertex at `zw`: straight segments inside the two faces, which miss the cone.
+        let carry = |phi_f: f64, cf: &[Point; 3], zw: C, cg: &[Point; 3]| {
+            phi_f + (zw / centroid(cf)).arg() + (centroid(cg) / zw).arg()
+        };
         let mut sector_faces = Vec::with_capacity(d);
         for k in 0..d as isize {
-            let mut list: Vec<(u32, [Point; 3], RigidMotion)> = Vec::new();
+            let mut list: Vec<Candidate> = Vec::new();
             for j in [k - 1, k, k + 1] {
                 let jj = j.rem_euclid(d as isize) as usize;
                 let fj = sf.faces[jj].0;
                 let uj = unrolled(j);
-                for &w in &mesh.face(fj) {
+                // Face j spans less than π from the cone: its centroid's angle from the middle
+                // of its sector.
+                let mid_j = sf.start_angles[jj]
+                    + 0.5 * sf.corner_angles[jj]
+                    + j.div_euclid(d as isize) as f64 * theta;
+                let phi_j = mid_j + (centroid(&uj) * C::from_polar(1.0, -mid_j)).arg();
+                for (wi, &w) in mesh.face(fj).iter().enumerate() {
                     if w == s {
                         continue;
                     }
+                    let zw = cz(uj[wi]);
                     let Some(wf) = space.vertex_frame(w) else {
                         continue;
                     };
@@ -147,7 +171,8 @@ impl Hole {
                         }
                         let cu = c.map(|p| apply(&m, p));
                         let (mc, _) = fit_rigid(&cu, &space.canonical_coords(*g));
-                        list.push((*g, cu, mc));
+                        let phi = carry(phi_j, &uj, zw, &cu);
+                        list.push((*g, cu, mc, phi));
                     }
                 }
             }
@@ -170,23 +195,25 @@ impl Hole {
                     let Some(wf) = space.vertex_frame(w) else {
                         continue;
                     };
-                    let Some((fw, cw, cu)) = wf
-                        .faces
-                        .iter()
-                        .find_map(|(g, c)| list.iter().find(|x| x.0 == *g).map(|x| (*g, *c, x.1)))
-                    else {
+                    let Some((fw, cw, cu, phi_w)) = wf.faces.iter().find_map(|(g, c)| {
+                        list.iter().find(|x| x.0 == *g).map(|x| (*g, *c, x.1, x.3))
+                    }) else {
                         continue;
                     };
-                    let _ = fw;
+                    let Some(wi) = mesh.face(fw).iter().position(|&x| x == w) else {
+                        continue;
+                    };
+                    let zw = cz(cu[wi]);
                     let (m, _) = fit_rigid(&cw, &cu);
                     let mut add = Vec::new();
                     for (g, c) in &wf.faces {
                         if !space.is_active(*g) || list.iter().any(|x| x.0 == *g) {
                             continue;
                         }
-                        let cu = c.map(|p| apply(&m, p));
-                        let (mc, _) = fit_rigid(&cu, &space.canonical_coords(*g));
-                        add.push((*g, cu, mc));
+                        let cn = c.map(|p| apply(&m, p));
+                        let (mc, _) = fit_rigid(&cn, &space.canonical_coords(*g));
+                        let phi = carry(phi_w, &cu, zw, &cn);
+                        add.push((*g, cn, mc, phi));
                     }
                     list.extend(add);
                 }
@@ -321,7 +348,7 @@ impl Hole {
         let phi = phi.rem_euclid(self.cone_angle);
         let p = [rho * phi.cos(), rho * phi.sin()];
         let mut best: Option<(f64, Located)> = None;
-        for (g, c, m) in &self.sector_faces[k] {
+        for (g, c, m, phi_c) in &self.sector_faces[k] {
             let area = det3(c[0], c[1], c[2]);
             let b = [
                 det3(p, c[1], c[2]) / area,
@@ -329,7 +356,14 @@ impl Hole {
                 det3(c[0], c[1], p) / area,
             ];
             let q = b[0].min(b[1]).min(b[2]);
-            if q >= -1e-12 && best.as_ref().is_none_or(|(s, _)| q > *s) {
+            // The face must hold the point on the right sheet of the cone (a face of a
+            // graded neighbourhood can overlap the plane point a full turn of 2π away).
+            let cc = cz([
+                (c[0][0] + c[1][0] + c[2][0]) / 3.0,
+                (c[0][1] + c[1][1] + c[2][1]) / 3.0,
+            ]);
+            let sheet = (phi_c + (cz(p) / cc).arg() - phi).abs() < 1e-6;
+            if q >= -1e-12 && sheet && best.as_ref().is_none_or(|(s, _)| q > *s) {
                 best = Some((
                     q,
                     Located {
@@ -343,24 +377,84 @@ impl Hole {
         best.map(|x| x.1)
     }
 
-    /// Cone polar coordinates of unrolled point relative to this hole: is the point of face `g`
-    /// with barycentric `bary` inside the seam? (`None` when `g` is not in the two-ring.)
+    /// Developed corners of active face `g` in the unrolled frame (from the first sector whose
+    /// candidate list holds it), or `None` when `g` is not in the two-ring.
+    fn developed(&self, g: u32) -> Option<([Point; 3], f64)> {
+        self.sector_faces
+            .iter()
+            .find_map(|list| list.iter().find(|x| x.0 == g).map(|x| (x.1, x.3)))
+    }
+
+    /// Cone polar coordinates `(ρ, φ)` of the point of face `g` with barycentric `bary`
+    /// (`None` when `g` is not in the two-ring). `φ` is measured from the direction of the
+    /// face's centroid, whose unrolled angle was tracked through the development.
+    pub fn cone_polar(&self, g: u32, bary: [f64; 3]) -> Option<(f64, f64)> {
+        let (c, phi_c) = self.developed(g)?;
+        let at = |b: [f64; 3]| {
+            cz([
+                b[0] * c[0][0] + b[1] * c[1][0] + b[2] * c[2][0],
+                b[0] * c[0][1] + b[1] * c[1][1] + b[2] * c[2][1],
+            ])
+        };
+        let zc = at([1.0 / 3.0; 3]);
+        let z = at(bary);
+        Some((z.norm(), phi_c + (z / zc).arg()))
+    }
+
+    /// The seam parameter `ψ = 2πφ/Θ` of unrolled angle `φ`, in `[0, 2π)`.
+    pub fn psi_of_phi(&self, phi: f64) -> f64 {
+        (2.0 * PI * phi / self.cone_angle).rem_euclid(2.0 * PI)
+    }
+
+    /// Signed level of the seam at the point of face `g` with barycentric `bary`:
+    /// `ln ρ − ln R(ψ)`, negative inside the seam, zero on it (`None` outside the two-ring).
+    pub fn seam_level(&self, g: u32, bary: [f64; 3]) -> Option<f64> {
+        let (rho, phi) = self.cone_polar(g, bary)?;
+        Some(rho.ln() - self.radius(2.0 * PI * phi / self.cone_angle).ln())
+    }
+
+    /// Is the point of face `g` with barycentric `bary` inside the seam? (`None` when `g` is
+    /// not in the two-ring.)
     pub fn inside_seam(&self, g: u32, bary: [f64; 3]) -> Option<bool> {
-        for (k, list) in self.sector_faces.iter().enumerate() {
-            if let Some((_, c, _)) = list.iter().find(|x| x.0 == g) {
-                let p = [
-                    bary[0] * c[0][0] + bary[1] * c[1][0] + bary[2] * c[2][0],
-                    bary[0] * c[0][1] + bary[1] * c[1][1] + bary[2] * c[2][1],
-                ];
-                let mid = 0.5 * (self.sector_start[k] + self.sector_start[k + 1]);
-                let z = cz(p) * C::from_polar(1.0, -mid);
-                let phi = mid + z.arg();
-                let rho = z.norm();
-                let psi = 2.0 * PI * phi / self.cone_angle;
-                return Some(rho < self.radius(psi));
+        self.seam_level(g, bary).map(|l| l < 0.0)
+    }
+
+    /// Where the straight segment from barycentric `a` to `b` of face `g` crosses the seam,
+    /// for endpoints on opposite sides: `(s, bary, ψ)` with the point `(1 − s) a + s b`, found by
+    /// bisection of [`Hole::seam_level`] to `|Δs| ≤ 2⁻⁶⁰` (the level is smooth along the
+    /// segment, which is straight in the unrolled frame). When rounding puts both endpoints on
+    /// one side, the endpoint nearer the seam is returned (`s = 0` or `1`). `None` when `g` is
+    /// not in the two-ring.
+    pub fn seam_crossing(&self, g: u32, a: [f64; 3], b: [f64; 3]) -> Option<(f64, [f64; 3], f64)> {
+        let at = |s: f64| -> [f64; 3] { std::array::from_fn(|k| (1.0 - s) * a[k] + s * b[k]) };
+        let la = self.seam_level(g, a)?;
+        let lb = self.seam_level(g, b)?;
+        let s = if la == 0.0 || (la < 0.0) == (lb < 0.0) && la.abs() <= lb.abs() {
+            0.0
+        } else if lb == 0.0 || (la < 0.0) == (lb < 0.0) {
+            1.0
+        } else {
+            let (mut lo, mut hi) = (0.0f64, 1.0f64);
+            let neg_at_lo = la < 0.0;
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                let l = self.seam_level(g, at(mid))?;
+                if l == 0.0 {
+                    lo = mid;
+                    hi = mid;
+                    break;
+                }
+                if (l < 0.0) == neg_at_lo {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
             }
-        }
-        None
+            0.5 * (lo + hi)
+        };
+        let bary = at(s);
+        let (_, phi) = self.cone_polar(g, bary)?;
+        Some((s, bary, self.psi_of_phi(phi)))
     }
 
     /// The seam point at `ψ`: spline value `C(ψ)`, `D(ψ) = R ∂S/∂ρ`, and the spline's partials

@@ -15,6 +15,13 @@
 //!    interior edge, the two one-sided limits evaluated in their own canonical charts and
 //!    transformed into one), [`tessellate`] and [`MeshDistance`] (errors of spline samples
 //!    against the input mesh as a percentage of the bounding-box diagonal).
+//!
+//! The tessellation is one welded, consistently oriented mesh, closed for a closed input: the
+//! spline part is trimmed exactly at each seam (the crossings of the grid with the seam curve
+//! are computed on the seam in (face, barycentric) coordinates through the hole's unrolled
+//! cone coordinates) and the fill patch is triangulated on rings whose outer ring is exactly
+//! those seam vertices, so there is no gap and no T-junction and vertex normals average
+//! across the seam (`tests/spline_seam.rs`).
 
 use std::collections::HashMap;
 use std::time::Instant;
@@ -489,20 +496,54 @@ pub fn continuity<A: FlatCharts + Sync + ?Sized>(
     })
 }
 
-/// A tessellated spline surface.
+/// A tessellated spline surface: one welded, consistently oriented triangle mesh. The spline
+/// part is trimmed exactly at the seams; each fill patch's outer ring is the spline part's
+/// seam vertices, so spline and fill share those vertices and edges (no gap, no T-junction,
+/// vertex normals average across the seam). A closed input gives a closed mesh.
 #[derive(Debug, Clone, Default)]
 pub struct Tessellation {
     pub positions: Vec<[f64; 3]>,
     pub triangles: Vec<[u32; 3]>,
-    /// Domain face of each vertex (`-1` for fill-patch vertices).
+    /// Domain face of each vertex (`-1` for the fill patches' own vertices; seam vertices
+    /// are points of the spline and carry their face).
     pub vertex_face: Vec<i64>,
     /// Canonical chart of the face (`-1` for the fill).
     pub vertex_chart: Vec<i64>,
+    /// Barycentric coordinates of each vertex in its `vertex_face` (`[0; 3]` for the fill).
+    pub vertex_bary: Vec<[f64; 3]>,
     /// Triangles `0..spline_triangles` are spline, the rest fill.
     pub spline_triangles: usize,
-    /// Patch boundaries: images of the domain edges, then the seams.
+    /// Patch boundaries: images of the domain edges (trimmed at the seams), then the seams.
     pub boundaries: Vec<Vec<[f64; 3]>>,
+    /// The seam of each fill patch as it is in the mesh.
+    pub seams: Vec<SeamLoop>,
 }
+
+/// The seam of one fill patch in a [`Tessellation`]: vertices that lie on the seam curve, in
+/// the order of the spline part's boundary (spline on the left).
+#[derive(Debug, Clone, Default)]
+pub struct SeamLoop {
+    /// Index into [`ManifoldSpline::holes`].
+    pub hole: usize,
+    pub vertices: Vec<u32>,
+    /// Seam parameter `ψ ∈ [0, 2π)` of each vertex: its position is the spline at
+    /// (`vertex_face`, `vertex_bary`) and also [`Hole::fill_point`] at `t = 1`, `ψ`.
+    pub psi: Vec<f64>,
+    /// Grid points moved onto the seam (crossings closer than [`SEAM_SNAP`] of a grid edge to
+    /// one of its ends).
+    pub snapped: usize,
+}
+
+/// A grid edge crossing the seam closer than this fraction of its length to one end moves
+/// that end onto the seam instead of cutting the edge there (no sliver triangles; the move
+/// is along the grid edge, so no triangle folds).
+pub const SEAM_SNAP: f64 = 0.25;
+
+/// First ring step of the fill patch's triangulation next to the seam, as a fraction of its
+/// regular ring step (see [`tessellate`]).
+pub const FILL_GRADING: f64 = 0.5;
+/// Growth of the fill's ring steps from the seam inwards.
+pub const FILL_GROWTH: f64 = 1.5;
 
 /// A grid point of the tessellation that several faces share: a domain vertex, or the `k`-th
 /// of the `m − 1` inner points of a domain edge counted from the origin of its lower-numbered
@@ -538,24 +579,57 @@ fn grid_key(mesh: &crate::mesh::Mesh, f: u32, w: [usize; 3]) -> Option<GridKey> 
     Some(GridKey::Edge(mesh.he_edge(h), k))
 }
 
-/// Sample every active face on a grid of `m` segments per edge; drop the sub-triangles inside
-/// a seam; add each fill patch on a polar grid. The spline part is one welded mesh (grid points
-/// on domain vertices and edges are shared between the faces that meet there); the spline
-/// part and the fill meet at the seam but are not stitched into one mesh.
+/// Seam level of a point: the hole whose two-ring holds it and `ln ρ − ln R` (negative inside);
+/// `None` away from every hole.
+type SeamLevel = Option<(usize, f64)>;
+
+/// Where a grid edge of the tessellation crosses a seam.
+#[derive(Debug, Clone, Copy)]
+struct Crossing {
+    hole: usize,
+    face: u32,
+    bary: [f64; 3],
+    psi: f64,
+    /// Fraction of the edge from its lower-numbered end.
+    s: f64,
+}
+
+/// Sample every active face on a grid of `m` segments per edge and weld the grid points on
+/// domain vertices and edges (the spline is continuous there), so the spline part is one
+/// connected mesh. Trim it at each seam: grid points get the sign of [`Hole::seam_level`];
+/// grid edges that cross the seam are cut at the crossing, found on the seam in (face,
+/// barycentric) coordinates through the hole's unrolled cone coordinates
+/// ([`Hole::seam_crossing`]); crossings within [`SEAM_SNAP`] of a grid point move that point
+/// onto the seam instead. Sub-triangles keep their part outside the seam (a triangle or a quad
+/// split along its better diagonal). The boundary edges of the trimmed part form one closed
+/// curve per seam, all of whose vertices lie on the seam; the fill patch is triangulated on
+/// rings `t = k/n_t` of its disk whose outer ring is exactly that curve (inner rings placed
+/// by the seam's arc length, consecutive rings zipped by parameter order). Unused grid points
+/// are dropped.
 pub fn tessellate<A: FlatCharts + Sync + ?Sized>(
     space: &ManifoldSpace<'_, A>,
     spline: &ManifoldSpline,
     m: usize,
 ) -> Result<Tessellation> {
     use rayon::prelude::*;
+    use std::collections::BTreeMap;
     let m = m.max(1);
     let charts = space.charts();
     let mesh = charts.mesh();
     let control = &spline.control;
+    let holes = &spline.holes;
     let grid: Vec<(usize, usize)> = (0..=m)
         .flat_map(|i| (0..=m - i).map(move |j| (i, j)))
         .collect();
     let idx = |i: usize, j: usize| -> usize { grid.iter().position(|&x| x == (i, j)).unwrap_or(0) };
+    let bary_of = |q: usize| -> [f64; 3] {
+        let (i, j) = grid[q];
+        [
+            (m - i - j) as f64 / m as f64,
+            i as f64 / m as f64,
+            j as f64 / m as f64,
+        ]
+    };
     let mut subtri = Vec::new();
     for i in 0..m {
         for j in 0..m - i {
@@ -568,42 +642,42 @@ pub fn tessellate<A: FlatCharts + Sync + ?Sized>(
     let faces: Vec<u32> = (0..mesh.n_faces() as u32)
         .filter(|&f| space.is_active(f))
         .collect();
+    // Seam level of a point: (hole, ln ρ − ln R), negative inside.
+    let level_at = |f: u32, b: [f64; 3]| -> SeamLevel {
+        holes
+            .iter()
+            .enumerate()
+            .find_map(|(h, hole)| hole.seam_level(f, b).map(|l| (h, l)))
+    };
     #[allow(clippy::type_complexity)]
-    let per: Vec<(Vec<[f64; 3]>, Vec<bool>)> = faces
+    let per: Vec<(Vec<[f64; 3]>, Vec<SeamLevel>)> = faces
         .par_iter()
-        .map(|&f| -> Result<(Vec<[f64; 3]>, Vec<bool>)> {
+        .map(|&f| -> Result<(Vec<[f64; 3]>, Vec<SeamLevel>)> {
             let mut ws = Workspace::default();
             let mut out = [0.0; 3];
             let mut p = Vec::with_capacity(grid.len());
-            let mut inside = Vec::with_capacity(grid.len());
-            for &(i, j) in &grid {
-                let b = [
-                    (m - i - j) as f64 / m as f64,
-                    i as f64 / m as f64,
-                    j as f64 / m as f64,
-                ];
+            let mut lv = Vec::with_capacity(grid.len());
+            for q in 0..grid.len() {
+                let b = bary_of(q);
                 space.evaluate(control, 3, f, b, 0, &mut ws, &mut out)?;
                 p.push(out);
-                inside.push(
-                    spline
-                        .holes
-                        .iter()
-                        .any(|h| h.inside_seam(f, b).unwrap_or(false)),
-                );
+                lv.push(level_at(f, b));
             }
-            Ok((p, inside))
+            Ok((p, lv))
         })
         .collect::<Result<_>>()?;
     // Weld: a grid point on a domain vertex or edge is one vertex of the tessellation, shared
-    // by the faces around it (the spline is continuous there; its value is taken from the
-    // first face that reaches the point), so the spline part is one connected mesh and vertex
-    // normals average across patch boundaries instead of stopping at them.
+    // by the faces around it (its value and seam level are taken from the first face that
+    // reaches it), so the spline part is one connected mesh and vertex normals average across
+    // patch boundaries instead of stopping at them.
     let mut t = Tessellation::default();
+    let mut level: Vec<SeamLevel> = Vec::new();
     let mut shared: HashMap<GridKey, u32> = HashMap::new();
-    let mut local = vec![0u32; grid.len()];
-    for (k, (p, inside)) in per.into_iter().enumerate() {
+    let mut ids: Vec<Vec<u32>> = Vec::with_capacity(faces.len());
+    for (k, (p, lv)) in per.into_iter().enumerate() {
         let f = faces[k];
         let chart = space.canonical_chart(f) as i64;
+        let mut local = Vec::with_capacity(grid.len());
         for (q, &(i, j)) in grid.iter().enumerate() {
             let key = grid_key(mesh, f, [m - i - j, i, j]);
             let next = t.positions.len() as u32;
@@ -615,20 +689,282 @@ pub fn tessellate<A: FlatCharts + Sync + ?Sized>(
                 t.positions.push(p[q]);
                 t.vertex_face.push(f as i64);
                 t.vertex_chart.push(chart);
+                t.vertex_bary.push(bary_of(q));
+                level.push(lv[q]);
             }
-            local[q] = id;
+            local.push(id);
         }
+        ids.push(local);
+    }
+    let inside = |l: SeamLevel| l.is_some_and(|(_, x)| x < 0.0);
+    // Grid edges that cross a seam, keyed by their (lower, higher) vertex ids.
+    let mut crossings: BTreeMap<(u32, u32), Crossing> = BTreeMap::new();
+    for (k, &f) in faces.iter().enumerate() {
         for s in &subtri {
-            if s.iter().any(|&q| inside[q]) {
+            for e in 0..3 {
+                let (qa, qb) = (s[e], s[(e + 1) % 3]);
+                let (a, b) = (ids[k][qa], ids[k][qb]);
+                let (la, lb) = (level[a as usize], level[b as usize]);
+                if inside(la) == inside(lb) {
+                    continue;
+                }
+                let key = (a.min(b), a.max(b));
+                if crossings.contains_key(&key) {
+                    continue;
+                }
+                let h = la.or(lb).map(|x| x.0).unwrap_or(0);
+                let (s_ab, bary, psi) = holes[h]
+                    .seam_crossing(f, bary_of(qa), bary_of(qb))
+                    .ok_or_else(|| {
+                        Error::numerical(format!(
+                            "tessellation: face {f} meets the seam around vertex {} but is not in \
+                             its two-ring",
+                            holes[h].vertex
+                        ))
+                    })?;
+                crossings.insert(
+                    key,
+                    Crossing {
+                        hole: h,
+                        face: f,
+                        bary,
+                        psi,
+                        s: if a < b { s_ab } else { 1.0 - s_ab },
+                    },
+                );
+            }
+        }
+    }
+    // Snap: a grid point whose nearest crossing is within SEAM_SNAP of it moves there.
+    let mut snap: BTreeMap<u32, (f64, (u32, u32))> = BTreeMap::new();
+    for (&key, c) in &crossings {
+        for (v, d) in [(key.0, c.s), (key.1, 1.0 - c.s)] {
+            if d < SEAM_SNAP && snap.get(&v).is_none_or(|x| d < x.0) {
+                snap.insert(v, (d, key));
+            }
+        }
+    }
+    // Seam parameter of the vertices on a seam.
+    let mut seam_psi: Vec<Option<f64>> = vec![None; t.positions.len()];
+    let mut snapped = vec![0usize; holes.len()];
+    let mut moved: Vec<(u32, Crossing)> = Vec::with_capacity(snap.len());
+    for (&v, &(_, key)) in &snap {
+        let c = crossings[&key];
+        seam_psi[v as usize] = Some(c.psi);
+        level[v as usize] = Some((c.hole, 0.0));
+        snapped[c.hole] += 1;
+        moved.push((v, c));
+    }
+    crossings.retain(|k, _| seam_psi[k.0 as usize].is_none() && seam_psi[k.1 as usize].is_none());
+    // New vertices at the remaining crossings.
+    let mut crossing_vertex: HashMap<(u32, u32), u32> = HashMap::new();
+    let first_new = t.positions.len();
+    for (&key, c) in &crossings {
+        crossing_vertex.insert(key, t.positions.len() as u32);
+        t.positions.push([0.0; 3]);
+        t.vertex_face.push(c.face as i64);
+        t.vertex_chart.push(space.canonical_chart(c.face) as i64);
+        t.vertex_bary.push(c.bary);
+        level.push(Some((c.hole, 0.0)));
+        seam_psi.push(Some(c.psi));
+    }
+    let evaluated: Vec<[f64; 3]> = moved
+        .iter()
+        .map(|x| &x.1)
+        .chain(crossings.values())
+        .collect::<Vec<_>>()
+        .par_iter()
+        .map(|c| -> Result<[f64; 3]> {
+            let mut ws = Workspace::default();
+            let mut out = [0.0; 3];
+            space.evaluate(control, 3, c.face, c.bary, 0, &mut ws, &mut out)?;
+            Ok(out)
+        })
+        .collect::<Result<_>>()?;
+    for (k, (v, c)) in moved.iter().enumerate() {
+        let v = *v as usize;
+        t.positions[v] = evaluated[k];
+        t.vertex_face[v] = c.face as i64;
+        t.vertex_chart[v] = space.canonical_chart(c.face) as i64;
+        t.vertex_bary[v] = c.bary;
+    }
+    for (k, p) in evaluated[moved.len()..].iter().enumerate() {
+        t.positions[first_new + k] = *p;
+    }
+    // Clip the sub-triangles: keep the part outside the seams.
+    #[derive(Clone, Copy, PartialEq, Eq)]
+    enum Side {
+        In,
+        On,
+        Out,
+    }
+    let side = |v: u32| {
+        if seam_psi[v as usize].is_some() {
+            Side::On
+        } else if inside(level[v as usize]) {
+            Side::In
+        } else {
+            Side::Out
+        }
+    };
+    for local in &ids {
+        for s in &subtri {
+            let g = s.map(|q| local[q]);
+            let sides = g.map(side);
+            if !sides.contains(&Side::Out) {
                 continue;
             }
-            t.triangles.push(s.map(|q| local[q]));
+            if !sides.contains(&Side::In) {
+                t.triangles.push(g);
+                continue;
+            }
+            let mut poly: Vec<u32> = Vec::with_capacity(4);
+            for e in 0..3 {
+                let (a, b) = (g[e], g[(e + 1) % 3]);
+                if sides[e] != Side::In {
+                    poly.push(a);
+                }
+                let pair = (sides[e], sides[(e + 1) % 3]);
+                if pair == (Side::In, Side::Out) || pair == (Side::Out, Side::In) {
+                    let key = (a.min(b), a.max(b));
+                    poly.push(*crossing_vertex.get(&key).ok_or_else(|| {
+                        Error::numerical(format!(
+                            "tessellation: grid edge {key:?} crosses a seam but has no crossing point"
+                        ))
+                    })?);
+                }
+            }
+            match poly.len() {
+                3 => t.triangles.push([poly[0], poly[1], poly[2]]),
+                4 => {
+                    let p = |v: u32| t.positions[v as usize];
+                    let q = |a: u32, b: u32, c: u32| min_angle(p(a), p(b), p(c));
+                    let d02 = q(poly[0], poly[1], poly[2]).min(q(poly[0], poly[2], poly[3]));
+                    let d13 = q(poly[0], poly[1], poly[3]).min(q(poly[1], poly[2], poly[3]));
+                    if d02 >= d13 {
+                        t.triangles.push([poly[0], poly[1], poly[2]]);
+                        t.triangles.push([poly[0], poly[2], poly[3]]);
+                    } else {
+                        t.triangles.push([poly[0], poly[1], poly[3]]);
+                        t.triangles.push([poly[1], poly[2], poly[3]]);
+                    }
+                }
+                _ => {}
+            }
         }
     }
     t.spline_triangles = t.triangles.len();
-    // Domain edges as polylines (once per edge).
+    // The seams as the spline part's boundary: directed edges without a reverse whose ends are
+    // both on a seam, chained into one closed curve per hole.
+    let mut directed: HashMap<(u32, u32), ()> = HashMap::with_capacity(3 * t.triangles.len());
+    for tri in &t.triangles {
+        for e in 0..3 {
+            directed.insert((tri[e], tri[(e + 1) % 3]), ());
+        }
+    }
+    let mut next: Vec<BTreeMap<u32, u32>> = vec![BTreeMap::new(); holes.len()];
+    for tri in &t.triangles {
+        for e in 0..3 {
+            let (a, b) = (tri[e], tri[(e + 1) % 3]);
+            if directed.contains_key(&(b, a))
+                || seam_psi[a as usize].is_none()
+                || seam_psi[b as usize].is_none()
+            {
+                continue;
+            }
+            let h = level[a as usize].map(|x| x.0).unwrap_or(0);
+            if next[h].insert(a, b).is_some() {
+                return Err(Error::numerical(format!(
+                    "tessellation: the trimmed spline touches itself at a point of the seam around \
+                     vertex {} (try another resolution than {m})",
+                    holes[h].vertex
+                )));
+            }
+        }
+    }
+    for (h, hole) in holes.iter().enumerate() {
+        let Some((&start, _)) = next[h].iter().next() else {
+            return Err(Error::numerical(format!(
+                "tessellation: the seam around vertex {} crosses no grid edge",
+                hole.vertex
+            )));
+        };
+        let mut vertices = vec![start];
+        let mut v = start;
+        loop {
+            let Some(&w) = next[h].get(&v) else {
+                return Err(Error::numerical(format!(
+                    "tessellation: the seam around vertex {} is not a closed curve",
+                    hole.vertex
+                )));
+            };
+            if w == start {
+                break;
+            }
+            if vertices.len() > next[h].len() {
+                break;
+            }
+            vertices.push(w);
+            v = w;
+        }
+        if vertices.len() != next[h].len() {
+            return Err(Error::numerical(format!(
+                "tessellation: the trimmed spline has {} boundary edges on the seam around vertex \
+                 {} but they form a curve of {} (the seam is not one closed curve; try another \
+                 resolution than {m})",
+                next[h].len(),
+                hole.vertex,
+                vertices.len()
+            )));
+        }
+        let psi = vertices
+            .iter()
+            .map(|&v| seam_psi[v as usize].unwrap_or(0.0))
+            .collect();
+        t.seams.push(SeamLoop {
+            hole: h,
+            vertices,
+            psi,
+            snapped: snapped[h],
+        });
+    }
+    // Fill patches whose outer rings are the seams.
+    for seam in t.seams.clone() {
+        fill_patch(space, spline, &seam, &mut t)?;
+    }
+    // Drop the grid points no triangle uses (those inside the seams).
+    let mut map = vec![u32::MAX; t.positions.len()];
+    let mut n = 0u32;
+    for tri in &t.triangles {
+        for &v in tri {
+            if map[v as usize] == u32::MAX {
+                map[v as usize] = n;
+                n += 1;
+            }
+        }
+    }
+    let mut order = vec![0usize; n as usize];
+    for (v, &w) in map.iter().enumerate() {
+        if w != u32::MAX {
+            order[w as usize] = v;
+        }
+    }
+    t.positions = order.iter().map(|&v| t.positions[v]).collect();
+    t.vertex_face = order.iter().map(|&v| t.vertex_face[v]).collect();
+    t.vertex_chart = order.iter().map(|&v| t.vertex_chart[v]).collect();
+    t.vertex_bary = order.iter().map(|&v| t.vertex_bary[v]).collect();
+    for tri in &mut t.triangles {
+        *tri = tri.map(|v| map[v as usize]);
+    }
+    for seam in &mut t.seams {
+        for v in &mut seam.vertices {
+            *v = map[*v as usize];
+        }
+    }
+    // Domain edges as polylines (once per edge), trimmed at the seams.
     let mut ws = Workspace::default();
     let mut out = [0.0; 3];
+    let mut lines = Vec::new();
     for h in 0..mesh.n_corners() as u32 {
         let f = h / 3;
         let tw = mesh.he_twin(h);
@@ -638,74 +974,247 @@ pub fn tessellate<A: FlatCharts + Sync + ?Sized>(
             continue;
         }
         let i = h as usize % 3;
-        let mut line = Vec::with_capacity(m + 1);
+        let mut line: Vec<[f64; 3]> = Vec::with_capacity(m + 1);
+        let mut prev: Option<([f64; 3], SeamLevel)> = None;
         for s in 0..=m {
             let a = s as f64 / m as f64;
             let mut b = [0.0; 3];
             b[i] = 1.0 - a;
             b[(i + 1) % 3] = a;
-            if spline
-                .holes
-                .iter()
-                .any(|hh| hh.inside_seam(f, b).unwrap_or(false))
-            {
+            let lv = level_at(f, b);
+            if let Some((pb, pl)) = prev {
+                if inside(pl) != inside(lv) {
+                    // The edge enters or leaves a seam between two samples: end or start the
+                    // polyline on the seam.
+                    let hh = pl.or(lv).map(|x| x.0).unwrap_or(0);
+                    if let Some((_, bc, _)) = holes[hh].seam_crossing(f, pb, b) {
+                        space.evaluate(control, 3, f, bc, 0, &mut ws, &mut out)?;
+                        line.push(out);
+                    }
+                    if inside(lv) {
+                        if line.len() >= 2 {
+                            lines.push(std::mem::take(&mut line));
+                        }
+                        line.clear();
+                    }
+                }
+            }
+            prev = Some((b, lv));
+            if inside(lv) {
                 continue;
             }
             space.evaluate(control, 3, f, b, 0, &mut ws, &mut out)?;
             line.push(out);
         }
         if line.len() >= 2 {
-            t.boundaries.push(line);
+            lines.push(line);
         }
     }
-    // Fill patches on a polar grid.
-    for hole in &spline.holes {
-        let nt = 3 * m;
-        let npsi = 48.max(8 * m);
-        let center = t.positions.len() as u32;
-        t.positions.push(hole.center);
-        t.vertex_face.push(-1);
-        t.vertex_chart.push(-1);
-        let rows: Vec<Vec<[f64; 3]>> = (1..=nt)
-            .into_par_iter()
-            .map(|it| -> Result<Vec<[f64; 3]>> {
-                let mut ws = Workspace::default();
-                (0..npsi)
-                    .map(|j| {
-                        hole.fill_point(
-                            space,
-                            control,
-                            it as f64 / nt as f64,
-                            2.0 * std::f64::consts::PI * j as f64 / npsi as f64,
-                            &mut ws,
-                        )
-                    })
-                    .collect()
-            })
-            .collect::<Result<_>>()?;
-        let start = t.positions.len() as u32;
-        for r in &rows {
-            t.positions.extend_from_slice(r);
-            t.vertex_face.extend(std::iter::repeat_n(-1, r.len()));
-            t.vertex_chart.extend(std::iter::repeat_n(-1, r.len()));
-        }
-        let at = |it: usize, j: usize| start + (it * npsi + j % npsi) as u32;
-        for j in 0..npsi {
-            t.triangles.push([center, at(0, j), at(0, j + 1)]);
-        }
-        for it in 0..nt - 1 {
-            for j in 0..npsi {
-                t.triangles
-                    .push([at(it, j), at(it + 1, j), at(it + 1, j + 1)]);
-                t.triangles
-                    .push([at(it, j), at(it + 1, j + 1), at(it, j + 1)]);
-            }
-        }
-        let mut seam: Vec<[f64; 3]> = rows[nt - 1].clone();
-        seam.push(rows[nt - 1][0]);
-        t.boundaries.push(seam);
+    t.boundaries = lines;
+    for seam in &t.seams {
+        let mut line: Vec<[f64; 3]> = seam
+            .vertices
+            .iter()
+            .map(|&v| t.positions[v as usize])
+            .collect();
+        line.push(line[0]);
+        t.boundaries.push(line);
     }
     Ok(t)
+}
+
+/// Smallest angle of a triangle (radians; 0 for a degenerate one).
+fn min_angle(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+    let ang = |p: [f64; 3], q: [f64; 3], r: [f64; 3]| {
+        let (u, v) = (sub3(q, p), sub3(r, p));
+        let d = (dot3(u, u) * dot3(v, v)).sqrt();
+        if d > 0.0 {
+            (dot3(u, v) / d).clamp(-1.0, 1.0).acos()
+        } else {
+            0.0
+        }
+    };
+    ang(a, b, c).min(ang(b, c, a)).min(ang(c, a, b))
+}
+
+/// Triangulate the fill patch of `seam.hole` inside its seam loop (already vertices of `t`):
+/// the seam is the ring `t = 1` of the patch's disk; the regular ring step `1/n_t` makes rings
+/// about as far apart as the seam's vertices. Next to the seam the steps start at
+/// [`FILL_GRADING`]`/n_t` and grow by [`FILL_GROWTH`] (the patch bends more than the spline
+/// there, and the spline's trimmed triangles are small), and those rings keep the seam's own
+/// `ψ` (a quad strip along radial lines, which cannot fold however thin). The regular rings
+/// inside have `max(5, round(n t))` points at equal steps of the seam's arc length, and the
+/// centre closes the disk. Consecutive rings are zipped by arc-length order; orientation is
+/// the spline's.
+fn fill_patch<A: FlatCharts + Sync + ?Sized>(
+    space: &ManifoldSpace<'_, A>,
+    spline: &ManifoldSpline,
+    seam: &SeamLoop,
+    t: &mut Tessellation,
+) -> Result<()> {
+    use rayon::prelude::*;
+    use std::f64::consts::PI;
+    let hole = &spline.holes[seam.hole];
+    let n = seam.vertices.len();
+    if n < 3 {
+        return Err(Error::numerical(format!(
+            "tessellation: the seam around vertex {} has only {n} vertices",
+            hole.vertex
+        )));
+    }
+    // ψ unwrapped along the loop; the loop must wind once around the cone.
+    let mut psi_u = Vec::with_capacity(n + 1);
+    psi_u.push(seam.psi[0]);
+    for k in 1..=n {
+        let d = seam.psi[k % n] - seam.psi[k - 1];
+        let d = d - 2.0 * PI * (d / (2.0 * PI)).round();
+        psi_u.push(psi_u[k - 1] + d);
+    }
+    let total = psi_u[n] - psi_u[0];
+    if (total.abs() - 2.0 * PI).abs() > 1e-6 {
+        return Err(Error::numerical(format!(
+            "tessellation: the seam around vertex {} winds {:.3} times around it, not once",
+            hole.vertex,
+            total / (2.0 * PI)
+        )));
+    }
+    // Ring order: increasing ψ. The fill's triangles (inner, outer_j, outer_j+1) then run
+    // along the seam in increasing ψ; the spline's boundary runs the other way for a
+    // consistent orientation, so flip when the loop's ψ increases.
+    let increasing = total > 0.0;
+    // Loop index of ring position k.
+    let at: Vec<usize> = (0..n)
+        .map(|k| if increasing { k } else { (n - k) % n })
+        .collect();
+    let ring_ids: Vec<u32> = at.iter().map(|&k| seam.vertices[k]).collect();
+    // Unwrapped ψ in ring order, closing value at index n.
+    let mut rpsi: Vec<f64> = Vec::with_capacity(n + 1);
+    rpsi.push(seam.psi[at[0]]);
+    for k in 1..=n {
+        let d = seam.psi[at[k % n]] - seam.psi[at[k - 1]];
+        rpsi.push(rpsi[k - 1] + d - 2.0 * PI * (d / (2.0 * PI)).round());
+    }
+    let pos = |v: u32| t.positions[v as usize];
+    // Arc length of the seam polygon, normalised to [0, 1].
+    let mut arc = vec![0.0; n + 1];
+    for k in 1..=n {
+        let d = sub3(pos(ring_ids[k % n]), pos(ring_ids[k - 1]));
+        arc[k] = arc[k - 1] + dot3(d, d).sqrt();
+    }
+    let length = arc[n];
+    if length <= 0.0 || !length.is_finite() {
+        return Err(Error::numerical(format!(
+            "tessellation: the seam around vertex {} has no length",
+            hole.vertex
+        )));
+    }
+    for a in &mut arc {
+        *a /= length;
+    }
+    let spacing = length / n as f64;
+    let radius = ring_ids
+        .iter()
+        .map(|&v| {
+            let d = sub3(pos(v), hole.center);
+            dot3(d, d).sqrt()
+        })
+        .sum::<f64>()
+        / n as f64;
+    let nt = ((radius / spacing).round() as usize).clamp(1, 4 * n);
+    let psi_at = |u: f64| -> f64 {
+        let j = match arc.binary_search_by(|x| x.total_cmp(&u)) {
+            Ok(j) => j.min(n - 1),
+            Err(j) => j.saturating_sub(1).min(n - 1),
+        };
+        let w = (u - arc[j]) / (arc[j + 1] - arc[j]).max(1e-300);
+        rpsi[j] + w.clamp(0.0, 1.0) * (rpsi[j + 1] - rpsi[j])
+    };
+    // Ring radii: steps of FILL_GRADING / nt next to the seam, growing by FILL_GROWTH up to
+    // 1/nt (the patch bends more than the spline next to the seam, and the spline's trimmed
+    // triangles are small there).
+    let (beta, growth) = (FILL_GRADING, FILL_GROWTH);
+    let full = 1.0 / nt as f64;
+    // (t, aligned): rings whose step is below `full` keep the seam's own ψ (radial lines
+    // through the seam vertices: a quad strip that cannot fold however thin it is).
+    let mut ts: Vec<(f64, bool)> = Vec::new();
+    let (mut tk, mut step) = (1.0, beta * full);
+    loop {
+        tk -= step;
+        if tk < 0.5 * full {
+            break;
+        }
+        ts.push((tk, step < full));
+        step = (step * growth).min(full);
+    }
+    // Ring at t: (t, arc parameters, ψ). Aligned rings: the seam's; the others
+    // max(5, round(n t)) points at equal steps of the seam's arc length.
+    let rings: Vec<(f64, Vec<f64>, Vec<f64>)> = ts
+        .iter()
+        .rev()
+        .map(|&(tk, aligned)| {
+            if aligned {
+                (tk, arc[..n].to_vec(), rpsi[..n].to_vec())
+            } else {
+                let c = (n as f64 * tk).round().max(5.0) as usize;
+                let us: Vec<f64> = (0..c).map(|j| j as f64 / c as f64).collect();
+                let ps = us.iter().map(|&u| psi_at(u)).collect();
+                (tk, us, ps)
+            }
+        })
+        .collect();
+    let values: Vec<Vec<[f64; 3]>> = rings
+        .par_iter()
+        .map(|(tk, _, ps)| -> Result<Vec<[f64; 3]>> {
+            let mut ws = Workspace::default();
+            ps.iter()
+                .map(|&psi| hole.fill_point(space, &spline.control, *tk, psi, &mut ws))
+                .collect()
+        })
+        .collect::<Result<_>>()?;
+    let push = |t: &mut Tessellation, p: [f64; 3]| -> u32 {
+        t.positions.push(p);
+        t.vertex_face.push(-1);
+        t.vertex_chart.push(-1);
+        t.vertex_bary.push([0.0; 3]);
+        t.positions.len() as u32 - 1
+    };
+    let center = push(t, hole.center);
+    // Each ring as (vertex ids, arc parameters).
+    let mut all: Vec<(Vec<u32>, Vec<f64>)> = Vec::with_capacity(nt);
+    for ((_, us, _), vals) in rings.iter().zip(&values) {
+        let ids = vals.iter().map(|&p| push(t, p)).collect();
+        all.push((ids, us.clone()));
+    }
+    all.push((ring_ids, arc[..n].to_vec()));
+    let mut tris: Vec<[u32; 3]> = Vec::new();
+    let (first, _) = &all[0];
+    for j in 0..first.len() {
+        tris.push([center, first[j], first[(j + 1) % first.len()]]);
+    }
+    for w in all.windows(2) {
+        let (a, ua) = (&w[0].0, &w[0].1);
+        let (b, ub) = (&w[1].0, &w[1].1);
+        let (p, q) = (a.len(), b.len());
+        let (mut i, mut j) = (0, 0);
+        while i < p || j < q {
+            let na = if i + 1 < p { ua[i + 1] } else { 1.0 };
+            let nb = if j + 1 < q { ub[j + 1] } else { 1.0 };
+            if j < q && (i == p || nb <= na) {
+                tris.push([a[i % p], b[j], b[(j + 1) % q]]);
+                j += 1;
+            } else {
+                tris.push([a[i], b[j % q], a[(i + 1) % p]]);
+                i += 1;
+            }
+        }
+    }
+    if increasing {
+        for tri in &mut tris {
+            tri.swap(1, 2);
+        }
+    }
+    t.triangles.extend(tris);
+    Ok(())
 }
 
 /// Distances from points to a triangle mesh (exact point–triangle distance, uniform grid of
