@@ -446,6 +446,90 @@ fn fill_patch_meets_the_spline_g1() {
     }
 }
 
+/// The fill is C² at its centre: near `t = 0` it agrees with its quadratic Taylor polynomial in
+/// the disk's coordinates `(x, y) = t (cos ψ, sin ψ)` up to `O(t³)`. Measured as the residual
+/// of the best quadratic fit to samples on the circle of radius `ε`: it must fall like `ε³`
+/// (ratio ≥ 6 per halving; ~8 for a C³ patch, 4 for a patch whose second-order term depends on
+/// ψ other than through a quadratic form — the radial Hermite fill had that, and its zebra
+/// stripes showed a starburst at the centre).
+#[test]
+fn fill_patch_is_c2_at_its_centre() {
+    let s = genus2();
+    let dom = flat_domain(&s, largest_valence(&s), &mut NoProgress).unwrap();
+    let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
+    let control = subdivided_and_faired(&space, 1);
+    let hole = Hole::new(&space, &control, dom.singular.unwrap()).unwrap();
+    let mut ws = Workspace::default();
+    let residual = |eps: f64, ws: &mut Workspace| -> f64 {
+        // Least squares over the monomials 1, x, y, x², xy, y² (normal equations, 6×6).
+        let k = 48;
+        let mut ata = [[0.0f64; 6]; 6];
+        let mut atb = [[0.0f64; 3]; 6];
+        let mut rows = Vec::new();
+        for j in 0..k {
+            let psi = 2.0 * std::f64::consts::PI * (j as f64 + 0.25) / k as f64;
+            let (x, y) = (psi.cos(), psi.sin()); // in units of eps
+            let m = [1.0, x, y, x * x, x * y, y * y];
+            let f = hole.fill_point(&space, &control, eps, psi, ws).unwrap();
+            for a in 0..6 {
+                for b in 0..6 {
+                    ata[a][b] += m[a] * m[b];
+                }
+                for d in 0..3 {
+                    atb[a][d] += m[a] * f[d];
+                }
+            }
+            rows.push((m, f));
+        }
+        // Gaussian elimination with partial pivoting.
+        let mut a = ata;
+        let mut b = atb;
+        for c in 0..6 {
+            let p = (c..6)
+                .max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))
+                .unwrap();
+            a.swap(c, p);
+            b.swap(c, p);
+            let (pa, pb) = (a[c], b[c]);
+            for r in 0..6 {
+                if r != c {
+                    let f = a[r][c] / pa[c];
+                    for (x, y) in a[r].iter_mut().zip(&pa) {
+                        *x -= f * y;
+                    }
+                    for (x, y) in b[r].iter_mut().zip(&pb) {
+                        *x -= f * y;
+                    }
+                }
+            }
+        }
+        let coef: Vec<[f64; 3]> = (0..6)
+            .map(|r| std::array::from_fn(|d| b[r][d] / a[r][r]))
+            .collect();
+        rows.iter()
+            .map(|(m, f)| {
+                (0..3)
+                    .map(|d| {
+                        let g: f64 = (0..6).map(|i| m[i] * coef[i][d]).sum();
+                        (g - f[d]).powi(2)
+                    })
+                    .sum::<f64>()
+            })
+            .sum::<f64>()
+            .sqrt()
+    };
+    let (r1, r2, r3) = (
+        residual(0.04, &mut ws),
+        residual(0.02, &mut ws),
+        residual(0.01, &mut ws),
+    );
+    eprintln!("fill centre: quadratic-fit residuals {r1:.3e} {r2:.3e} {r3:.3e}");
+    assert!(
+        r1 / r2 >= 6.0 && r2 / r3 >= 6.0,
+        "{r1:.3e} {r2:.3e} {r3:.3e}"
+    );
+}
+
 fn end_to_end(name: &str, s: &Surface, dom: &FlatDomain, degree: usize, max_error_percent: f64) {
     let dist = MeshDistance::new(&s.positions, s.mesh.faces());
     let opts = SplineOptions {

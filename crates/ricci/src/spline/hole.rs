@@ -16,16 +16,28 @@
 //! more rings of stars, developed into the unrolled cone); otherwise construction fails naming
 //! `s` (a very irregular neighbourhood).
 //!
-//! **Fill.** Over the unit disk `(t, ψ)` a radial cubic Hermite patch
-//! `F(t, ψ) = h₀₀(t) P₀ + h₁₀(t) T(ψ) + h₀₁(t) C(ψ) + h₁₁(t) D(ψ)` with the seam data
-//! `C(ψ) = S(R, φ)` and `D(ψ) = R ∂S/∂ρ` taken from the spline `S` itself, `P₀` the mean of
-//! `C − D` and `T(ψ) = a cos ψ + b sin ψ` the first Fourier mode of `D` (so a plane is
-//! reproduced exactly and the patch has a tangent plane at its centre). At `t = 1` the patch
-//! has the spline's value and its tangents `∂F/∂t = D`, `∂F/∂ψ = dC/dψ` lie in the spline's
-//! tangent plane: the join is G¹ (measured by [`Hole::seam_normal_jump`]). This is not the
-//! paper's planar triangular B-spline fill; it is a single smooth patch, C¹ at its centre.
+//! **Fill.** Over the unit disk `(t, ψ)`, `(x, y) = t (cos ψ, sin ψ)`, the patch matches the
+//! seam data `C(ψ) = S(R, φ)` and `D(ψ) = R ∂S/∂ρ` of the spline `S` itself: at `t = 1` it has
+//! the spline's value and `∂F/∂t = D`, `∂F/∂ψ = dC/dψ`, both in the spline's tangent plane, so
+//! the join is G¹ (measured by [`Hole::seam_normal_jump`]). It is built from the Fourier modes
+//! `C_k, D_k`, `k ≤ K` (`K` ≤ 32) of the seam data: mode `k` gets the radial profile
+//! `α_k t^k + β_k t^{k+2}` with `α_k + β_k = C_k`, `k α_k + (k + 2) β_k = D_k` — `t^k e^{ikψ}`
+//! and `t^{k+2} e^{ikψ}` are the polynomials `z^k` and `|z|² z^k`, so this part is a polynomial
+//! in `(x, y)`, and it reproduces a plane — plus the rest, `C − C_K` and `D − D_K`, with the
+//! cubic Hermite profiles of order `t³` at the centre (`4t³ − 3t⁴`, `t⁴ − t³`). The patch is
+//! therefore C² at its centre (test `fill_patch_is_c2_at_its_centre`: the quadratic Taylor fit's
+//! residual falls like `ε³`). The earlier radial cubic Hermite patch, `h₀₀ P₀ + h₁₀ T + h₀₁ C +
+//! h₁₁ D` for every mode at once, gave every Fourier mode of `C` and `D` a `t²` term at the
+//! centre: only C¹ there, and a starburst in the zebra stripes. This is not the paper's planar
+//! triangular B-spline fill; it is a single smooth patch.
 
 use std::f64::consts::PI;
+
+/// Fourier modes of the seam data carried by the fill's polynomial part (at most `ns / 8` of
+/// the seam samples).
+const FILL_MODES: usize = 32;
+/// Order at the centre of the profiles that carry the rest of the seam data.
+const REST_ORDER: usize = 3;
 
 use num_complex::Complex64 as C;
 
@@ -75,6 +87,9 @@ pub struct Hole {
     pub center: [f64; 3],
     tangent_a: [f64; 3],
     tangent_b: [f64; 3],
+    /// Fourier coefficients (cos, sin) of `C(ψ)` and `D(ψ)`, modes `0..=K`.
+    seam_modes: Vec<[[f64; 3]; 2]>,
+    cross_modes: Vec<[[f64; 3]; 2]>,
     /// Smallest `R(ψ) / r_link(ψ) − 1` over the checked samples.
     pub min_clearance: f64,
 }
@@ -230,6 +245,8 @@ impl Hole {
             shift: 0.0,
             center: [0.0; 3],
             tangent_a: [0.0; 3],
+            seam_modes: Vec::new(),
+            cross_modes: Vec::new(),
             tangent_b: [0.0; 3],
             min_clearance: 0.0,
         };
@@ -283,20 +300,29 @@ impl Hole {
                 "hole filling at singular vertex {s}: no smooth seam fits between its link and the two-ring ({last_err})"
             )));
         }
-        // Fill centre and tangents from the seam data.
+        // Fourier modes of the seam data (module docs, *Fill*).
         let ns = 4 * M.min(64 * d).max(256) / 4;
-        let mut p0 = [0.0; 3];
-        let (mut ta, mut tb) = ([0.0; 3], [0.0; 3]);
+        let modes = (ns / 8).min(FILL_MODES);
+        let mut cm = vec![[[0.0; 3]; 2]; modes + 1];
+        let mut dm = vec![[[0.0; 3]; 2]; modes + 1];
         let mut ws = Workspace::default();
         for j in 0..ns {
             let psi = 2.0 * PI * j as f64 / ns as f64;
             let (c, dd, _) = hole.seam_data(space, control, psi, &mut ws)?;
-            for k in 0..3 {
-                p0[k] += (c[k] - dd[k]) / ns as f64;
-                ta[k] += 2.0 * dd[k] * psi.cos() / ns as f64;
-                tb[k] += 2.0 * dd[k] * psi.sin() / ns as f64;
+            for k in 0..=modes {
+                let w = if k == 0 { 1.0 } else { 2.0 } / ns as f64;
+                let (co, si) = ((k as f64 * psi).cos() * w, (k as f64 * psi).sin() * w);
+                for x in 0..3 {
+                    cm[k][0][x] += c[x] * co;
+                    cm[k][1][x] += c[x] * si;
+                    dm[k][0][x] += dd[x] * co;
+                    dm[k][1][x] += dd[x] * si;
+                }
             }
         }
+        hole.seam_modes = cm;
+        hole.cross_modes = dm;
+        let (p0, [ta, tb]) = (hole.low_mode_value(0.0, 0.0), hole.low_mode_tangents());
         hole.center = p0;
         hole.tangent_a = ta;
         hole.tangent_b = tb;
@@ -505,17 +531,63 @@ impl Hole {
         ws: &mut Workspace,
     ) -> Result<[f64; 3]> {
         let (c, dd, _) = self.seam_data(space, control, psi, ws)?;
-        let (t2, t3) = (t * t, t * t * t);
-        let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
-        let h10 = t3 - 2.0 * t2 + t;
-        let h01 = -2.0 * t3 + 3.0 * t2;
-        let h11 = t3 - t2;
+        // Low modes: `α_k t^k + β_k t^{k+2}` per mode (a polynomial in the disk's x, y);
+        // the rest of the seam data with profiles vanishing to order `REST_ORDER` at the centre.
+        let low = self.low_mode_value(t, psi);
+        let (lc, ld) = self.low_mode_seam(psi);
+        let m = REST_ORDER as i32;
+        let tm = t.powi(m);
+        let p = (m as f64 + 1.0) * tm - m as f64 * tm * t;
+        let q = tm * t - tm;
         let mut f = [0.0; 3];
         for k in 0..3 {
-            let tk = self.tangent_a[k] * psi.cos() + self.tangent_b[k] * psi.sin();
-            f[k] = h00 * self.center[k] + h10 * tk + h01 * c[k] + h11 * dd[k];
+            f[k] = low[k] + p * (c[k] - lc[k]) + q * (dd[k] - ld[k]);
         }
         Ok(f)
+    }
+
+    /// `Σ_k (α_k t^k + β_k t^{k+2})(cos kψ, sin kψ)` over the stored modes, with
+    /// `α_k + β_k = C_k` and `k α_k + (k + 2) β_k = D_k` (value and radial derivative of the
+    /// truncated seam data at `t = 1`).
+    fn low_mode_value(&self, t: f64, psi: f64) -> [f64; 3] {
+        let mut f = [0.0; 3];
+        for (k, (cc, dk)) in self.seam_modes.iter().zip(&self.cross_modes).enumerate() {
+            let kf = k as f64;
+            let tk = t.powi(k as i32);
+            let (co, si) = ((kf * psi).cos(), (kf * psi).sin());
+            for x in 0..3 {
+                for (s, trig) in [(0, co), (1, si)] {
+                    let beta = 0.5 * (dk[s][x] - kf * cc[s][x]);
+                    let alpha = cc[s][x] - beta;
+                    f[x] += trig * tk * (alpha + beta * t * t);
+                }
+            }
+        }
+        f
+    }
+
+    /// The truncated seam data `(C_K(ψ), D_K(ψ))`.
+    fn low_mode_seam(&self, psi: f64) -> ([f64; 3], [f64; 3]) {
+        let (mut c, mut d) = ([0.0; 3], [0.0; 3]);
+        for (k, (cc, dk)) in self.seam_modes.iter().zip(&self.cross_modes).enumerate() {
+            let (co, si) = ((k as f64 * psi).cos(), (k as f64 * psi).sin());
+            for x in 0..3 {
+                c[x] += cc[0][x] * co + cc[1][x] * si;
+                d[x] += dk[0][x] * co + dk[1][x] * si;
+            }
+        }
+        (c, d)
+    }
+
+    /// The fill's tangent vectors at its centre, `∂F/∂x` and `∂F/∂y` (mode 1's `α_1`).
+    fn low_mode_tangents(&self) -> [[f64; 3]; 2] {
+        let (Some(c1), Some(d1)) = (self.seam_modes.get(1), self.cross_modes.get(1)) else {
+            return [[0.0; 3]; 2];
+        };
+        let alpha = |s: usize| -> [f64; 3] {
+            std::array::from_fn(|x| c1[s][x] - 0.5 * (d1[s][x] - c1[s][x]))
+        };
+        [alpha(0), alpha(1)]
     }
 
     /// Measure the join at `samples` seam points: the angle between the spline's normal
