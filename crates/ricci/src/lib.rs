@@ -28,6 +28,7 @@ pub mod layout;
 pub mod mesh;
 pub mod metric;
 pub mod progress;
+pub mod simd;
 pub mod spline;
 
 pub use error::{Error, Result};

@@ -101,6 +101,7 @@ impl SymmetricSolver {
                 Default::default(),
             )
             .is_ok();
+        crate::simd::clear_upper_state_here();
         self.factored = if ok { Factored::Llt } else { Factored::None };
         ok
     }
@@ -131,6 +132,7 @@ impl SymmetricSolver {
                 Default::default(),
             )
             .is_ok();
+        crate::simd::clear_upper_state_here();
         self.factored = if ok { Factored::Ldlt } else { Factored::None };
         ok && self.l_values.iter().all(|x| x.is_finite())
     }
@@ -151,5 +153,6 @@ impl SymmetricSolver {
                 .solve_in_place_with_conj(Conj::No, x, Par::Seq, stack),
             Factored::None => {}
         }
+        crate::simd::clear_upper_state_here();
     }
 }

@@ -520,6 +520,8 @@ fn exact_round_step(
     let mut x = r.to_vec();
     solve(&mut x);
     woodbury(&mut solve, &terms, &mut x);
+    // faer's kernels leave the AVX upper state dirty (`crate::simd`).
+    crate::simd::clear_upper_state();
     x.iter().all(|v| v.is_finite()).then_some(x)
 }
 

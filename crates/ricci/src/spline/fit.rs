@@ -402,6 +402,7 @@ pub fn fair<S: SplineSpace + ?Sized>(
                 z[(i, 0)] = r[i];
             }
             llt.solve_in_place(z.as_mut());
+            crate::simd::clear_upper_state();
             (0..m).map(|i| z[(i, 0)]).collect()
         };
         // Preconditioned conjugate gradients on the consistent system A Aᵀ y = A c, one coordinate
@@ -842,9 +843,15 @@ fn energy_gram<S: SplineSpace + ?Sized>(space: &S, blocks: &mut Blocks) -> Resul
                     v[(3 * r + c, col)] += dc;
                 }
             }
-            Ok((groups, v.transpose() * &v))
+            let g = v.transpose() * &v;
+            // This thread goes on with the next triangle's basis evaluations (`crate::simd`).
+            crate::simd::clear_upper_state_here();
+            Ok((groups, g))
         })
         .collect::<Result<_>>()?;
+    // faer's dense kernels leave the AVX upper state dirty on the threads that ran them, which
+    // slows all later baseline (SSE) code there ~10× (`crate::simd`).
+    crate::simd::clear_upper_state();
     for (groups, g) in grams {
         for (la, &ta) in groups.iter().enumerate() {
             for (lb, &tb) in groups.iter().enumerate() {
@@ -995,6 +1002,9 @@ pub fn fit<S: SplineSpace + ?Sized>(
         }
     }
     llt.solve_in_place(sol.as_mut());
+    drop(llt);
+    // The supernodal factorisation ran faer's dense kernels too (`crate::simd`).
+    crate::simd::clear_upper_state();
     let mut x = vec![0.0; nc * dim];
     for k in 0..nc {
         for d in 0..dim {
