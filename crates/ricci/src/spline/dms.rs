@@ -749,18 +749,23 @@ impl TriangleBasis {
     /// Evaluate all `N_{I,β}` and their partials up to `order` at `u` as limits from direction
     /// `dir`: `out[b * n_partials(order) + partial_index(a, c)]` for β number `b`.
     pub fn eval(&self, u: Point, dir: Point, order: usize, work: &mut Vec<f64>, out: &mut [f64]) {
-        let np = n_partials(order);
         self.family.eval(u, dir, order, work, out);
-        for (b, s) in self.scale.iter().enumerate() {
-            for v in &mut out[b * np..(b + 1) * np] {
-                *v *= s;
-            }
-        }
+        self.apply_scale(order, out);
     }
 
     /// The centroid of the knots: the origin of [`Self::eval_offset`].
     pub fn origin(&self) -> Point {
         self.family.origin()
+    }
+
+    /// Simplex splines → `N_{I,β} = |d_β| M(· | V_β)` (values and partials, in place).
+    fn apply_scale(&self, order: usize, out: &mut [f64]) {
+        let np = n_partials(order);
+        for (b, s) in self.scale.iter().enumerate() {
+            for v in &mut out[b * np..(b + 1) * np] {
+                *v *= s;
+            }
+        }
     }
 
     /// [`Self::eval`] at `origin() + x`, the point given by its offset from the knots'
@@ -773,13 +778,8 @@ impl TriangleBasis {
         work: &mut Vec<f64>,
         out: &mut [f64],
     ) {
-        let np = n_partials(order);
         self.family.eval_offset(x, dir, order, work, out);
-        for (b, s) in self.scale.iter().enumerate() {
-            for v in &mut out[b * np..(b + 1) * np] {
-                *v *= s;
-            }
-        }
+        self.apply_scale(order, out);
     }
 
     /// [`Self::eval_offset`] with the recurrence in double-double
@@ -792,13 +792,8 @@ impl TriangleBasis {
         work: &mut Vec<Dd>,
         out: &mut [f64],
     ) {
-        let np = n_partials(order);
         self.family.eval_offset_extended(x, dir, order, work, out);
-        for (b, s) in self.scale.iter().enumerate() {
-            for v in &mut out[b * np..(b + 1) * np] {
-                *v *= s;
-            }
-        }
+        self.apply_scale(order, out);
     }
 
     /// The arguments `t_{0,0..β_0−1}, t_{1,0..β_1−1}, t_{2,0..β_2−1}` at which the blossom gives

@@ -148,14 +148,29 @@ pub fn evaluate<S: SplineSpace + ?Sized>(
             np * dim
         )));
     }
-    out[..np * dim].fill(0.0);
     let m = space.basis_at(face, param, order, ws)?;
+    combine(control, dim, m, np, ws, out);
+    Ok(())
+}
+
+/// `out = Σ_i c_{indices[i]} values[i]` over the first `m` basis functions of `ws`, summed as
+/// `c_0 + Σ_i (c_i − c_0) values[i]` (partials: without the `c_0` term), `c_0` the first
+/// function's control point: equal by the partition of unity (`Σ N = 1`, `Σ ∂^α N = 0`), but
+/// the terms are of the size of the spline's support instead of its distance from the origin.
+/// A face's second partials are sums of terms up to 10⁶ × their result; in the plain form
+/// their rounding (`ε |c|`) alone reached 1e-10 of `∂²F`.
+pub(crate) fn combine(
+    control: &[f64],
+    dim: usize,
+    m: usize,
+    np: usize,
+    ws: &Workspace,
+    out: &mut [f64],
+) {
+    out[..np * dim].fill(0.0);
     if m == 0 {
-        return Ok(());
+        return;
     }
-    // `c_0 + Σ (c − c_0) N` (partials without `c_0`): equal to `Σ c N` by the partition of
-    // unity, with terms of the size of the support instead of the distance from the origin
-    // (see `ManifoldSpace::evaluate`).
     let g0 = ws.indices[0] as usize;
     let c0 = &control[g0 * dim..(g0 + 1) * dim];
     for i in 0..m {
@@ -174,7 +189,6 @@ pub fn evaluate<S: SplineSpace + ?Sized>(
     for d in 0..dim {
         out[d] += c0[d];
     }
-    Ok(())
 }
 
 /// One fairing constraint `c̃[single] − Σ_b weights[b] c̃[target * nb + b] = 0`.

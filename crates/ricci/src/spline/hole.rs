@@ -83,13 +83,11 @@ pub struct Hole {
     /// Seam radius: `ln R(ψ) = a₀ + Σ a_k cos kψ + b_k sin kψ + shift`.
     fourier: Vec<(f64, f64)>,
     shift: f64,
-    /// Centre of the fill and its tangent directions (3 coordinates each).
+    /// Centre of the fill, `F(0, ·) = α_0`.
     pub center: [f64; 3],
-    tangent_a: [f64; 3],
-    tangent_b: [f64; 3],
-    /// Fourier coefficients (cos, sin) of `C(ψ)` and `D(ψ)`, modes `0..=K`.
-    seam_modes: Vec<[[f64; 3]; 2]>,
-    cross_modes: Vec<[[f64; 3]; 2]>,
+    /// Per Fourier mode `k = 0..=K` of the seam data, the coefficients `α_k`, `β_k` of its
+    /// radial profile `α_k t^k + β_k t^{k+2}`, for the cos and the sin part (module docs).
+    profile: Vec<[[[f64; 3]; 2]; 2]>,
     /// Smallest `R(ψ) / r_link(ψ) − 1` over the checked samples.
     pub min_clearance: f64,
 }
@@ -244,10 +242,7 @@ impl Hole {
             fourier: Vec::new(),
             shift: 0.0,
             center: [0.0; 3],
-            tangent_a: [0.0; 3],
-            seam_modes: Vec::new(),
-            cross_modes: Vec::new(),
-            tangent_b: [0.0; 3],
+            profile: Vec::new(),
             min_clearance: 0.0,
         };
         let _ = link_ids;
@@ -320,12 +315,20 @@ impl Hole {
                 }
             }
         }
-        hole.seam_modes = cm;
-        hole.cross_modes = dm;
-        let (p0, [ta, tb]) = (hole.low_mode_value(0.0, 0.0), hole.low_mode_tangents());
-        hole.center = p0;
-        hole.tangent_a = ta;
-        hole.tangent_b = tb;
+        // α_k + β_k = C_k and k α_k + (k + 2) β_k = D_k.
+        hole.profile = cm
+            .iter()
+            .zip(&dm)
+            .enumerate()
+            .map(|(k, (ck, dk))| {
+                let beta: [[f64; 3]; 2] = std::array::from_fn(|p| {
+                    std::array::from_fn(|x| 0.5 * (dk[p][x] - k as f64 * ck[p][x]))
+                });
+                let alpha = std::array::from_fn(|p| std::array::from_fn(|x| ck[p][x] - beta[p][x]));
+                [alpha, beta]
+            })
+            .collect();
+        hole.center = hole.profile[0][0][0];
         Ok(hole)
     }
 
@@ -546,48 +549,36 @@ impl Hole {
         Ok(f)
     }
 
-    /// `Σ_k (α_k t^k + β_k t^{k+2})(cos kψ, sin kψ)` over the stored modes, with
-    /// `α_k + β_k = C_k` and `k α_k + (k + 2) β_k = D_k` (value and radial derivative of the
-    /// truncated seam data at `t = 1`).
+    /// `Σ_k (α_k t^k + β_k t^{k+2})(cos kψ, sin kψ)` over the stored modes (value and radial
+    /// derivative of the truncated seam data at `t = 1`).
     fn low_mode_value(&self, t: f64, psi: f64) -> [f64; 3] {
         let mut f = [0.0; 3];
-        for (k, (cc, dk)) in self.seam_modes.iter().zip(&self.cross_modes).enumerate() {
-            let kf = k as f64;
+        for (k, [alpha, beta]) in self.profile.iter().enumerate() {
             let tk = t.powi(k as i32);
-            let (co, si) = ((kf * psi).cos(), (kf * psi).sin());
-            for x in 0..3 {
-                for (s, trig) in [(0, co), (1, si)] {
-                    let beta = 0.5 * (dk[s][x] - kf * cc[s][x]);
-                    let alpha = cc[s][x] - beta;
-                    f[x] += trig * tk * (alpha + beta * t * t);
+            let trig = [(k as f64 * psi).cos(), (k as f64 * psi).sin()];
+            for p in 0..2 {
+                for x in 0..3 {
+                    f[x] += trig[p] * tk * (alpha[p][x] + beta[p][x] * t * t);
                 }
             }
         }
         f
     }
 
-    /// The truncated seam data `(C_K(ψ), D_K(ψ))`.
+    /// The truncated seam data `(C_K(ψ), D_K(ψ))`: `C_k = α_k + β_k`, `D_k = k α_k + (k + 2) β_k`.
     fn low_mode_seam(&self, psi: f64) -> ([f64; 3], [f64; 3]) {
         let (mut c, mut d) = ([0.0; 3], [0.0; 3]);
-        for (k, (cc, dk)) in self.seam_modes.iter().zip(&self.cross_modes).enumerate() {
-            let (co, si) = ((k as f64 * psi).cos(), (k as f64 * psi).sin());
-            for x in 0..3 {
-                c[x] += cc[0][x] * co + cc[1][x] * si;
-                d[x] += dk[0][x] * co + dk[1][x] * si;
+        for (k, [alpha, beta]) in self.profile.iter().enumerate() {
+            let kf = k as f64;
+            let trig = [(kf * psi).cos(), (kf * psi).sin()];
+            for p in 0..2 {
+                for x in 0..3 {
+                    c[x] += trig[p] * (alpha[p][x] + beta[p][x]);
+                    d[x] += trig[p] * (kf * alpha[p][x] + (kf + 2.0) * beta[p][x]);
+                }
             }
         }
         (c, d)
-    }
-
-    /// The fill's tangent vectors at its centre, `∂F/∂x` and `∂F/∂y` (mode 1's `α_1`).
-    fn low_mode_tangents(&self) -> [[f64; 3]; 2] {
-        let (Some(c1), Some(d1)) = (self.seam_modes.get(1), self.cross_modes.get(1)) else {
-            return [[0.0; 3]; 2];
-        };
-        let alpha = |s: usize| -> [f64; 3] {
-            std::array::from_fn(|x| c1[s][x] - 0.5 * (d1[s][x] - c1[s][x]))
-        };
-        [alpha(0), alpha(1)]
     }
 
     /// Measure the join at `samples` seam points: the angle between the spline's normal

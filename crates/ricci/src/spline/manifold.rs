@@ -89,7 +89,7 @@ use super::dms::{
     blossom_weights_of, general_position_involving, hash64, multi_indices, needs_shrink,
     per_triangle, unit, KnotOptions, Precision, TriangleBasis, Workspace, MAX_DEGREE,
 };
-use super::fit::SplineSpace;
+use super::fit::{combine, SplineSpace};
 use super::simplex::{det3, n_partials, partial_index, Point};
 
 #[inline]
@@ -1127,44 +1127,8 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
             )));
         }
         let m = self.basis_at_bary(g, bary, order, ws)?;
-        self.combine(control, dim, m, np, ws, out);
+        combine(control, dim, m, np, ws, out);
         Ok(())
-    }
-
-    /// `out = Σ_i c_{indices[i]} values[i]` over the first `m` basis functions of `ws`,
-    /// summed as `c_0 + Σ_i (c_i − c_0) values[i]` (partials: without the `c_0` term) with
-    /// `c_0` the first function's control point: equal by the partition of unity
-    /// (`Σ N = 1`, `Σ ∂^α N = 0`), but the terms are of the size of the spline's support
-    /// instead of its distance from the origin. A face's second partials are sums of terms
-    /// up to 10⁶ × their result; in the plain form their rounding (`ε |c|`) alone reached
-    /// 1e-10 of `∂²F`.
-    fn combine(
-        &self,
-        control: &[f64],
-        dim: usize,
-        m: usize,
-        np: usize,
-        ws: &Workspace,
-        out: &mut [f64],
-    ) {
-        out[..np * dim].fill(0.0);
-        if m == 0 {
-            return;
-        }
-        let g0 = ws.indices[0] as usize;
-        let c0 = &control[g0 * dim..(g0 + 1) * dim];
-        for i in 0..m {
-            let gidx = ws.indices[i] as usize;
-            for k in 0..np {
-                let v = ws.values[i * np + k];
-                for d in 0..dim {
-                    out[k * dim + d] += v * (control[gidx * dim + d] - c0[d]);
-                }
-            }
-        }
-        for d in 0..dim {
-            out[d] += c0[d];
-        }
     }
 
     /// `F` and partials at the point `u` of face `g` given in chart `chart`, partials in that
@@ -1188,7 +1152,7 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
             ));
         }
         let m = self.basis_in_chart(chart, g, u, order, ws)?;
-        self.combine(control, dim, m, np, ws, out);
+        combine(control, dim, m, np, ws, out);
         Ok(())
     }
 

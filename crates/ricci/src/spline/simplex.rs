@@ -188,6 +188,36 @@ struct Node {
     degree: f64,
 }
 
+impl Node {
+    /// The variant used at `x` (the one whose barycentric coordinates there are smallest) and
+    /// those coordinates.
+    #[inline]
+    fn variant_at(&self, x: Point) -> (&Variant, [f64; 3]) {
+        let lam = self.var[0].lambda(x);
+        if self.two {
+            let lam2 = self.var[1].lambda(x);
+            let s1 = lam[0].abs() + lam[1].abs() + lam[2].abs();
+            let s2 = lam2[0].abs() + lam2[1].abs() + lam2[2].abs();
+            if s2 < s1 {
+                return (&self.var[1], lam2);
+            }
+        }
+        (&self.var[0], lam)
+    }
+}
+
+/// The evaluation direction `d` (`[1, 0]` for a zero `dir`) and its counter-clockwise
+/// rotation `d⊥` (module docs, *Half-open convention*).
+#[inline]
+fn limit_directions(dir: Point) -> (Point, Point) {
+    let d = if dir[0] == 0.0 && dir[1] == 0.0 {
+        [1.0, 0.0]
+    } else {
+        dir
+    };
+    (d, [-d[1], d[0]])
+}
+
 /// A family of simplex splines over one array of knots, evaluated together (see module docs).
 #[derive(Debug, Clone)]
 pub struct SimplexFamily {
@@ -359,12 +389,7 @@ impl SimplexFamily {
         if work.len() < need {
             work.resize(need, 0.0);
         }
-        let d = if dir[0] == 0.0 && dir[1] == 0.0 {
-            [1.0, 0.0]
-        } else {
-            dir
-        };
-        let dp = [-d[1], d[0]];
+        let (d, dp) = limit_directions(dir);
         let nl = self.leaves.len();
         for (i, leaf) in self.leaves.iter().enumerate() {
             let inside = leaf.lines.iter().all(|l| l.admits(x, d, dp));
@@ -375,17 +400,7 @@ impl SimplexFamily {
             }
         }
         for (k, nd) in self.nodes.iter().enumerate() {
-            let mut v = &nd.var[0];
-            let mut lam = v.lambda(x);
-            if nd.two {
-                let lam2 = nd.var[1].lambda(x);
-                let s1 = lam[0].abs() + lam[1].abs() + lam[2].abs();
-                let s2 = lam2[0].abs() + lam2[1].abs() + lam2[2].abs();
-                if s2 < s1 {
-                    v = &nd.var[1];
-                    lam = lam2;
-                }
-            }
+            let (v, lam) = nd.variant_at(x);
             let (done, rest) = work.split_at_mut((nl + k) * np);
             let me = &mut rest[..np];
             let c = [
@@ -447,12 +462,7 @@ impl SimplexFamily {
         if work.len() < need {
             work.resize(need, Dd::ZERO);
         }
-        let d = if dir[0] == 0.0 && dir[1] == 0.0 {
-            [1.0, 0.0]
-        } else {
-            dir
-        };
-        let dp = [-d[1], d[0]];
+        let (d, dp) = limit_directions(dir);
         let x = [xd[0].f64(), xd[1].f64()];
         let nl = self.leaves.len();
         for (i, leaf) in self.leaves.iter().enumerate() {
@@ -464,16 +474,7 @@ impl SimplexFamily {
             }
         }
         for (k, nd) in self.nodes.iter().enumerate() {
-            let mut v = &nd.var[0];
-            if nd.two {
-                let lam = v.lambda(x);
-                let lam2 = nd.var[1].lambda(x);
-                let s1 = lam[0].abs() + lam[1].abs() + lam[2].abs();
-                let s2 = lam2[0].abs() + lam2[1].abs() + lam2[2].abs();
-                if s2 < s1 {
-                    v = &nd.var[1];
-                }
-            }
+            let (v, _) = nd.variant_at(x);
             let (done, rest) = work.split_at_mut((nl + k) * np);
             let me = &mut rest[..np];
             let c = [
