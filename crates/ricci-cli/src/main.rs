@@ -45,7 +45,20 @@ enum Command {
 }
 
 fn main() {
-    let cli = Cli::parse();
+    // With `--json`, a failure also prints `{"error": "..."}` on stdout (DESIGN.md §4), so a
+    // script always gets one JSON object.
+    let json = std::env::args_os().any(|a| a == "--json");
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            if json && e.use_stderr() {
+                let text = e.to_string();
+                let first = text.lines().next().unwrap_or("bad arguments");
+                util::print_error_json(first.trim_start_matches("error: "));
+            }
+            e.exit()
+        }
+    };
     let result = match cli.command {
         Command::Info(a) => cmd::info::run(a),
         Command::Generate(a) => cmd::generate::run(a),
@@ -60,7 +73,11 @@ fn main() {
         Command::Spline(a) => cmd::spline::run(a),
     };
     if let Err(e) = result {
-        eprintln!("error: {}", util::sentence(&e));
+        let sentence = util::sentence(&e);
+        if json {
+            util::print_error_json(&sentence);
+        }
+        eprintln!("error: {sentence}");
         std::process::exit(util::exit_code(&e));
     }
 }

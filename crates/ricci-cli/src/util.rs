@@ -61,10 +61,24 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Set once a command has printed its JSON object, so that a failure after it (e.g. the demo
+/// exiting 1 after writing the report of its other stages) does not print a second one.
+static PRINTED_JSON: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
 /// Print one JSON object on stdout.
 pub fn print_json(v: &serde_json::Value) {
+    PRINTED_JSON.store(true, std::sync::atomic::Ordering::SeqCst);
     println!(
         "{}",
         serde_json::to_string_pretty(v).unwrap_or_else(|_| "{}".into())
     );
+}
+
+/// Print `{"error": sentence}` on stdout (a failed command run with `--json`).
+/// Nothing is printed if the command printed its own JSON object already.
+pub fn print_error_json(sentence: &str) {
+    if PRINTED_JSON.swap(true, std::sync::atomic::Ordering::SeqCst) {
+        return;
+    }
+    println!("{}", serde_json::json!({ "error": sentence }));
 }

@@ -501,7 +501,12 @@ fn an_output_folder_that_cannot_be_written_exits_1_with_one_sentence() {
             err.starts_with("error: ") && err.contains("not-a-folder"),
             "{err}"
         );
-        assert!(out.stdout.is_empty());
+        // --json: the failure is one JSON object on stdout with the same sentence.
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("{\"error\": …}");
+        assert_eq!(
+            format!("error: {}", v["error"].as_str().unwrap_or("")),
+            err.trim()
+        );
     }
     assert_eq!(std::fs::read(&file).unwrap(), b"x");
 }

@@ -153,6 +153,19 @@ fn refusals_exit_with_the_right_code_and_write_nothing() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
     assert!(o.stdout.is_empty());
+    // The same with --json: exit 2 and `{"error": …}` naming the argument.
+    let o = ricci()
+        .arg("flow")
+        .arg(&mesh)
+        .args(["--scheme", "banana", "--json"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+    assert!(
+        v["error"].as_str().is_some_and(|e| e.contains("banana")),
+        "{v}"
+    );
     // Inadmissible target (Gauss–Bonnet): exit 1, one sentence naming the problem.
     let o = ricci()
         .arg("flow")
@@ -162,8 +175,20 @@ fn refusals_exit_with_the_right_code_and_write_nothing() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(1));
-    assert!(o.stdout.is_empty(), "nothing on stdout on error");
+    // With --json, stdout holds exactly `{"error": sentence}`, the sentence of stderr.
+    let v: serde_json::Value =
+        serde_json::from_slice(&o.stdout).expect("with --json, a failure prints one JSON object");
     let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(
+        v.as_object().map(|m| m.len()),
+        Some(1),
+        "only the error key: {v}"
+    );
+    assert_eq!(
+        format!("error: {}", v["error"].as_str().unwrap_or("")),
+        err.trim(),
+        "the JSON error is the stderr sentence"
+    );
     assert!(
         err.contains("Gauss–Bonnet") && err.contains("off by"),
         "{err}"

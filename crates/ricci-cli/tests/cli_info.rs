@@ -32,8 +32,19 @@ fn refused(path: &str, json: bool) -> String {
     let out = ricci(&args);
     let stderr = String::from_utf8_lossy(&out.stderr).to_string();
     assert_eq!(out.status.code(), Some(1), "{path}: {stderr}");
-    assert!(out.stdout.is_empty(), "{path}: stdout not empty");
     assert_eq!(stderr.lines().count(), 1, "{path}: {stderr}");
+    if json {
+        // `{"error": sentence}` on stdout, the same sentence as on stderr.
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout)
+            .unwrap_or_else(|_| panic!("{path}: stdout is not one JSON object"));
+        assert_eq!(
+            format!("error: {}", v["error"].as_str().unwrap_or("")),
+            stderr.trim(),
+            "{path}"
+        );
+    } else {
+        assert!(out.stdout.is_empty(), "{path}: stdout not empty");
+    }
     stderr
 }
 

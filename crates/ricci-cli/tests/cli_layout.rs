@@ -177,3 +177,56 @@ fn bad_input_and_arguments() {
     assert_eq!(v["geometry"], "spherical");
     assert_eq!(v["flipped_faces"], 0);
 }
+
+/// A metric file whose flow did not converge is refused by `layout`, `spectrum` and `cut`
+/// with exit 1 and one sentence that says why, and nothing is written (it used to give a
+/// layout with flipped faces and a deck group that does not close, with exit 0).
+#[test]
+fn a_metric_that_did_not_converge_is_refused() {
+    let mesh = genus2();
+    let metric = tmp("unconverged.json");
+    let o = Command::new(bin())
+        .args([
+            "flow",
+            "--geometry",
+            "hyperbolic",
+            "--max-iterations",
+            "1",
+            "--out",
+        ])
+        .arg(&metric)
+        .arg(&mesh)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("did not converge"),
+        "the flow warns"
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&metric).unwrap()).unwrap();
+    assert_eq!(v["converged"], false, "the metric file says so");
+    let uv = tmp("unconverged-uv.obj");
+    for cmd in [
+        vec!["layout", "--out", uv.to_str().unwrap()],
+        vec!["spectrum"],
+        vec!["cut", "--out", uv.to_str().unwrap()],
+    ] {
+        let o = Command::new(bin())
+            .args(&cmd[..1])
+            .arg(&mesh)
+            .args(&cmd[1..])
+            .arg("--metric")
+            .arg(&metric)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{cmd:?}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{cmd:?}: {err}");
+        assert!(
+            err.contains("unconverged.json") && err.contains("did not converge"),
+            "{cmd:?}: {err}"
+        );
+        assert!(!uv.exists(), "{cmd:?} wrote nothing");
+    }
+}

@@ -49,67 +49,12 @@ pub struct Args {
     pub json: bool,
 }
 
-/// Read METRIC.json into (geometry, lengths by edge id of `s`).
+/// Read METRIC.json into (geometry, lengths by edge id of `s`); a metric whose flow did not
+/// converge is refused (`ricci::metric::file`).
 fn read_metric(path: &Path, s: &Surface) -> anyhow::Result<(Geometry, Vec<f64>)> {
-    let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
-    let v: Value =
-        serde_json::from_str(&text).map_err(|e| anyhow::anyhow!("{name}: not JSON: {e}"))?;
-    let geometry: Geometry = v
-        .get("geometry")
-        .and_then(|g| g.as_str())
-        .unwrap_or("euclidean")
-        .parse()
-        .map_err(|e: String| anyhow::anyhow!("{name}: {e}"))?;
-    let lens = v
-        .get("lengths")
-        .and_then(|l| l.as_array())
-        .ok_or_else(|| anyhow::anyhow!("{name}: no \"lengths\" array"))?;
-    let edges = v
-        .get("edge_vertices")
-        .and_then(|e| e.as_array())
-        .or_else(|| v.get("edges").and_then(|e| e.as_array()));
-    let m = &s.mesh;
-    let mut out = vec![f64::NAN; m.n_edges()];
-    for (i, item) in lens.iter().enumerate() {
-        let (a, b, l) = if let Some(arr) = item.as_array() {
-            let f = |k: usize| arr.get(k).and_then(|x| x.as_f64());
-            match (f(0), f(1), f(2)) {
-                (Some(a), Some(b), Some(l)) => (a as u32, b as u32, l),
-                _ => anyhow::bail!("{name}: lengths[{i}] is not [u, v, length]"),
-            }
-        } else if let Some(l) = item.as_f64() {
-            let e = edges
-                .and_then(|e| e.get(i))
-                .and_then(|e| e.as_array())
-                .ok_or_else(|| {
-                    anyhow::anyhow!("{name}: lengths[{i}] has no vertex pair in \"edge_vertices\"")
-                })?;
-            let f = |k: usize| e.get(k).and_then(|x| x.as_u64());
-            match (f(0), f(1)) {
-                (Some(a), Some(b)) => (a as u32, b as u32, l),
-                _ => anyhow::bail!("{name}: edges[{i}] is not [u, v]"),
-            }
-        } else {
-            let f = |k: &str| item.get(k).and_then(|x| x.as_f64());
-            match (f("u").or(f("a")), f("v").or(f("b")), f("length").or(f("l"))) {
-                (Some(a), Some(b), Some(l)) => (a as u32, b as u32, l),
-                _ => anyhow::bail!("{name}: lengths[{i}] is not {{u, v, length}}"),
-            }
-        };
-        let h = (a < m.n_vertices() as u32 && b < m.n_vertices() as u32)
-            .then(|| m.halfedge_between(a, b))
-            .flatten()
-            .ok_or_else(|| {
-                anyhow::anyhow!("{name}: lengths[{i}]: ({a}, {b}) is not an edge of the mesh")
-            })?;
-        out[m.he_edge(h) as usize] = l;
-    }
-    if let Some(e) = out.iter().position(|l| l.is_nan()) {
-        let [a, b] = m.edge_vertices(e as u32);
-        anyhow::bail!("{name}: no length for edge ({a}, {b})");
-    }
-    Ok((geometry, out))
+    let m = ricci::metric::file::read_metric_file(path, &s.mesh)?;
+    m.check_usable(&path.display().to_string())?;
+    Ok((m.geometry, m.lengths))
 }
 
 /// The cut mesh with the polygon sides as named `l` polylines (also written by `ricci demo`).

@@ -81,37 +81,35 @@ pub struct Args {
     pub json: bool,
 }
 
-/// METRIC.json of a flow result (also written by `ricci demo`).
+/// METRIC.json of a flow result (also written by `ricci demo`): see
+/// `ricci::flow::FlowResult::metric_json` and `ricci::metric::file`.
 pub fn metric_json(r: &FlowResult, mesh: &ricci::mesh::Mesh, source: &str) -> serde_json::Value {
-    let target: Vec<serde_json::Value> = r
-        .target
-        .iter()
-        .zip(&r.fixed)
-        .map(|(&t, &f)| if f { serde_json::Value::Null } else { json!(t) })
-        .collect();
-    let edge_vertices: Vec<[u32; 2]> = (0..mesh.n_edges() as u32)
-        .map(|e| mesh.edge_vertices(e))
-        .collect();
-    json!({
-        "mesh": source,
-        "geometry": r.geometry,
-        "scheme": r.scheme,
-        "solver": r.solver,
-        "route": r.route,
-        "target": r.target_description,
-        "converged": r.converged,
-        "max_curvature_error": r.max_curvature_error,
-        "gauss_bonnet_error": r.gauss_bonnet_error,
-        "input_scale": r.input_scale,
-        "area": r.area,
-        "vertices": mesh.n_vertices(),
-        "edges": mesh.n_edges(),
-        "u": r.u,
-        "curvature": r.curvature,
-        "target_curvature": target,
-        "edge_vertices": edge_vertices,
-        "lengths": r.lengths,
-    })
+    r.metric_json(mesh, source)
+}
+
+/// Why a flow result is not converged, in one sentence: the curvature error when that is the
+/// reason, otherwise the faces that violate the triangle inequality (a curvature reached on
+/// such faces is not a metric on this triangulation).
+pub fn not_converged_reason(r: &FlowResult) -> String {
+    if r.max_curvature_error > r.tolerance {
+        format!(
+            "the flow did not converge (max |K − K̄| = {:.3e} > {:.1e} after {} iterations)",
+            r.max_curvature_error, r.tolerance, r.iterations
+        )
+    } else if r.degenerate_faces > 0 {
+        format!(
+            "the flow did not converge: max |K − K̄| = {:.3e} reached the tolerance, but {} \
+             face(s) violate the triangle inequality in the final metric, so it is not a metric \
+             on this triangulation (try --scheme thurston, or --refine-degenerate N with \
+             --refined-out MESH)",
+            r.max_curvature_error, r.degenerate_faces
+        )
+    } else {
+        format!(
+            "the flow did not converge (max |K − K̄| = {:.3e}, tolerance {:.1e}, {} iterations)",
+            r.max_curvature_error, r.tolerance, r.iterations
+        )
+    }
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -208,11 +206,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         write_atomic(out, serde_json::to_string(&v)?.as_bytes())?;
     }
     if !r.converged {
-        eprintln!(
-            "warning: {}: the flow did not converge (max |K − K̄| = {:.3e} > {:.1e} after {} \
-             iterations)",
-            source, r.max_curvature_error, r.tolerance, r.iterations
-        );
+        eprintln!("warning: {source}: {}", not_converged_reason(&r));
     }
     if a.json {
         print_json(&json!({

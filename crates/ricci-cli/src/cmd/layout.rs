@@ -70,67 +70,9 @@ pub struct Args {
 /// Per-edge lengths from a metric file (`ricci flow --out`): `lengths` by edge id, matched by
 /// the vertex pairs in `edge_vertices` (`[[a, b], …]`) when present.
 pub fn read_metric(path: &PathBuf, surface: &Surface) -> anyhow::Result<(Geometry, Vec<f64>)> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let v: Value = serde_json::from_str(&text)
-        .map_err(|e| anyhow::anyhow!("{}: not valid JSON ({e})", path.display()))?;
-    let geometry: Geometry = v
-        .get("geometry")
-        .and_then(|g| g.as_str())
-        .ok_or_else(|| anyhow::anyhow!("{}: no \"geometry\" key", path.display()))?
-        .parse()
-        .map_err(|e: String| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let lengths: Vec<f64> = v
-        .get("lengths")
-        .and_then(|l| l.as_array())
-        .ok_or_else(|| anyhow::anyhow!("{}: no \"lengths\" array", path.display()))?
-        .iter()
-        .enumerate()
-        .map(|(i, x)| {
-            x.as_f64()
-                .ok_or_else(|| anyhow::anyhow!("{}: length {i} is not a number", path.display()))
-        })
-        .collect::<anyhow::Result<_>>()?;
-    let m = &surface.mesh;
-    if lengths.len() != m.n_edges() {
-        anyhow::bail!(
-            "{}: {} lengths for a mesh with {} edges",
-            path.display(),
-            lengths.len(),
-            m.n_edges()
-        );
-    }
-    let pairs = v
-        .get("edge_vertices")
-        .or_else(|| v.get("edges"))
-        .and_then(|e| e.as_array());
-    if let Some(edges) = pairs {
-        let mut out = vec![f64::NAN; m.n_edges()];
-        for (i, e) in edges.iter().enumerate() {
-            let pair = e.as_array().map(|p| {
-                p.iter()
-                    .filter_map(|x| x.as_u64())
-                    .map(|x| x as u32)
-                    .collect::<Vec<_>>()
-            });
-            let Some([a, b]) = pair.as_deref().and_then(|p| <[u32; 2]>::try_from(p).ok()) else {
-                anyhow::bail!("{}: edge {i} is not a pair of vertex ids", path.display());
-            };
-            let nv = m.n_vertices() as u32;
-            let h = (a < nv && b < nv)
-                .then(|| m.halfedge_between(a, b))
-                .flatten()
-                .ok_or_else(|| {
-                    anyhow::anyhow!(
-                        "{}: edge {i} ({a}, {b}) is not an edge of the mesh",
-                        path.display()
-                    )
-                })?;
-            out[m.he_edge(h) as usize] = lengths[i];
-        }
-        return Ok((geometry, out));
-    }
-    Ok((geometry, lengths))
+    let m = ricci::metric::file::read_metric_file(path, &surface.mesh)?;
+    m.check_usable(&path.display().to_string())?;
+    Ok((m.geometry, m.lengths))
 }
 
 fn c2(z: Complex) -> Value {

@@ -178,6 +178,52 @@ pub struct FlowResult {
     pub notes: Vec<String>,
 }
 
+impl FlowResult {
+    /// The metric file of this result on `mesh` (the mesh the flow ran on): the format read
+    /// by [`crate::metric::file::read_metric_file`] — geometry, what the flow reached
+    /// (`converged`, `max_curvature_error`, `degenerate_faces`), per-vertex `u`, `curvature`
+    /// and `target_curvature` (null where the vertex was held fixed), per-edge `lengths` with
+    /// `edge_vertices` (edge `i` joins `edge_vertices[i]`). `source` names the input.
+    pub fn metric_json(&self, mesh: &Mesh, source: &str) -> serde_json::Value {
+        let target: Vec<serde_json::Value> = self
+            .target
+            .iter()
+            .zip(&self.fixed)
+            .map(|(&t, &f)| {
+                if f {
+                    serde_json::Value::Null
+                } else {
+                    serde_json::json!(t)
+                }
+            })
+            .collect();
+        let edge_vertices: Vec<[u32; 2]> = (0..mesh.n_edges() as u32)
+            .map(|e| mesh.edge_vertices(e))
+            .collect();
+        serde_json::json!({
+            "mesh": source,
+            "geometry": self.geometry,
+            "scheme": self.scheme,
+            "solver": self.solver,
+            "route": self.route,
+            "target": self.target_description,
+            "converged": self.converged,
+            "max_curvature_error": self.max_curvature_error,
+            "gauss_bonnet_error": self.gauss_bonnet_error,
+            "degenerate_faces": self.degenerate_faces,
+            "input_scale": self.input_scale,
+            "area": self.area,
+            "vertices": mesh.n_vertices(),
+            "edges": mesh.n_edges(),
+            "u": self.u,
+            "curvature": self.curvature,
+            "target_curvature": target,
+            "edge_vertices": edge_vertices,
+            "lengths": self.lengths,
+        })
+    }
+}
+
 /// Run discrete Ricci flow on a connected mesh with Euclidean edge `lengths` (by edge id).
 pub fn ricci_flow(
     mesh: &Mesh,

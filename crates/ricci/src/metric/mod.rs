@@ -4,7 +4,8 @@
 //! * [`geometry`] — the backgrounds E², H², S² and their stable cosine laws;
 //! * [`scheme`] — Thurston / tangential / inversive distance circle packings and vertex scaling;
 //! * [`conformal`] — the initial conformal structure built from a mesh's edge lengths;
-//! * [`kernel`] — the allocation-free evaluation of lengths, angles, curvature and Hessian.
+//! * [`kernel`] — the allocation-free evaluation of lengths, angles, curvature and Hessian;
+//! * [`file`] — the metric file (`METRIC.json`): one reader and writer for every command.
 //!
 //! **Energy and signs.** We use the convex Ricci energy `E(u) = ∫ Σ (K_i − K̄_i) du_i`, whose
 //! gradient is `K − K̄` and whose Hessian is `H = ∂K/∂u` (positive semidefinite in E², with the
@@ -16,6 +17,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod conformal;
+pub mod file;
 pub mod geometry;
 pub mod kernel;
 pub mod scheme;
