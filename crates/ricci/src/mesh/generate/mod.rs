@@ -24,11 +24,14 @@
 //!   Delaunay triangulation and optimal-Delaunay smoothing;
 //! * genus g — [`implicit`] + [`remesh`]: a chain of g tori blended by a smooth minimum,
 //!   marching tetrahedra, isotropic remeshing (Botsch–Kobbelt) with projection onto the
-//!   implicit surface, and an angle-improving pass.
+//!   implicit surface, and an angle-improving pass;
+//! * re-triangulations of a surface (midpoint subdivision, random off-centre face splits) and
+//!   an irregular torus — [`retriangulate`]: the test inputs of re-triangulation invariance.
 
 pub mod implicit;
 pub mod planar;
 pub mod remesh;
+pub mod retriangulate;
 pub mod sphere;
 pub mod torus;
 
@@ -41,6 +44,7 @@ use std::f64::consts::PI;
 
 pub use implicit::ToriChain;
 pub use remesh::Implicit;
+pub use retriangulate::{irregular_torus, midpoint_subdivision, random_face_splits};
 pub use sphere::icosphere;
 pub use torus::{torus, torus_grid};
 
