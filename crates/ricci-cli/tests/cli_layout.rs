@@ -230,3 +230,35 @@ fn a_metric_that_did_not_converge_is_refused() {
         assert!(!uv.exists(), "{cmd:?} wrote nothing");
     }
 }
+
+/// The README's workflow: `ricci layout MESH --out uv.obj`, then `ricci render MESH --uv
+/// uv.obj --checker 16`. The layout's uv.obj lives on the cut's refined triangulation (more
+/// faces than MESH), so render draws that triangulation, with a checkerboard (it used to
+/// exit 1: "uv.obj: 1938 faces, but the mesh has 1536").
+#[test]
+fn readme_workflow_layout_then_render_checkerboard() {
+    let mesh = genus2();
+    let (uv, png) = (tmp("wf-uv.obj"), tmp("wf.png"));
+    let o = Command::new(bin())
+        .arg("layout")
+        .arg(&mesh)
+        .arg("--out")
+        .arg(&uv)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = Command::new(bin())
+        .arg("render")
+        .arg(&mesh)
+        .arg("--uv")
+        .arg(&uv)
+        .args(["--checker", "16", "--size", "200", "--json", "--out"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["uv"], "per-corner", "{v}");
+    let img = std::fs::read(&png).unwrap();
+    assert!(img.starts_with(b"\x89PNG"), "a PNG was written");
+}

@@ -215,6 +215,25 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let range_arg = parse_range(&a.range)?;
 
     let (surface, _report) = read_surface(&a.mesh)?;
+    // A UV file on another triangulation of the same surface (the refined or cut mesh that
+    // `ricci layout` writes, with its own 3D positions): render that triangulation.
+    let surface = match &a.uv {
+        Some(path) => match uv_file_surface(path, &surface)? {
+            Some(s) => {
+                eprintln!(
+                    "note: {} has {} faces where {} has {}; rendering the UV file's own \
+                     triangulation of the surface",
+                    path.display(),
+                    s.mesh.n_faces(),
+                    a.mesh.display(),
+                    surface.mesh.n_faces()
+                );
+                s
+            }
+            None => surface,
+        },
+        None => surface,
+    };
     let positions = &surface.positions;
     let triangles = surface.mesh.faces();
 
@@ -592,6 +611,46 @@ fn has_corner_uvs(path: &Path) -> bool {
 /// Texture coordinates for `mesh` from a UV file whose faces match it face by face: its `vt`
 /// (or, for a planar mesh without `vt`, its x and y) at the corner with the same position,
 /// or at the same corner when positions differ (a layout written with planar positions).
+/// The surface of a UV file whose faces differ from the mesh's but which carries 3D
+/// positions of its own (not a flat layout) and texture coordinates: `ricci layout` writes
+/// the UVs on the triangulation it laid out (refined near the cut), with that triangulation's
+/// positions on the input surface. `None` when the file has the mesh's face count (the
+/// usual case) or is flat.
+fn uv_file_surface(path: &Path, mesh: &Surface) -> anyhow::Result<Option<Surface>> {
+    let soup = ricci::mesh::io::read_soup(path)?;
+    let has_uv = soup.corner_uvs.is_some() || soup.uvs.is_some();
+    let (u, _) = ricci::mesh::build_surface(soup)?;
+    if u.mesh.n_faces() == mesh.mesh.n_faces() || !has_uv {
+        return Ok(None);
+    }
+    let d = u.diagonal().max(f64::MIN_POSITIVE);
+    let flat = u.positions.iter().all(|p| p[2].abs() <= 1e-9 * d);
+    // The same surface: the same area (a refinement or common subdivision has the input's
+    // area exactly; a piece of the surface or another surface does not).
+    let (a0, a1) = (embedded_area(mesh), embedded_area(&u));
+    let same = (a1 - a0).abs() <= 1e-6 * a0.max(f64::MIN_POSITIVE);
+    Ok((!flat && same).then_some(u))
+}
+
+/// Area of an embedded surface from its positions.
+fn embedded_area(s: &Surface) -> f64 {
+    s.mesh
+        .faces()
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| s.positions[v as usize]);
+            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            let x = [
+                u[1] * w[2] - u[2] * w[1],
+                u[2] * w[0] - u[0] * w[2],
+                u[0] * w[1] - u[1] * w[0],
+            ];
+            0.5 * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt()
+        })
+        .sum()
+}
+
 fn uvs_from_file(path: &Path, mesh: &Surface) -> anyhow::Result<FoundUvs> {
     let soup = ricci::mesh::io::read_soup(path)?;
     let (in_polygons, in_corner_uvs) = (soup.polygons.clone(), soup.corner_uvs.clone());
