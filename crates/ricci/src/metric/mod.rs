@@ -5,7 +5,9 @@
 //! * [`scheme`] — Thurston / tangential / inversive distance circle packings and vertex scaling;
 //! * [`conformal`] — the initial conformal structure built from a mesh's edge lengths;
 //! * [`kernel`] — the allocation-free evaluation of lengths, angles, curvature and Hessian;
-//! * [`file`] — the metric file (`METRIC.json`): one reader and writer for every command.
+//! * [`file`] — the metric file (`METRIC.json`): one reader and writer for every command;
+//! * [`intrinsic`] — intrinsic (Δ-complex) triangulations with log Penner coordinates, Ptolemy
+//!   flips and the Penner Delaunay criterion (discrete conformal equivalence).
 //!
 //! **Energy and signs.** We use the convex Ricci energy `E(u) = ∫ Σ (K_i − K̄_i) du_i`, whose
 //! gradient is `K − K̄` and whose Hessian is `H = ∂K/∂u` (positive semidefinite in E², with the
@@ -19,6 +21,7 @@
 pub mod conformal;
 pub mod file;
 pub mod geometry;
+pub mod intrinsic;
 pub mod kernel;
 pub mod scheme;
 
