@@ -17,14 +17,16 @@
 use crate::util::{print_json, write_atomic, UsageError};
 use indicatif::{ProgressBar, ProgressStyle};
 use ricci::layout::cover::{tiles_by_radius, word_string};
-use ricci::layout::export::obj_with_uv;
+use ricci::layout::export::obj_with_corner_uv;
+use ricci::layout::input_uv::input_face_uvs;
 use ricci::layout::isometry::{Complex, Mobius, RigidMotion};
 use ricci::layout::pipeline::{cut_disk, cut_disk_polished, uniformization_geometry, CutDisk};
 use ricci::layout::place::{layout, layout_dd, minimax_centre, Space};
 use ricci::layout::svg::{fundamental_domain_svg, sphere_svg, tiling_svg};
 use ricci::layout::{deck_group, DeckGroup, Isometry, Layout, Polygon};
-use ricci::mesh::{io::read_surface, topology, Surface};
-use ricci::metric::{Euclidean, Geometry, Hyperbolic, Spherical};
+use ricci::mesh::{io::read_surface, topology, Mesh, Surface};
+use ricci::metric::file::MetricFile;
+use ricci::metric::{Euclidean, Geometry, Hyperbolic, Scheme, Spherical};
 use serde_json::{json, Value};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -40,6 +42,11 @@ pub struct Args {
     /// geodesic-boundary by topology). Ignored with --metric.
     #[arg(long)]
     pub target: Option<String>,
+    /// Discrete conformal scheme of the flow (see `ricci flow`; default: conformal — vertex
+    /// scaling with intrinsic Delaunay flips — in E² and H², thurston on the sphere). Ignored
+    /// with --metric.
+    #[arg(long)]
+    pub scheme: Option<Scheme>,
     /// Metric from `ricci flow --out` (JSON with `geometry` and per-edge `lengths`).
     #[arg(long)]
     pub metric: Option<PathBuf>,
@@ -69,10 +76,10 @@ pub struct Args {
 
 /// Per-edge lengths from a metric file (`ricci flow --out`): `lengths` by edge id, matched by
 /// the vertex pairs in `edge_vertices` (`[[a, b], …]`) when present.
-pub fn read_metric(path: &PathBuf, surface: &Surface) -> anyhow::Result<(Geometry, Vec<f64>)> {
+pub fn read_metric(path: &std::path::Path, surface: &Surface) -> anyhow::Result<MetricFile> {
     let m = ricci::metric::file::read_metric_file(path, &surface.mesh)?;
     m.check_usable(&path.display().to_string())?;
-    Ok((m.geometry, m.lengths))
+    Ok(m)
 }
 
 fn c2(z: Complex) -> Value {
@@ -153,6 +160,10 @@ pub fn spinner(json: bool) -> Bar {
 /// A metric with optional double-double low parts of its lengths.
 pub struct PolishedLengths {
     pub geometry: Geometry,
+    /// The triangulation the lengths belong to when it is not the input's: the intrinsic
+    /// Delaunay triangulation of a conformal flow (or of a metric file that brings its own).
+    /// Input vertices keep their ids in it.
+    pub mesh: Option<Mesh>,
     pub lengths: Vec<f64>,
     /// `Some` when the metric was polished to double-double.
     pub lengths_lo: Option<Vec<f64>>,
@@ -170,15 +181,17 @@ pub fn polished_metric(
     surface: &Surface,
     geometry: Option<Geometry>,
     target: Option<&str>,
+    scheme: Option<Scheme>,
     metric_file: Option<&PathBuf>,
     polish: bool,
     progress: &mut dyn ricci::progress::Progress,
 ) -> anyhow::Result<PolishedLengths> {
     use ricci::layout::pipeline::{polish_lengths, polish_uniformization};
-    let (g, lengths, flow, report) =
-        metric_and_flow(surface, geometry, target, metric_file, progress)?;
+    let (g, own, lengths, flow, report) =
+        metric_and_flow(surface, geometry, target, scheme, metric_file, progress)?;
     let mut out = PolishedLengths {
         geometry: g,
+        mesh: own,
         lengths,
         lengths_lo: None,
         report,
@@ -192,9 +205,13 @@ pub fn polished_metric(
         return Ok(out);
     }
     progress.report("polish", None, "polishing the metric to double-double");
-    let res = match &flow {
-        Some(f) => polish_uniformization(&surface.mesh, &surface.edge_lengths(), f),
-        None => polish_lengths(&surface.mesh, &out.lengths, &vec![0.0; out.lengths.len()]),
+    let res = match (&flow, &out.mesh) {
+        (Some(f), _) => polish_uniformization(&surface.mesh, &surface.edge_lengths(), f),
+        (None, own) => polish_lengths(
+            own.as_ref().unwrap_or(&surface.mesh),
+            &out.lengths,
+            &vec![0.0; out.lengths.len()],
+        ),
     };
     match res {
         Ok(p) => {
@@ -211,16 +228,32 @@ pub fn polished_metric(
     Ok(out)
 }
 
+/// (geometry, the triangulation of the metric when it is not the input's, lengths, the flow,
+/// the `metric` report).
+type MetricAndFlow = (
+    Geometry,
+    Option<Mesh>,
+    Vec<f64>,
+    Option<ricci::flow::FlowResult>,
+    Value,
+);
+
 /// The metric to use: from the file or from the flow (returned too, with its report).
 fn metric_and_flow(
     surface: &Surface,
     geometry: Option<Geometry>,
     target: Option<&str>,
+    scheme: Option<Scheme>,
     metric_file: Option<&PathBuf>,
     progress: &mut dyn ricci::progress::Progress,
-) -> anyhow::Result<(Geometry, Vec<f64>, Option<ricci::flow::FlowResult>, Value)> {
+) -> anyhow::Result<MetricAndFlow> {
     if let Some(path) = metric_file {
-        let (g, l) = read_metric(path, surface)?;
+        let MetricFile {
+            geometry: g,
+            lengths: l,
+            mesh: own,
+            ..
+        } = read_metric(path, surface)?;
         if let Some(want) = geometry {
             if want != g {
                 return Err(UsageError(format!(
@@ -229,7 +262,13 @@ fn metric_and_flow(
                 .into());
             }
         }
-        return Ok((g, l, None, json!({"source": path.display().to_string()})));
+        let mut report = json!({"source": path.display().to_string()});
+        if let Some(m) = &own {
+            report["triangulation"] = json!({
+                "kind": "intrinsic", "vertices": m.n_vertices(), "faces": m.n_faces(),
+            });
+        }
+        return Ok((g, own, l, None, report));
     }
     let g = match geometry {
         Some(g) => g,
@@ -241,6 +280,7 @@ fn metric_and_flow(
     // E² and S²: 1e-11 (1e-12 stalls at rounding on some 20k-face meshes).
     let mut opts = ricci::flow::FlowOptions {
         geometry: g,
+        scheme: scheme.unwrap_or_else(|| ricci::flow::default_scheme(g)),
         tolerance: if g == Geometry::Hyperbolic {
             1e-12
         } else {
@@ -257,24 +297,37 @@ fn metric_and_flow(
         None => ricci::flow::TargetSpec::FreeBoundary,
     };
     let r = ricci::flow::ricci_flow(&surface.mesh, &surface.edge_lengths(), &opts, progress)?;
-    let report = json!({
-        "source": "flow", "target": r.target_description, "iterations": r.iterations,
+    let mut report = json!({
+        "source": "flow", "scheme": r.scheme, "target": r.target_description,
+        "iterations": r.iterations,
         "converged": r.converged, "max_curvature_error": r.max_curvature_error,
         "gauss_bonnet_error": r.gauss_bonnet_error, "seconds": r.seconds,
     });
     if !r.converged {
         anyhow::bail!(
-            "the Ricci flow did not converge (max curvature error {:.3e}); no layout computed",
-            r.max_curvature_error
+            "{}; no layout computed",
+            super::flow::not_converged_reason(&r)
         );
     }
+    let own = r.triangulation.as_ref().map(|t| {
+        report["triangulation"] = json!({
+            "kind": "intrinsic", "flips": t.initial_flips + t.flips, "splits": t.splits,
+            "vertices": t.simplicial.mesh.n_vertices(), "faces": t.simplicial.mesh.n_faces(),
+        });
+        t.simplicial.mesh.clone()
+    });
     let lengths = r.lengths.clone();
-    Ok((g, lengths, Some(r), report))
+    Ok((g, own, lengths, Some(r), report))
 }
 
+/// Lay out the cut disk (or the disk `work`), compute the deck group and write the files.
+/// `work` is the triangulation the metric lives on (the input's, or the intrinsic one of a
+/// conformal flow, input vertices first).
+#[allow(clippy::too_many_arguments)]
 fn planar<S: Space<Point = Complex>>(
     a: &Args,
     surface: &Surface,
+    work: &Mesh,
     disk: Option<&CutDisk>,
     lengths: &[f64],
     lengths_lo: Option<&[f64]>,
@@ -289,7 +342,7 @@ where
             &d.lengths[..],
             (!d.lengths_lo.is_empty()).then_some(&d.lengths_lo[..]),
         ),
-        None => (&surface.mesh, lengths, lengths_lo),
+        None => (work, lengths, lengths_lo),
     };
     let l: Layout<Complex> = layout_dd::<S>(mesh, lens, lo, a.seed_face)?;
     out["flipped_faces"] = json!(l.flipped_faces.len());
@@ -318,19 +371,27 @@ where
             out["relation_error"] = Value::Null;
         }
     }
+    // UVs on the input's own faces: each corner takes the layout position of its vertex,
+    // mapped across the seams by the deck group (`ricci::layout::input_uv`).
+    let origin: Vec<u32> = match disk {
+        Some(d) => d.vertex_origin.clone(),
+        None => (0..mesh.n_vertices() as u32).collect(),
+    };
+    let uvs = input_face_uvs::<S>(&surface.mesh, &l.positions, &origin, group.as_ref())?;
+    out["uv"] = json!({
+        "faces": "input",
+        "flipped_faces": uvs.flipped_faces.len(),
+        "seam_faces": uvs.seam_faces,
+    });
     if let Some(path) = &a.out {
-        let uv: Vec<[f64; 2]> = l.positions.iter().map(|z| [z.re, z.im]).collect();
+        let corner: Vec<[f64; 2]> = uvs.corner.iter().map(|z| [z.re, z.im]).collect();
         let comments = vec![
             format!("ricci layout of {} ({})", a.mesh.display(), S::KIND.name()),
-            "vt: layout coordinates of the cut mesh (Poincaré disk for hyperbolic)".to_string(),
+            "vt: layout coordinates per corner of the input's faces (Poincaré disk for \
+             hyperbolic); several vt per vertex along the seams"
+                .to_string(),
         ];
-        let text = obj_with_uv(
-            &surface_positions(surface, disk),
-            &surface_faces(surface, disk),
-            &uv,
-            mesh.faces(),
-            &comments,
-        );
+        let text = obj_with_corner_uv(&surface.positions, surface.mesh.faces(), &corner, &comments);
         write_atomic(path, text.as_bytes())?;
     }
     if let Some(path) = &a.svg {
@@ -375,16 +436,6 @@ where
     Ok(())
 }
 
-/// 3D positions for the OBJ: the refined surface's when the cut refined it.
-fn surface_positions(surface: &Surface, disk: Option<&CutDisk>) -> Vec<[f64; 3]> {
-    disk.and_then(|d| d.cut.refined.positions.clone())
-        .unwrap_or_else(|| surface.positions.clone())
-}
-fn surface_faces(surface: &Surface, disk: Option<&CutDisk>) -> Vec<[u32; 3]> {
-    disk.map(|d| d.cut.refined.mesh.faces().to_vec())
-        .unwrap_or_else(|| surface.mesh.faces().to_vec())
-}
-
 pub fn run(a: Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let geometry: Option<Geometry> = match &a.geometry {
@@ -398,6 +449,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut bar = spinner(a.json);
     let PolishedLengths {
         geometry,
+        mesh: own_mesh,
         lengths,
         lengths_lo,
         report: metric_report,
@@ -406,10 +458,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         &surface,
         geometry,
         a.target.as_deref(),
+        a.scheme,
         a.metric.as_ref(),
         !a.no_polish,
         &mut bar,
-    )?;
+    )
+    .map_err(|e| anyhow::anyhow!("{}: {}", a.mesh.display(), crate::util::sentence(&e)))?;
+    // The triangulation the metric lives on, and the input's positions when it is the input.
+    let work: &Mesh = own_mesh.as_ref().unwrap_or(&surface.mesh);
+    let work_positions = own_mesh.is_none().then_some(&surface.positions[..]);
     let t = topology(&surface.mesh);
     let comp = t
         .components
@@ -428,7 +485,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             anyhow::bail!("spherical layouts need a closed genus-0 surface");
         }
         bar.0.set_message("layout on the sphere");
-        let l = layout::<Spherical>(&surface.mesh, &lengths, a.seed_face)?;
+        let l = layout::<Spherical>(work, &lengths, a.seed_face)?;
         out["flipped_faces"] = json!(l.flipped_faces.len());
         out["degenerate_faces"] = json!(l.degenerate_faces.len());
         out["seed_face"] = json!(l.seed_face);
@@ -443,13 +500,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             for p in &l.positions {
                 text.push_str(&format!("v {:e} {:e} {:e}\n", p[0], p[1], p[2]));
             }
-            for t in surface.mesh.faces() {
+            for t in work.faces() {
                 text.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
             }
             write_atomic(path, text.as_bytes())?;
         }
         if let Some(path) = &a.svg {
-            write_atomic(path, sphere_svg(&surface.mesh, &l.positions).as_bytes())?;
+            write_atomic(path, sphere_svg(work, &l.positions).as_bytes())?;
         }
     } else {
         let disk = if simply_connected && comp.boundary_loops == 1 {
@@ -458,25 +515,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             bar.0.set_message("cutting along canonical loops");
             let d = match &lengths_lo {
                 Some(lo) => {
-                    let d = cut_disk_polished(
-                        &surface.mesh,
-                        &lengths,
-                        lo,
-                        Some(&surface.positions),
-                        a.base,
-                        &mut bar,
-                    )?;
+                    let d =
+                        cut_disk_polished(work, &lengths, lo, work_positions, a.base, &mut bar)?;
                     polish_report["refined"] = json!(d.refined_polish);
                     d
                 }
-                None => cut_disk(
-                    &surface.mesh,
-                    &lengths,
-                    geometry,
-                    Some(&surface.positions),
-                    a.base,
-                    &mut bar,
-                )?,
+                None => cut_disk(work, &lengths, geometry, work_positions, a.base, &mut bar)?,
             };
             out["boundary_word"] = json!(d.polygon.word());
             out["base_vertex"] = json!(d.cut.base);
@@ -494,12 +538,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             Geometry::Hyperbolic => planar::<Hyperbolic>(
                 &a,
                 &surface,
+                work,
                 disk.as_ref(),
                 &lengths,
                 lengths_lo.as_deref(),
                 &mut out,
             )?,
-            _ => planar::<Euclidean>(&a, &surface, disk.as_ref(), &lengths, None, &mut out)?,
+            _ => planar::<Euclidean>(&a, &surface, work, disk.as_ref(), &lengths, None, &mut out)?,
         }
     }
     bar.0.finish_and_clear();

@@ -25,6 +25,10 @@ pub struct Args {
     /// Number of lengths.
     #[arg(long, default_value_t = 8)]
     pub count: usize,
+    /// Discrete conformal scheme of the flow (see `ricci flow`; default: conformal, vertex
+    /// scaling with intrinsic Delaunay flips). Ignored with --metric.
+    #[arg(long)]
+    pub scheme: Option<ricci::metric::Scheme>,
     /// Metric from `ricci flow --out` (flat for genus 1, hyperbolic otherwise).
     #[arg(long)]
     pub metric: Option<PathBuf>,
@@ -63,6 +67,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut bar = spinner(a.json);
     let PolishedLengths {
         geometry,
+        mesh: own_mesh,
         lengths,
         lengths_lo,
         report: metric_report,
@@ -71,18 +76,21 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         &surface,
         Some(want),
         None,
+        a.scheme,
         a.metric.as_ref(),
         true,
         &mut bar,
-    )?;
+    )
+    .map_err(|e| anyhow::anyhow!("{}: {}", a.mesh.display(), crate::util::sentence(&e)))?;
+    let work = own_mesh.as_ref().unwrap_or(&surface.mesh);
     bar.0.set_message("cutting along canonical loops");
     let disk = match &lengths_lo {
         Some(lo) => {
-            let d = cut_disk_polished(&surface.mesh, &lengths, lo, None, a.base, &mut bar)?;
+            let d = cut_disk_polished(work, &lengths, lo, None, a.base, &mut bar)?;
             polish_report["refined"] = json!(d.refined_polish);
             d
         }
-        None => cut_disk(&surface.mesh, &lengths, geometry, None, a.base, &mut bar)?,
+        None => cut_disk(work, &lengths, geometry, None, a.base, &mut bar)?,
     };
     bar.0.set_message("layout, deck group and spectrum");
     let (abs, extra) = if geometry == Geometry::Euclidean {

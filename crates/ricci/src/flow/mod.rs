@@ -96,6 +96,17 @@ pub enum SphereRoute {
     Puncture,
 }
 
+/// The scheme used when the user names none: [`Scheme::Conformal`] (discrete conformal
+/// equivalence — vertex scaling with intrinsic Delaunay flips: the conformal class of the
+/// user's own mesh) in E² and H²; on the sphere, where the conformal scheme is not
+/// implemented yet, Thurston circle packing with its puncture route.
+pub fn default_scheme(geometry: Geometry) -> Scheme {
+    match geometry {
+        Geometry::Spherical => Scheme::Thurston,
+        _ => Scheme::Conformal,
+    }
+}
+
 /// Options of [`ricci_flow`].
 #[derive(Debug, Clone)]
 pub struct FlowOptions {
@@ -217,7 +228,14 @@ impl FlowResult {
     /// (`converged`, `max_curvature_error`, `degenerate_faces`), per-vertex `u`, `curvature`
     /// and `target_curvature` (null where the vertex was held fixed), per-edge `lengths` with
     /// `edge_vertices` (edge `i` joins `edge_vertices[i]`). `source` names the input.
+    ///
+    /// A [`Scheme::Conformal`] result lives on its intrinsic triangulation: then the edges
+    /// are those of `triangulation.simplicial.mesh` (whatever `mesh` is given), and the file
+    /// also holds its `faces` (input vertices keep their ids, split vertices are appended) and
+    /// `"triangulation": "intrinsic"`, so that readers rebuild the mesh the lengths belong to.
     pub fn metric_json(&self, mesh: &Mesh, source: &str) -> serde_json::Value {
+        let intrinsic = self.triangulation.as_ref().map(|t| &t.simplicial.mesh);
+        let mesh = intrinsic.unwrap_or(mesh);
         let target: Vec<serde_json::Value> = self
             .target
             .iter()
@@ -233,7 +251,7 @@ impl FlowResult {
         let edge_vertices: Vec<[u32; 2]> = (0..mesh.n_edges() as u32)
             .map(|e| mesh.edge_vertices(e))
             .collect();
-        serde_json::json!({
+        let mut v = serde_json::json!({
             "mesh": source,
             "geometry": self.geometry,
             "scheme": self.scheme,
@@ -253,7 +271,15 @@ impl FlowResult {
             "target_curvature": target,
             "edge_vertices": edge_vertices,
             "lengths": self.lengths,
-        })
+        });
+        if let Some(t) = &self.triangulation {
+            v["triangulation"] = serde_json::json!("intrinsic");
+            v["faces"] = serde_json::json!(mesh.faces());
+            v["input_vertices"] = serde_json::json!(t.triangulation.n_vertices);
+            v["flips"] = serde_json::json!(t.initial_flips + t.flips);
+            v["splits"] = serde_json::json!(t.splits);
+        }
+        v
     }
 }
 

@@ -40,3 +40,31 @@ pub fn obj_with_uv(
     }
     s
 }
+
+/// OBJ text of a surface with one texture coordinate per face corner (`corner_uv[3f + i]`
+/// for corner `i` of face `f`): corners of one vertex with the same coordinate share a `vt`
+/// line, so the seams are where a vertex has several.
+pub fn obj_with_corner_uv(
+    positions: &[[f64; 3]],
+    faces: &[[u32; 3]],
+    corner_uv: &[[f64; 2]],
+    comments: &[String],
+) -> String {
+    let mut index: std::collections::HashMap<(u32, u64, u64), u32> =
+        std::collections::HashMap::with_capacity(positions.len() + positions.len() / 8);
+    let mut uv = Vec::with_capacity(positions.len());
+    let mut uv_faces = Vec::with_capacity(faces.len());
+    for (f, t) in faces.iter().enumerate() {
+        let mut out = [0u32; 3];
+        for i in 0..3 {
+            let c = corner_uv[3 * f + i];
+            let key = (t[i], c[0].to_bits(), c[1].to_bits());
+            out[i] = *index.entry(key).or_insert_with(|| {
+                uv.push(c);
+                (uv.len() - 1) as u32
+            });
+        }
+        uv_faces.push(out);
+    }
+    obj_with_uv(positions, faces, &uv, &uv_faces, comments)
+}

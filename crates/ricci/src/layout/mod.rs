@@ -14,6 +14,8 @@
 //! * [`pipeline`] — surface with metric → canonical cut → layout → deck group (with the
 //!   uniformization flow when no metric is given; H² metrics polished to double-double).
 //! * [`svg`], [`export`] — pictures of the fundamental domain and tilings; OBJ with UVs.
+//! * [`input_uv`] — UVs on the input's own faces from a layout of another triangulation of
+//!   the surface (refined or intrinsic), mapped across the seams by the deck group.
 //! * [`synthetic`] — closed surfaces with exact flat / hyperbolic metrics and known polygons
 //!   (flat tori, regular 4g-gons), the references of the tests.
 
@@ -21,6 +23,7 @@ pub mod cover;
 pub mod dd;
 pub mod deck;
 pub mod export;
+pub mod input_uv;
 pub mod isometry;
 pub mod pipeline;
 pub mod place;

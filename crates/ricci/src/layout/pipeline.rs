@@ -178,6 +178,18 @@ pub fn polish_uniformization(
             flow.max_curvature_error
         )));
     }
+    if let Some(t) = &flow.triangulation {
+        // A conformal flow's metric lives on its intrinsic triangulation: polish it there in
+        // place (new vertices of the splits are flat, so the target is 0 everywhere).
+        if flow.fixed.iter().any(|&f| f) || flow.target.iter().any(|&k| k != 0.0) {
+            return Err(Error::input(
+                "the metric has cone points or a fixed boundary; only uniform hyperbolic \
+                 metrics are polished",
+            ));
+        }
+        let m = &t.simplicial.mesh;
+        return polish_lengths(m, &flow.lengths, &vec![0.0; m.n_edges()]);
+    }
     let structure =
         ConformalStructure::new(mesh, lengths, flow.geometry, flow.scheme, flow.input_scale)?;
     polish_metric(

@@ -9,6 +9,11 @@
 //! * what the flow reached, when known: `converged`, `max_curvature_error`,
 //!   `degenerate_faces` — a metric written by a flow that did not converge says so, and
 //!   [`MetricFile::check_usable`] refuses it with one sentence;
+//! * `faces` (with `"triangulation": "intrinsic"`): the metric lives on its own triangulation
+//!   of the surface — the intrinsic Delaunay triangulation of `--scheme conformal`, input
+//!   vertices first with their ids, vertices of metric-preserving splits appended. The
+//!   lengths are matched on that mesh, which must have the input's Euler characteristic and
+//!   at least its vertices; it is returned in [`MetricFile::mesh`];
 //! * everything else that `ricci flow` writes (`u`, `curvature`, `target_curvature`, …) is
 //!   informative and not read back.
 //!
@@ -34,6 +39,16 @@ pub struct MetricFile {
     pub max_curvature_error: Option<f64>,
     /// `degenerate_faces` as written by the flow.
     pub degenerate_faces: Option<usize>,
+    /// The triangulation the lengths belong to when the file brings its own (`faces`);
+    /// `None`: the mesh the file was read against.
+    pub mesh: Option<Mesh>,
+}
+
+impl MetricFile {
+    /// The mesh the lengths belong to: the file's own triangulation, else `input`.
+    pub fn mesh_or<'a>(&'a self, input: &'a Mesh) -> &'a Mesh {
+        self.mesh.as_ref().unwrap_or(input)
+    }
 }
 
 impl MetricFile {
@@ -75,9 +90,11 @@ pub fn read_metric_file(path: &Path, mesh: &Mesh) -> Result<MetricFile> {
 }
 
 /// Parse the text of a metric file on `mesh`.
-pub fn parse_metric(text: &str, mesh: &Mesh) -> Result<MetricFile> {
+pub fn parse_metric(text: &str, input: &Mesh) -> Result<MetricFile> {
     let v: Value =
         serde_json::from_str(text).map_err(|e| Error::input(format!("not valid JSON ({e})")))?;
+    let own = own_triangulation(&v, input)?;
+    let mesh = own.as_ref().unwrap_or(input);
     let geometry: Geometry = match v.get("geometry") {
         None => Geometry::Euclidean,
         Some(g) => g
@@ -186,7 +203,49 @@ pub fn parse_metric(text: &str, mesh: &Mesh) -> Result<MetricFile> {
             .get("degenerate_faces")
             .and_then(|c| c.as_u64())
             .map(|d| d as usize),
+        mesh: own,
     })
+}
+
+/// The file's own triangulation (`faces`), checked against the input mesh: at least its
+/// vertices, the same Euler characteristic.
+fn own_triangulation(v: &Value, input: &Mesh) -> Result<Option<Mesh>> {
+    let Some(faces) = v.get("faces") else {
+        return Ok(None);
+    };
+    let faces = faces
+        .as_array()
+        .ok_or_else(|| Error::input("\"faces\" is not an array"))?;
+    let mut tris = Vec::with_capacity(faces.len());
+    let mut nv = 0u64;
+    for (f, t) in faces.iter().enumerate() {
+        let ids: Vec<u64> = t
+            .as_array()
+            .map(|a| a.iter().filter_map(|x| x.as_u64()).collect())
+            .unwrap_or_default();
+        let [a, b, c] = <[u64; 3]>::try_from(ids)
+            .map_err(|_| Error::input(format!("faces[{f}] is not three vertex ids")))?;
+        if a.max(b).max(c) >= u32::MAX as u64 / 2 {
+            return Err(Error::input(format!(
+                "faces[{f}] has a vertex id out of range"
+            )));
+        }
+        nv = nv.max(a + 1).max(b + 1).max(c + 1);
+        tris.push([a as u32, b as u32, c as u32]);
+    }
+    let nv = (nv as usize).max(input.n_vertices());
+    let mesh = Mesh::from_triangles(nv, tris)
+        .map_err(|e| Error::input(format!("its \"faces\" are not a valid mesh ({e})")))?;
+    let chi = |m: &Mesh| m.n_vertices() as i64 - m.n_edges() as i64 + m.n_faces() as i64;
+    if chi(&mesh) != chi(input) {
+        return Err(Error::input(format!(
+            "its triangulation has Euler characteristic {}, the mesh {}: it is a metric of \
+             another surface",
+            chi(&mesh),
+            chi(input)
+        )));
+    }
+    Ok(Some(mesh))
 }
 
 /// Every face's lengths form a triangle of `geometry` (strict triangle inequalities; on the
@@ -286,6 +345,27 @@ mod tests {
         assert!(e.to_string().contains("(2, 3)"), "{e}");
         let e = parse_metric(r#"{"lengths": [[0,7,1]]}"#, &m).unwrap_err();
         assert!(e.to_string().contains("not an edge"), "{e}");
+    }
+
+    #[test]
+    fn a_metric_on_its_own_triangulation_is_matched_on_it() {
+        // The square with the other diagonal (1, 3): edges (1, 3) is not an input edge.
+        let m = square();
+        let text = r#"{"triangulation": "intrinsic", "faces": [[0, 1, 3], [1, 2, 3]],
+            "lengths": [[0,1,1],[1,3,1.3],[3,0,1],[1,2,1],[2,3,1]]}"#;
+        let r = parse_metric(text, &m).unwrap();
+        let own = r.mesh.as_ref().expect("own mesh");
+        let h = own.halfedge_between(1, 3).unwrap();
+        assert_eq!(r.lengths[own.he_edge(h) as usize], 1.3);
+        assert!(m.halfedge_between(1, 3).is_none());
+        // Another surface (two triangles apart, χ = 2) is refused.
+        let e = parse_metric(
+            r#"{"faces": [[0, 1, 2], [3, 4, 5]], "lengths": [[0,1,1],[1,2,1],[2,0,1],
+                [3,4,1],[4,5,1],[5,3,1]]}"#,
+            &m,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("Euler characteristic"), "{e}");
     }
 
     #[test]
