@@ -26,16 +26,23 @@ pub enum Route {
 pub struct Args {
     /// Mesh file (OBJ, OFF, PLY, STL); one connected component.
     pub mesh: PathBuf,
-    /// Background geometry: euclidean, hyperbolic or spherical.
-    #[arg(long, default_value = "euclidean")]
-    pub geometry: Geometry,
-    /// Discrete conformal scheme: thurston, tangential, inversive or yamabe.
-    #[arg(long, default_value = "thurston")]
-    pub scheme: Scheme,
+    /// Background geometry: euclidean, hyperbolic or spherical (default: the one the
+    /// surface's topology uniformizes to — spherical for closed genus 0, euclidean for genus 1
+    /// and for disks, hyperbolic otherwise; euclidean for cone, free-boundary and
+    /// round-boundary targets, hyperbolic for geodesic-boundary).
+    #[arg(long)]
+    pub geometry: Option<Geometry>,
+    /// Discrete conformal scheme: conformal (vertex scaling with intrinsic Delaunay flips —
+    /// the conformal class of the mesh itself; default in E² and H²), thurston (the papers'
+    /// circle packing; default on the sphere), tangential, inversive or yamabe (plain vertex
+    /// scaling on the input's triangulation).
+    #[arg(long)]
+    pub scheme: Option<Scheme>,
     /// Target curvature: uniform, cone:V=K,..., single-cone:V, free-boundary, round-boundary,
-    /// geodesic-boundary or file:PATH (K in radians; -2pi, pi/2 accepted).
-    #[arg(long, default_value = "uniform")]
-    pub target: TargetSpec,
+    /// geodesic-boundary or file:PATH (K in radians; -2pi, pi/2 accepted). Default: uniform
+    /// for closed surfaces, free-boundary in E² and geodesic-boundary in H² for bordered ones.
+    #[arg(long)]
+    pub target: Option<TargetSpec>,
     /// Optimizer: newton or gradient (the papers' flow u += ε(K̄ − K)).
     #[arg(long, default_value = "newton")]
     pub solver: Solver,
@@ -114,10 +121,34 @@ pub fn not_converged_reason(r: &FlowResult) -> String {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let (surface, _report) = read_surface(&a.mesh)?;
+    let bordered = surface.mesh.has_boundary();
+    // Targets that name a flat metric (cones, free or round boundary) or a hyperbolic one.
+    let flat = matches!(
+        a.target,
+        Some(TargetSpec::Cones(_))
+            | Some(TargetSpec::SingleCone(_))
+            | Some(TargetSpec::FreeBoundary)
+            | Some(TargetSpec::RoundBoundary)
+    );
+    let geometry = match a.geometry {
+        Some(g) => g,
+        None if flat => Geometry::Euclidean,
+        None if matches!(a.target, Some(TargetSpec::GeodesicBoundary)) => Geometry::Hyperbolic,
+        None => ricci::layout::pipeline::uniformization_geometry(&surface.mesh)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?,
+    };
+    let target = match &a.target {
+        Some(t) => t.clone(),
+        None if !bordered => TargetSpec::Uniform,
+        None if geometry == Geometry::Hyperbolic => TargetSpec::GeodesicBoundary,
+        None => TargetSpec::FreeBoundary,
+    };
     let options = FlowOptions {
-        geometry: a.geometry,
-        scheme: a.scheme,
-        target: a.target.clone(),
+        geometry,
+        scheme: a
+            .scheme
+            .unwrap_or_else(|| ricci::flow::default_scheme(geometry)),
+        target,
         solver: a.solver,
         tolerance: a.tolerance,
         max_iterations: a.max_iterations,
@@ -230,6 +261,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "clamped_edges": r.clamped_edges,
             "initial_length_error": r.initial_length_error,
             "degenerate_faces": r.degenerate_faces,
+            "flips": r.triangulation.as_ref().map(|t| t.initial_flips + t.flips),
+            "triangulation": r.triangulation.as_ref().map(|t| json!({
+                "kind": "intrinsic",
+                "initial_flips": t.initial_flips,
+                "flips": t.flips,
+                "splits": t.splits,
+                "vertices": t.simplicial.mesh.n_vertices(),
+                "faces": t.simplicial.mesh.n_faces(),
+            })),
             "pinned": r.pinned,
             "notes": r.notes,
             "refinement": refinement,
@@ -259,6 +299,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             println!(
                 "    {:5}  max |K − K̄| {:.3e}  step {:.2e}  {:.3} s",
                 h.iteration, h.max_curvature_error, h.step, h.seconds
+            );
+        }
+        if let Some(t) = &r.triangulation {
+            println!(
+                "  intrinsic Delaunay triangulation: {} + {} flips, {} splits ({} vertices, {} \
+                 faces)",
+                t.initial_flips,
+                t.flips,
+                t.splits,
+                t.simplicial.mesh.n_vertices(),
+                t.simplicial.mesh.n_faces()
             );
         }
         for n in &r.notes {

@@ -365,6 +365,20 @@ where
             out["max_edge_spread"] = json!(g.max_edge_spread);
             out["max_edge_spread_matrix"] = json!(g.max_edge_spread_matrix);
             out["max_vertex_error"] = json!(g.max_vertex_error);
+            if S::KIND == Geometry::Euclidean {
+                // Genus 1: the flat torus's modulus τ from the two translations.
+                let t: Vec<Complex> = g
+                    .generators
+                    .iter()
+                    .flatten()
+                    .map(|m| m.apply(Complex::new(0.0, 0.0)) - Complex::new(0.0, 0.0))
+                    .collect();
+                if t.len() == 2 {
+                    if let Ok(tau) = ricci::analysis::spectrum::torus_modulus(t[0], t[1]) {
+                        out["modulus"] = json!([tau.0, tau.1]);
+                    }
+                }
+            }
         }
         _ => {
             out["deck_generators"] = json!([]);

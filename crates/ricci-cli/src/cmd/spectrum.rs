@@ -101,7 +101,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             anyhow::bail!("expected two translation generators, found {}", gens.len());
         }
         let sp = lattice_spectrum(gens[0].1.t, gens[1].1.t, a.count)?;
-        (sp, json!({"relation_error": g.relation_error}))
+        let tau = ricci::analysis::spectrum::torus_modulus(gens[0].1.t, gens[1].1.t)?;
+        (
+            sp,
+            json!({"relation_error": g.relation_error, "modulus": [tau.0, tau.1]}),
+        )
     } else {
         let lo = (!disk.lengths_lo.is_empty()).then_some(&disk.lengths_lo[..]);
         let l = layout_dd::<Hyperbolic>(&disk.mesh, &disk.lengths, lo, None)?;
@@ -130,6 +134,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "normalized": normalized,
         "metric": metric_report,
         "metric_polish": polish_report,
+        "modulus": extra.get("modulus").cloned(),
         "details": extra,
         "boundary_word": disk.polygon.word(),
         "seconds": t0.elapsed().as_secs_f64(),

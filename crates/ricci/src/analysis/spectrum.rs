@@ -34,6 +34,38 @@ use crate::layout::isometry::{disk_distance, poincare_to_hyperboloid, Complex, I
 use crate::layout::place::Layout;
 use std::collections::{HashMap, VecDeque};
 
+/// The modulus `τ` of the flat torus `C/(ω₁Z + ω₂Z)`: the ratio of a reduced basis, in the
+/// fundamental domain of SL(2, Z) (`Im τ > 0`, `|Re τ| ≤ 1/2`, `|τ| ≥ 1`; on the boundary
+/// `Re τ ≥ 0` when `|τ| = 1` or `|Re τ| = 1/2`). Two flat tori are similar (conformally
+/// equivalent) iff their moduli are equal. Returns `(Re τ, Im τ)`.
+pub fn torus_modulus(w1: Complex, w2: Complex) -> Result<(f64, f64)> {
+    if !(w1.norm() > 0.0 && w2.norm() > 0.0) || (w2 / w1).im.abs() < 1e-14 {
+        return Err(Error::numerical(
+            "the translation generators of the torus are degenerate (not a lattice)",
+        ));
+    }
+    let mut t = w2 / w1;
+    if t.im < 0.0 {
+        t = -t;
+    }
+    for _ in 0..200 {
+        t.re -= t.re.round();
+        if t.norm_sqr() < 1.0 - 1e-15 {
+            t = -Complex::new(1.0, 0.0) / t;
+        } else {
+            break;
+        }
+    }
+    // Boundary conventions (up to rounding).
+    if (t.re.abs() - 0.5).abs() < 1e-13 {
+        t.re = 0.5;
+    }
+    if (t.norm() - 1.0).abs() < 1e-13 && t.re < 0.0 {
+        t.re = -t.re;
+    }
+    Ok((t.re, t.im))
+}
+
 /// The first `count` lengths of the spectrum of the flat torus `C/(ω₁Z + ω₂Z)` (lattice
 /// vectors up to sign, including non-primitive ones), sorted.
 pub fn lattice_spectrum(w1: Complex, w2: Complex, count: usize) -> Result<Vec<f64>> {
@@ -446,4 +478,47 @@ pub fn fuchsian_spectrum(
     }
     Err(last_err
         .unwrap_or_else(|| Error::numerical("the spectrum search did not find enough classes")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// τ does not depend on the basis: any SL(2, Z) change of basis, a rotation and a scaling
+    /// of the lattice give the same reduced modulus.
+    #[test]
+    fn torus_modulus_is_invariant_under_change_of_basis() {
+        for tau in [
+            Complex::new(0.0, 1.0),
+            Complex::new(0.5, 3f64.sqrt() / 2.0),
+            Complex::new(0.31, 1.7),
+            Complex::new(-0.2, 3.873),
+        ] {
+            let (w1, w2) = (Complex::new(1.0, 0.0), tau);
+            let want = torus_modulus(w1, w2).unwrap();
+            // |Re| ≤ 1/2, |τ| ≥ 1.
+            assert!(want.0.abs() <= 0.5 + 1e-15 && want.0.hypot(want.1) >= 1.0 - 1e-15);
+            let rot = Complex::from_polar(2.7, 0.83);
+            for (a, b, c, d) in [
+                (1, 0, 0, 1),
+                (2, 1, 1, 1),
+                (1, 3, 0, 1),
+                (0, -1, 1, 0),
+                (5, 2, 2, 1),
+            ] {
+                let (v1, v2) = (
+                    (w1 * a as f64 + w2 * b as f64) * rot,
+                    (w1 * c as f64 + w2 * d as f64) * rot,
+                );
+                let got = torus_modulus(v1, v2).unwrap();
+                assert!(
+                    (got.0 - want.0).abs() < 1e-12 && (got.1 - want.1).abs() < 1e-12,
+                    "{tau}: {got:?} vs {want:?}"
+                );
+            }
+        }
+        // The rectangle of side ratio 3.873: τ = 3.873 i.
+        let t = torus_modulus(Complex::new(0.0, 2.0), Complex::new(2.0 * 3.873, 0.0)).unwrap();
+        assert!(t.0.abs() < 1e-15 && (t.1 - 3.873).abs() < 1e-12, "{t:?}");
+    }
 }
