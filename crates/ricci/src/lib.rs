@@ -27,8 +27,12 @@ pub mod flow;
 pub mod layout;
 pub mod mesh;
 pub mod metric;
+pub mod numeric;
 pub mod progress;
-pub mod simd;
 pub mod spline;
+
+/// Compatibility re-export: `simd` moved to [`numeric::simd`]; the path `crate::simd` keeps
+/// working.
+pub use numeric::simd;
 
 pub use error::{Error, Result};

@@ -31,7 +31,6 @@
 
 use super::AtlasOptions;
 use crate::error::{Error, Result};
-use crate::flow::linear::SymmetricSolver;
 use crate::flow::TargetSpec;
 use crate::mesh::refine::Refiner;
 use crate::mesh::{Mesh, Surface};
@@ -39,6 +38,7 @@ use crate::metric::Scheme;
 use crate::metric::{
     euler_characteristic, ConformalStructure, Evaluator, Geometry, HessianPattern,
 };
+use crate::numeric::sparse::SymmetricSolver;
 use crate::progress::Progress;
 use serde::Serialize;
 use std::f64::consts::PI;

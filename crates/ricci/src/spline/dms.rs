@@ -38,8 +38,8 @@
 //! paper 000 (eq. 14, Fig. 13) constrains control points by it.
 
 use crate::error::{Error, Result};
-use crate::layout::dd::Dd;
 use crate::mesh::Mesh;
+use crate::numeric::dd::Dd;
 
 use super::poly::Polynomial;
 use super::simplex::{det3, n_partials, Point, SimplexFamily};

@@ -30,11 +30,11 @@
 
 use std::collections::HashMap;
 
-use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
-use faer::{Mat, Side};
+use faer::Mat;
 
 use crate::error::{Error, Result};
+use crate::numeric::{dense::gram, sparse::Cholesky};
 
 use super::dms::{multi_indices, DmsSpace, Precision, Workspace};
 use super::simplex::{n_partials, Point};
@@ -407,7 +407,7 @@ pub fn fair<S: SplineSpace + ?Sized>(
         let aat = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &t2)
             .map_err(|e| Error::numerical(format!("fairing: could not assemble A Aᵀ ({e:?})")))?;
         drop(t2);
-        let Ok(llt) = aat.sp_cholesky(Side::Lower) else {
+        let Ok(llt) = Cholesky::factor(aat.as_ref()) else {
             continue;
         };
         let precond = |r: &[f64]| -> Vec<f64> {
@@ -416,7 +416,6 @@ pub fn fair<S: SplineSpace + ?Sized>(
                 z[(i, 0)] = r[i];
             }
             llt.solve_in_place(z.as_mut());
-            crate::simd::clear_upper_state();
             (0..m).map(|i| z[(i, 0)]).collect()
         };
         // Preconditioned conjugate gradients on the consistent system A Aᵀ y = A c, one coordinate
@@ -857,15 +856,12 @@ fn energy_gram<S: SplineSpace + ?Sized>(space: &S, blocks: &mut Blocks) -> Resul
                     v[(3 * r + c, col)] += dc;
                 }
             }
-            let g = v.transpose() * &v;
-            // This thread goes on with the next triangle's basis evaluations (`crate::simd`).
-            crate::simd::clear_upper_state_here();
+            // (`gram` leaves this thread's vector registers clean for the next triangle's
+            // basis evaluations, `crate::numeric::simd`.)
+            let g = gram(&v);
             Ok((groups, g))
         })
         .collect::<Result<_>>()?;
-    // faer's dense kernels leave the AVX upper state dirty on the threads that ran them, which
-    // slows all later baseline (SSE) code there ~10× (`crate::simd`).
-    crate::simd::clear_upper_state();
     for (groups, g) in grams {
         for (la, &ta) in groups.iter().enumerate() {
             for (lb, &tb) in groups.iter().enumerate() {
@@ -1006,7 +1002,7 @@ pub fn fit<S: SplineSpace + ?Sized>(
         Error::numerical(format!("fit: could not assemble the normal matrix ({e:?})"))
     })?;
     drop(trip);
-    let llt = h.sp_cholesky(Side::Lower).map_err(|e| {
+    let llt = Cholesky::factor(h.as_ref()).map_err(|e| {
         Error::numerical(format!("fit: Cholesky of the normal matrix failed ({e:?})"))
     })?;
     let mut sol = Mat::<f64>::zeros(nc, dim);
@@ -1017,8 +1013,6 @@ pub fn fit<S: SplineSpace + ?Sized>(
     }
     llt.solve_in_place(sol.as_mut());
     drop(llt);
-    // The supernodal factorisation ran faer's dense kernels too (`crate::simd`).
-    crate::simd::clear_upper_state();
     let mut x = vec![0.0; nc * dim];
     for k in 0..nc {
         for d in 0..dim {

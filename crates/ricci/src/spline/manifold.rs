@@ -81,9 +81,9 @@ use rayon::prelude::*;
 
 use crate::atlas::{fit_rigid, ChartId, FlatCharts};
 use crate::error::{Error, Result};
-use crate::layout::dd::Dd;
 use crate::layout::RigidMotion;
 use crate::mesh::Mesh;
+use crate::numeric::dd::Dd;
 
 use super::dms::{
     blossom_weights_of, general_position_involving, hash64, multi_indices, needs_shrink,
