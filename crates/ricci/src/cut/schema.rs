@@ -55,8 +55,9 @@
 use super::homology::Cohomology;
 use super::system::{RawKind, RawPath, SearchStats};
 use crate::error::{Error, Result};
-use crate::mesh::refine::{MinItem, Refiner};
 use crate::mesh::{Mesh, NONE};
+use crate::metric::refine::Refiner;
+use crate::numeric::dijkstra::MinItem;
 use std::collections::BinaryHeap;
 
 /// Loops and their bookkeeping on a mutable refinement.

@@ -756,7 +756,7 @@ mod round_jacobian_tests {
                 target.update_round(&ev.ws.lengths, &ev.ws.dlengths, &ev.data.edges);
                 let nf = pattern.n();
                 let r: Vec<f64> = (0..nf).map(|c| ((c as f64) * 1.3).cos()).collect();
-                let d = exact_round_step(&ev, &target, &pattern, &values, &r, &mut None)
+                let d = exact_round_step(&ev, &target, &pattern, &values, &r, &mut SparseLu::new())
                     .unwrap_or_else(|| panic!("{scheme} {n}"));
                 let dmax = d.iter().fold(0.0f64, |m, x| m.max(x.abs()));
                 let h = 1e-5 / dmax;

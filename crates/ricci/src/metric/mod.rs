@@ -4,7 +4,9 @@
 //! * [`geometry`] — the backgrounds E², H², S² and their stable cosine laws;
 //! * [`scheme`] — Thurston / tangential / inversive distance circle packings and vertex scaling;
 //! * [`conformal`] — the initial conformal structure built from a mesh's edge lengths;
-//! * [`kernel`] — the allocation-free evaluation of lengths, angles, curvature and Hessian.
+//! * [`kernel`] — the allocation-free evaluation of lengths, angles, curvature and Hessian;
+//! * [`refine`] — intrinsic refinement: metric-preserving edge splits and flips in E², H², S²
+//!   (paper 000 Step 2), moved here from `mesh` because it needs the background geometries.
 //!
 //! **Energy and signs.** We use the convex Ricci energy `E(u) = ∫ Σ (K_i − K̄_i) du_i`, whose
 //! gradient is `K − K̄` and whose Hessian is `H = ∂K/∂u` (positive semidefinite in E², with the
@@ -18,6 +20,7 @@
 pub mod conformal;
 pub mod geometry;
 pub mod kernel;
+pub mod refine;
 pub mod scheme;
 
 pub use conformal::ConformalStructure;

@@ -15,7 +15,10 @@
 
 pub mod dd;
 pub mod dense;
+pub mod dijkstra;
 pub mod simd;
 pub mod sparse;
+pub mod vec3;
 
 pub use dd::{Cdd, Dd};
+pub use vec3::heron;

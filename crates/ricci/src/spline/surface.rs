@@ -140,7 +140,7 @@ pub fn flat_domain(
             .map(|h| lengths[mesh.he_edge(h) as usize])
             .sum::<f64>()
             / mesh.valence(s).max(1) as f64;
-        let mut rf = crate::mesh::refine::Refiner::new(
+        let mut rf = crate::metric::refine::Refiner::new(
             mesh,
             &lengths,
             Geometry::Euclidean,
@@ -1230,12 +1230,7 @@ pub struct MeshDistance {
     pub diagonal: f64,
 }
 
-fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
+use crate::numeric::vec3::{dot as dot3, sub as sub3};
 
 /// Distance from `p` to triangle `t` (Ericson, *Real-Time Collision Detection*, 5.1.5).
 pub fn point_triangle_distance(p: [f64; 3], t: &[[f64; 3]; 3]) -> f64 {
