@@ -34,10 +34,11 @@ use crate::metric::{Geometry, Scheme};
 use crate::progress::Progress;
 
 use super::dms::{KnotOptions, Workspace};
-use super::fit::{evaluate, fair, fit, DataPoint, FairingReport, FitOptions, FitReport};
+use super::fit::{fair, fit, DataPoint, FairingReport, FitOptions, FitReport};
 use super::hole::{Hole, SeamReport};
 use super::manifold::{apply, rotate_partials, LocalCharts, ManifoldReport, ManifoldSpace};
 use super::simplex::{n_partials, Point};
+use super::space::evaluate;
 
 /// Where the cone of a closed surface of genus ≥ 2 goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
