@@ -60,6 +60,15 @@ impl Dijkstra {
         }
     }
 
+    /// Extend to `n` vertices (new ones unreached); never shrinks.
+    pub fn grow(&mut self, n: usize) {
+        if n > self.dist.len() {
+            self.dist.resize(n, f64::INFINITY);
+            self.pred.resize(n, NO_PRED);
+            self.settled.resize(n, false);
+        }
+    }
+
     /// Forget the last search.
     pub fn reset(&mut self) {
         for &v in &self.touched {
