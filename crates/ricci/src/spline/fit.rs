@@ -607,6 +607,9 @@ fn energy_gram<S: SplineSpace + ?Sized>(space: &S, blocks: &mut Blocks) -> Resul
             Ok((groups, g))
         })
         .collect::<Result<_>>()?;
+    // faer may have spread a product over other threads of the pool, which `gram` cannot
+    // clean from the calling thread: clean them all once after the phase.
+    crate::numeric::simd::clear_upper_state();
     for (groups, g) in grams {
         for (la, &ta) in groups.iter().enumerate() {
             for (lb, &tb) in groups.iter().enumerate() {
