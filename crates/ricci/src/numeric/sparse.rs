@@ -44,6 +44,20 @@ pub struct LowerCsc<'a> {
     pub row_idx: &'a [u32],
 }
 
+/// The matrix with lower-triangle pattern `(col_ptr, row_idx)` and `values` (checked by
+/// [`SymmetricSolver::new`] and the callers).
+fn lower<'a>(
+    n: usize,
+    col_ptr: &'a [u32],
+    row_idx: &'a [u32],
+    values: &'a [f64],
+) -> SparseColMatRef<'a, u32, f64> {
+    SparseColMatRef::new(
+        SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx),
+        values,
+    )
+}
+
 /// A reusable sparse symmetric factorization for one sparsity pattern (lower triangle).
 pub struct SymmetricSolver {
     n: usize,
@@ -109,18 +123,14 @@ impl SymmetricSolver {
     }
 
     /// Numeric LLᵀ factorization of the matrix with the pattern's lower-triangle `values`.
-    /// Returns false if the matrix is not numerically positive definite.
+    /// Returns false if the matrix is not numerically positive definite (or `values` does not
+    /// fit the pattern).
     pub fn factor_llt(&mut self, values: &[f64]) -> bool {
-        let a = SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(
-                self.n,
-                self.n,
-                &self.col_ptr,
-                None,
-                &self.row_idx,
-            ),
-            values,
-        );
+        if values.len() != self.row_idx.len() {
+            self.factored = Factored::None;
+            return false;
+        }
+        let a = lower(self.n, &self.col_ptr, &self.row_idx, values);
         let stack = MemStack::new(&mut self.mem);
         let ok = self
             .symbolic
@@ -142,16 +152,11 @@ impl SymmetricSolver {
     /// Numeric LDLᵀ factorization (symmetric indefinite, no pivoting beyond the fill-reducing
     /// ordering). Returns false on a zero pivot.
     pub fn factor_ldlt(&mut self, values: &[f64]) -> bool {
-        let a = SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(
-                self.n,
-                self.n,
-                &self.col_ptr,
-                None,
-                &self.row_idx,
-            ),
-            values,
-        );
+        if values.len() != self.row_idx.len() {
+            self.factored = Factored::None;
+            return false;
+        }
+        let a = lower(self.n, &self.col_ptr, &self.row_idx, values);
         let stack = MemStack::new(&mut self.mem);
         let ok = self
             .symbolic
@@ -257,5 +262,140 @@ impl Cholesky {
         use faer::linalg::solvers::Solve;
         self.llt.solve_in_place(rhs);
         super::simd::clear_upper_state();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::sparse::Triplet;
+
+    /// Tridiagonal `A = tridiag(−1, d(i), −1)` of size `n`: lower-triangle CSC pattern and
+    /// values.
+    fn tridiagonal(n: usize, d: impl Fn(usize) -> f64) -> (Vec<u32>, Vec<u32>, Vec<f64>) {
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0u32], Vec::new(), Vec::new());
+        for j in 0..n {
+            row_idx.push(j as u32);
+            values.push(d(j));
+            if j + 1 < n {
+                row_idx.push(j as u32 + 1);
+                values.push(-1.0);
+            }
+            col_ptr.push(row_idx.len() as u32);
+        }
+        (col_ptr, row_idx, values)
+    }
+
+    /// `A x` for the tridiagonal matrix.
+    fn apply(d: impl Fn(usize) -> f64, x: &[f64]) -> Vec<f64> {
+        let n = x.len();
+        (0..n)
+            .map(|i| {
+                let l = if i > 0 { x[i - 1] } else { 0.0 };
+                let r = if i + 1 < n { x[i + 1] } else { 0.0 };
+                d(i) * x[i] - l - r
+            })
+            .collect()
+    }
+
+    fn max_error(x: &[f64], y: &[f64]) -> f64 {
+        x.iter()
+            .zip(y)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn symmetric_solver_reuses_its_analysis_for_definite_and_indefinite_matrices() {
+        let n = 50;
+        let want: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let (col_ptr, row_idx, _) = tridiagonal(n, |_| 0.0);
+        let mut s = SymmetricSolver::new(LowerCsc {
+            n,
+            col_ptr: &col_ptr,
+            row_idx: &row_idx,
+        })
+        .unwrap();
+        // Positive definite (diagonal 2.5 > 2), then indefinite (diagonal ±3, eigenvalues of
+        // both signs, pivots away from 0) with the same symbolic factorization.
+        let definite = |_: usize| 2.5;
+        let indefinite = |i: usize| if i % 2 == 0 { 3.0 } else { -3.0 };
+        let (_, _, values) = tridiagonal(n, definite);
+        assert!(s.factor_llt(&values));
+        let mut x = apply(definite, &want);
+        s.solve(&mut x);
+        let err = max_error(&x, &want);
+        assert!(err < 1e-12, "definite: error {err}");
+        let (_, _, values) = tridiagonal(n, indefinite);
+        assert!(s.factor_ldlt(&values));
+        let mut x = apply(indefinite, &want);
+        s.solve(&mut x);
+        let err = max_error(&x, &want);
+        assert!(err < 1e-12, "indefinite: error {err}");
+        // LLᵀ refuses the indefinite matrix; a wrong number of values is refused too.
+        assert!(!s.factor_llt(&values));
+        assert!(!s.factor_llt(&values[1..]));
+        // An invalid pattern is an error, not a panic.
+        let bad = LowerCsc {
+            n: 3,
+            col_ptr: &[0, 1, 2],
+            row_idx: &[0, 1],
+        };
+        assert!(SymmetricSolver::new(bad).is_err());
+    }
+
+    #[test]
+    fn sparse_lu_and_cholesky_solve_their_systems() {
+        // Non-symmetric 3×3: A = [[4, 1, 0], [2, 5, 1], [0, 3, 6]], x = (1, −2, 3).
+        let a = [[4.0, 1.0, 0.0], [2.0, 5.0, 1.0], [0.0, 3.0, 6.0]];
+        let want = [1.0, -2.0, 3.0];
+        let b: Vec<f64> = (0..3)
+            .map(|i| (0..3).map(|j| a[i][j] * want[j]).sum())
+            .collect();
+        let trip: Vec<Triplet<u32, u32, f64>> = (0..3)
+            .flat_map(|i| (0..3).map(move |j| (i, j)))
+            .filter(|&(i, j)| a[i][j] != 0.0)
+            .map(|(i, j)| Triplet::new(i as u32, j as u32, a[i][j]))
+            .collect();
+        let mut lu = SparseLu::new();
+        for _ in 0..2 {
+            assert!(lu.factor(3, &trip));
+            let mut x = b.clone();
+            lu.solve(&mut x);
+            for k in 0..3 {
+                assert!((x[k] - want[k]).abs() < 1e-14, "{x:?}");
+            }
+        }
+        // Cholesky of the SPD tridiagonal matrix, two right-hand sides.
+        let n = 20;
+        let (col_ptr, row_idx, values) = tridiagonal(n, |_| 3.0);
+        let mut t = Vec::new();
+        for j in 0..n {
+            for k in col_ptr[j] as usize..col_ptr[j + 1] as usize {
+                let i = row_idx[k] as usize;
+                t.push(Triplet::new(i, j, values[k]));
+                if i != j {
+                    t.push(Triplet::new(j, i, values[k]));
+                }
+            }
+        }
+        let m = faer::sparse::SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &t).unwrap();
+        let c = Cholesky::factor(m.as_ref()).unwrap();
+        let xs: [Vec<f64>; 2] = [
+            (0..n).map(|i| i as f64).collect(),
+            (0..n).map(|i| (i as f64).cos()).collect(),
+        ];
+        let mut rhs = faer::Mat::<f64>::zeros(n, 2);
+        for (c, x) in xs.iter().enumerate() {
+            for (i, v) in apply(|_| 3.0, x).into_iter().enumerate() {
+                rhs[(i, c)] = v;
+            }
+        }
+        c.solve_in_place(rhs.as_mut());
+        for (c, x) in xs.iter().enumerate() {
+            for i in 0..n {
+                assert!((rhs[(i, c)] - x[i]).abs() < 1e-12);
+            }
+        }
     }
 }
