@@ -319,7 +319,7 @@ mod tests {
         // Positive definite (diagonal 2.5 > 2), then indefinite (diagonal ±3, eigenvalues of
         // both signs, pivots away from 0) with the same symbolic factorization.
         let definite = |_: usize| 2.5;
-        let indefinite = |i: usize| if i % 2 == 0 { 3.0 } else { -3.0 };
+        let indefinite = |i: usize| if i.is_multiple_of(2) { 3.0 } else { -3.0 };
         let (_, _, values) = tridiagonal(n, definite);
         assert!(s.factor_llt(&values));
         let mut x = apply(definite, &want);
