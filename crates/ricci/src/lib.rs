@@ -3,17 +3,32 @@
 //! Discrete surface Ricci flow and the structures and splines built on it, following
 //! Gu, Jin, Luo et al. (see `shared/papers` and `DESIGN.md`).
 //!
-//! The pipeline, one module per stage:
+//! The pipeline, one module per stage, each using only the stages before it:
 //!
+//! ```text
+//! numeric < mesh < metric < flow < cut < layout ≈ analysis < atlas < spline
+//! ```
+//!
+//! * [`numeric`] — the bottom layer, used by every stage and using none: double-double
+//!   arithmetic, the faer wrappers for sparse solves and dense products (with the
+//!   vector-register hygiene of [`numeric::simd`] inside them), one Dijkstra, R³ helpers and
+//!   Heron's formula;
 //! * [`mesh`] — connectivity (half-edge arrays), positions, validation, topology, formats,
 //!   procedural surfaces;
-//! * [`metric`] — background geometries, discrete conformal schemes, curvature, Hessian;
+//! * [`metric`] — background geometries, discrete conformal schemes, curvature, Hessian,
+//!   intrinsic refinement (edge splits and flips that keep the metric);
 //! * [`flow`] — target curvatures and solvers (Newton, gradient flow);
 //! * [`cut`] — homotopy bases, canonical fundamental group generators, slicing;
 //! * [`layout`] — isometric layouts in the plane, the Poincaré disk and the sphere, deck groups;
+//! * [`analysis`] — distortion, geodesic spectrum (beside `layout`: it uses it);
 //! * [`atlas`] — affine atlas with one extraordinary point;
-//! * [`analysis`] — distortion, geodesic spectrum;
 //! * [`spline`] — triangular B-splines (DMS) and manifold splines.
+//!
+//! [`error`] and [`progress`] are utilities every module may use. The order is checked by
+//! `tests/layers.rs` (every `crate::…` path of every source file); the few paths kept
+//! for code written against the old layout (`layout::dd::{Dd, Cdd}`, `flow::linear`,
+//! `mesh::refine`, `crate::simd`, `atlas::heron`, `spline::fit::{SplineSpace, evaluate, …}`)
+//! are marked *compatibility re-exports*.
 //!
 //! Connectivity, metric and embedding are separate types: a [`mesh::Mesh`] knows who is next
 //! to whom, edge lengths live in plain `Vec<f64>` indexed by edge id, and positions live in a
@@ -27,8 +42,12 @@ pub mod flow;
 pub mod layout;
 pub mod mesh;
 pub mod metric;
+pub mod numeric;
 pub mod progress;
-pub mod simd;
 pub mod spline;
+
+/// Compatibility re-export: `simd` moved to [`numeric::simd`]; the path `crate::simd` keeps
+/// working.
+pub use numeric::simd;
 
 pub use error::{Error, Result};

@@ -11,14 +11,14 @@
 //!    to the boundary, `u` keeps its initial value there);
 //!    `k` user cones (`cones`) on closed surfaces.
 //! 2. **Connectivity modification** (Step 2): intrinsic, metric-preserving edge splits
-//!    ([`crate::mesh::refine`]) raise the valence of every cone `v` to at least
+//!    ([`crate::metric::refine`]) raise the valence of every cone `v` to at least
 //!    `⌈4 − 2K̄(v)/π⌉`; the canonical cut then grades the neighbourhood of its base vertex
 //!    (the cone) so its `4g` loops fit; finally the cone's one-ring neighbours get valence
 //!    ≥ 6 by splitting their outer link edges off the cut ([`raise_ring_valence`]) — the
 //!    cut's grading leaves valence-4 neighbours, and without this the Chow–Luo condition on
 //!    the cone's closed one-ring refuses the target for genus ≥ 3. Then Step 2 (ii) proper:
 //!    every vertex within `rings` (3) edge-rings of a cone gets valence ≥ 6 by intrinsic,
-//!    metric-preserving **edge flips** ([`crate::mesh::refine::Refiner::flip`]) that move
+//!    metric-preserving **edge flips** ([`crate::metric::refine::Refiner::flip`]) that move
 //!    spare valence inwards, and splits that make room where no flip can
 //!    ([`flip_ring_valence`]); neither touches an edge of the cut loops or at a cone, so the
 //!    loops stay edge paths. All of this happens before the flow, which therefore runs on the
@@ -63,8 +63,8 @@ use crate::error::{Error, Result};
 use crate::flow::{ricci_flow, FlowOptions, TargetSpec};
 use crate::layout::place::layout;
 use crate::layout::RigidMotion;
-use crate::mesh::refine::Refiner;
 use crate::mesh::{topology, Mesh, Surface, NONE};
+use crate::metric::refine::Refiner;
 use crate::metric::{Euclidean, Geometry, Scheme};
 use crate::progress::Progress;
 use serde::Serialize;
@@ -1291,11 +1291,11 @@ pub fn flat_flow_limited(
 /// link edge of each such neighbour that avoids the cones and the `protected` edges (vertex
 /// pairs, smaller first). Returns the refinement and the number of splits.
 pub fn raise_ring_valence(
-    refined: crate::mesh::refine::Refined,
+    refined: crate::metric::refine::Refined,
     cones: &[(u32, f64)],
     min: usize,
     protected: &std::collections::HashSet<(u32, u32)>,
-) -> Result<(crate::mesh::refine::Refined, usize)> {
+) -> Result<(crate::metric::refine::Refined, usize)> {
     let mut refined = refined;
     let mut total = 0;
     for _round in 0..16 {
@@ -1379,12 +1379,12 @@ pub struct RingValenceWork {
 /// Vertex ids are kept (new vertices appended), so the cut loops stay edge paths: a flip
 /// never crosses an edge other than the one it removes, and protected edges are never split.
 pub fn flip_ring_valence(
-    refined: crate::mesh::refine::Refined,
+    refined: crate::metric::refine::Refined,
     cones: &[(u32, f64)],
     rings: usize,
     protected: &std::collections::HashSet<(u32, u32)>,
     max_ops: usize,
-) -> Result<(crate::mesh::refine::Refined, RingValenceWork)> {
+) -> Result<(crate::metric::refine::Refined, RingValenceWork)> {
     let mut work = RingValenceWork::default();
     if rings == 0 || cones.is_empty() {
         work.complete = true;
@@ -1578,18 +1578,9 @@ pub fn area_distortion(
     sum / n.max(1) as f64
 }
 
-/// Area of a Euclidean triangle from its sides (Kahan's stable Heron formula).
-pub fn heron(l: [f64; 3]) -> f64 {
-    let mut s = l;
-    s.sort_by(|a, b| b.total_cmp(a));
-    let [a, b, c] = s;
-    let p = (a + (b + c)) * (c - (a - b)) * (c + (a - b)) * (a + (b - c));
-    if p > 0.0 {
-        0.25 * p.sqrt()
-    } else {
-        0.0
-    }
-}
+/// Compatibility re-export: Heron's formula (Kahan's stable form) moved to
+/// [`crate::numeric::heron`]; the path `ricci::atlas::heron` keeps working.
+pub use crate::numeric::heron;
 
 /// Add to `cut_edge` a shortest path (in `lengths`) from the current cut graph to every cone
 /// in `others`, through vertices off the cut graph and off the boundary.
@@ -1599,8 +1590,7 @@ fn add_slits(
     cut_edge: &mut [bool],
     others: &[(u32, f64)],
 ) -> Result<()> {
-    use crate::mesh::refine::MinItem;
-    use std::collections::BinaryHeap;
+    use crate::numeric::dijkstra::{Dijkstra, NO_PRED};
     for &(target, _) in others {
         let nv = mesh.n_vertices();
         let mut on_cut = vec![false; nv];
@@ -1614,41 +1604,27 @@ fn add_slits(
         if on_cut[target as usize] {
             continue;
         }
-        let mut dist = vec![f64::INFINITY; nv];
-        let mut parent = vec![NONE; nv];
-        let mut heap = BinaryHeap::new();
-        dist[target as usize] = 0.0;
-        heap.push(MinItem(0.0, target));
-        let mut hit = NONE;
-        while let Some(MinItem(d, v)) = heap.pop() {
-            if d > dist[v as usize] {
-                continue;
-            }
-            if on_cut[v as usize] {
-                hit = v;
-                break;
-            }
-            for h in mesh.outgoing(v) {
-                let w = mesh.he_tip(h);
-                if mesh.is_boundary_vertex(w) && !on_cut[w as usize] {
-                    continue;
-                }
-                let nd = d + lengths[mesh.he_edge(h) as usize];
-                if nd < dist[w as usize] {
-                    dist[w as usize] = nd;
-                    parent[w as usize] = v;
-                    heap.push(MinItem(nd, w));
-                }
-            }
-        }
-        if hit == NONE {
+        let on_cut = &on_cut;
+        let mut search = Dijkstra::new(nv);
+        search.offer(target, 0.0, NO_PRED);
+        let hit = search.run(
+            |v| {
+                mesh.outgoing(v).filter_map(move |h| {
+                    let w = mesh.he_tip(h);
+                    (!mesh.is_boundary_vertex(w) || on_cut[w as usize])
+                        .then(|| (w, lengths[mesh.he_edge(h) as usize]))
+                })
+            },
+            |_, v| on_cut[v as usize],
+        );
+        let Some(hit) = hit else {
             return Err(Error::topology(format!(
                 "cone vertex {target} cannot be joined to the cut graph"
             )));
-        }
+        };
         let mut v = hit;
         while v != target {
-            let p = parent[v as usize];
+            let p = search.pred(v);
             let h = mesh
                 .halfedge_between(p, v)
                 .ok_or_else(|| Error::numerical("internal error: slit path without an edge"))?;

@@ -31,14 +31,14 @@
 
 use super::AtlasOptions;
 use crate::error::{Error, Result};
-use crate::flow::linear::SymmetricSolver;
 use crate::flow::TargetSpec;
-use crate::mesh::refine::Refiner;
 use crate::mesh::{Mesh, Surface};
+use crate::metric::refine::Refiner;
 use crate::metric::Scheme;
 use crate::metric::{
     euler_characteristic, ConformalStructure, Evaluator, Geometry, HessianPattern,
 };
+use crate::numeric::sparse::SymmetricSolver;
 use crate::progress::Progress;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -365,7 +365,7 @@ pub fn candidate_mesh(
     v: u32,
     kappa: f64,
     graded: bool,
-) -> Result<crate::mesh::refine::Refined> {
+) -> Result<crate::metric::refine::Refined> {
     let need = (4.0 - 2.0 * kappa / PI - 1e-9).ceil().max(3.0) as usize;
     let mut r = Refiner::new(mesh, lengths, Geometry::Euclidean, None)?;
     r.raise_valence(v, need)?;

@@ -16,7 +16,7 @@
 //! symplectic matrix (`a_i·b_i = +1`).
 //!
 //! Steps: (1) raise the valence of `x` and grade its neighbourhood by intrinsic,
-//! metric-preserving edge splits ([`crate::mesh::refine`]); (2) a Z₂ cohomology basis by
+//! metric-preserving edge splits ([`crate::metric::refine`]); (2) a Z₂ cohomology basis by
 //! tree–cotree ([`homology`]); (3) the loops; (4) slicing ([`mod@slice`]) and reading the
 //! polygon.
 //!
@@ -50,12 +50,11 @@ pub mod slice;
 pub mod system;
 
 use crate::error::{Error, Result};
-use crate::mesh::refine::{MinItem, Refined, Refiner};
 use crate::mesh::{topology, Mesh, NONE};
+use crate::metric::refine::{Refined, Refiner};
 use crate::metric::Geometry;
 use crate::progress::Progress;
 use serde::Serialize;
-use std::collections::BinaryHeap;
 use system::{RawKind, RawPath};
 
 pub use homology::Cohomology;
@@ -990,26 +989,10 @@ impl CanonicalCut {
 
 /// Shortest-path distances from `sources` (Dijkstra over edges).
 pub(crate) fn distances(mesh: &Mesh, lengths: &[f64], sources: &[u32]) -> Vec<f64> {
-    let mut dist = vec![f64::INFINITY; mesh.n_vertices()];
-    let mut heap = BinaryHeap::new();
-    for &s in sources {
-        dist[s as usize] = 0.0;
-        heap.push(MinItem(0.0, s));
-    }
-    while let Some(MinItem(d, v)) = heap.pop() {
-        if d > dist[v as usize] {
-            continue;
-        }
-        for h in mesh.outgoing(v) {
-            let w = mesh.he_tip(h);
-            let nd = d + lengths[mesh.he_edge(h) as usize];
-            if nd < dist[w as usize] {
-                dist[w as usize] = nd;
-                heap.push(MinItem(nd, w));
-            }
-        }
-    }
-    dist
+    crate::numeric::dijkstra::distances(mesh.n_vertices(), sources, |v| {
+        mesh.outgoing(v)
+            .map(move |h| (mesh.he_tip(h), lengths[mesh.he_edge(h) as usize]))
+    })
 }
 
 /// A central interior vertex: with `v₁` farthest from an arbitrary vertex and `v₂` farthest

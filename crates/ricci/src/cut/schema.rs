@@ -55,9 +55,9 @@
 use super::homology::Cohomology;
 use super::system::{RawKind, RawPath, SearchStats};
 use crate::error::{Error, Result};
-use crate::mesh::refine::{MinItem, Refiner};
 use crate::mesh::{Mesh, NONE};
-use std::collections::BinaryHeap;
+use crate::metric::refine::Refiner;
+use crate::numeric::dijkstra::Dijkstra;
 
 /// Loops and their bookkeeping on a mutable refinement.
 struct Loops {
@@ -78,14 +78,10 @@ pub(crate) struct Schema {
     loops: Vec<Option<Loops>>,
     /// Echelon basis (pivot bit, vector) of the classes of the current loops (phase 1).
     basis: Vec<(usize, Vec<u64>)>,
-    dist: Vec<f64>,
-    pred: Vec<u32>,
-    stamp: Vec<u32>,
-    done: Vec<u32>,
-    gen: u32,
+    /// The Dijkstra searches (distances, predecessor half-edges).
+    search: Dijkstra,
     branch: Vec<u32>,
     parity: Vec<u64>,
-    heap: BinaryHeap<MinItem>,
     /// Scratch list of outgoing half-edges.
     buf: Vec<u32>,
     pub stats: SearchStats,
@@ -132,14 +128,9 @@ impl Schema {
             pos: Vec::new(),
             loops: Vec::new(),
             basis: Vec::new(),
-            dist: Vec::new(),
-            pred: Vec::new(),
-            stamp: Vec::new(),
-            done: Vec::new(),
-            gen: 0,
+            search: Dijkstra::new(0),
             branch: Vec::new(),
             parity: Vec::new(),
-            heap: BinaryHeap::new(),
             buf: Vec::new(),
             stats: SearchStats {
                 attempts: 1,
@@ -159,10 +150,7 @@ impl Schema {
         if self.loop_of.len() < nv {
             self.loop_of.resize(nv, NONE);
             self.pos.resize(nv, 0);
-            self.dist.resize(nv, f64::INFINITY);
-            self.pred.resize(nv, NONE);
-            self.stamp.resize(nv, 0);
-            self.done.resize(nv, 0);
+            self.search.grow(nv);
             self.branch.resize(nv, NONE);
             self.parity.resize(nv * self.words, 0);
         }
@@ -419,49 +407,23 @@ impl Schema {
         }
     }
 
-    // --- Dijkstra with generation stamps ---
+    // --- Dijkstra (`crate::numeric::dijkstra`) ---
 
     fn start_search(&mut self) {
         self.ensure();
-        self.gen = self.gen.wrapping_add(1);
-        if self.gen == 0 {
-            self.stamp.iter_mut().for_each(|s| *s = 0);
-            self.done.iter_mut().for_each(|s| *s = 0);
-            self.gen = 1;
-        }
-        self.heap.clear();
+        self.search.reset();
         self.stats.searches += 1;
     }
     #[inline]
-    fn d(&self, v: u32) -> f64 {
-        if self.stamp[v as usize] == self.gen {
-            self.dist[v as usize]
-        } else {
-            f64::INFINITY
-        }
-    }
-    #[inline]
     fn settled(&self, v: u32) -> bool {
-        self.done[v as usize] == self.gen
+        self.search.is_settled(v)
     }
     #[inline]
     fn offer(&mut self, v: u32, d: f64, h: u32) {
-        if d < self.d(v) {
-            self.stamp[v as usize] = self.gen;
-            self.dist[v as usize] = d;
-            self.pred[v as usize] = h;
-            self.heap.push(MinItem(d, v));
-        }
+        self.search.offer(v, d, h);
     }
     fn pop(&mut self) -> Option<(f64, u32)> {
-        while let Some(MinItem(d, v)) = self.heap.pop() {
-            if self.settled(v) || d > self.d(v) {
-                continue;
-            }
-            self.done[v as usize] = self.gen;
-            return Some((d, v));
-        }
-        None
+        self.search.pop()
     }
     /// `[x, …, v]` along the predecessors of the current search (sources have `pred` from `x`,
     /// or `NONE` for a source at distance 0).
@@ -469,7 +431,7 @@ impl Schema {
         let mut out = vec![v];
         let mut cur = v;
         loop {
-            let h = self.pred[cur as usize];
+            let h = self.search.pred(cur);
             if h == NONE {
                 break;
             }
@@ -507,7 +469,7 @@ impl Schema {
                     break;
                 }
             }
-            let hp = self.pred[v as usize];
+            let hp = self.search.pred(v);
             let u = self.r.he_origin(hp);
             let vi = v as usize;
             if u == x {
@@ -553,7 +515,7 @@ impl Schema {
                             ^ self.parity[wi * wd + k]
                             ^ self.omega[h as usize * wd + k];
                     }
-                    let len = d + self.dist[wi] + l;
+                    let len = d + self.search.dist(w) + l;
                     if best.is_some_and(|b| len >= b.0) {
                         continue;
                     }
@@ -655,7 +617,7 @@ impl Schema {
                 let z = self.r.he_tip(h);
                 if self.free(z) && !self.settled(z) {
                     let l = self.r.length(h);
-                    self.offer(z, self.dist[v as usize] + l, h);
+                    self.offer(z, self.search.dist(v) + l, h);
                 }
             }
             self.buf = buf;
@@ -669,7 +631,7 @@ impl Schema {
         let mut back = vec![t];
         let mut cur = t;
         while cur != w {
-            cur = self.r.he_origin(self.pred[cur as usize]);
+            cur = self.r.he_origin(self.search.pred(cur));
             back.push(cur);
         }
         back.reverse();

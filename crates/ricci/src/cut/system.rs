@@ -26,7 +26,7 @@
 //!   (same gap), avoiding `a_i` and all earlier loops: it crosses `a_i` once, at `x`;
 //! * slots are a budget: every handle may waste at most its fair share of the spare slots, so
 //!   that the later handles still find room (with the valence raised and the neighbourhood
-//!   graded by [`crate::mesh::refine`], there are enough of them);
+//!   graded by [`crate::metric::refine`], there are enough of them);
 //! * searches enter a neighbour of `x` only as a source or a target (loops must not run along
 //!   the link of `x` and use up its slots), and edges next to earlier cuts cost three times
 //!   their length, so that loops keep a free row of vertices between them;
@@ -42,9 +42,9 @@
 //!
 
 use super::homology::Cohomology;
-use crate::mesh::refine::MinItem;
 use crate::mesh::{Mesh, NONE};
-use std::collections::{BinaryHeap, HashMap};
+use crate::numeric::dijkstra::Dijkstra as Search;
+use std::collections::HashMap;
 
 /// Candidate first loops tried per handle and budget round before refining along the loops
 /// found so far (each try costs up to two Dijkstra searches).
@@ -122,59 +122,6 @@ struct Gap {
     /// Path ids of the ends before and after the gap (`NONE` when there are no ends).
     before: u32,
     after: u32,
-}
-
-/// Dijkstra buffers with cheap reset.
-struct Search {
-    dist: Vec<f64>,
-    /// Half-edge through which the vertex was reached (origin = parent, `x` for sources).
-    pred: Vec<u32>,
-    settled: Vec<bool>,
-    touched: Vec<u32>,
-    heap: BinaryHeap<MinItem>,
-}
-
-impl Search {
-    fn new(nv: usize) -> Search {
-        Search {
-            dist: vec![f64::INFINITY; nv],
-            pred: vec![NONE; nv],
-            settled: vec![false; nv],
-            touched: Vec::new(),
-            heap: BinaryHeap::new(),
-        }
-    }
-    fn reset(&mut self) {
-        for &v in &self.touched {
-            self.dist[v as usize] = f64::INFINITY;
-            self.pred[v as usize] = NONE;
-            self.settled[v as usize] = false;
-        }
-        self.touched.clear();
-        self.heap.clear();
-    }
-    #[inline]
-    fn offer(&mut self, v: u32, d: f64, h: u32) {
-        if d < self.dist[v as usize] {
-            if self.dist[v as usize] == f64::INFINITY {
-                self.touched.push(v);
-            }
-            self.dist[v as usize] = d;
-            self.pred[v as usize] = h;
-            self.heap.push(MinItem(d, v));
-        }
-    }
-    /// Pop the next vertex to settle, or `None`.
-    fn pop(&mut self) -> Option<(f64, u32)> {
-        while let Some(MinItem(d, v)) = self.heap.pop() {
-            if self.settled[v as usize] || d > self.dist[v as usize] {
-                continue;
-            }
-            self.settled[v as usize] = true;
-            return Some((d, v));
-        }
-        None
-    }
 }
 
 struct State<'a> {
@@ -428,7 +375,7 @@ impl<'a> State<'a> {
             }
         }
         while let Some((d, v)) = self.s1.pop() {
-            let h = self.s1.pred[v as usize];
+            let h = self.s1.pred(v);
             let u = m.he_origin(h);
             let om = self.inp.coh.edge(m.he_edge(h));
             if u == self.inp.x {
@@ -444,7 +391,7 @@ impl<'a> State<'a> {
                 let (g, w, l) = self.adj[k as usize];
                 // Neighbours of x are only entered from x: loops must not run along the link.
                 if self.blocked[w as usize]
-                    || self.s1.settled[w as usize]
+                    || self.s1.is_settled(w)
                     || self.slot_of[w as usize] != NONE
                 {
                     continue;
@@ -460,7 +407,7 @@ impl<'a> State<'a> {
         let mut out = vec![v];
         let mut cur = v;
         while cur != x {
-            let h = search.pred[cur as usize];
+            let h = search.pred(cur);
             cur = m.he_origin(h);
             out.push(cur);
         }
@@ -528,11 +475,11 @@ impl<'a> State<'a> {
         for e in 0..m.n_edges() as u32 {
             let h = m.edge_halfedge(e);
             let (u, w) = (m.he_origin(h), m.he_tip(h));
-            if !(self.s1.settled[u as usize] && self.s1.settled[w as usize]) {
+            if !(self.s1.is_settled(u) && self.s1.is_settled(w)) {
                 continue;
             }
             // Tree edges close nothing.
-            if self.s1.pred[w as usize] == h || self.s1.pred[u as usize] == m.he_twin(h) {
+            if self.s1.pred(w) == h || self.s1.pred(u) == m.he_twin(h) {
                 continue;
             }
             let (bu, bw) = (
@@ -545,8 +492,7 @@ impl<'a> State<'a> {
                     ^ self.parity[w as usize * words + j]
                     ^ om[j];
             }
-            let len =
-                self.s1.dist[u as usize] + self.s1.dist[w as usize] + self.inp.lengths[e as usize];
+            let len = self.s1.dist(u) + self.s1.dist(w) + self.inp.lengths[e as usize];
             consider(
                 Candidate {
                     len,
@@ -560,7 +506,7 @@ impl<'a> State<'a> {
         }
         for &s in sources {
             let w = self.slot_nbr(s);
-            if !self.usable(s) || !self.s1.settled[w as usize] {
+            if !self.usable(s) || !self.s1.is_settled(w) {
                 continue;
             }
             let bw = self.branch[w as usize] as usize;
@@ -571,7 +517,7 @@ impl<'a> State<'a> {
             for j in 0..words {
                 par[j] = self.parity[w as usize * words + j] ^ om[j];
             }
-            let len = self.s1.dist[w as usize] + self.slot_len(s);
+            let len = self.s1.dist(w) + self.slot_len(s);
             consider(
                 Candidate {
                     len,
@@ -645,7 +591,7 @@ impl<'a> State<'a> {
                 let (g, z, l) = self.adj[k as usize];
                 let sz = self.slot_of[z as usize];
                 if self.blocked[z as usize]
-                    || self.s2.settled[z as usize]
+                    || self.s2.is_settled(z)
                     || (sz != NONE && !target[sz as usize])
                 {
                     continue;
@@ -666,7 +612,7 @@ impl<'a> State<'a> {
         let mut back = vec![best_v];
         let mut cur = best_v;
         while cur != w {
-            cur = m.he_origin(self.s2.pred[cur as usize]);
+            cur = m.he_origin(self.s2.pred(cur));
             back.push(cur);
         }
         back.reverse();
@@ -912,7 +858,7 @@ impl<'a> State<'a> {
                 break;
             }
             let sv = self.slot_of[v as usize];
-            if sv != NONE && target_ok[sv as usize] && m.he_origin(self.s2.pred[v as usize]) != x {
+            if sv != NONE && target_ok[sv as usize] && m.he_origin(self.s2.pred(v)) != x {
                 let total = d + self.slot_len(sv as usize);
                 if total < best {
                     best = total;
@@ -923,7 +869,7 @@ impl<'a> State<'a> {
                 let (g, w, l) = self.adj[k as usize];
                 let sw = self.slot_of[w as usize];
                 if self.blocked[w as usize]
-                    || self.s2.settled[w as usize]
+                    || self.s2.is_settled(w)
                     || (sw != NONE && !target_ok[sw as usize])
                 {
                     continue;
@@ -1012,7 +958,7 @@ impl<'a> State<'a> {
                     continue;
                 }
                 if self.blocked[w as usize]
-                    || self.s1.settled[w as usize]
+                    || self.s1.is_settled(w)
                     || self.slot_of[w as usize] != NONE
                 {
                     continue;

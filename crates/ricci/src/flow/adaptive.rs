@@ -1,6 +1,6 @@
 //! Ricci flow with adaptive, metric-preserving refinement of the faces where the discrete
 //! conformal metric does not exist on the given triangulation (DESIGN.md §3; the splits of
-//! [`crate::mesh::refine`]).
+//! [`crate::metric::refine`]).
 //!
 //! A discrete conformal class on a fixed triangulation can miss a target: with vertex scaling
 //! the convex (extended) energy then has its minimum at a "metric" whose faces violate the
@@ -17,8 +17,8 @@
 
 use super::{ricci_flow, FlowOptions, FlowResult};
 use crate::error::Result;
-use crate::mesh::refine::{Refined, Refiner};
 use crate::mesh::Mesh;
+use crate::metric::refine::{Refined, Refiner};
 use crate::metric::{Geometry, Scheme};
 use crate::progress::Progress;
 use std::f64::consts::PI;

@@ -35,11 +35,11 @@
 //! domain or increases the largest error tenfold; in E² without fixed vertices the mean of `u`
 //! is kept (the papers' normalization `Σ u = const`).
 
-use super::linear::SymmetricSolver;
 use super::target::Target;
 use super::IterationRecord;
 use crate::error::Result;
 use crate::metric::{Evaluator, HessianPattern};
+use crate::numeric::sparse::{SparseLu, SymmetricSolver};
 use crate::progress::Progress;
 use std::time::Instant;
 
@@ -142,7 +142,7 @@ pub fn newton(
     let mut rejected_exact = 0usize;
     let mut mass = vec![0.0; n];
     let dynamic = target.is_dynamic();
-    let mut lu_symbolic = None;
+    let mut lu = SparseLu::new();
     loop {
         if !ev.evaluate_with_hessian(&u, &pattern, &mut values) {
             notes.push("the metric left the domain of the scheme".into());
@@ -214,7 +214,7 @@ pub fn newton(
         // LU ([`exact_round_step`]); if that fails, take a chord step instead.
         let mut exact_delta = None;
         if dynamic && exact {
-            match exact_round_step(ev, target, &pattern, &values, &r0, &mut lu_symbolic) {
+            match exact_round_step(ev, target, &pattern, &values, &r0, &mut lu) {
                 Some(d) => exact_delta = Some(d),
                 None => {
                     exact_failed = true;
@@ -445,10 +445,9 @@ fn exact_round_step(
     pattern: &HessianPattern,
     values: &[f64],
     r: &[f64],
-    symbolic: &mut Option<faer::sparse::linalg::solvers::SymbolicLu<u32>>,
+    lu: &mut SparseLu,
 ) -> Option<Vec<f64>> {
-    use faer::linalg::solvers::SolveCore;
-    use faer::sparse::{SparseColMat, Triplet};
+    use faer::sparse::Triplet;
     let nf = pattern.n();
     let mut trip: Vec<Triplet<u32, u32, f64>> = Vec::with_capacity(2 * values.len());
     for c in 0..nf {
@@ -501,27 +500,16 @@ fn exact_round_step(
         }
         terms.push((p, q, 0.5 * c.sign / c.s));
     }
-    let a = SparseColMat::<u32, f64>::try_new_from_triplets(nf, nf, &trip).ok()?;
     // The triplets come in the same order with the same pattern at every step, so the
     // symbolic factorization (ordering, elimination structure) is computed once.
-    if symbolic.is_none() {
-        *symbolic = faer::sparse::linalg::solvers::SymbolicLu::try_new(a.symbolic()).ok();
+    if !lu.factor(nf, &trip) {
+        return None;
     }
-    let lu =
-        faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(symbolic.clone()?, a.as_ref())
-            .ok()?;
-    let mut solve = |x: &mut [f64]| {
-        let n = x.len();
-        lu.solve_in_place_with_conj(
-            faer::Conj::No,
-            faer::MatMut::from_column_major_slice_mut(x, n, 1),
-        );
-    };
+    let lu = &*lu;
+    let mut solve = |x: &mut [f64]| lu.solve(x);
     let mut x = r.to_vec();
     solve(&mut x);
     woodbury(&mut solve, &terms, &mut x);
-    // faer's kernels leave the AVX upper state dirty (`crate::simd`).
-    crate::simd::clear_upper_state();
     x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
@@ -768,7 +756,7 @@ mod round_jacobian_tests {
                 target.update_round(&ev.ws.lengths, &ev.ws.dlengths, &ev.data.edges);
                 let nf = pattern.n();
                 let r: Vec<f64> = (0..nf).map(|c| ((c as f64) * 1.3).cos()).collect();
-                let d = exact_round_step(&ev, &target, &pattern, &values, &r, &mut None)
+                let d = exact_round_step(&ev, &target, &pattern, &values, &r, &mut SparseLu::new())
                     .unwrap_or_else(|| panic!("{scheme} {n}"));
                 let dmax = d.iter().fold(0.0f64, |m, x| m.max(x.abs()));
                 let h = 1e-5 / dmax;

@@ -3,7 +3,7 @@
 //!
 //! The flow ([`super::newton`]) stops at max |K − K̄| ≈ 5e-15: `K = 2π − Σθ` evaluated in
 //! double precision cannot resolve less. The hyperbolic layout and deck group run in
-//! double-double ([`crate::layout::dd`]), and on surfaces with long canonical loops the
+//! double-double ([`crate::numeric::dd`]), and on surfaces with long canonical loops the
 //! remaining curvature error, amplified by ~sinh of the distance from the centre of the
 //! Poincaré disk, is what limits the agreement of deck maps computed from different edges.
 //!
@@ -36,11 +36,11 @@
 // `!(x > 0.0)` is used on purpose: it is also true for NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use super::linear::SymmetricSolver;
 use crate::error::{Error, Result};
-use crate::layout::dd::{Cdd, Dd};
 use crate::mesh::Mesh;
 use crate::metric::{ConformalStructure, Evaluator, Geometry, HessianPattern};
+use crate::numeric::dd::{Cdd, Dd};
+use crate::numeric::sparse::SymmetricSolver;
 
 /// Settings of [`polish_metric`].
 #[derive(Debug, Clone, Copy)]

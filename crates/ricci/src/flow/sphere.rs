@@ -22,13 +22,13 @@
 //!    exact for vertex scaling when the embedding is valid), then spherical Newton from there:
 //!    the start is close to the solution set with its Möbius freedom already centred.
 
-use super::linear::SymmetricSolver;
 use super::newton::{self, NewtonSettings, SolveOutcome};
 use super::target::Target;
 use super::FlowOptions;
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, NONE};
 use crate::metric::{Evaluator, Geometry, HessianPattern, Scheme};
+use crate::numeric::sparse::SymmetricSolver;
 use crate::progress::Progress;
 
 /// Run the puncture route; `ev` and `target` belong to the spherical problem on `mesh`.

@@ -449,16 +449,7 @@ pub struct Rotation {
     pub m: [[f64; 3]; 3],
 }
 
-pub(crate) fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-pub(crate) fn cross3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
+pub(crate) use crate::numeric::vec3::{cross as cross3, dot as dot3};
 pub(crate) fn normalize3(a: [f64; 3]) -> [f64; 3] {
     let n = dot3(a, a).sqrt();
     if n > 0.0 {

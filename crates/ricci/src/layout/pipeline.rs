@@ -206,7 +206,7 @@ pub fn polish_uniformization(
 /// Polish a double-double hyperbolic metric with zero target curvature in place by vertex
 /// scaling (see the module docs); returns the polished lengths.
 pub fn polish_lengths(mesh: &Mesh, lengths: &[f64], lengths_lo: &[f64]) -> Result<PolishedMetric> {
-    use crate::layout::dd::Dd;
+    use crate::numeric::dd::Dd;
     let ne = mesh.n_edges();
     if lengths.len() != ne || lengths_lo.len() != ne {
         return Err(Error::input(format!(

@@ -9,8 +9,11 @@ pub mod connectivity;
 pub mod generate;
 pub mod io;
 pub mod quality;
-pub mod refine;
 pub mod topology;
+
+/// Compatibility re-export: intrinsic refinement (it needs the background geometries) moved
+/// to [`crate::metric::refine`]; the path `crate::mesh::refine` keeps working.
+pub use crate::metric::refine;
 
 pub use build::{build_surface, BuildReport, PolygonSoup};
 pub use connectivity::{Mesh, NONE};
@@ -66,7 +69,4 @@ impl Surface {
     }
 }
 
-#[inline]
-pub(crate) fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-}
+pub(crate) use crate::numeric::vec3::dist;

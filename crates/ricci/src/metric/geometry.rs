@@ -212,12 +212,7 @@ impl Background for Euclidean {
         }
     }
     fn area(a: f64, b: f64, c: f64) -> f64 {
-        // Kahan's stable Heron formula (sides sorted a ≥ b ≥ c).
-        let mut s = [a, b, c];
-        s.sort_by(|x, y| y.total_cmp(x));
-        let [a, b, c] = s;
-        let p = (a + (b + c)) * (c - (a - b)) * (c + (a - b)) * (a + (b - c));
-        0.25 * p.max(0.0).sqrt()
+        crate::numeric::heron([a, b, c])
     }
 }
 

@@ -215,6 +215,18 @@ pub struct HessianPattern {
     pub edge_slot: Vec<u32>,
 }
 
+/// The pattern as the lower triangle of a symmetric matrix in CSC, for
+/// [`crate::numeric::sparse::SymmetricSolver::new`].
+impl<'a> From<&'a HessianPattern> for crate::numeric::sparse::LowerCsc<'a> {
+    fn from(p: &'a HessianPattern) -> Self {
+        crate::numeric::sparse::LowerCsc {
+            n: p.n(),
+            col_ptr: &p.col_ptr,
+            row_idx: &p.row_idx,
+        }
+    }
+}
+
 impl HessianPattern {
     /// Pattern over the vertices with `fixed[v] == false`.
     pub fn new(md: &MeshData, fixed: &[bool]) -> HessianPattern {

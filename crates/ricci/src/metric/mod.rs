@@ -7,7 +7,9 @@
 //! * [`kernel`] — the allocation-free evaluation of lengths, angles, curvature and Hessian;
 //! * [`file`] — the metric file (`METRIC.json`): one reader and writer for every command;
 //! * [`intrinsic`] — intrinsic (Δ-complex) triangulations with log Penner coordinates, Ptolemy
-//!   flips and the Penner Delaunay criterion (discrete conformal equivalence).
+//!   flips and the Penner Delaunay criterion (discrete conformal equivalence);
+//! * [`refine`] — intrinsic refinement: metric-preserving edge splits and flips in E², H², S²
+//!   (paper 000 Step 2), moved here from `mesh` because it needs the background geometries.
 //!
 //! **Energy and signs.** We use the convex Ricci energy `E(u) = ∫ Σ (K_i − K̄_i) du_i`, whose
 //! gradient is `K − K̄` and whose Hessian is `H = ∂K/∂u` (positive semidefinite in E², with the
@@ -23,6 +25,7 @@ pub mod file;
 pub mod geometry;
 pub mod intrinsic;
 pub mod kernel;
+pub mod refine;
 pub mod scheme;
 
 pub use conformal::ConformalStructure;

@@ -38,8 +38,8 @@
 //! paper 000 (eq. 14, Fig. 13) constrains control points by it.
 
 use crate::error::{Error, Result};
-use crate::layout::dd::Dd;
 use crate::mesh::Mesh;
+use crate::numeric::dd::Dd;
 
 use super::poly::Polynomial;
 use super::simplex::{det3, n_partials, Point, SimplexFamily};
@@ -1217,7 +1217,10 @@ impl DmsSpace {
         ws: &mut Workspace,
         out: &mut [f64],
     ) -> Result<()> {
-        crate::spline::fit::evaluate(self, control, dim, face, u, order, ws, out)
+        let n = self.domain().n_faces() * per_triangle(self.degree());
+        evaluate_with(control, dim, n, order, ws, out, |ws| {
+            self.basis_at(face, u, order, ws)
+        })
     }
 
     /// Control points (`dim` = 1) of a polynomial of degree `≤ n` by blossoming: the spline
@@ -1264,5 +1267,70 @@ impl DmsSpace {
             }
         }
         Ok(c)
+    }
+}
+
+/// `F = Σ c N` and its partials up to `order` (`out[k * dim + d]`) for a spline space with
+/// `n_control_points` control points, `basis` filling `ws` with the basis functions at the
+/// point ([`DmsSpace::evaluate`], [`super::space::evaluate`]).
+pub(crate) fn evaluate_with(
+    control: &[f64],
+    dim: usize,
+    n_control_points: usize,
+    order: usize,
+    ws: &mut Workspace,
+    out: &mut [f64],
+    basis: impl FnOnce(&mut Workspace) -> Result<usize>,
+) -> Result<()> {
+    let np = n_partials(order);
+    if control.len() != n_control_points * dim || out.len() < np * dim {
+        return Err(Error::input(format!(
+            "spline evaluation: {} control numbers for {} control points of dimension {dim}, output of {} for {} numbers",
+            control.len(),
+            n_control_points,
+            out.len(),
+            np * dim
+        )));
+    }
+    let m = basis(ws)?;
+    combine(control, dim, m, np, ws, out);
+    Ok(())
+}
+
+/// `out = Σ_i c_{indices[i]} values[i]` over the first `m` basis functions of `ws`, summed as
+/// `c_0 + Σ_i (c_i − c_0) values[i]` (partials: without the `c_0` term), `c_0` the first
+/// function's control point: equal by the partition of unity (`Σ N = 1`, `Σ ∂^α N = 0`), but
+/// the terms are of the size of the spline's support instead of its distance from the origin.
+/// A face's second partials are sums of terms up to 10⁶ × their result; in the plain form
+/// their rounding (`ε |c|`) alone reached 1e-10 of `∂²F`.
+pub(crate) fn combine(
+    control: &[f64],
+    dim: usize,
+    m: usize,
+    np: usize,
+    ws: &Workspace,
+    out: &mut [f64],
+) {
+    out[..np * dim].fill(0.0);
+    if m == 0 {
+        return;
+    }
+    let g0 = ws.indices[0] as usize;
+    let c0 = &control[g0 * dim..(g0 + 1) * dim];
+    for i in 0..m {
+        let g = ws.indices[i] as usize;
+        let vals = &ws.values[i * np..(i + 1) * np];
+        let c = &control[g * dim..(g + 1) * dim];
+        for k in 0..np {
+            let v = vals[k];
+            if v != 0.0 {
+                for d in 0..dim {
+                    out[k * dim + d] += v * (c[d] - c0[d]);
+                }
+            }
+        }
+    }
+    for d in 0..dim {
+        out[d] += c0[d];
     }
 }

@@ -30,166 +30,23 @@
 
 use std::collections::HashMap;
 
-use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
-use faer::{Mat, Side};
+use faer::Mat;
 
 use crate::error::{Error, Result};
+use crate::numeric::{dense::gram, sparse::Cholesky};
 
-use super::dms::{multi_indices, DmsSpace, Precision, Workspace};
+use super::dms::{multi_indices, Precision, Workspace};
 use super::simplex::{n_partials, Point};
 
-/// What the fairing and the fit need from a spline space: the planar [`DmsSpace`] and the
-/// manifold space of [`crate::spline::manifold`] both provide it. Control points are indexed
-/// `triangle * per_triangle + position of β`; a *parameter point* is whatever the space uses
-/// to name a point of a triangle (the domain point for [`DmsSpace`], the coordinates in the
-/// face's canonical chart for a manifold space), and derivatives are taken in an orthonormal
-/// frame of that parametrisation.
-pub trait SplineSpace: Sync {
-    fn degree(&self) -> usize;
-    /// Number of triangles (control points are stored for all of them; inactive triangles
-    /// carry control points that no basis function uses).
-    fn n_triangles(&self) -> usize;
-    fn per_triangle(&self) -> usize {
-        super::dms::per_triangle(self.degree())
-    }
-    fn n_control_points(&self) -> usize {
-        self.n_triangles() * self.per_triangle()
-    }
-    /// Ordered pairs `(I, J, o)` of triangles of the spline that share an edge, `o` the local
-    /// index of `I`'s vertex opposite the edge (both orientations of every edge).
-    fn neighbour_pairs(&self) -> Vec<(u32, u32, usize)>;
-    /// Blossom weights of `J`'s control points at the blossom arguments of `I`'s control point
-    /// `β` (both expressed in one coordinate system).
-    fn blossom_weights_between(&self, i: u32, beta: [usize; 3], j: u32, out: &mut [f64]);
-    /// All basis functions that may be non-zero at `param` in triangle `face`, with partials
-    /// up to `order` (see [`DmsSpace::basis_at`]).
-    fn basis_at(&self, face: u32, param: Point, order: usize, ws: &mut Workspace) -> Result<usize>;
-    /// Quadrature of the thin-plate energy with `rule` on every triangle — barycentric
-    /// points with weights as fractions of the triangle's area: `(face, parameter point,
-    /// weight)`.
-    fn quadrature_with(&self, rule: &[([f64; 3], f64)]) -> Vec<(u32, Point, f64)>;
-    /// The quadrature of the fit and of [`thin_plate_energy`]:
-    /// [`quadrature_with`](Self::quadrature_with) the rule [`quadrature_barycentric`].
-    fn quadrature(&self) -> Vec<(u32, Point, f64)> {
-        self.quadrature_with(&quadrature_barycentric())
-    }
-    /// Mean edge length and total area of the parameter domain (to make `λ` scale-free).
-    fn domain_scale(&self) -> (f64, f64);
-}
-
-impl SplineSpace for DmsSpace {
-    fn degree(&self) -> usize {
-        DmsSpace::degree(self)
-    }
-    fn n_triangles(&self) -> usize {
-        self.domain().n_faces()
-    }
-    fn neighbour_pairs(&self) -> Vec<(u32, u32, usize)> {
-        let mesh = self.domain().mesh();
-        let mut out = Vec::new();
-        for h in 0..mesh.n_corners() as u32 {
-            let t = mesh.he_twin(h);
-            if mesh.is_boundary_halfedge(t) {
-                continue;
-            }
-            out.push((h / 3, t / 3, (h as usize % 3 + 2) % 3));
-        }
-        out
-    }
-    fn blossom_weights_between(&self, i: u32, beta: [usize; 3], j: u32, out: &mut [f64]) {
-        let args = self.triangle(i).blossom_args(beta);
-        self.triangle(j).blossom_weights(&args, out);
-    }
-    fn basis_at(&self, face: u32, param: Point, order: usize, ws: &mut Workspace) -> Result<usize> {
-        DmsSpace::basis_at(self, face, param, order, ws)
-    }
-    fn quadrature_with(&self, rule: &[([f64; 3], f64)]) -> Vec<(u32, Point, f64)> {
-        quadrature(self, rule)
-    }
-    fn domain_scale(&self) -> (f64, f64) {
-        let dom = self.domain();
-        let mesh = dom.mesh();
-        let mut hsum = 0.0;
-        for e in 0..mesh.n_edges() as u32 {
-            let [a, b] = mesh.edge_vertices(e).map(|v| dom.points()[v as usize]);
-            hsum += (a[0] - b[0]).hypot(a[1] - b[1]);
-        }
-        let area: f64 = (0..dom.n_faces() as u32)
-            .map(|f| {
-                let [a, b, c] = dom.face_points(f);
-                0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
-            })
-            .sum();
-        (hsum / mesh.n_edges().max(1) as f64, area)
-    }
-}
-
-/// `F = Σ c N` and its partials up to `order` at a parameter point of any [`SplineSpace`]
-/// (`out[k * dim + d]`, see [`DmsSpace::evaluate`]).
-#[allow(clippy::too_many_arguments)]
-pub fn evaluate<S: SplineSpace + ?Sized>(
-    space: &S,
-    control: &[f64],
-    dim: usize,
-    face: u32,
-    param: Point,
-    order: usize,
-    ws: &mut Workspace,
-    out: &mut [f64],
-) -> Result<()> {
-    let np = n_partials(order);
-    if control.len() != space.n_control_points() * dim || out.len() < np * dim {
-        return Err(Error::input(format!(
-            "spline evaluation: {} control numbers for {} control points of dimension {dim}, output of {} for {} numbers",
-            control.len(),
-            space.n_control_points(),
-            out.len(),
-            np * dim
-        )));
-    }
-    let m = space.basis_at(face, param, order, ws)?;
-    combine(control, dim, m, np, ws, out);
-    Ok(())
-}
-
-/// `out = Σ_i c_{indices[i]} values[i]` over the first `m` basis functions of `ws`, summed as
-/// `c_0 + Σ_i (c_i − c_0) values[i]` (partials: without the `c_0` term), `c_0` the first
-/// function's control point: equal by the partition of unity (`Σ N = 1`, `Σ ∂^α N = 0`), but
-/// the terms are of the size of the spline's support instead of its distance from the origin.
-/// A face's second partials are sums of terms up to 10⁶ × their result; in the plain form
-/// their rounding (`ε |c|`) alone reached 1e-10 of `∂²F`.
-pub(crate) fn combine(
-    control: &[f64],
-    dim: usize,
-    m: usize,
-    np: usize,
-    ws: &Workspace,
-    out: &mut [f64],
-) {
-    out[..np * dim].fill(0.0);
-    if m == 0 {
-        return;
-    }
-    let g0 = ws.indices[0] as usize;
-    let c0 = &control[g0 * dim..(g0 + 1) * dim];
-    for i in 0..m {
-        let g = ws.indices[i] as usize;
-        let vals = &ws.values[i * np..(i + 1) * np];
-        let c = &control[g * dim..(g + 1) * dim];
-        for k in 0..np {
-            let v = vals[k];
-            if v != 0.0 {
-                for d in 0..dim {
-                    out[k * dim + d] += v * (c[d] - c0[d]);
-                }
-            }
-        }
-    }
-    for d in 0..dim {
-        out[d] += c0[d];
-    }
-}
+/// Compatibility re-exports: the spline-space interface and the quadrature rules moved to
+/// [`super::space`] and [`super::quadrature`] (so that [`super::dms`] and this module no
+/// longer import each other); the paths `spline::fit::…` keep working.
+pub use super::quadrature::{
+    quadrature_barycentric, quadrature_barycentric_graded, quadrature_barycentric_subdivided,
+    QUADRATURE_GRADING, QUADRATURE_SUBDIVISION,
+};
+pub use super::space::{evaluate, SplineSpace};
 
 /// One fairing constraint `c̃[single] − Σ_b weights[b] c̃[target * nb + b] = 0`.
 #[derive(Debug, Clone)]
@@ -407,7 +264,7 @@ pub fn fair<S: SplineSpace + ?Sized>(
         let aat = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &t2)
             .map_err(|e| Error::numerical(format!("fairing: could not assemble A Aᵀ ({e:?})")))?;
         drop(t2);
-        let Ok(llt) = aat.sp_cholesky(Side::Lower) else {
+        let Ok(llt) = Cholesky::factor(aat.as_ref()) else {
             continue;
         };
         let precond = |r: &[f64]| -> Vec<f64> {
@@ -416,7 +273,6 @@ pub fn fair<S: SplineSpace + ?Sized>(
                 z[(i, 0)] = r[i];
             }
             llt.solve_in_place(z.as_mut());
-            crate::simd::clear_upper_state();
             (0..m).map(|i| z[(i, 0)]).collect()
         };
         // Preconditioned conjugate gradients on the consistent system A Aᵀ y = A c, one coordinate
@@ -659,118 +515,6 @@ impl Blocks {
     }
 }
 
-/// Sub-triangles per edge of the thin-plate quadrature rule ([`quadrature_barycentric`]).
-///
-/// Within one domain triangle a DMS spline is not one polynomial: the knot lines of the
-/// simplex splines whose supports overlap it cut it into many polynomial pieces, smallest
-/// near the vertices, whose knot clouds they come from. A rule exact for one quadratic is
-/// not enough, and the fit finds whatever the rule does not see: with the former 12-point
-/// rule (2 per edge, no grading) a fit of eight.off to its vertices lowered the rule's energy
-/// from 679 to 384 while the energy measured with 3 072 points per triangle was 465 and the
-/// zebra stripes turned to noise at the vertices. 3 per edge graded twice towards the corners
-/// (315 points) makes the fit honest: its result's energy with 768 and 3 072 uniform points
-/// agrees to 0.5 % (426 vs 428), its own estimate is 10 % low (test `spline_fit`), at about
-/// 26× the cost of the old rule. Only the fit uses the rule.
-pub const QUADRATURE_SUBDIVISION: usize = 3;
-
-/// Levels of grading of the quadrature rule towards the triangle's corners
-/// ([`quadrature_barycentric_graded`]).
-pub const QUADRATURE_GRADING: usize = 2;
-
-/// A thin-plate quadrature rule of one triangle: the triangle cut into `k²` congruent
-/// sub-triangles (`k` per edge), the 3-point rule (points at 1/6, 1/6, 2/3, exact for
-/// quadratics) in each — `3k²` barycentric points, each of weight `1/(3k²)` of the area.
-pub fn quadrature_barycentric_subdivided(k: usize) -> Vec<[f64; 3]> {
-    let k = k.max(1);
-    let rule = [
-        [2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0],
-        [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
-        [1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0],
-    ];
-    let p = |i: usize, j: usize| {
-        [
-            (k - i - j) as f64 / k as f64,
-            i as f64 / k as f64,
-            j as f64 / k as f64,
-        ]
-    };
-    let mut out = Vec::with_capacity(3 * k * k);
-    for i in 0..k {
-        for j in 0..k - i {
-            let mut subs = vec![[p(i, j), p(i + 1, j), p(i, j + 1)]];
-            if i + j + 1 < k {
-                subs.push([p(i + 1, j), p(i + 1, j + 1), p(i, j + 1)]);
-            }
-            for s in subs {
-                for r in &rule {
-                    let mut x = [0.0; 3];
-                    for (c, xc) in x.iter_mut().enumerate() {
-                        *xc = r[0] * s[0][c] + r[1] * s[1][c] + r[2] * s[2][c];
-                    }
-                    out.push(x);
-                }
-            }
-        }
-    }
-    out
-}
-
-/// [`quadrature_barycentric_subdivided`]`(k)` with the `3` sub-triangles at the corners
-/// replaced, `depth` times recursively, by the same rule (grading towards the vertices, where
-/// the knot clouds cut the spline into its smallest polynomial pieces). Returns
-/// `(barycentric point, weight as a fraction of the triangle's area)`.
-pub fn quadrature_barycentric_graded(k: usize, depth: usize) -> Vec<([f64; 3], f64)> {
-    let k = k.max(2);
-    let base = quadrature_barycentric_subdivided(k);
-    let w = 1.0 / base.len() as f64;
-    // Sub-triangle of a base point: (i, j, upper) from its position; corner sub-triangles are
-    // the three whose vertex is a corner of the triangle.
-    let corner_of = |x: &[f64; 3]| (0..3).find(|&c| x[c] * k as f64 > (k - 1) as f64);
-    let mut out: Vec<([f64; 3], f64)> = Vec::new();
-    for x in &base {
-        if depth == 0 || corner_of(x).is_none() {
-            out.push((*x, w));
-        }
-    }
-    if depth > 0 {
-        let inner = quadrature_barycentric_graded(k, depth - 1);
-        let s = 1.0 / k as f64;
-        for c in 0..3 {
-            // Corner sub-triangle: corner c, and the points at 1/k along the two edges.
-            for (y, wy) in &inner {
-                let mut x = [0.0; 3];
-                for (d, xd) in x.iter_mut().enumerate() {
-                    *xd = s * y[d];
-                }
-                x[c] += 1.0 - s;
-                out.push((x, wy * s * s));
-            }
-        }
-    }
-    out
-}
-
-/// The thin-plate quadrature rule of the fit:
-/// [`quadrature_barycentric_graded`]`(`[`QUADRATURE_SUBDIVISION`]`, `[`QUADRATURE_GRADING`]`)`.
-pub fn quadrature_barycentric() -> Vec<([f64; 3], f64)> {
-    quadrature_barycentric_graded(QUADRATURE_SUBDIVISION, QUADRATURE_GRADING)
-}
-
-/// Thin-plate quadrature (`rule` on every face, equal weights). Returns
-/// `(face, point, weight)`.
-fn quadrature(space: &DmsSpace, rule: &[([f64; 3], f64)]) -> Vec<(u32, Point, f64)> {
-    let dom = space.domain();
-    let mut q = Vec::with_capacity(dom.n_faces() * rule.len());
-    for f in 0..dom.n_faces() as u32 {
-        let [a, b, c] = dom.face_points(f);
-        let area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
-        for &(bary, w) in rule {
-            q.push((f, dom.point_in_face(f, bary), area * w));
-        }
-    }
-    q
-}
-
 /// Thin-plate energy of a spline (the quadrature of [`fit`]).
 pub fn thin_plate_energy<S: SplineSpace + ?Sized>(
     space: &S,
@@ -857,15 +601,15 @@ fn energy_gram<S: SplineSpace + ?Sized>(space: &S, blocks: &mut Blocks) -> Resul
                     v[(3 * r + c, col)] += dc;
                 }
             }
-            let g = v.transpose() * &v;
-            // This thread goes on with the next triangle's basis evaluations (`crate::simd`).
-            crate::simd::clear_upper_state_here();
+            // (`gram` leaves this thread's vector registers clean for the next triangle's
+            // basis evaluations, `crate::numeric::simd`.)
+            let g = gram(&v);
             Ok((groups, g))
         })
         .collect::<Result<_>>()?;
-    // faer's dense kernels leave the AVX upper state dirty on the threads that ran them, which
-    // slows all later baseline (SSE) code there ~10× (`crate::simd`).
-    crate::simd::clear_upper_state();
+    // faer may have spread a product over other threads of the pool, which `gram` cannot
+    // clean from the calling thread: clean them all once after the phase.
+    crate::numeric::simd::clear_upper_state();
     for (groups, g) in grams {
         for (la, &ta) in groups.iter().enumerate() {
             for (lb, &tb) in groups.iter().enumerate() {
@@ -1006,7 +750,7 @@ pub fn fit<S: SplineSpace + ?Sized>(
         Error::numerical(format!("fit: could not assemble the normal matrix ({e:?})"))
     })?;
     drop(trip);
-    let llt = h.sp_cholesky(Side::Lower).map_err(|e| {
+    let llt = Cholesky::factor(h.as_ref()).map_err(|e| {
         Error::numerical(format!("fit: Cholesky of the normal matrix failed ({e:?})"))
     })?;
     let mut sol = Mat::<f64>::zeros(nc, dim);
@@ -1017,8 +761,6 @@ pub fn fit<S: SplineSpace + ?Sized>(
     }
     llt.solve_in_place(sol.as_mut());
     drop(llt);
-    // The supernodal factorisation ran faer's dense kernels too (`crate::simd`).
-    crate::simd::clear_upper_state();
     let mut x = vec![0.0; nc * dim];
     for k in 0..nc {
         for d in 0..dim {

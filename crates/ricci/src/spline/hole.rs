@@ -46,9 +46,9 @@ use crate::error::{Error, Result};
 use crate::layout::RigidMotion;
 
 use super::dms::Workspace;
-use super::fit::evaluate;
 use super::manifold::{apply, cz, rotate_partials, star_frame, ManifoldSpace};
 use super::simplex::{det3, Point};
+use super::space::evaluate;
 
 /// A point of the two-ring of a cone: face, barycentric coordinates, and the motion from the
 /// unrolled frame to the face's canonical chart.

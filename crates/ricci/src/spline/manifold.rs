@@ -81,16 +81,17 @@ use rayon::prelude::*;
 
 use crate::atlas::{fit_rigid, ChartId, FlatCharts};
 use crate::error::{Error, Result};
-use crate::layout::dd::Dd;
 use crate::layout::RigidMotion;
 use crate::mesh::Mesh;
+use crate::numeric::dd::Dd;
 
+use super::dms::combine;
 use super::dms::{
     blossom_weights_of, general_position_involving, hash64, multi_indices, needs_shrink,
     per_triangle, unit, KnotOptions, Precision, TriangleBasis, Workspace, MAX_DEGREE,
 };
-use super::fit::{combine, SplineSpace};
 use super::simplex::{det3, n_partials, partial_index, Point};
+use super::space::SplineSpace;
 
 #[inline]
 pub(crate) fn cz(p: Point) -> C {

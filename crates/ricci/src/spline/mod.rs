@@ -5,8 +5,13 @@
 //! * [`poly`] — bivariate polynomials and their blossoms;
 //! * [`dms`] — the DMS basis over a planar triangulation: knot clouds, admissibility, evaluation
 //!   of splines and derivatives, control points of polynomials, B-patch blossoms;
+//! * [`space`] — [`space::SplineSpace`], what the fairing and the fit need from a spline space
+//!   (implemented by [`dms::DmsSpace`] and [`manifold::ManifoldSpace`]), and evaluation of
+//!   `Σ c N` on any of them;
+//! * [`quadrature`] — the graded quadrature rules of the thin-plate energy;
 //! * [`fit`] — paper 000's fairing by constrained least squares (fairness parameter `r`) and a
-//!   least-squares fit to data with a thin-plate fairness term, generic over [`fit::SplineSpace`];
+//!   least-squares fit to data with a thin-plate fairness term, generic over
+//!   [`space::SplineSpace`];
 //! * [`manifold`] — the same basis over a flat cone metric and its charts (paper 000 §5): knots
 //!   in vertex frames, bases in home charts, chart-independent evaluation, the independent chart
 //!   provider [`manifold::LocalCharts`];
@@ -22,5 +27,7 @@ pub mod fit;
 pub mod hole;
 pub mod manifold;
 pub mod poly;
+pub mod quadrature;
 pub mod simplex;
+pub mod space;
 pub mod surface;

@@ -41,7 +41,7 @@
 use std::collections::HashMap;
 
 use crate::error::{Error, Result};
-use crate::layout::dd::Dd;
+use crate::numeric::dd::Dd;
 
 /// A point or vector in the plane.
 pub type Point = [f64; 2];

@@ -34,10 +34,11 @@ use crate::metric::{Geometry, Scheme};
 use crate::progress::Progress;
 
 use super::dms::{KnotOptions, Workspace};
-use super::fit::{evaluate, fair, fit, DataPoint, FairingReport, FitOptions, FitReport};
+use super::fit::{fair, fit, DataPoint, FairingReport, FitOptions, FitReport};
 use super::hole::{Hole, SeamReport};
 use super::manifold::{apply, rotate_partials, LocalCharts, ManifoldReport, ManifoldSpace};
 use super::simplex::{n_partials, Point};
+use super::space::evaluate;
 
 /// Where the cone of a closed surface of genus ≥ 2 goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -140,7 +141,7 @@ pub fn flat_domain(
             .map(|h| lengths[mesh.he_edge(h) as usize])
             .sum::<f64>()
             / mesh.valence(s).max(1) as f64;
-        let mut rf = crate::mesh::refine::Refiner::new(
+        let mut rf = crate::metric::refine::Refiner::new(
             mesh,
             &lengths,
             Geometry::Euclidean,
@@ -1230,12 +1231,7 @@ pub struct MeshDistance {
     pub diagonal: f64,
 }
 
-fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
+use crate::numeric::vec3::{dot as dot3, sub as sub3};
 
 /// Distance from `p` to triangle `t` (Ericson, *Real-Time Collision Detection*, 5.1.5).
 pub fn point_triangle_distance(p: [f64; 3], t: &[[f64; 3]; 3]) -> f64 {

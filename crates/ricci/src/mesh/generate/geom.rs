@@ -1,47 +1,7 @@
-//! Small vector helpers and triangle-quality measures shared by the generators.
+//! Triangle-quality measures shared by the generators (the vector helpers are
+//! [`crate::numeric::vec3`]'s).
 
-pub(crate) type P3 = [f64; 3];
-
-#[inline]
-pub(crate) fn sub(a: P3, b: P3) -> P3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-#[inline]
-pub(crate) fn add(a: P3, b: P3) -> P3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-#[inline]
-pub(crate) fn scale(a: P3, s: f64) -> P3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-#[inline]
-pub(crate) fn dot(a: P3, b: P3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-#[inline]
-pub(crate) fn cross(a: P3, b: P3) -> P3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-#[inline]
-pub(crate) fn norm(a: P3) -> f64 {
-    dot(a, a).sqrt()
-}
-#[inline]
-pub(crate) fn dist(a: P3, b: P3) -> f64 {
-    norm(sub(a, b))
-}
-#[inline]
-pub(crate) fn lerp(a: P3, b: P3, t: f64) -> P3 {
-    [
-        a[0] + t * (b[0] - a[0]),
-        a[1] + t * (b[1] - a[1]),
-        a[2] + t * (b[2] - a[2]),
-    ]
-}
+pub(crate) use crate::numeric::vec3::{add, cross, dist, dot, lerp, norm, scale, sub, Vec3 as P3};
 
 /// Unnormalised normal `(b − a) × (c − a)` (twice the area vector).
 #[inline]

@@ -7,8 +7,10 @@
 //! 2-core Xeon VM: after the spline fit's per-triangle Gram products the double-double spline
 //! evaluation ran 10× slower on the threads that had run a kernel (continuity report of the
 //! demo surface 0.20 s → 2.2 s, until the process ended). `vzeroupper` on every thread of the
-//! pool restores the clean state: [`clear_upper_state`] after parallel phases,
-//! [`clear_upper_state_here`] after the flows' sequential sparse factorisations and solves.
+//! pool restores the clean state: [`clear_upper_state`] after kernels that may have run on the
+//! pool, [`clear_upper_state_here`] after sequential ones. The library calls them only inside
+//! the faer wrappers of [`super::sparse`] and [`super::dense`]; code that calls faer's
+//! factorizations or dense products directly must call them itself.
 
 /// Execute `vzeroupper` on the calling thread (when the CPU has AVX): after a sequential faer
 /// factorisation or solve (`Par::Seq`), which ran its kernels on this thread only.

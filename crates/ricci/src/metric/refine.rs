@@ -34,11 +34,10 @@
 //! appended), vertices keep their ids (new ones are appended), and the provenance of every new
 //! vertex (edge endpoints and parameter) is recorded.
 
-use super::connectivity::{Mesh, NONE};
+use super::Geometry;
 use crate::error::{Error, Result};
-use crate::metric::Geometry;
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
+use crate::mesh::{Mesh, NONE};
+use crate::numeric::dijkstra::{Dijkstra, NO_PRED};
 use std::f64::consts::PI;
 
 /// Where a vertex created by refinement lies: on the edge from `a` to `b` (ids in the refined
@@ -716,22 +715,17 @@ impl Refiner {
             adj[fill[b as usize] as usize] = (a, l);
             fill[b as usize] += 1;
         }
-        let mut dist = vec![f64::INFINITY; nv];
-        let mut heap = BinaryHeap::new();
-        dist[x as usize] = 0.0;
-        heap.push(MinItem(0.0, x));
-        while let Some(MinItem(d, v)) = heap.pop() {
-            if d > dist[v as usize] || d > cutoff {
-                continue;
-            }
-            for &(w, l) in &adj[start[v as usize] as usize..start[v as usize + 1] as usize] {
-                let nd = d + l;
-                if nd < dist[w as usize] {
-                    dist[w as usize] = nd;
-                    heap.push(MinItem(nd, w));
-                }
-            }
-        }
+        let mut search = Dijkstra::new(nv);
+        search.offer(x, 0.0, NO_PRED);
+        search.run(
+            |v| {
+                adj[start[v as usize] as usize..start[v as usize + 1] as usize]
+                    .iter()
+                    .copied()
+            },
+            |d, _| d > cutoff,
+        );
+        let mut dist = search.into_distances();
         for d in &mut dist {
             if *d > cutoff {
                 *d = f64::INFINITY;
@@ -956,26 +950,6 @@ pub fn side(g: Geometry, b: f64, c: f64, theta: f64) -> f64 {
                 .min(1.0)
                 .asin()
         }
-    }
-}
-
-/// Min-heap item for Dijkstra (smallest distance first).
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct MinItem(pub f64, pub u32);
-impl PartialEq for MinItem {
-    fn eq(&self, o: &Self) -> bool {
-        self.cmp(o) == Ordering::Equal
-    }
-}
-impl Eq for MinItem {}
-impl PartialOrd for MinItem {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for MinItem {
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.0.total_cmp(&self.0).then_with(|| o.1.cmp(&self.1))
     }
 }
 

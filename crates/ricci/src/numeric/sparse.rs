@@ -1,0 +1,401 @@
+//! Sparse linear solves with faer, the only place the library factorizes sparse matrices.
+//!
+//! * [`SymmetricSolver`] — symmetric matrices with a fixed pattern (lower triangle, CSC,
+//!   [`LowerCsc`]): AMD ordering and the symbolic Cholesky factorization are computed once
+//!   and reused for every numeric factorization (LLᵀ for positive definite matrices such as
+//!   the E² and H² Hessians of the flows, LDLᵀ for the indefinite S² Hessian).
+//!   Single-threaded factorization (DESIGN.md §2 measured no gain from two threads on this
+//!   machine).
+//! * [`SparseLu`] — general square matrices assembled from triplets with the same pattern at
+//!   every call: the symbolic LU analysis is computed once.
+//! * [`Cholesky`] — one-shot sparse Cholesky LLᵀ of a symmetric positive definite matrix
+//!   assembled from triplets (faer's supernodal factorization), solved for several
+//!   right-hand sides.
+//!
+//! faer's dense kernels inside these factorizations leave the upper halves of the AVX
+//! registers dirty; every factorization and solve here ends with `vzeroupper`
+//! ([`super::simd`]), so callers never have to.
+
+use crate::error::{Error, Result};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky,
+    SymmetricOrdering,
+};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, MatMut, Par, Side};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Factored {
+    None,
+    Llt,
+    Ldlt,
+}
+
+/// The pattern of the lower triangle of a symmetric `n × n` matrix in compressed sparse
+/// columns: the rows of column `j` are `row_idx[col_ptr[j]..col_ptr[j + 1]]`, and a matrix
+/// with this pattern is given by its values in the same order.
+#[derive(Debug, Clone, Copy)]
+pub struct LowerCsc<'a> {
+    pub n: usize,
+    pub col_ptr: &'a [u32],
+    pub row_idx: &'a [u32],
+}
+
+/// The matrix with lower-triangle pattern `(col_ptr, row_idx)` and `values` (checked by
+/// [`SymmetricSolver::new`] and the callers).
+fn lower<'a>(
+    n: usize,
+    col_ptr: &'a [u32],
+    row_idx: &'a [u32],
+    values: &'a [f64],
+) -> SparseColMatRef<'a, u32, f64> {
+    SparseColMatRef::new(
+        SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx),
+        values,
+    )
+}
+
+/// A reusable sparse symmetric factorization for one sparsity pattern (lower triangle).
+pub struct SymmetricSolver {
+    n: usize,
+    col_ptr: Vec<u32>,
+    row_idx: Vec<u32>,
+    symbolic: SymbolicCholesky<u32>,
+    l_values: Vec<f64>,
+    mem: MemBuffer,
+    factored: Factored,
+    /// Number of nonzeros of the factor (for reports).
+    pub factor_nnz: usize,
+}
+
+impl SymmetricSolver {
+    /// Symbolic analysis (AMD ordering, elimination tree, supernodes) of `pattern` (a
+    /// [`LowerCsc`], or anything that converts to one, such as a Hessian pattern).
+    pub fn new<'a>(pattern: impl Into<LowerCsc<'a>>) -> Result<SymmetricSolver> {
+        let pattern = pattern.into();
+        let n = pattern.n;
+        if pattern.col_ptr.len() != n + 1
+            || pattern.col_ptr[n] as usize != pattern.row_idx.len()
+            || pattern.col_ptr.windows(2).any(|w| w[0] > w[1])
+            || pattern.row_idx.iter().any(|&r| r as usize >= n)
+        {
+            return Err(Error::numerical(format!(
+                "the sparse pattern is not a valid {n}×{n} CSC pattern"
+            )));
+        }
+        let col_ptr = pattern.col_ptr.to_vec();
+        let row_idx = pattern.row_idx.to_vec();
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
+        let symbolic = factorize_symbolic_cholesky(
+            sym,
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| Error::numerical(format!("symbolic Cholesky factorization failed: {e:?}")))?;
+        let par = Par::Seq;
+        let req = StackReq::any_of(&[
+            symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
+            symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()),
+            symbolic.solve_in_place_scratch::<f64>(1, par),
+        ]);
+        let mem = MemBuffer::try_new(req)
+            .map_err(|_| Error::numerical("out of memory for the Cholesky workspace"))?;
+        let len = symbolic.len_val();
+        Ok(SymmetricSolver {
+            n,
+            col_ptr,
+            row_idx,
+            symbolic,
+            l_values: vec![0.0; len],
+            mem,
+            factored: Factored::None,
+            factor_nnz: len,
+        })
+    }
+
+    /// Dimension of the matrix.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// Numeric LLᵀ factorization of the matrix with the pattern's lower-triangle `values`.
+    /// Returns false if the matrix is not numerically positive definite (or `values` does not
+    /// fit the pattern).
+    pub fn factor_llt(&mut self, values: &[f64]) -> bool {
+        if values.len() != self.row_idx.len() {
+            self.factored = Factored::None;
+            return false;
+        }
+        let a = lower(self.n, &self.col_ptr, &self.row_idx, values);
+        let stack = MemStack::new(&mut self.mem);
+        let ok = self
+            .symbolic
+            .factorize_numeric_llt(
+                &mut self.l_values,
+                a,
+                Side::Lower,
+                LltRegularization::default(),
+                Par::Seq,
+                stack,
+                Default::default(),
+            )
+            .is_ok();
+        super::simd::clear_upper_state_here();
+        self.factored = if ok { Factored::Llt } else { Factored::None };
+        ok
+    }
+
+    /// Numeric LDLᵀ factorization (symmetric indefinite, no pivoting beyond the fill-reducing
+    /// ordering). Returns false on a zero pivot.
+    pub fn factor_ldlt(&mut self, values: &[f64]) -> bool {
+        if values.len() != self.row_idx.len() {
+            self.factored = Factored::None;
+            return false;
+        }
+        let a = lower(self.n, &self.col_ptr, &self.row_idx, values);
+        let stack = MemStack::new(&mut self.mem);
+        let ok = self
+            .symbolic
+            .factorize_numeric_ldlt(
+                &mut self.l_values,
+                a,
+                Side::Lower,
+                LdltRegularization::default(),
+                Par::Seq,
+                stack,
+                Default::default(),
+            )
+            .is_ok();
+        super::simd::clear_upper_state_here();
+        self.factored = if ok { Factored::Ldlt } else { Factored::None };
+        ok && self.l_values.iter().all(|x| x.is_finite())
+    }
+
+    /// Solve in place with the last factorization.
+    pub fn solve(&mut self, rhs: &mut [f64]) {
+        debug_assert_eq!(rhs.len(), self.n);
+        let stack = MemStack::new(&mut self.mem);
+        let x = MatMut::from_column_major_slice_mut(rhs, self.n, 1);
+        match self.factored {
+            Factored::Llt => LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
+                Conj::No,
+                x,
+                Par::Seq,
+                stack,
+            ),
+            Factored::Ldlt => LdltRef::new(&self.symbolic, &self.l_values)
+                .solve_in_place_with_conj(Conj::No, x, Par::Seq, stack),
+            Factored::None => {}
+        }
+        super::simd::clear_upper_state_here();
+    }
+}
+
+/// A sparse LU factorization of square matrices assembled from triplets, with the symbolic
+/// analysis (ordering, elimination structure) computed at the first factorization and reused
+/// while the triplets keep the same pattern in the same order.
+#[derive(Default)]
+pub struct SparseLu {
+    symbolic: Option<faer::sparse::linalg::solvers::SymbolicLu<u32>>,
+    lu: Option<faer::sparse::linalg::solvers::Lu<u32, f64>>,
+}
+
+impl SparseLu {
+    pub fn new() -> SparseLu {
+        SparseLu::default()
+    }
+
+    /// Factorize the `n × n` matrix with entries `(row, col, value)` (duplicates are summed).
+    /// Returns false when the matrix cannot be assembled or is numerically singular.
+    pub fn factor(&mut self, n: usize, triplets: &[faer::sparse::Triplet<u32, u32, f64>]) -> bool {
+        use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+        self.lu = None;
+        let Ok(a) = faer::sparse::SparseColMat::<u32, f64>::try_new_from_triplets(n, n, triplets)
+        else {
+            return false;
+        };
+        if self.symbolic.is_none() {
+            self.symbolic = SymbolicLu::try_new(a.symbolic()).ok();
+        }
+        let Some(symbolic) = self.symbolic.clone() else {
+            return false;
+        };
+        self.lu = Lu::try_new_with_symbolic(symbolic, a.as_ref()).ok();
+        super::simd::clear_upper_state();
+        self.lu.is_some()
+    }
+
+    /// Solve in place with the last factorization (no-op without one).
+    pub fn solve(&self, x: &mut [f64]) {
+        use faer::linalg::solvers::SolveCore;
+        if let Some(lu) = &self.lu {
+            let n = x.len();
+            lu.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(x, n, 1));
+            super::simd::clear_upper_state();
+        }
+    }
+}
+
+/// A one-shot sparse Cholesky factorization LLᵀ of a symmetric positive definite matrix
+/// (faer's supernodal factorization, which may run dense kernels on the pool's threads).
+pub struct Cholesky {
+    llt: faer::sparse::linalg::solvers::Llt<usize, f64>,
+}
+
+impl Cholesky {
+    /// Factorize `a` (its lower triangle is read); the error is faer's, for the caller's
+    /// message (the matrix is not numerically positive definite).
+    pub fn factor(
+        a: faer::sparse::SparseColMatRef<'_, usize, f64>,
+    ) -> std::result::Result<Cholesky, faer::sparse::linalg::LltError> {
+        let llt = a.sp_cholesky(Side::Lower);
+        super::simd::clear_upper_state();
+        Ok(Cholesky { llt: llt? })
+    }
+
+    /// Solve in place for the columns of `rhs`.
+    pub fn solve_in_place(&self, rhs: faer::MatMut<'_, f64>) {
+        use faer::linalg::solvers::Solve;
+        self.llt.solve_in_place(rhs);
+        super::simd::clear_upper_state();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::sparse::Triplet;
+
+    /// Tridiagonal `A = tridiag(−1, d(i), −1)` of size `n`: lower-triangle CSC pattern and
+    /// values.
+    fn tridiagonal(n: usize, d: impl Fn(usize) -> f64) -> (Vec<u32>, Vec<u32>, Vec<f64>) {
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0u32], Vec::new(), Vec::new());
+        for j in 0..n {
+            row_idx.push(j as u32);
+            values.push(d(j));
+            if j + 1 < n {
+                row_idx.push(j as u32 + 1);
+                values.push(-1.0);
+            }
+            col_ptr.push(row_idx.len() as u32);
+        }
+        (col_ptr, row_idx, values)
+    }
+
+    /// `A x` for the tridiagonal matrix.
+    fn apply(d: impl Fn(usize) -> f64, x: &[f64]) -> Vec<f64> {
+        let n = x.len();
+        (0..n)
+            .map(|i| {
+                let l = if i > 0 { x[i - 1] } else { 0.0 };
+                let r = if i + 1 < n { x[i + 1] } else { 0.0 };
+                d(i) * x[i] - l - r
+            })
+            .collect()
+    }
+
+    fn max_error(x: &[f64], y: &[f64]) -> f64 {
+        x.iter()
+            .zip(y)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn symmetric_solver_reuses_its_analysis_for_definite_and_indefinite_matrices() {
+        let n = 50;
+        let want: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let (col_ptr, row_idx, _) = tridiagonal(n, |_| 0.0);
+        let mut s = SymmetricSolver::new(LowerCsc {
+            n,
+            col_ptr: &col_ptr,
+            row_idx: &row_idx,
+        })
+        .unwrap();
+        // Positive definite (diagonal 2.5 > 2), then indefinite (diagonal ±3, eigenvalues of
+        // both signs, pivots away from 0) with the same symbolic factorization.
+        let definite = |_: usize| 2.5;
+        let indefinite = |i: usize| if i.is_multiple_of(2) { 3.0 } else { -3.0 };
+        let (_, _, values) = tridiagonal(n, definite);
+        assert!(s.factor_llt(&values));
+        let mut x = apply(definite, &want);
+        s.solve(&mut x);
+        let err = max_error(&x, &want);
+        assert!(err < 1e-12, "definite: error {err}");
+        let (_, _, values) = tridiagonal(n, indefinite);
+        assert!(s.factor_ldlt(&values));
+        let mut x = apply(indefinite, &want);
+        s.solve(&mut x);
+        let err = max_error(&x, &want);
+        assert!(err < 1e-12, "indefinite: error {err}");
+        // LLᵀ refuses the indefinite matrix; a wrong number of values is refused too.
+        assert!(!s.factor_llt(&values));
+        assert!(!s.factor_llt(&values[1..]));
+        // An invalid pattern is an error, not a panic.
+        let bad = LowerCsc {
+            n: 3,
+            col_ptr: &[0, 1, 2],
+            row_idx: &[0, 1],
+        };
+        assert!(SymmetricSolver::new(bad).is_err());
+    }
+
+    #[test]
+    fn sparse_lu_and_cholesky_solve_their_systems() {
+        // Non-symmetric 3×3: A = [[4, 1, 0], [2, 5, 1], [0, 3, 6]], x = (1, −2, 3).
+        let a = [[4.0, 1.0, 0.0], [2.0, 5.0, 1.0], [0.0, 3.0, 6.0]];
+        let want = [1.0, -2.0, 3.0];
+        let b: Vec<f64> = (0..3)
+            .map(|i| (0..3).map(|j| a[i][j] * want[j]).sum())
+            .collect();
+        let trip: Vec<Triplet<u32, u32, f64>> = (0..3)
+            .flat_map(|i| (0..3).map(move |j| (i, j)))
+            .filter(|&(i, j)| a[i][j] != 0.0)
+            .map(|(i, j)| Triplet::new(i as u32, j as u32, a[i][j]))
+            .collect();
+        let mut lu = SparseLu::new();
+        for _ in 0..2 {
+            assert!(lu.factor(3, &trip));
+            let mut x = b.clone();
+            lu.solve(&mut x);
+            for k in 0..3 {
+                assert!((x[k] - want[k]).abs() < 1e-14, "{x:?}");
+            }
+        }
+        // Cholesky of the SPD tridiagonal matrix, two right-hand sides.
+        let n = 20;
+        let (col_ptr, row_idx, values) = tridiagonal(n, |_| 3.0);
+        let mut t = Vec::new();
+        for j in 0..n {
+            for k in col_ptr[j] as usize..col_ptr[j + 1] as usize {
+                let i = row_idx[k] as usize;
+                t.push(Triplet::new(i, j, values[k]));
+                if i != j {
+                    t.push(Triplet::new(j, i, values[k]));
+                }
+            }
+        }
+        let m = faer::sparse::SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &t).unwrap();
+        let c = Cholesky::factor(m.as_ref()).unwrap();
+        let xs: [Vec<f64>; 2] = [
+            (0..n).map(|i| i as f64).collect(),
+            (0..n).map(|i| (i as f64).cos()).collect(),
+        ];
+        let mut rhs = faer::Mat::<f64>::zeros(n, 2);
+        for (c, x) in xs.iter().enumerate() {
+            for (i, v) in apply(|_| 3.0, x).into_iter().enumerate() {
+                rhs[(i, c)] = v;
+            }
+        }
+        c.solve_in_place(rhs.as_mut());
+        for (c, x) in xs.iter().enumerate() {
+            for i in 0..n {
+                assert!((rhs[(i, c)] - x[i]).abs() < 1e-12);
+            }
+        }
+    }
+}
