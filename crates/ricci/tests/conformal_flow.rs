@@ -633,3 +633,28 @@ fn to_simplicial_splits_loops_and_multi_edges() {
         );
     }
 }
+
+/// The contract with input-edge tracking: replaying `flip_log` on the input triangulation
+/// reproduces the final connectivity (same half-edge arrays, edge ids and end points).
+#[test]
+fn flip_log_replays_to_the_final_triangulation() {
+    let s = genus2();
+    let chi = metric::euler_characteristic(&s.mesh);
+    let cones = separated_vertices(&s.mesh, (-chi) as usize, 5);
+    let r = conformal(
+        &s,
+        Geometry::Euclidean,
+        TargetSpec::Cones(cones.iter().map(|&v| (v, -2.0 * PI)).collect()),
+    );
+    check_result("genus-2 cones", &r);
+    let fin = &r.triangulation.as_ref().unwrap().triangulation;
+    assert!(fin.flip_log.len() > 100);
+    let mut t =
+        IntrinsicTriangulation::from_mesh(&s.mesh, Geometry::Euclidean, &s.edge_lengths()).unwrap();
+    for &e in &fin.flip_log {
+        assert!(t.flip(e), "edge {e} of the log cannot be flipped on replay");
+    }
+    assert_eq!(t.origin, fin.origin);
+    assert_eq!(t.twin, fin.twin);
+    assert_eq!(t.edge, fin.edge);
+}
