@@ -6,7 +6,9 @@
 //! * [`conformal`] — the initial conformal structure built from a mesh's edge lengths;
 //! * [`kernel`] — the allocation-free evaluation of lengths, angles, curvature and Hessian;
 //! * [`intrinsic`] — intrinsic (Δ-complex) triangulations with log Penner coordinates, Ptolemy
-//!   flips and the Penner Delaunay criterion (discrete conformal equivalence).
+//!   flips and the Penner Delaunay criterion (discrete conformal equivalence);
+//! * [`common_subdivision`] — normal coordinates of the input edges through the flips, the
+//!   overlay of the input and the intrinsic triangulation, UVs by projective interpolation.
 //!
 //! **Energy and signs.** We use the convex Ricci energy `E(u) = ∫ Σ (K_i − K̄_i) du_i`, whose
 //! gradient is `K − K̄` and whose Hessian is `H = ∂K/∂u` (positive semidefinite in E², with the
@@ -17,6 +19,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
+pub mod common_subdivision;
 pub mod conformal;
 pub mod geometry;
 pub mod intrinsic;
