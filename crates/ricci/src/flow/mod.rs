@@ -10,6 +10,12 @@
 //! The result carries per-vertex `u`, `K`, `K̄`, per-edge final lengths, the residual history
 //! and an honest `converged` flag.
 //!
+//! [`Scheme::Conformal`] runs [`conformal`] instead (discrete conformal equivalence with
+//! intrinsic Delaunay flips): its result lives on an intrinsic triangulation, returned in
+//! [`FlowResult::triangulation`]; `u`, `curvature`, `target` and `fixed` are per input vertex,
+//! `lengths` are by edge id of the simplicial mesh [`IntrinsicResult::simplicial`] (not of the
+//! input mesh).
+//!
 //! Conventions of the result:
 //! * Euclidean metrics are determined up to scale; the result is scaled so its area equals the
 //!   area of the input mesh (when no vertex is held fixed).
@@ -22,6 +28,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod adaptive;
+pub mod conformal;
 pub mod linear;
 pub mod newton;
 pub mod polish;
@@ -176,6 +183,32 @@ pub struct FlowResult {
     pub pinned: Vec<u32>,
     pub seconds: f64,
     pub notes: Vec<String>,
+    /// [`Scheme::Conformal`] only: the final intrinsic triangulation (then `lengths` belong to
+    /// its simplicial mesh `triangulation.simplicial.mesh`, not to the input mesh).
+    pub triangulation: Option<IntrinsicResult>,
+}
+
+/// The intrinsic triangulation a [`Scheme::Conformal`] flow ends on.
+#[derive(Debug, Clone, Serialize)]
+pub struct IntrinsicResult {
+    /// The final Delaunay Δ-complex: same vertex ids as the input; `lambda` holds the final
+    /// metric's log Penner coordinates (`u` already applied); `flip_log` lists every flip
+    /// (edge ids, in order) from the input triangulation — first the isometric flips to the
+    /// input metric's Delaunay triangulation, then the Ptolemy flips of the solve.
+    #[serde(skip)]
+    pub triangulation: crate::metric::intrinsic::IntrinsicTriangulation,
+    /// A simplicial mesh with the same metric (self-loops and multi-edges split at their
+    /// midpoints, new vertices flat and appended), the mesh `FlowResult::lengths` refer to.
+    #[serde(skip)]
+    pub simplicial: crate::metric::intrinsic::SimplicialMesh,
+    /// Isometric flips that made the input metric Delaunay.
+    pub initial_flips: usize,
+    /// Ptolemy flips of the solve (including line-search trials).
+    pub flips: usize,
+    /// Edge splits of `to_simplicial`.
+    pub splits: usize,
+    /// Vertices of the simplicial mesh (input vertices + splits).
+    pub simplicial_vertices: usize,
 }
 
 /// Run discrete Ricci flow on a connected mesh with Euclidean edge `lengths` (by edge id).
@@ -227,6 +260,18 @@ pub fn ricci_flow(
             }
         }
     };
+    if options.scheme == Scheme::Conformal {
+        return conformal_flow(
+            mesh,
+            lengths,
+            options,
+            target,
+            scale,
+            euclid_area,
+            t0,
+            progress,
+        );
+    }
     let structure = ConformalStructure::new(mesh, lengths, geometry, options.scheme, scale)?;
     let mut ev = Evaluator::new(mesh, structure);
     let u0 = ev.structure.u0.clone();
@@ -420,5 +465,171 @@ pub fn ricci_flow(
         pinned,
         seconds: t0.elapsed().as_secs_f64(),
         notes,
+        triangulation: None,
+    })
+}
+
+/// [`ricci_flow`] for [`Scheme::Conformal`]: isometric flips to the input metric's intrinsic
+/// Delaunay triangulation, Newton's method of [`conformal`], E² area normalization, and the
+/// simplicial mesh of the final metric.
+#[allow(clippy::too_many_arguments)]
+fn conformal_flow(
+    mesh: &Mesh,
+    lengths: &[f64],
+    options: &FlowOptions,
+    mut target: Target,
+    scale: f64,
+    euclid_area: f64,
+    t0: Instant,
+    progress: &mut dyn Progress,
+) -> Result<FlowResult> {
+    use crate::metric::intrinsic::IntrinsicTriangulation;
+    let geometry = options.geometry;
+    if geometry == Geometry::Spherical {
+        return Err(Error::input(
+            "the conformal scheme supports euclidean and hyperbolic geometry (the sphere \
+             through a puncture is not implemented yet); use --scheme yamabe for spherical",
+        ));
+    }
+    if options.solver != Solver::Newton {
+        return Err(Error::input(
+            "the conformal scheme is solved by Newton's method only (use --solver newton)",
+        ));
+    }
+    let chi = euler_characteristic(mesh);
+    let scaled: Vec<f64> = lengths.iter().map(|&l| l * scale).collect();
+    let mut tri = IntrinsicTriangulation::from_mesh(mesh, geometry, &scaled)?;
+    if target.is_dynamic() {
+        target::set_round_totals(&mut target, &scaled, &[], &[]);
+    }
+    target::check_gauss_bonnet(mesh, geometry, &target)?;
+    for v in 0..mesh.n_vertices() as u32 {
+        if target.fixed[v as usize] || mesh.is_isolated(v) {
+            continue;
+        }
+        let max = if mesh.is_boundary_vertex(v) {
+            PI
+        } else {
+            2.0 * PI
+        };
+        if target.curvature[v as usize] >= max {
+            return Err(Error::input(format!(
+                "target curvature {:.6} at vertex {v} leaves no cone angle (it must be below \
+                 {max:.6})",
+                target.curvature[v as usize]
+            )));
+        }
+    }
+    let flip_budget = 200 * mesh.n_edges() + 10_000;
+    let init = tri.make_delaunay_isometric(geometry, flip_budget);
+    if !init.delaunay {
+        return Err(Error::numerical(format!(
+            "the input metric did not become Delaunay within {flip_budget} flips"
+        )));
+    }
+    let has_fixed = target
+        .fixed
+        .iter()
+        .enumerate()
+        .any(|(v, &f)| f && !mesh.is_isolated(v as u32));
+    let mut pinned = Vec::new();
+    if geometry == Geometry::Euclidean && !has_fixed {
+        let v = (0..mesh.n_vertices() as u32)
+            .filter(|&v| !mesh.is_isolated(v))
+            .max_by(|&a, &b| {
+                let ka = (!mesh.is_boundary_vertex(a), mesh.valence(a));
+                let kb = (!mesh.is_boundary_vertex(b), mesh.valence(b));
+                ka.cmp(&kb).then(b.cmp(&a))
+            });
+        if let Some(v) = v {
+            pinned.push(v);
+        }
+    }
+    let settings = conformal::ConformalSettings {
+        geometry,
+        tolerance: options.tolerance,
+        max_iterations: options.max_iterations.unwrap_or(if target.is_dynamic() {
+            200
+        } else {
+            50
+        }),
+        flip_budget,
+        pinned: pinned.clone(),
+    };
+    let out = conformal::solve(&mut tri, &mut target, &settings, progress)?;
+    let mut notes = out.notes.clone();
+    let mut u = out.u;
+    let mut state = out.state;
+    if geometry == Geometry::Euclidean && !has_fixed && state.area > 0.0 && euclid_area > 0.0 {
+        // Scale to the input area (the Penner Delaunay criterion is scale invariant).
+        let c = 0.5 * (euclid_area / state.area).ln();
+        for x in u.iter_mut() {
+            *x += c;
+        }
+        if !conformal::evaluate(&mut tri, geometry, &u, flip_budget, &mut state) {
+            return Err(Error::numerical("the final metric needed too many flips"));
+        }
+    }
+    if target.is_dynamic() {
+        let l = tri.lengths(Geometry::Euclidean, &u);
+        target.update_round(&l, &[], &[]);
+    }
+    let max_err = newton::max_error(&state.curvature, &target);
+    let ksum: f64 = state.curvature.iter().sum();
+    let gb = (ksum + geometry.curvature() * state.area - 2.0 * PI * chi as f64).abs();
+    let degenerate = state.degenerate_faces;
+    let converged = out.converged && max_err <= options.tolerance && degenerate == 0;
+    if out.converged && max_err > options.tolerance {
+        notes.push(format!(
+            "after rescaling, max |K − K̄| = {max_err:.3e} exceeds the tolerance"
+        ));
+    }
+    if degenerate > 0 {
+        notes.push(format!(
+            "{degenerate} face(s) of the final Delaunay triangulation violate the triangle \
+             inequality"
+        ));
+    }
+    let simplicial = tri.to_simplicial(geometry, &u)?;
+    // Bake u into the stored coordinates.
+    let mut final_tri = tri.clone();
+    for e in 0..tri.n_edges() as u32 {
+        final_tri.lambda[e as usize] = tri.scaled_lambda(e, &u);
+    }
+    let result_lengths = simplicial.lengths.clone();
+    let triangulation = IntrinsicResult {
+        initial_flips: init.flips,
+        flips: out.flips,
+        splits: simplicial.splits,
+        simplicial_vertices: simplicial.mesh.n_vertices(),
+        triangulation: final_tri,
+        simplicial,
+    };
+    Ok(FlowResult {
+        geometry,
+        scheme: options.scheme,
+        solver: options.solver,
+        route: "newton".into(),
+        target_description: target.description.clone(),
+        u,
+        curvature: state.curvature.clone(),
+        target: target.curvature.clone(),
+        fixed: target.fixed.clone(),
+        lengths: result_lengths,
+        iterations: out.iterations,
+        history: out.history,
+        converged,
+        tolerance: options.tolerance,
+        max_curvature_error: max_err,
+        gauss_bonnet_error: gb,
+        area: state.area,
+        input_scale: scale,
+        clamped_edges: 0,
+        initial_length_error: 0.0,
+        degenerate_faces: degenerate,
+        pinned,
+        seconds: t0.elapsed().as_secs_f64(),
+        notes,
+        triangulation: Some(triangulation),
     })
 }

@@ -148,7 +148,7 @@ impl ConformalStructure {
             clamped_edges: 0,
             initial_length_error: 0.0,
         };
-        if scheme == Scheme::Yamabe {
+        if !scheme.is_circle_packing() {
             for e in 0..ne {
                 s.eta[e] = B::half_sine(l0[e]);
             }
@@ -200,7 +200,7 @@ impl ConformalStructure {
                     }
                     eta
                 }
-                Scheme::Yamabe => unreachable!(),
+                Scheme::Yamabe | Scheme::Conformal => unreachable!(),
             };
             s.eta[e] = eta;
             let l = B::circle_packing_length(ga, gb, eta);

@@ -31,6 +31,10 @@ pub enum Scheme {
     Inversive,
     /// Vertex scaling (discrete Yamabe flow; reproduces the input lengths exactly).
     Yamabe,
+    /// Discrete conformal equivalence: vertex scaling on the intrinsic Delaunay triangulation
+    /// of the current metric, with Ptolemy flips ([`crate::flow::conformal`]); the result
+    /// lives on an intrinsic triangulation.
+    Conformal,
 }
 
 impl Scheme {
@@ -40,11 +44,12 @@ impl Scheme {
             Scheme::Tangential => "tangential",
             Scheme::Inversive => "inversive",
             Scheme::Yamabe => "yamabe",
+            Scheme::Conformal => "conformal",
         }
     }
     /// True for the three circle-packing schemes.
     pub fn is_circle_packing(self) -> bool {
-        !matches!(self, Scheme::Yamabe)
+        !matches!(self, Scheme::Yamabe | Scheme::Conformal)
     }
 }
 
@@ -62,8 +67,10 @@ impl FromStr for Scheme {
             "tangential" | "tangent" => Ok(Scheme::Tangential),
             "inversive" | "inversive-distance" => Ok(Scheme::Inversive),
             "yamabe" | "vertex-scaling" => Ok(Scheme::Yamabe),
+            "conformal" | "dce" | "delaunay" => Ok(Scheme::Conformal),
             _ => Err(format!(
-                "unknown scheme '{s}' (expected thurston, tangential, inversive or yamabe)"
+                "unknown scheme '{s}' (expected thurston, tangential, inversive, yamabe or \
+                 conformal)"
             )),
         }
     }

@@ -1,0 +1,516 @@
+//! Discrete conformal equivalence: Newton's method for vertex scaling on the intrinsic Delaunay
+//! triangulation of the current metric (Gu–Luo–Sun–Wu 2018 for E², Gu–Guo–Luo–Sun–Wu 2018
+//! for H²; Springborn 2020; Bobenko–Pinkall–Springborn 2015 for the convex energy;
+//! Gillespie–Springborn–Crane 2021 (CEPS) §4 for the algorithm; DESIGN.md §3 "Our default").
+//!
+//! The input metric is first made intrinsically Delaunay with *isometric* flips
+//! ([`IntrinsicTriangulation::make_delaunay_isometric`]) — its log Penner coordinates on that
+//! triangulation define the discrete conformal class. Every evaluation at `u` then scales the
+//! coordinates (`λ̃ = λ + u_i + u_j`), flips to the Penner Delaunay triangulation with Ptolemy
+//! flips (which preserve the class), and computes corner angles with the stable half-angle
+//! cosine law of the background (`l = e^{λ̃/2}` in E², `l = 2 asinh e^{λ̃/2}` in H²), the
+//! curvature `K_i = 2π − Σθ` (`π − Σθ` on the boundary; every corner of a Δ-complex counted)
+//! and the Hessian `H = ∂K/∂u` per face by the chain rule `∂θ/∂u = (∂θ/∂l)(∂l/∂u)` with
+//! `∂l_ij/∂u_i = s(l/2)/c(l/2)` (E²: `l/2`, which makes `H` the cotangent Laplacian
+//! `(cot θ_k + cot θ_l)/2` of the current triangulation; H²: `tanh(l/2)`).
+//!
+//! **Energy.** `E(u) = ∫ Σ (K_i − K̄_i) du_i` is convex and C¹ across flips (its Hessian is
+//! the Laplacian of whichever Delaunay triangulation is current; BPS 2015 Thm 4.2, GLSW 2018).
+//! The line search accepts `u + tδ` when the convexity bound `E(u+tδ) − E(u) ≤ t g(t)`
+//! (`g(t) = (K(u+tδ) − K̄)·δ`) already proves Armijo's condition (`g(t) ≤ c g(0)`, `c = 10⁻⁴`),
+//! when Simpson's estimate `t(g(0) + 4g(t/2) + g(t))/6 ≤ c t g(0)` does, or when the largest
+//! curvature error at least halves (Newton's quadratic phase).
+//!
+//! **Linear algebra.** Sparse Cholesky (faer) on a lower-triangular pattern that only grows:
+//! the symbolic factorization is redone only when flips create a vertex pair that the pattern
+//! lacks (entries of vanished pairs are stored as zeros).
+//!
+//! **Targets.** Per-vertex `K̄` from [`super::target`]; fixed vertices (free boundary) keep
+//! `u = 0`; round boundaries re-evaluate `K̄` from the current boundary lengths after every
+//! accepted step (boundary edges never flip, so the loops' edge ids stay valid) and take
+//! Newton steps with the target frozen (chord steps).
+
+#![allow(clippy::needless_range_loop)]
+
+use super::linear::SymmetricSolver;
+use super::newton::max_error;
+use super::target::Target;
+use super::IterationRecord;
+use crate::error::{Error, Result};
+use crate::mesh::NONE;
+use crate::metric::intrinsic::{length_of_lambda, IntrinsicTriangulation};
+use crate::metric::kernel::angle_derivatives;
+use crate::metric::{Euclidean, Geometry, HessianPattern, Hyperbolic, Spherical};
+use crate::progress::Progress;
+use std::f64::consts::PI;
+use std::time::Instant;
+
+/// Settings of [`solve`].
+#[derive(Debug, Clone)]
+pub struct ConformalSettings {
+    pub geometry: Geometry,
+    /// Stop when max |K − K̄| ≤ tolerance.
+    pub tolerance: f64,
+    pub max_iterations: usize,
+    /// Flips allowed in one evaluation.
+    pub flip_budget: usize,
+    /// Vertices held at `u = 0` besides the target's fixed ones (the E² scale pin).
+    pub pinned: Vec<u32>,
+}
+
+/// Angles, curvature and per-face angle Jacobians of the current triangulation at some `u`.
+#[derive(Debug, Clone, Default)]
+pub struct ConformalState {
+    /// Corner angles, by corner `3f + i` of the intrinsic triangulation.
+    pub angles: Vec<f64>,
+    /// `K_i` per vertex.
+    pub curvature: Vec<f64>,
+    /// `∂θ_m/∂u_{v_n}` per face in local corner indices (`jac[9f + 3m + n]`).
+    pub jac: Vec<f64>,
+    /// Faces violating a triangle inequality.
+    pub degenerate_faces: usize,
+    /// Total background area.
+    pub area: f64,
+    /// Flips made by the evaluation.
+    pub flips: usize,
+}
+
+/// Evaluate the metric `u` on `tri`: flip to Delaunay (Ptolemy), angles, curvature, Jacobians.
+/// Returns false when the flip budget runs out.
+pub fn evaluate(
+    tri: &mut IntrinsicTriangulation,
+    geometry: Geometry,
+    u: &[f64],
+    flip_budget: usize,
+    state: &mut ConformalState,
+) -> bool {
+    let rep = tri.make_delaunay(u, flip_budget);
+    state.flips = rep.flips;
+    if !rep.delaunay {
+        return false;
+    }
+    match geometry {
+        Geometry::Euclidean => evaluate_angles::<Euclidean>(tri, geometry, u, state),
+        Geometry::Hyperbolic => evaluate_angles::<Hyperbolic>(tri, geometry, u, state),
+        Geometry::Spherical => evaluate_angles::<Spherical>(tri, geometry, u, state),
+    }
+    true
+}
+
+fn evaluate_angles<B: crate::metric::Background>(
+    tri: &IntrinsicTriangulation,
+    geometry: Geometry,
+    u: &[f64],
+    st: &mut ConformalState,
+) {
+    let nf = tri.n_faces();
+    let nv = tri.n_vertices;
+    st.angles.resize(3 * nf, 0.0);
+    st.jac.resize(9 * nf, 0.0);
+    st.curvature.clear();
+    st.curvature
+        .extend((0..nv).map(|v| if tri.boundary_vertex[v] { PI } else { 2.0 * PI }));
+    st.degenerate_faces = 0;
+    let mut area = 0.0;
+    let mut used = vec![false; nv];
+    for f in 0..nf {
+        let b = 3 * f;
+        // Side m is opposite corner m: the edge of half-edge 3f + (m+1)%3.
+        let mut l = [0.0; 3];
+        let mut ht = [0.0; 3];
+        for m in 0..3 {
+            let h = (b + (m + 1) % 3) as u32;
+            let lam = tri.lambda[tri.edge[h as usize] as usize]
+                + u.get(tri.origin[h as usize] as usize)
+                    .copied()
+                    .unwrap_or(0.0)
+                + u.get(tri.tip(h) as usize).copied().unwrap_or(0.0);
+            l[m] = length_of_lambda(geometry, lam);
+            ht[m] = B::half_tangent(l[m]);
+        }
+        let (th, d, deg) = angle_derivatives::<B>(l);
+        if deg {
+            st.degenerate_faces += 1;
+        }
+        for m in 0..3 {
+            let v = tri.origin[b + m] as usize;
+            used[v] = true;
+            st.angles[b + m] = th[m];
+            st.curvature[v] -= th[m];
+            for n in 0..3 {
+                // ∂θ_m/∂u_n = Σ_{k ≠ n} ∂θ_m/∂l_k · ∂l_k/∂u (edge k has corners k+1, k+2).
+                let mut s = 0.0;
+                for k in 0..3 {
+                    if k != n {
+                        s += d[m][k] * ht[k];
+                    }
+                }
+                st.jac[9 * f + 3 * m + n] = s;
+            }
+        }
+        area += match geometry {
+            Geometry::Euclidean => B::area(l[0], l[1], l[2]),
+            Geometry::Hyperbolic => (PI - th[0] - th[1] - th[2]).max(0.0),
+            Geometry::Spherical => (th[0] + th[1] + th[2] - PI).max(0.0),
+        };
+    }
+    for v in 0..nv {
+        if !used[v] {
+            st.curvature[v] = 0.0;
+        }
+    }
+    st.area = area;
+}
+
+/// The lower-triangular Hessian pattern over the free vertices that only grows, with its
+/// symbolic factorization.
+struct GrowingPattern {
+    free_index: Vec<u32>,
+    free_vertex: Vec<u32>,
+    col_ptr: Vec<u32>,
+    row_idx: Vec<u32>,
+    solver: Option<SymmetricSolver>,
+    /// Symbolic factorizations computed.
+    symbolic_count: usize,
+}
+
+impl GrowingPattern {
+    fn new(held: &[bool]) -> GrowingPattern {
+        let mut free_index = vec![NONE; held.len()];
+        let mut free_vertex = Vec::new();
+        for (v, &h) in held.iter().enumerate() {
+            if !h {
+                free_index[v] = free_vertex.len() as u32;
+                free_vertex.push(v as u32);
+            }
+        }
+        let n = free_vertex.len();
+        GrowingPattern {
+            free_index,
+            free_vertex,
+            col_ptr: (0..=n as u32).collect(),
+            row_idx: (0..n as u32).collect(),
+            solver: None,
+            symbolic_count: 0,
+        }
+    }
+    fn n(&self) -> usize {
+        self.free_vertex.len()
+    }
+    fn slot(&self, c: u32, r: u32) -> Option<usize> {
+        let (s, t) = (
+            self.col_ptr[c as usize] as usize,
+            self.col_ptr[c as usize + 1] as usize,
+        );
+        self.row_idx[s..t].binary_search(&r).ok().map(|k| s + k)
+    }
+    /// Make sure every vertex pair joined by an edge of `tri` is in the pattern; redo the
+    /// symbolic factorization if the pattern grew.
+    fn cover(&mut self, tri: &IntrinsicTriangulation) -> Result<()> {
+        let mut missing: Vec<(u32, u32)> = Vec::new();
+        for e in 0..tri.n_edges() as u32 {
+            let [a, b] = tri.edge_vertices(e);
+            let (ia, ib) = (self.free_index[a as usize], self.free_index[b as usize]);
+            if a == b || ia == NONE || ib == NONE {
+                continue;
+            }
+            let (c, r) = (ia.min(ib), ia.max(ib));
+            if self.slot(c, r).is_none() {
+                missing.push((c, r));
+            }
+        }
+        if missing.is_empty() && self.solver.is_some() {
+            return Ok(());
+        }
+        let n = self.n();
+        let mut cols: Vec<Vec<u32>> = (0..n)
+            .map(|c| self.row_idx[self.col_ptr[c] as usize..self.col_ptr[c + 1] as usize].to_vec())
+            .collect();
+        for (c, r) in missing {
+            cols[c as usize].push(r);
+        }
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut row_idx = Vec::new();
+        col_ptr.push(0u32);
+        for mut col in cols {
+            col.sort_unstable();
+            col.dedup();
+            row_idx.extend_from_slice(&col);
+            col_ptr.push(row_idx.len() as u32);
+        }
+        self.col_ptr = col_ptr;
+        self.row_idx = row_idx;
+        let pattern = HessianPattern {
+            free_index: self.free_index.clone(),
+            free_vertex: self.free_vertex.clone(),
+            col_ptr: self.col_ptr.clone(),
+            row_idx: self.row_idx.clone(),
+            diag_slot: Vec::new(),
+            edge_slot: Vec::new(),
+        };
+        self.solver = Some(SymmetricSolver::new(&pattern)?);
+        self.symbolic_count += 1;
+        Ok(())
+    }
+    /// Lower-triangle values of `H = ∂K/∂u` (free vertices) from the state's Jacobians.
+    fn assemble(&self, tri: &IntrinsicTriangulation, st: &ConformalState, values: &mut Vec<f64>) {
+        values.clear();
+        values.resize(self.row_idx.len(), 0.0);
+        for f in 0..tri.n_faces() {
+            let vs = tri.face(f as u32);
+            for m in 0..3 {
+                let r = self.free_index[vs[m] as usize];
+                if r == NONE {
+                    continue;
+                }
+                for n in 0..3 {
+                    let c = self.free_index[vs[n] as usize];
+                    if c == NONE || c > r {
+                        continue;
+                    }
+                    if let Some(s) = self.slot(c, r) {
+                        values[s] -= st.jac[9 * f + 3 * m + n];
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// What [`solve`] produced.
+#[derive(Debug, Clone)]
+pub struct ConformalOutcome {
+    pub u: Vec<f64>,
+    pub iterations: usize,
+    pub history: Vec<IterationRecord>,
+    pub converged: bool,
+    pub max_error: f64,
+    /// Ptolemy flips made during the solve (the isometric initial flips not included).
+    pub flips: usize,
+    /// Symbolic factorizations computed (the pattern grew this many times, plus one).
+    pub symbolic_factorizations: usize,
+    pub state: ConformalState,
+    pub notes: Vec<String>,
+}
+
+/// Newton's method for the target `target` on `tri` (already Delaunay for its base metric),
+/// starting from `u = 0`.
+pub fn solve(
+    tri: &mut IntrinsicTriangulation,
+    target: &mut Target,
+    settings: &ConformalSettings,
+    progress: &mut dyn Progress,
+) -> Result<ConformalOutcome> {
+    let t0 = Instant::now();
+    let n = tri.n_vertices;
+    let geometry = settings.geometry;
+    if target.curvature.len() != n || target.fixed.len() != n {
+        return Err(Error::input(format!(
+            "target has {} values for {} vertices",
+            target.curvature.len(),
+            n
+        )));
+    }
+    let mut held = target.fixed.clone();
+    for &p in &settings.pinned {
+        held[p as usize] = true;
+    }
+    let dynamic = target.is_dynamic();
+    let mut pattern = GrowingPattern::new(&held);
+    let mut values = Vec::new();
+    let mut u = vec![0.0; n];
+    let mut st = ConformalState::default();
+    let mut trial_st = ConformalState::default();
+    let mut mid_st = ConformalState::default();
+    let mut history = Vec::new();
+    let mut notes = Vec::new();
+    let mut flips = 0usize;
+    let mut converged = false;
+    let mut err;
+    let mut it = 0;
+    let mut last_step = 0.0;
+    let mut energy = 0.0;
+    let mut delta = vec![0.0; n];
+    let mut trial = vec![0.0; n];
+    let mut rhs = vec![0.0; pattern.n()];
+    let c_armijo = 1e-4;
+    if !evaluate(tri, geometry, &u, settings.flip_budget, &mut st) {
+        return Err(Error::numerical(format!(
+            "the initial metric needed more than {} Delaunay flips",
+            settings.flip_budget
+        )));
+    }
+    flips += st.flips;
+    let update_round = |tri: &IntrinsicTriangulation, u: &[f64], target: &mut Target| {
+        let lengths = tri.lengths(Geometry::Euclidean, u);
+        target.update_round(&lengths, &[], &[]);
+    };
+    if dynamic {
+        update_round(tri, &u, target);
+    }
+    loop {
+        err = max_error(&st.curvature, target);
+        history.push(IterationRecord {
+            iteration: it,
+            max_curvature_error: err,
+            energy: (!dynamic).then_some(energy),
+            step: last_step,
+            seconds: t0.elapsed().as_secs_f64(),
+        });
+        progress.report(
+            "conformal",
+            None,
+            &format!("iteration {it}: max |K − K̄| = {err:.3e}"),
+        );
+        if !err.is_finite() {
+            notes.push("the curvature became non-finite".into());
+            break;
+        }
+        if err <= settings.tolerance {
+            converged = true;
+            break;
+        }
+        if it >= settings.max_iterations {
+            break;
+        }
+        it += 1;
+        pattern.cover(tri)?;
+        pattern.assemble(tri, &st, &mut values);
+        // r = K̄ − K on the free vertices; with a scale pin the mean is removed (Gauss–Bonnet
+        // makes it vanish up to rounding, which would otherwise pile up at the pin).
+        let shift = if settings.pinned.is_empty() {
+            0.0
+        } else {
+            let (s, c) = (0..n)
+                .filter(|&i| !target.fixed[i])
+                .fold((0.0, 0usize), |(s, c), i| {
+                    (s + target.curvature[i] - st.curvature[i], c + 1)
+                });
+            s / c.max(1) as f64
+        };
+        for (c, &v) in pattern.free_vertex.iter().enumerate() {
+            rhs[c] = target.curvature[v as usize] - st.curvature[v as usize] - shift;
+        }
+        let solver = pattern.solver.as_mut().expect("pattern covered");
+        let mut step = rhs.clone();
+        if solver.factor_llt(&values) {
+            solver.solve(&mut step);
+        } else {
+            notes.push(format!(
+                "iteration {it}: the Hessian was not numerically positive definite; gradient step"
+            ));
+        }
+        delta.iter_mut().for_each(|x| *x = 0.0);
+        for (c, &v) in pattern.free_vertex.iter().enumerate() {
+            delta[v as usize] = step[c];
+        }
+        // g(t) = (K(u + tδ) − K̄)·δ.
+        let grad = |s: &ConformalState, target: &Target| -> f64 {
+            let mut g = 0.0;
+            for i in 0..n {
+                if !held[i] {
+                    g += (s.curvature[i] - target.curvature[i]) * delta[i];
+                }
+            }
+            g
+        };
+        let g0 = grad(&st, target);
+        if !(g0 < 0.0) {
+            notes.push(format!(
+                "iteration {it}: the Newton direction is not a descent direction (g = {g0:.3e})"
+            ));
+            break;
+        }
+        let mut t = 1.0;
+        let mut accepted = false;
+        let mut need_reevaluation = false;
+        for _ in 0..40 {
+            for i in 0..n {
+                trial[i] = u[i] + t * delta[i];
+            }
+            if evaluate(tri, geometry, &trial, settings.flip_budget, &mut trial_st)
+                && trial_st.degenerate_faces == 0
+            {
+                flips += trial_st.flips;
+                let gt = grad(&trial_st, target);
+                let et = max_error(&trial_st.curvature, target);
+                let mut ok = gt <= c_armijo * g0 || et <= 0.5 * err;
+                let mut de = t * gt;
+                if !ok {
+                    need_reevaluation = true;
+                    for i in 0..n {
+                        trial[i] = u[i] + 0.5 * t * delta[i];
+                    }
+                    if evaluate(tri, geometry, &trial, settings.flip_budget, &mut mid_st) {
+                        flips += mid_st.flips;
+                        let gh = grad(&mid_st, target);
+                        de = t * (g0 + 4.0 * gh + gt) / 6.0;
+                        ok = de <= c_armijo * t * g0;
+                    }
+                    for i in 0..n {
+                        trial[i] = u[i] + t * delta[i];
+                    }
+                }
+                if ok {
+                    energy += de.min(0.0);
+                    accepted = true;
+                    break;
+                }
+            } else {
+                flips += trial_st.flips;
+            }
+            t *= 0.5;
+        }
+        if !accepted {
+            notes.push(format!("iteration {it}: the line search found no decrease"));
+            break;
+        }
+        if need_reevaluation {
+            // The triangulation may have moved on at t/2: make it Delaunay at the accepted u.
+            if !evaluate(tri, geometry, &trial, settings.flip_budget, &mut st) {
+                notes.push(format!("iteration {it}: flip budget exceeded"));
+                break;
+            }
+            flips += st.flips;
+        } else {
+            std::mem::swap(&mut st, &mut trial_st);
+        }
+        last_step = delta.iter().map(|x| (t * x).abs()).fold(0.0, f64::max);
+        std::mem::swap(&mut u, &mut trial);
+        if dynamic {
+            update_round(tri, &u, target);
+        }
+    }
+    if !converged && it >= settings.max_iterations {
+        notes.push(format!(
+            "not converged after {it} Newton iterations: max |K − K̄| = {err:.3e}"
+        ));
+    }
+    Ok(ConformalOutcome {
+        u,
+        iterations: it,
+        history,
+        converged,
+        max_error: err,
+        flips,
+        symbolic_factorizations: pattern.symbolic_count,
+        state: st,
+        notes,
+    })
+}
+
+/// The full symmetric `H = ∂K/∂u` of the state as `(i, j, value)` triplets over all vertices
+/// (duplicates to be summed), from the state's per-face Jacobians on `tri` (for tests and
+/// diagnostics).
+pub fn hessian_triplets(tri: &IntrinsicTriangulation, st: &ConformalState) -> Vec<(u32, u32, f64)> {
+    let mut out = Vec::with_capacity(9 * tri.n_faces());
+    for f in 0..tri.n_faces() {
+        let vs = tri.face(f as u32);
+        for m in 0..3 {
+            for n in 0..3 {
+                out.push((vs[m], vs[n], -st.jac[9 * f + 3 * m + n]));
+            }
+        }
+    }
+    out
+}
