@@ -465,3 +465,137 @@ fn rigid_from(
         [q0[0] + c * x - s * y, q0[1] + s * x + c * y]
     }
 }
+
+/// Many random flips on a torus with 9 vertices: the triangulation becomes a Δ-complex with
+/// self-loops and multi-edges, input edges cross one edge of T several times; the common
+/// subdivision stays a valid mesh of the input.
+#[test]
+fn delta_complex_with_loops_and_repeated_crossings() {
+    let n = 3usize;
+    let mut pos = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let (a, b) = (
+                2.0 * std::f64::consts::PI * i as f64 / n as f64,
+                2.0 * std::f64::consts::PI * (j as f64 + 0.3 * i as f64) / n as f64,
+            );
+            pos.push([
+                (2.0 + b.cos()) * a.cos(),
+                (2.0 + b.cos()) * a.sin(),
+                b.sin(),
+            ]);
+        }
+    }
+    let id = |i: usize, j: usize| ((j % n) * n + (i % n)) as u32;
+    let mut faces = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            faces.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let s = Surface::new(pos, faces).unwrap();
+    let lengths = lengths_for(&s);
+    for geometry in [Geometry::Euclidean, Geometry::Hyperbolic] {
+        let mut rng = Lcg(2024);
+        let lengths: Vec<f64> = if geometry == Geometry::Hyperbolic {
+            lengths.iter().map(|l| 0.3 * l).collect()
+        } else {
+            lengths.clone()
+        };
+        let mut tri = IntrinsicTriangulation::from_mesh(&s.mesh, geometry, &lengths).unwrap();
+        random_flips(&mut tri, &mut rng, 40);
+        let loops = (0..tri.n_edges() as u32)
+            .filter(|&e| {
+                let [a, b] = tri.edge_vertices(e);
+                a == b
+            })
+            .count();
+        let mut pairs: Vec<(u32, u32)> = (0..tri.n_edges() as u32)
+            .map(|e| {
+                let [a, b] = tri.edge_vertices(e);
+                (a.min(b), a.max(b))
+            })
+            .collect();
+        pairs.sort();
+        let multi = pairs.windows(2).filter(|w| w[0] == w[1]).count();
+        assert!(loops > 0 && multi > 0, "loops {loops}, multi-edges {multi}");
+        let sub = CommonSubdivision::new(&s.mesh, geometry, &lengths, &tri.flip_log).unwrap();
+        // Some input edge crosses some edge of T at least twice.
+        let mut seen: HashMap<(u32, u32), u32> = HashMap::new();
+        for c in &sub.crossings {
+            *seen.entry((c.input_edge, c.t_edge)).or_default() += 1;
+        }
+        assert!(seen.values().any(|&k| k >= 2));
+        check_valid(&s, &sub);
+        // Flipping back restores the input.
+        let mut log = tri.flip_log.clone();
+        log.extend(tri.flip_log.iter().rev());
+        let back = CommonSubdivision::new(&s.mesh, geometry, &lengths, &log).unwrap();
+        assert_eq!(back.crossings.len(), 0);
+    }
+}
+
+/// The conformal flow's result on real meshes (`$RICCI_MESHES`): face (free boundary, E²,
+/// a flat disk: the UV map must be continuous) and kitten (genus 1, flat torus, laid out face
+/// by face): a valid common subdivision and no flipped triangle.
+#[test]
+fn conformal_flow_on_real_meshes_has_no_flipped_triangle() {
+    use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
+    use ricci::metric::Scheme;
+    use ricci::progress::NoProgress;
+    let dir = match std::env::var("RICCI_MESHES") {
+        Ok(d) => std::path::PathBuf::from(d),
+        Err(_) => {
+            eprintln!("RICCI_MESHES unset: skipping the real meshes");
+            return;
+        }
+    };
+    for (file, target, disk) in [
+        ("face.off", TargetSpec::FreeBoundary, true),
+        ("kitten.nf20k.off", TargetSpec::Uniform, false),
+    ] {
+        let (s, _) = ricci::mesh::io::read_surface(&dir.join(file)).unwrap();
+        let o = FlowOptions {
+            geometry: Geometry::Euclidean,
+            scheme: Scheme::Conformal,
+            target,
+            ..FlowOptions::default()
+        };
+        let lengths = s.edge_lengths();
+        let r = ricci_flow(&s.mesh, &lengths, &o, &mut NoProgress).unwrap();
+        assert!(r.converged, "{file}: {:?}", r.notes);
+        let it = r.triangulation.as_ref().unwrap();
+        let scaled: Vec<f64> = lengths.iter().map(|l| l * r.input_scale).collect();
+        let sub = CommonSubdivision::from_triangulation(
+            &s.mesh,
+            Geometry::Euclidean,
+            &scaled,
+            &it.triangulation,
+            &r.u,
+        )
+        .unwrap();
+        check_valid(&s, &sub);
+        let layout = layout_euclidean(&sub.triangulation, &r.u).unwrap();
+        let uv = sub.uv(Geometry::Euclidean, &r.u, &layout).unwrap();
+        let flipped = sub.flipped_triangles(Geometry::Euclidean, &uv);
+        let (_, gap) = sub.vertex_uv(&uv, 0.0);
+        eprintln!(
+            "{file}: {} flips, {} crossings, {} triangles, {flipped} flipped, seam gap {gap:.2e}",
+            it.triangulation.flip_log.len(),
+            sub.crossings.len(),
+            sub.triangles.len()
+        );
+        assert_eq!(flipped, 0, "{file}");
+        if disk {
+            // A flat disk lays out without seams (up to the solver's tolerance).
+            let size = layout
+                .iter()
+                .fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()));
+            assert!(
+                gap < 1e-6 * size,
+                "{file}: seam gap {gap} in a flat disk of size {size}"
+            );
+        }
+    }
+}

@@ -249,36 +249,67 @@ pub struct CommonSubdivision {
 }
 
 impl CommonSubdivision {
-    /// Replay `flip_log` on the input triangulation of `mesh` (edge lengths `lengths` in
-    /// `geometry`, as the conformal solver started) with normal coordinates, then build the
-    /// common subdivision.
+    /// Replay `flip_log` — Ptolemy flips only — on the input triangulation of `mesh` (edge
+    /// lengths `lengths` in `geometry`) with normal coordinates, then build the common
+    /// subdivision in the hyperbolic structure of the input. For a log that starts with
+    /// isometric flips use [`CommonSubdivision::from_triangulation`].
     pub fn new(
         mesh: &Mesh,
         geometry: Geometry,
         lengths: &[f64],
         flip_log: &[u32],
     ) -> Result<CommonSubdivision> {
-        let mut tri = IntrinsicTriangulation::from_mesh(mesh, geometry, lengths)?;
-        let mut normal = vec![-1i32; tri.n_edges()];
-        for (step, &e) in flip_log.iter().enumerate() {
-            if e as usize >= tri.n_edges() {
-                return Err(Error::input(format!(
-                    "flip log entry {step} names edge {e}, but the mesh has {} edges",
-                    tri.n_edges()
-                )));
-            }
-            if !tri.is_flippable(e) {
-                return Err(Error::input(format!(
-                    "flip log entry {step}: edge {e} cannot be flipped (boundary, or one face on \
-                     both sides)"
-                )));
-            }
-            let n = flipped_normal_coordinate(&tri, &normal, e)?;
-            tri.flip(e);
-            normal[e as usize] = n;
-        }
-        tri.flip_log.clear();
+        let (tri, normal) = replay(mesh, geometry, lengths, flip_log)?;
         build(mesh, tri, normal, flip_log.len())
+    }
+
+    /// The common subdivision of `mesh` and the triangulation `t` a solver ended on, whose
+    /// `lambda` holds the final metric's log Penner coordinates and whose `flip_log` leads
+    /// from the input to it; `u` is the vertex scaling of the final metric (empty = 0).
+    ///
+    /// The combinatorics is replayed from the flip log (an isometric flip and a Ptolemy flip
+    /// change the connectivity in the same way); the geometry comes from `t`'s hyperbolic
+    /// structure with the decoration `λ_e − u_i − u_j`. When the log starts with isometric
+    /// flips (to the input metric's Delaunay triangulation, as `flow::conformal` does), the
+    /// input faces are mapped to the ideal triangles of that structure spanned by their
+    /// (straightened) edges — a continuous, piecewise projective homeomorphism that agrees
+    /// with the input metric on every input edge kept by the isometric flips.
+    pub fn from_triangulation(
+        mesh: &Mesh,
+        geometry: Geometry,
+        lengths: &[f64],
+        t: &IntrinsicTriangulation,
+        u: &[f64],
+    ) -> Result<CommonSubdivision> {
+        let (mut tri, normal) = replay(mesh, geometry, lengths, &t.flip_log)?;
+        if tri.origin != t.origin || tri.twin != t.twin || tri.edge != t.edge {
+            return Err(Error::input(
+                "replaying the flip log on the input does not reproduce the given triangulation",
+            ));
+        }
+        if !u.is_empty() && u.len() != t.n_vertices {
+            return Err(Error::input(format!(
+                "{} scale factors for {} vertices",
+                u.len(),
+                t.n_vertices
+            )));
+        }
+        for e in 0..t.n_edges() as u32 {
+            let [a, b] = t.edge_vertices(e);
+            let s = if u.is_empty() {
+                0.0
+            } else {
+                u[a as usize] + u[b as usize]
+            };
+            let x = t.lambda[e as usize] - s;
+            if !x.is_finite() {
+                return Err(Error::input(format!(
+                    "edge {e} of the triangulation has no finite log Penner coordinate"
+                )));
+            }
+            tri.lambda[e as usize] = x;
+        }
+        build(mesh, tri, normal, t.flip_log.len())
     }
 
     /// Number of vertices (input vertices and crossings).
@@ -513,6 +544,36 @@ fn half_lambda(tri: &Tri, h: u32) -> f64 {
     0.5 * tri.lambda[tri.edge[h as usize] as usize]
 }
 
+/// Replay `flip_log` on the input triangulation with normal coordinates.
+fn replay(
+    mesh: &Mesh,
+    geometry: Geometry,
+    lengths: &[f64],
+    flip_log: &[u32],
+) -> Result<(Tri, Vec<i32>)> {
+    let mut tri = IntrinsicTriangulation::from_mesh(mesh, geometry, lengths)?;
+    let mut normal = vec![-1i32; tri.n_edges()];
+    for (step, &e) in flip_log.iter().enumerate() {
+        if e as usize >= tri.n_edges() {
+            return Err(Error::input(format!(
+                "flip log entry {step} names edge {e}, but the mesh has {} edges",
+                tri.n_edges()
+            )));
+        }
+        if !tri.is_flippable(e) {
+            return Err(Error::input(format!(
+                "flip log entry {step}: edge {e} cannot be flipped (boundary, or one face on \
+                 both sides)"
+            )));
+        }
+        let n = flipped_normal_coordinate(&tri, &normal, e)?;
+        tri.flip(e);
+        normal[e as usize] = n;
+    }
+    tri.flip_log.clear();
+    Ok((tri, normal))
+}
+
 fn build(mesh: &Mesh, tri: Tri, normal: Vec<i32>, flips: usize) -> Result<CommonSubdivision> {
     let nv = mesh.n_vertices();
     let ne = tri.n_edges();
@@ -652,7 +713,8 @@ fn build(mesh: &Mesh, tri: Tri, normal: Vec<i32>, flips: usize) -> Result<Common
                     ((m - k) as u32, -rho_in)
                 };
                 let input_t = 1.0 / (1.0 + rho_in.exp());
-                let t_dir = if forward { input_t } else { 1.0 - input_t };
+                // Order along the traced direction, in log space (no saturation near ends).
+                let t_dir = if forward { -rho_in } else { rho_in };
                 if !(t_dir > last_t) {
                     order_violations += 1;
                 }
