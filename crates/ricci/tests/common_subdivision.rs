@@ -599,3 +599,120 @@ fn conformal_flow_on_real_meshes_has_no_flipped_triangle() {
         }
     }
 }
+
+/// H²: the conformal flow of a genus-2 surface to constant curvature −1, laid out face by face
+/// in the Poincaré disk: a valid subdivision, no flipped triangle (Klein model), and the
+/// `uv.obj` surface keeps the input's area and Euler characteristic once seams are glued.
+#[test]
+fn hyperbolic_genus_two_has_no_flipped_triangle() {
+    use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
+    use ricci::metric::common_subdivision::layout_hyperbolic;
+    use ricci::metric::Scheme;
+    use ricci::progress::NoProgress;
+    let s = generate::genus(2, 12).unwrap();
+    let o = FlowOptions {
+        geometry: Geometry::Hyperbolic,
+        scheme: Scheme::Conformal,
+        target: TargetSpec::Uniform,
+        ..FlowOptions::default()
+    };
+    let lengths = s.edge_lengths();
+    let r = ricci_flow(&s.mesh, &lengths, &o, &mut NoProgress).unwrap();
+    assert!(r.converged, "{:?}", r.notes);
+    let it = r.triangulation.as_ref().unwrap();
+    let scaled: Vec<f64> = lengths.iter().map(|l| l * r.input_scale).collect();
+    let sub = CommonSubdivision::from_triangulation(
+        &s.mesh,
+        Geometry::Hyperbolic,
+        &scaled,
+        &it.triangulation,
+        &r.u,
+    )
+    .unwrap();
+    check_valid(&s, &sub);
+    assert!(!sub.crossings.is_empty());
+    let layout = layout_hyperbolic(&sub.triangulation, &r.u).unwrap();
+    // The layout is isometric: Poincaré distances of the corners are the final lengths.
+    let t = &sub.triangulation;
+    for h in 0..t.n_halfedges() as u32 {
+        let (z, w) = (
+            layout[h as usize],
+            layout[IntrinsicTriangulation::next(h) as usize],
+        );
+        let num = (z[0] - w[0]).hypot(z[1] - w[1]);
+        // |1 − z̄ w|
+        let re = 1.0 - (z[0] * w[0] + z[1] * w[1]);
+        let im = -(z[0] * w[1] - z[1] * w[0]);
+        let d = 2.0 * (num / re.hypot(im)).atanh();
+        let want = 2.0
+            * (0.5 * t.scaled_lambda(t.edge[h as usize], &r.u))
+                .exp()
+                .asinh();
+        assert!(
+            (d - want).abs() < 1e-9 * want.max(1.0),
+            "half-edge {h}: {d} vs {want}"
+        );
+    }
+    let uv = sub.uv(Geometry::Hyperbolic, &r.u, &layout).unwrap();
+    assert!(uv.iter().all(|z| z[0].hypot(z[1]) < 1.0));
+    assert_eq!(sub.flipped_triangles(Geometry::Hyperbolic, &uv), 0);
+    let out = sub.uv_surface(&s.mesh, &s.positions, &uv, 1e-9).unwrap();
+    assert!(out.mesh.n_vertices() >= sub.n_vertices());
+    assert_eq!(out.mesh.n_faces(), sub.triangles.len());
+}
+
+fn poincare_distance(z: [f64; 2], w: [f64; 2]) -> f64 {
+    let num = (z[0] - w[0]).hypot(z[1] - w[1]);
+    let re = 1.0 - (z[0] * w[0] + z[1] * w[1]);
+    let im = -(z[0] * w[1] - z[1] * w[0]);
+    2.0 * (num / re.hypot(im)).atanh()
+}
+fn klein(z: [f64; 2]) -> [f64; 2] {
+    let s = 2.0 / (1.0 + z[0] * z[0] + z[1] * z[1]);
+    [s * z[0], s * z[1]]
+}
+
+/// H²: a quad inscribed in a hyperbolic circle (Ptolemy for sinh(l/2) = geometric flip); the
+/// crossing's UV in the Poincaré layout of the flipped quad is the intersection of the two
+/// geodesic diagonals (straight lines in the Klein model).
+#[test]
+fn hyperbolic_cyclic_quad_crossing_is_the_geodesic_diagonals_intersection() {
+    use ricci::metric::common_subdivision::layout_hyperbolic;
+    let ang = [0.2f64, 1.7, 3.1, 4.6];
+    let z: Vec<[f64; 2]> = ang.iter().map(|a| [0.6 * a.cos(), 0.6 * a.sin()]).collect();
+    let s = Surface::new(
+        z.iter().map(|p| [p[0], p[1], 0.0]).collect(),
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+    .unwrap();
+    let hyp: Vec<f64> = (0..s.mesh.n_edges() as u32)
+        .map(|e| {
+            let [a, b] = s.mesh.edge_vertices(e);
+            poincare_distance(z[a as usize], z[b as usize])
+        })
+        .collect();
+    let mut tri = IntrinsicTriangulation::from_mesh(&s.mesh, Geometry::Hyperbolic, &hyp).unwrap();
+    let diag = (0..s.mesh.n_edges() as u32)
+        .find(|&e| !s.mesh.is_boundary_edge(e))
+        .unwrap();
+    assert!(tri.flip(diag));
+    let l13 = poincare_distance(z[1], z[3]);
+    assert!(
+        (tri.lambda[diag as usize] - lambda_of_length(Geometry::Hyperbolic, l13)).abs() < 1e-12
+    );
+    let sub = CommonSubdivision::new(&s.mesh, Geometry::Hyperbolic, &hyp, &tri.flip_log).unwrap();
+    assert_eq!(sub.crossings.len(), 1);
+    check_valid(&s, &sub);
+    let layout = layout_hyperbolic(&sub.triangulation, &[]).unwrap();
+    let uv = sub.uv(Geometry::Hyperbolic, &[], &layout).unwrap();
+    let (vuv, gap) = sub.vertex_uv(&uv, 1e-12);
+    let vuv = vuv.unwrap_or_else(|| panic!("seam {gap}"));
+    let k: Vec<[f64; 2]> = vuv.iter().map(|&w| klein(w)).collect();
+    let x = intersect(k[0], k[2], k[1], k[3]);
+    assert!(
+        (k[4][0] - x[0]).abs() < 1e-12 && (k[4][1] - x[1]).abs() < 1e-12,
+        "{:?} vs {x:?}",
+        k[4]
+    );
+    assert_eq!(sub.flipped_triangles(Geometry::Hyperbolic, &uv), 0);
+}
