@@ -55,6 +55,9 @@
 //! is continuous, and each common-subdivision polygon (the intersection of two ideal triangles)
 //! is convex in both charts: a fan triangulation has no flipped triangle.
 
+// `!(x < y)` is meant: it is also true for NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, NONE};
 use crate::metric::intrinsic::IntrinsicTriangulation;
@@ -938,6 +941,7 @@ fn face_polygons(
 
 /// The input face left of the polygon side from boundary point `a` to `b` of face `f` of `T`,
 /// when that side lies on an input edge.
+#[allow(clippy::too_many_arguments)]
 fn side_input_face(
     mesh: &Mesh,
     sub: &CommonSubdivision,
