@@ -57,7 +57,7 @@ fn random_flips(tri: &mut IntrinsicTriangulation, rng: &mut Lcg, count: usize) {
 /// Everything that makes the common subdivision a mesh of the input surface.
 fn check_valid(surface: &Surface, sub: &CommonSubdivision) {
     let mesh = &surface.mesh;
-    let pos = sub.positions(mesh, &surface.positions);
+    let pos = sub.positions(mesh, &surface.positions).unwrap();
     assert_eq!(sub.report.order_violations, 0);
     // Area per input face and in total.
     let mut area = vec![0.0; mesh.n_faces()];
@@ -305,7 +305,7 @@ fn cyclic_quad_crossing_is_the_diagonals_intersection() {
     assert_eq!(sub.crossings.len(), 1);
     check_valid(&s, &sub);
     let x = intersect(z[0], z[2], z[1], z[3]);
-    let pos = sub.positions(&s.mesh, &s.positions);
+    let pos = sub.positions(&s.mesh, &s.positions).unwrap();
     let p = pos[4];
     assert!(
         (p[0] - x[0]).abs() < 1e-13 && (p[1] - x[1]).abs() < 1e-13,
@@ -389,7 +389,7 @@ fn flat_grid_with_mobius_scaling_maps_crossings_to_image_diagonals() {
     assert_eq!(sub.crossings.len(), flipped.len());
     check_valid(&s, &sub);
     // Input side: the crossing is the square's centre.
-    let p3 = sub.positions(&s.mesh, &s.positions);
+    let p3 = sub.positions(&s.mesh, &s.positions).unwrap();
     for (k, cr) in sub.crossings.iter().enumerate() {
         let [v0, v1] = s.mesh.edge_vertices(cr.input_edge);
         let mid = [0, 1].map(|i| 0.5 * (pos[v0 as usize][i] + pos[v1 as usize][i]));
@@ -595,6 +595,26 @@ fn conformal_flow_on_real_meshes_has_no_flipped_triangle() {
             assert!(
                 gap < 1e-6 * size,
                 "{file}: seam gap {gap} in a flat disk of size {size}"
+            );
+            // The uv.obj surface: one UV per vertex, the input's area.
+            let out = sub
+                .uv_surface(&s.mesh, &s.positions, &uv, 1e-9 * size)
+                .unwrap();
+            assert_eq!(out.mesh.n_vertices(), sub.n_vertices());
+            let area = |m: &Mesh, p: &[[f64; 3]]| -> f64 {
+                m.faces()
+                    .iter()
+                    .map(|f| tri_area(p[f[0] as usize], p[f[1] as usize], p[f[2] as usize]))
+                    .sum()
+            };
+            let (a0, a1) = (area(&s.mesh, &s.positions), area(&out.mesh, &out.positions));
+            assert!((a0 - a1).abs() <= 1e-12 * a0);
+            let mut obj = Vec::new();
+            ricci::mesh::io::write_obj(&mut obj, &out).unwrap();
+            let text = String::from_utf8(obj).unwrap();
+            assert_eq!(
+                text.lines().filter(|l| l.starts_with("vt ")).count(),
+                out.mesh.n_vertices()
             );
         }
     }

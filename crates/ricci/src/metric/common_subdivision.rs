@@ -321,15 +321,36 @@ impl CommonSubdivision {
     }
 
     /// Positions of all vertices on the input surface (`positions` = the input's).
-    pub fn positions(&self, mesh: &Mesh, positions: &[[f64; 3]]) -> Vec<[f64; 3]> {
-        let mut out = positions[..self.n_input_vertices].to_vec();
+    pub fn positions(&self, mesh: &Mesh, positions: &[[f64; 3]]) -> Result<Vec<[f64; 3]>> {
+        if positions.len() != self.n_input_vertices || mesh.n_vertices() != self.n_input_vertices {
+            return Err(Error::input(format!(
+                "{} positions for a common subdivision of a mesh with {} vertices",
+                positions.len(),
+                self.n_input_vertices
+            )));
+        }
+        let mut out = positions.to_vec();
         for c in &self.crossings {
             let [a, b] = mesh.edge_vertices(c.input_edge);
             let (pa, pb) = (positions[a as usize], positions[b as usize]);
             let t = c.input_t;
             out.push([0, 1, 2].map(|k| (1.0 - t) * pa[k] + t * pb[k]));
         }
-        out
+        Ok(out)
+    }
+
+    /// Parameter of crossing `c` along its edge of `T` (0 at `edge_vertices[0]`, 1 at `[1]`)
+    /// in the projective interpolation of the metric with vertex scaling `u` (empty = 0).
+    pub fn t_parameter(&self, c: u32, u: &[f64]) -> f64 {
+        let cr = &self.crossings[c as usize];
+        let [a, b] = self.triangulation.edge_vertices(cr.t_edge);
+        let du = if u.is_empty() {
+            0.0
+        } else {
+            u[b as usize] - u[a as usize]
+        };
+        // β_a/β_b = e^{ρ + u_b − u_a}; the parameter is β_b/(β_a + β_b).
+        1.0 / (1.0 + (cr.t_log_ratio + du).exp())
     }
 
     /// Per-vertex vertex-scaling factors `u` of a final metric whose log Penner coordinates
@@ -429,7 +450,7 @@ impl CommonSubdivision {
         (0..self.triangles.len())
             .filter(|&t| {
                 let q = [0, 1, 2].map(|i| {
-                    let z = uv[3 * t + i];
+                    let z = uv.get(3 * t + i).copied().unwrap_or([f64::NAN; 2]);
                     if geometry == Geometry::Hyperbolic {
                         let s = 2.0 / (1.0 + z[0] * z[0] + z[1] * z[1]);
                         [s * z[0], s * z[1]]
@@ -452,8 +473,10 @@ impl CommonSubdivision {
         for (t, tr) in self.triangles.iter().enumerate() {
             for i in 0..3 {
                 let v = tr[i] as usize;
-                let z = uv[3 * t + i];
-                if out[v][0].is_nan() {
+                let z = uv.get(3 * t + i).copied().unwrap_or([f64::NAN; 2]);
+                if z[0].is_nan() || z[1].is_nan() {
+                    worst = f64::INFINITY;
+                } else if out[v][0].is_nan() {
                     out[v] = z;
                 } else {
                     worst = worst.max((out[v][0] - z[0]).hypot(out[v][1] - z[1]));
@@ -1201,7 +1224,14 @@ impl CommonSubdivision {
         uv: &[[f64; 2]],
         tol: f64,
     ) -> Result<crate::mesh::Surface> {
-        let pos = self.positions(mesh, positions);
+        if uv.len() != 3 * self.triangles.len() {
+            return Err(Error::input(format!(
+                "{} UVs for {} triangle corners",
+                uv.len(),
+                3 * self.triangles.len()
+            )));
+        }
+        let pos = self.positions(mesh, positions)?;
         let mut copies: Vec<Vec<(u32, [f64; 2])>> = vec![Vec::new(); self.n_vertices()];
         let mut out_pos = Vec::with_capacity(pos.len());
         let mut out_uv = Vec::with_capacity(pos.len());
