@@ -576,3 +576,85 @@ fn spectra_on_the_intrinsic_triangulation() {
         "{sp:?} vs vertex scaling {spy:?}"
     );
 }
+
+/// `to_simplicial` on Δ-complexes with self-loops and multi-edges: the split vertices are flat,
+/// the input vertices keep their curvature, in E² and H².
+#[test]
+fn to_simplicial_splits_loops_and_multi_edges() {
+    for (geometry, scale) in [(Geometry::Euclidean, 1.0), (Geometry::Hyperbolic, 0.5)] {
+        let s = ricci::mesh::generate::torus(1.0, 0.4, 12).unwrap();
+        let s = if geometry == Geometry::Hyperbolic {
+            genus2()
+        } else {
+            s
+        };
+        let t0 = delaunay(&s, geometry, scale / mean_edge(&s));
+        let n = t0.n_vertices;
+        // Every vertex but one pushed far away: the Delaunay triangulation joins the remaining
+        // one to itself around the handles (self-loops) and to the others by several edges.
+        let mut u = vec![
+            if geometry == Geometry::Euclidean {
+                12.0
+            } else {
+                6.0
+            };
+            n
+        ];
+        u[0] = 0.0;
+        let (t, st) = eval(&t0, geometry, &u);
+        let bad = (0..t.n_edges() as u32)
+            .filter(|&e| {
+                let [a, b] = t.edge_vertices(e);
+                a == b
+            })
+            .count();
+        let sm = t.to_simplicial(geometry, &u).unwrap();
+        assert!(
+            sm.splits > 0,
+            "{geometry:?}: no splits needed ({bad} loops)"
+        );
+        let k = metric::curvature(&sm.mesh, geometry, &sm.lengths);
+        for v in 0..sm.mesh.n_vertices() {
+            let want = if v < n { st.curvature[v] } else { 0.0 };
+            assert!(
+                (k[v] - want).abs() < 1e-9,
+                "{geometry:?}: vertex {v}: {} vs {want}",
+                k[v]
+            );
+            assert_eq!(sm.vertex_origin[v], if v < n { v as u32 } else { u32::MAX });
+        }
+        let deg0 = (0..t.n_edges() as u32)
+            .filter(|&e| t.edge_vertices(e).contains(&0))
+            .count();
+        eprintln!(
+            "{geometry:?}: {bad} loops, {} splits, {} flips, {deg0} edges at vertex 0",
+            sm.splits,
+            t.flip_log.len() - t0.flip_log.len()
+        );
+    }
+}
+
+/// The contract with input-edge tracking: replaying `flip_log` on the input triangulation
+/// reproduces the final connectivity (same half-edge arrays, edge ids and end points).
+#[test]
+fn flip_log_replays_to_the_final_triangulation() {
+    let s = genus2();
+    let chi = metric::euler_characteristic(&s.mesh);
+    let cones = separated_vertices(&s.mesh, (-chi) as usize, 5);
+    let r = conformal(
+        &s,
+        Geometry::Euclidean,
+        TargetSpec::Cones(cones.iter().map(|&v| (v, -2.0 * PI)).collect()),
+    );
+    check_result("genus-2 cones", &r);
+    let fin = &r.triangulation.as_ref().unwrap().triangulation;
+    assert!(fin.flip_log.len() > 100);
+    let mut t =
+        IntrinsicTriangulation::from_mesh(&s.mesh, Geometry::Euclidean, &s.edge_lengths()).unwrap();
+    for &e in &fin.flip_log {
+        assert!(t.flip(e), "edge {e} of the log cannot be flipped on replay");
+    }
+    assert_eq!(t.origin, fin.origin);
+    assert_eq!(t.twin, fin.twin);
+    assert_eq!(t.edge, fin.edge);
+}

@@ -415,7 +415,7 @@ pub fn solve(
             g
         };
         let g0 = grad(&st, target);
-        if !(g0 < 0.0) {
+        if g0.is_nan() || g0 >= 0.0 {
             notes.push(format!(
                 "iteration {it}: the Newton direction is not a descent direction (g = {g0:.3e})"
             ));

@@ -144,7 +144,7 @@ impl IntrinsicTriangulation {
         let mut lambda = Vec::with_capacity(mesh.n_edges());
         for (e, &l) in lengths.iter().enumerate() {
             let x = lambda_of_length(geometry, l);
-            if !(l > 0.0) || !x.is_finite() {
+            if l.is_nan() || l <= 0.0 || !x.is_finite() {
                 return Err(Error::input(format!(
                     "edge {e} has length {l}, which has no log Penner coordinate in {}",
                     geometry.name()
@@ -420,16 +420,15 @@ impl IntrinsicTriangulation {
     pub fn check(&self) -> Result<()> {
         for h in 0..self.n_halfedges() as u32 {
             let t = self.twin[h as usize];
-            if t != NONE {
-                if self.twin[t as usize] != h
+            if t != NONE
+                && (self.twin[t as usize] != h
                     || self.edge[t as usize] != self.edge[h as usize]
                     || self.origin[t as usize] != self.tip(h)
-                    || self.tip(t) != self.origin[h as usize]
-                {
-                    return Err(Error::numerical(format!(
-                        "intrinsic triangulation: half-edge {h} and its twin {t} disagree"
-                    )));
-                }
+                    || self.tip(t) != self.origin[h as usize])
+            {
+                return Err(Error::numerical(format!(
+                    "intrinsic triangulation: half-edge {h} and its twin {t} disagree"
+                )));
             }
         }
         for (e, &h) in self.edge_he.iter().enumerate() {
