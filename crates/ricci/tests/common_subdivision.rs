@@ -736,3 +736,55 @@ fn hyperbolic_cyclic_quad_crossing_is_the_geodesic_diagonals_intersection() {
     );
     assert_eq!(sub.flipped_triangles(Geometry::Hyperbolic, &uv), 0);
 }
+
+/// Without `$RICCI_MESHES`: a jittered disk lifted to a bumpy height field, flattened by the
+/// conformal flow with free boundary (E²): the layout is a flat disk, so the UV map on the
+/// common subdivision is seamless, and no triangle is flipped.
+#[test]
+fn free_boundary_flattening_of_a_bumpy_disk_is_seamless_without_flips() {
+    use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
+    use ricci::metric::Scheme;
+    use ricci::progress::NoProgress;
+    let d = generate::disk(24).unwrap();
+    let mut rng = Lcg(31);
+    let pos: Vec<[f64; 3]> = d
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(v, p)| {
+            let (mut x, mut y) = (p[0], p[1]);
+            if !d.mesh.is_boundary_vertex(v as u32) {
+                x += 0.02 * (rng.next() - 0.5);
+                y += 0.02 * (rng.next() - 0.5);
+            }
+            [x, y, 0.6 * (3.0 * x).sin() * (2.0 * y).cos() + 0.8 * x * x]
+        })
+        .collect();
+    let s = Surface::new(pos, d.mesh.faces().to_vec()).unwrap();
+    let o = FlowOptions {
+        geometry: Geometry::Euclidean,
+        scheme: Scheme::Conformal,
+        target: TargetSpec::FreeBoundary,
+        ..FlowOptions::default()
+    };
+    let lengths = s.edge_lengths();
+    let r = ricci_flow(&s.mesh, &lengths, &o, &mut NoProgress).unwrap();
+    assert!(r.converged, "{:?}", r.notes);
+    let it = r.triangulation.as_ref().unwrap();
+    let scaled: Vec<f64> = lengths.iter().map(|l| l * r.input_scale).collect();
+    let sub = CommonSubdivision::from_triangulation(
+        &s.mesh,
+        Geometry::Euclidean,
+        &scaled,
+        &it.triangulation,
+        &r.u,
+    )
+    .unwrap();
+    assert!(sub.crossings.len() > 5, "{} crossings", sub.crossings.len());
+    check_valid(&s, &sub);
+    let layout = layout_euclidean(&sub.triangulation, &r.u).unwrap();
+    let uv = sub.uv(Geometry::Euclidean, &r.u, &layout).unwrap();
+    assert_eq!(sub.flipped_triangles(Geometry::Euclidean, &uv), 0);
+    let (vuv, gap) = sub.vertex_uv(&uv, 1e-8);
+    assert!(vuv.is_some(), "seam gap {gap}");
+}
