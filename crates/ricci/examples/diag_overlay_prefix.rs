@@ -41,8 +41,8 @@ fn main() {
         }
         let mut worst = 0.0f64;
         let mut changed = 0usize;
-        for e in 0..l.len() {
-            let d = 0.5 * (tri.lambda[e] - 2.0 * l[e].ln());
+        for (lam, len) in tri.lambda.iter().zip(&l) {
+            let d = 0.5 * (lam - 2.0 * len.ln());
             if d.abs() > 1e-12 {
                 changed += 1;
             }
