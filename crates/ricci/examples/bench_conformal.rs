@@ -134,7 +134,7 @@ fn main() {
                     secs,
                     cpu
                 );
-                if !r.converged {
+                if !r.notes.is_empty() {
                     println!("    notes: {:?}", r.notes);
                 }
             }
