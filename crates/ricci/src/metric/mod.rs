@@ -9,7 +9,9 @@
 //! * [`intrinsic`] — intrinsic (Δ-complex) triangulations with log Penner coordinates, Ptolemy
 //!   flips and the Penner Delaunay criterion (discrete conformal equivalence);
 //! * [`refine`] — intrinsic refinement: metric-preserving edge splits and flips in E², H², S²
-//!   (paper 000 Step 2), moved here from `mesh` because it needs the background geometries.
+//!   (paper 000 Step 2), moved here from `mesh` because it needs the background geometries;
+//! * [`common_subdivision`] — normal coordinates of the input edges through the flips, the
+//!   overlay of the input and the intrinsic triangulation, UVs by projective interpolation.
 //!
 //! **Energy and signs.** We use the convex Ricci energy `E(u) = ∫ Σ (K_i − K̄_i) du_i`, whose
 //! gradient is `K − K̄` and whose Hessian is `H = ∂K/∂u` (positive semidefinite in E², with the
@@ -20,6 +22,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
+pub mod common_subdivision;
 pub mod conformal;
 pub mod file;
 pub mod geometry;
