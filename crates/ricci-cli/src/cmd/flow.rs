@@ -7,10 +7,10 @@
 //! and `target_curvature` (null where the vertex was held fixed), and per-edge `lengths` with
 //! `edge_vertices` (edge `i` joins `edge_vertices[i]`), so other tools can match edges.
 
+use crate::util::read_surface;
 use crate::util::{print_json, write_atomic};
 use indicatif::{ProgressBar, ProgressStyle};
 use ricci::flow::{ricci_flow, FlowOptions, FlowResult, Solver, SphereRoute, TargetSpec};
-use ricci::mesh::io::read_surface;
 use ricci::metric::{Geometry, Scheme};
 use serde_json::json;
 use std::path::PathBuf;
