@@ -53,6 +53,7 @@ __all__ = [
     "layout",
     "read_mesh",
     "run",
+    "run_cli",
     "spectrum",
     "spline",
     "validate",
@@ -422,6 +423,18 @@ def run(
     ):
         data["out"] = None
     return _RESULTS.get(command, Report)(data, files, memory)
+
+
+def run_cli(args: "list[str]") -> Report:
+    """Run ``ricci ARGS --json`` in this process, arguments as on the command line
+    (``run_cli(["flow", "kitten.off", "--geometry", "hyperbolic"])``); its report, exactly as
+    the CLI prints it. Files are written where the arguments say; nothing is kept in memory."""
+    args = [os.fspath(a) if isinstance(a, os.PathLike) else str(a) for a in args]
+    if not args:
+        raise UsageError("run_cli needs a command: run_cli(['info', 'mesh.off'])")
+    argv = args[1:] + ([] if "--json" in args else ["--json"])
+    text, files = _native.run(args[0], argv, None, None, None)
+    return _RESULTS.get(args[0], Report)(json.loads(text) if text else {}, files)
 
 
 def read_mesh(path: PathLike) -> Mesh:
