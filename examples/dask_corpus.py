@@ -141,7 +141,7 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(a.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp{os.getpid()}")
-    tmp.write_text("".join(json.dumps(l, sort_keys=True) + "\n" for l in lines))
+    tmp.write_text("".join(json.dumps(l, sort_keys=True, ensure_ascii=False) + "\n" for l in lines), encoding="utf-8")
     os.replace(tmp, out)
     print(f"{len(meshes)} meshes: {done} ok, {failed} failed; {out}", file=sys.stderr)
     return 0
