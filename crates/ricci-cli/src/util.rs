@@ -27,6 +27,8 @@ pub struct Capture {
     pub json: Option<serde_json::Value>,
     /// Files written to paths under [`MEMORY_PREFIX`], by path.
     pub files: BTreeMap<String, Vec<u8>>,
+    /// JSON files given to [`write_json_atomic`] under [`MEMORY_PREFIX`], by path, unprinted.
+    pub json_files: BTreeMap<String, serde_json::Value>,
 }
 
 thread_local! {
@@ -134,6 +136,26 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
         anyhow::bail!("{}: {e}", path.display());
     }
     Ok(())
+}
+
+/// Write a JSON file atomically (compact); an active [`Capture`] keeps the value itself for
+/// paths under [`MEMORY_PREFIX`] (no text made or parsed: kitten's metric is 1.4 MB of it).
+pub fn write_json_atomic(path: &Path, v: serde_json::Value) -> anyhow::Result<()> {
+    let mut v = Some(v);
+    CAPTURE.with(|c| {
+        if let Some(c) = c.borrow_mut().as_mut() {
+            let name = path.to_string_lossy();
+            if name.starts_with(MEMORY_PREFIX) {
+                if let Some(v) = v.take() {
+                    c.json_files.insert(name.into_owned(), v);
+                }
+            }
+        }
+    });
+    match v {
+        Some(v) => write_atomic(path, serde_json::to_string(&v)?.as_bytes()),
+        None => Ok(()),
+    }
 }
 
 /// Print one JSON object on stdout (or keep it in the active [`Capture`]).

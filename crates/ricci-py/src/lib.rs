@@ -154,7 +154,9 @@ fn surface_from_bytes(vertices: &[u8], faces: &[u8]) -> ricci::Result<(Surface, 
 
 /// Run a subcommand: `argv` are its arguments (the mesh path first). With `vertices` and
 /// `faces`, the mesh is those arrays under the path `name`. Returns the JSON report (text; the
-/// empty string when the command printed none) and the files written under `<memory>/`.
+/// empty string when the command printed none) and the files written under `<memory>/`
+/// (bytes; a metric file as `(other keys as JSON, [u, curvature, target_curvature, lengths,
+/// edge_vertices] as bytes)`).
 #[pyfunction]
 #[pyo3(signature = (command, argv, name=None, vertices=None, faces=None))]
 fn run<'py>(
@@ -167,7 +169,7 @@ fn run<'py>(
 ) -> PyResult<(String, Bound<'py, PyDict>)> {
     let outcome = py.detach(|| {
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(
-            || -> Result<(String, Capture), Failure> {
+            || -> Result<(String, Capture, Vec<(String, MetricArrays)>), Failure> {
                 let mut capture = Capture::default();
                 if let (Some(v), Some(f)) = (vertices, faces) {
                     let label = name.clone().unwrap_or_else(|| "<array>".into());
@@ -175,18 +177,29 @@ fn run<'py>(
                         .map_err(|e| Failure::Input(e.in_file(&label).to_string()))?;
                     capture.input = Some((PathBuf::from(label), s, r));
                 }
-                let (r, captured) = with_capture(capture, || dispatch(command, &argv));
+                let (r, mut captured) = with_capture(capture, || dispatch(command, &argv));
                 r?;
+                // JSON files kept as values: metrics become arrays, anything else text.
+                let mut metrics = Vec::new();
+                for (path, v) in std::mem::take(&mut captured.json_files) {
+                    if v.get("edge_vertices").is_some() && v.get("u").is_some() {
+                        metrics.push((path, metric_arrays(v).map_err(Failure::Input)?));
+                    } else {
+                        let text = serde_json::to_string(&v)
+                            .map_err(|e| Failure::Input(format!("JSON: {e}")))?;
+                        captured.files.insert(path, text.into_bytes());
+                    }
+                }
                 let json = match &captured.json {
                     Some(v) => serde_json::to_string(v)
                         .map_err(|e| Failure::Input(format!("JSON: {e}")))?,
                     None => String::new(),
                 };
-                Ok((json, captured))
+                Ok((json, captured, metrics))
             },
         ))
     });
-    let (json, captured) = match outcome {
+    let (json, captured, metrics) = match outcome {
         Ok(Ok(x)) => x,
         Ok(Err(f)) => return Err(f.into_py()),
         Err(p) => return Err(RicciError::new_err(panic_message(p))),
@@ -194,6 +207,12 @@ fn run<'py>(
     let files = PyDict::new(py);
     for (k, v) in &captured.files {
         files.set_item(k, PyBytes::new(py, v))?;
+    }
+    for (k, (rest, arrays, ev)) in &metrics {
+        let mut parts: Vec<Bound<'py, PyBytes>> =
+            arrays.iter().map(|a| PyBytes::new(py, a)).collect();
+        parts.push(PyBytes::new(py, ev));
+        files.set_item(k, (rest.clone(), parts))?;
     }
     Ok((json, files))
 }
@@ -273,12 +292,80 @@ fn validate(
     .map_err(RicciError::new_err)
 }
 
+/// A metric (`ricci flow --out` METRIC.json) as arrays: (the other keys as JSON, [u,
+/// curvature, target_curvature (NaN for null), lengths] as float64 bytes, edge_vertices as
+/// int64 bytes).
+type MetricArrays = (String, Vec<Vec<u8>>, Vec<u8>);
+
+fn metric_arrays(mut v: serde_json::Value) -> Result<MetricArrays, String> {
+    let obj = v
+        .as_object_mut()
+        .ok_or_else(|| "the metric is not a JSON object".to_string())?;
+    let mut floats = |key: &str| -> Result<Vec<u8>, String> {
+        let a = obj.remove(key).unwrap_or_default();
+        let a = a.as_array().ok_or_else(|| format!("no {key:?} array"))?;
+        Ok(a.iter()
+            .flat_map(|x| x.as_f64().unwrap_or(f64::NAN).to_ne_bytes())
+            .collect())
+    };
+    let arrays = vec![
+        floats("u")?,
+        floats("curvature")?,
+        floats("target_curvature")?,
+        floats("lengths")?,
+    ];
+    let ev = obj.remove("edge_vertices").unwrap_or_default();
+    let ev: Vec<u8> = ev
+        .as_array()
+        .ok_or_else(|| "no \"edge_vertices\" array".to_string())?
+        .iter()
+        .flat_map(|p| {
+            let p = p.as_array().map(|p| &p[..]).unwrap_or(&[]);
+            [0, 1].map(|k| p.get(k).and_then(|x| x.as_i64()).unwrap_or(-1))
+        })
+        .flat_map(|i| i.to_ne_bytes())
+        .collect();
+    let rest = serde_json::to_string(&v).map_err(|e| e.to_string())?;
+    Ok((rest, arrays, ev))
+}
+
+/// Benchmark helper (`bench/overhead.py`): the library call that `flow(path)` wraps —
+/// `read_surface` + `ricci_flow` with the CLI's default options, no progress, no report —
+/// timed in Rust, `repeats` times. Returns (seconds per call, max curvature error of the last).
+#[pyfunction]
+fn _library_flow_seconds(
+    py: Python<'_>,
+    path: PathBuf,
+    repeats: usize,
+) -> PyResult<(Vec<f64>, f64)> {
+    py.detach(|| {
+        let mut times = Vec::with_capacity(repeats);
+        let mut err = f64::NAN;
+        for _ in 0..repeats {
+            let t0 = std::time::Instant::now();
+            let (s, _) = ricci::mesh::io::read_surface(&path).map_err(|e| e.to_string())?;
+            let r = ricci::flow::ricci_flow(
+                &s.mesh,
+                &s.edge_lengths(),
+                &ricci::flow::FlowOptions::default(),
+                &mut ricci::progress::NoProgress,
+            )
+            .map_err(|e| e.to_string())?;
+            times.push(t0.elapsed().as_secs_f64());
+            err = r.max_curvature_error;
+        }
+        Ok::<_, String>((times, err))
+    })
+    .map_err(RicciError::new_err)
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(read_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(write_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(validate, m)?)?;
+    m.add_function(wrap_pyfunction!(_library_flow_seconds, m)?)?;
     m.add("RicciError", m.py().get_type::<RicciError>())?;
     m.add("UsageError", m.py().get_type::<UsageError>())?;
     m.add("COMMANDS", COMMANDS.to_vec())?;

@@ -8,7 +8,7 @@
 //! `edge_vertices` (edge `i` joins `edge_vertices[i]`), so other tools can match edges.
 
 use crate::util::read_surface;
-use crate::util::{print_json, write_atomic};
+use crate::util::{print_json, write_json_atomic};
 use indicatif::{ProgressBar, ProgressStyle};
 use ricci::flow::{ricci_flow, FlowOptions, FlowResult, Solver, SphereRoute, TargetSpec};
 use ricci::metric::{Geometry, Scheme};
@@ -204,8 +204,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ricci::mesh::io::write_surface(path, &surface)?;
     }
     if let Some(out) = &a.out {
-        let v = metric_json(&r, &surface.mesh, &source);
-        write_atomic(out, serde_json::to_string(&v)?.as_bytes())?;
+        write_json_atomic(out, metric_json(&r, &surface.mesh, &source))?;
     }
     if !r.converged {
         eprintln!(

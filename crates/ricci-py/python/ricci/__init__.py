@@ -180,22 +180,19 @@ class FlowResult(Report):
     target_curvature: Optional[np.ndarray]
     lengths: Optional[np.ndarray]
     edge_vertices: Optional[np.ndarray]
-    metric: Optional[Dict[str, Any]]
+    metric: Optional[Dict[str, Any]]  # METRIC.json's other keys (geometry, scheme, target, …)
 
     def __init__(self, data, files=None, memory=None):
         super().__init__(data, files)
         self.metric = self.u = self.curvature = None
         self.target_curvature = self.lengths = self.edge_vertices = None
         if memory and memory in self.files:
-            m = json.loads(self.files[memory])
-            self.metric = m
-            self.u = np.asarray(m["u"], dtype=np.float64)
-            self.curvature = np.asarray(m["curvature"], dtype=np.float64)
-            self.target_curvature = np.array(
-                [np.nan if x is None else x for x in m["target_curvature"]], dtype=np.float64
-            )
-            self.lengths = np.asarray(m["lengths"], dtype=np.float64)
-            self.edge_vertices = np.asarray(m["edge_vertices"], dtype=np.int64).reshape(-1, 2)
+            rest, (u, k, target, lengths, edges) = self.files.pop(memory)
+            f64 = lambda b: np.frombuffer(b, dtype=np.float64).copy()
+            self.metric = json.loads(rest)
+            self.u, self.curvature, self.target_curvature = f64(u), f64(k), f64(target)
+            self.lengths = f64(lengths)
+            self.edge_vertices = np.frombuffer(edges, dtype=np.int64).reshape(-1, 2).copy()
 
 
 class LayoutResult(Report):
