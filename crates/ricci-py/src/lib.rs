@@ -113,7 +113,7 @@ fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
 /// A validated surface from raw arrays: `vertices` n×3 float64, `faces` m×3 int64, both
 /// C-contiguous in native byte order.
 fn surface_from_bytes(vertices: &[u8], faces: &[u8]) -> ricci::Result<(Surface, BuildReport)> {
-    if vertices.len() % 24 != 0 || faces.len() % 24 != 0 {
+    if !vertices.len().is_multiple_of(24) || !faces.len().is_multiple_of(24) {
         return Err(ricci::Error::input(
             "vertices must be an (n, 3) float64 array and faces an (m, 3) int64 array",
         ));
@@ -152,6 +152,10 @@ fn surface_from_bytes(vertices: &[u8], faces: &[u8]) -> ricci::Result<(Surface, 
     })
 }
 
+/// What a run returns before it becomes Python objects: the report's JSON text, the capture
+/// and the metric files as arrays.
+type Outcome = (String, Capture, Vec<(String, MetricArrays)>);
+
 /// Run a subcommand: `argv` are its arguments (the mesh path first). With `vertices` and
 /// `faces`, the mesh is those arrays under the path `name`. Returns the JSON report (text; the
 /// empty string when the command printed none) and the files written under `<memory>/`
@@ -169,7 +173,7 @@ fn run<'py>(
 ) -> PyResult<(String, Bound<'py, PyDict>)> {
     let outcome = py.detach(|| {
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(
-            || -> Result<(String, Capture, Vec<(String, MetricArrays)>), Failure> {
+            || -> Result<Outcome, Failure> {
                 let mut capture = Capture::default();
                 if let (Some(v), Some(f)) = (vertices, faces) {
                     let label = name.clone().unwrap_or_else(|| "<array>".into());

@@ -310,7 +310,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if a.jobs == Some(0) {
         return Err(UsageError("--jobs must be at least 1".into()).into());
     }
-    if a.timeout.is_some_and(|t| !(t > 0.0)) {
+    if a.timeout.is_some_and(|t| t.is_nan() || t <= 0.0) {
         return Err(UsageError("--timeout must be a positive number of seconds".into()).into());
     }
     let meshes = manifest_meshes(&a.manifest)?;
