@@ -3,8 +3,7 @@
 //!
 //! Exit codes: 0 success, 1 bad input (the library refused the data), 2 bad arguments.
 
-mod cmd;
-mod util;
+use ricci_cli::{cmd, util};
 
 use clap::{Parser, Subcommand};
 
@@ -42,6 +41,8 @@ enum Command {
     Atlas(cmd::atlas::Args),
     /// Manifold triangular B-spline surface with at most one extraordinary point.
     Spline(cmd::spline::Args),
+    /// One subcommand over many meshes in parallel: JSON lines, resumable.
+    Batch(cmd::batch::Args),
 }
 
 fn main() {
@@ -71,6 +72,7 @@ fn main() {
         Command::Demo(a) => cmd::demo::run(a),
         Command::Atlas(a) => cmd::atlas::run(a),
         Command::Spline(a) => cmd::spline::run(a),
+        Command::Batch(a) => cmd::batch::run(a),
     };
     if let Err(e) = result {
         let sentence = util::sentence(&e);

@@ -1,7 +1,73 @@
-//! Small helpers shared by the subcommands: atomic file output, JSON printing, exit codes.
+//! Small helpers shared by the subcommands: atomic file output, JSON printing, exit codes,
+//! reading the input mesh.
+//!
+//! The Python package (`crates/ricci-py`) runs the subcommands' own `run` functions so that
+//! its results are the CLI's JSON to the last digit. For that, three of these helpers have an
+//! in-memory mode on the calling thread ([`Capture`]): [`read_surface`] can be handed an
+//! already validated surface (numpy arrays) under a name, [`print_json`] keeps the report
+//! instead of printing it, and [`write_atomic`] keeps files whose path starts with
+//! [`MEMORY_PREFIX`] instead of writing them. Without a capture they do what the CLI does.
 
+use std::cell::RefCell;
+use std::collections::BTreeMap;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+use ricci::mesh::{BuildReport, Surface};
+
+/// Output paths starting with this are kept in memory by an active [`Capture`].
+pub const MEMORY_PREFIX: &str = "<memory>/";
+
+/// What one subcommand run produced, kept on its thread instead of printed or written.
+#[derive(Default)]
+pub struct Capture {
+    /// A surface to return from [`read_surface`] for the path `input.0` (instead of reading).
+    pub input: Option<(PathBuf, Surface, BuildReport)>,
+    /// The JSON report [`print_json`] was given.
+    pub json: Option<serde_json::Value>,
+    /// Files written to paths under [`MEMORY_PREFIX`], by path.
+    pub files: BTreeMap<String, Vec<u8>>,
+    /// JSON files given to [`write_json_atomic`] under [`MEMORY_PREFIX`], by path, unprinted.
+    pub json_files: BTreeMap<String, serde_json::Value>,
+}
+
+thread_local! {
+    static CAPTURE: RefCell<Option<Capture>> = const { RefCell::new(None) };
+}
+
+/// Run `f` with `capture` active on this thread; returns `f`'s result and what was captured.
+/// The capture is removed again even when `f` panics.
+pub fn with_capture<T>(capture: Capture, f: impl FnOnce() -> T) -> (T, Capture) {
+    struct Reset;
+    impl Drop for Reset {
+        fn drop(&mut self) {
+            CAPTURE.with(|c| c.borrow_mut().take());
+        }
+    }
+    CAPTURE.with(|c| *c.borrow_mut() = Some(capture));
+    let reset = Reset;
+    let out = f();
+    let captured = CAPTURE.with(|c| c.borrow_mut().take()).unwrap_or_default();
+    drop(reset);
+    (out, captured)
+}
+
+/// Read and validate the input mesh (`ricci::mesh::io::read_surface`), or return the surface
+/// an active [`Capture`] holds under this path.
+pub fn read_surface(path: &Path) -> ricci::Result<(Surface, BuildReport)> {
+    let given = CAPTURE.with(|c| {
+        c.borrow().as_ref().and_then(|c| {
+            c.input
+                .as_ref()
+                .filter(|(p, _, _)| p == path)
+                .map(|(_, s, r)| (s.clone(), r.clone()))
+        })
+    });
+    match given {
+        Some(x) => Ok(x),
+        None => ricci::mesh::io::read_surface(path),
+    }
+}
 
 /// Error raised for bad command-line arguments that clap cannot check (exit code 2).
 #[derive(Debug)]
@@ -38,6 +104,17 @@ pub fn sentence(e: &anyhow::Error) -> String {
 /// Write a file atomically: to a temporary file next to it, then rename. Nothing
 /// half-written is left behind if writing fails.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    let kept = CAPTURE.with(|c| match c.borrow_mut().as_mut() {
+        Some(c) if path.to_string_lossy().starts_with(MEMORY_PREFIX) => {
+            c.files
+                .insert(path.to_string_lossy().into_owned(), bytes.to_vec());
+            true
+        }
+        _ => false,
+    });
+    if kept {
+        return Ok(());
+    }
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
@@ -65,9 +142,39 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
 /// exiting 1 after writing the report of its other stages) does not print a second one.
 static PRINTED_JSON: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
-/// Print one JSON object on stdout.
+/// Write a JSON file atomically (compact); an active [`Capture`] keeps the value itself for
+/// paths under [`MEMORY_PREFIX`] (no text made or parsed: kitten's metric is 1.4 MB of it).
+pub fn write_json_atomic(path: &Path, v: serde_json::Value) -> anyhow::Result<()> {
+    let mut v = Some(v);
+    CAPTURE.with(|c| {
+        if let Some(c) = c.borrow_mut().as_mut() {
+            let name = path.to_string_lossy();
+            if name.starts_with(MEMORY_PREFIX) {
+                if let Some(v) = v.take() {
+                    c.json_files.insert(name.into_owned(), v);
+                }
+            }
+        }
+    });
+    match v {
+        Some(v) => write_atomic(path, serde_json::to_string(&v)?.as_bytes()),
+        None => Ok(()),
+    }
+}
+
+/// Print one JSON object on stdout (or keep it in the active [`Capture`]).
 pub fn print_json(v: &serde_json::Value) {
     PRINTED_JSON.store(true, std::sync::atomic::Ordering::SeqCst);
+    let kept = CAPTURE.with(|c| match c.borrow_mut().as_mut() {
+        Some(c) => {
+            c.json = Some(v.clone());
+            true
+        }
+        None => false,
+    });
+    if kept {
+        return;
+    }
     println!(
         "{}",
         serde_json::to_string_pretty(v).unwrap_or_else(|_| "{}".into())

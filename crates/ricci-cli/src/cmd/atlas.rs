@@ -8,11 +8,11 @@
 //! every candidate flow of the placement prints one line on stderr (vertex, converged or not,
 //! distortion or best residual, iterations, seconds).
 
+use crate::util::read_surface;
 use crate::util::{print_json, write_atomic, UsageError};
 use indicatif::{ProgressBar, ProgressStyle};
 use ricci::atlas::{svg, AffineAtlas, AtlasOptions, FlatCharts, Singularity};
 use ricci::flow::TargetSpec;
-use ricci::mesh::io::read_surface;
 use serde_json::{json, Value};
 use std::path::PathBuf;
 use std::time::Instant;

@@ -12,10 +12,10 @@
 //! are used for the loops and the
 //! refinement. Without it the Euclidean lengths of the positions are used.
 
+use crate::util::read_surface;
 use crate::util::{print_json, write_atomic, UsageError};
 use indicatif::{ProgressBar, ProgressStyle};
 use ricci::cut::{canonical_cut, CanonicalCut, CutOptions};
-use ricci::mesh::io::read_surface;
 use ricci::mesh::Surface;
 use ricci::metric::Geometry;
 use serde_json::{json, Value};

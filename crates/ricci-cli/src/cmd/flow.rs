@@ -7,10 +7,10 @@
 //! and `target_curvature` (null where the vertex was held fixed), and per-edge `lengths` with
 //! `edge_vertices` (edge `i` joins `edge_vertices[i]`), so other tools can match edges.
 
-use crate::util::{print_json, write_atomic};
+use crate::util::read_surface;
+use crate::util::{print_json, write_json_atomic};
 use indicatif::{ProgressBar, ProgressStyle};
 use ricci::flow::{ricci_flow, FlowOptions, FlowResult, Solver, SphereRoute, TargetSpec};
-use ricci::mesh::io::read_surface;
 use ricci::metric::{Geometry, Scheme};
 use serde_json::json;
 use std::path::PathBuf;
@@ -233,8 +233,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ricci::mesh::io::write_surface(path, &surface)?;
     }
     if let Some(out) = &a.out {
-        let v = metric_json(&r, &surface.mesh, &source);
-        write_atomic(out, serde_json::to_string(&v)?.as_bytes())?;
+        write_json_atomic(out, metric_json(&r, &surface.mesh, &source))?;
     }
     if !r.converged {
         eprintln!("warning: {source}: {}", not_converged_reason(&r));

@@ -6,7 +6,7 @@
 //! (exit code 1), so `orientable` and `manifold` are always `true` in a report.
 
 use crate::util::print_json;
-use ricci::mesh::io::read_surface;
+use crate::util::read_surface;
 use ricci::mesh::quality::face_angles;
 use ricci::mesh::topology;
 use ricci::mesh::{BuildReport, Surface};

@@ -14,6 +14,7 @@
 //! UV.obj keeps the surface's own vertices (`v`) and gives every corner the layout coordinate
 //! of its cut-mesh vertex (`vt`; for the sphere, `v` are the points on the unit sphere).
 
+use crate::util::read_surface;
 use crate::util::{print_json, write_atomic, UsageError};
 use indicatif::{ProgressBar, ProgressStyle};
 use ricci::layout::cover::{tiles_by_radius, word_string};
@@ -24,7 +25,7 @@ use ricci::layout::pipeline::{cut_disk, cut_disk_polished, uniformization_geomet
 use ricci::layout::place::{layout, layout_dd, minimax_centre, Space};
 use ricci::layout::svg::{fundamental_domain_svg, sphere_svg, tiling_svg};
 use ricci::layout::{deck_group, DeckGroup, Isometry, Layout, Polygon};
-use ricci::mesh::{io::read_surface, topology, Mesh, Surface};
+use ricci::mesh::{topology, Mesh, Surface};
 use ricci::metric::file::MetricFile;
 use ricci::metric::{Euclidean, Geometry, Hyperbolic, Scheme, Spherical};
 use serde_json::{json, Value};

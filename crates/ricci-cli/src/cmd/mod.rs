@@ -1,6 +1,7 @@
 //! One module per subcommand; each has `Args` (clap) and `run`.
 
 pub mod atlas;
+pub mod batch;
 pub mod cut;
 pub mod demo;
 pub mod flow;

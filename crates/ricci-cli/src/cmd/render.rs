@@ -6,9 +6,10 @@
 //! legend; otherwise a checkerboard (or `--circles`) when UVs are known (`--uv FILE`, or `vt`
 //! in the mesh file itself); otherwise plain grey.
 
+use crate::util::read_surface;
 use crate::util::{print_json, write_atomic, UsageError};
 use anyhow::{bail, Context};
-use ricci::mesh::{io::read_surface, Surface};
+use ricci::mesh::Surface;
 use ricci_render::render::Uvs;
 use ricci_render::{
     fields, gltf, render, Background, Checker, Circles, Colormap, Lighting, Paint, Polyline,

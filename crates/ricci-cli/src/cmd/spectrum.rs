@@ -7,12 +7,13 @@
 //! double-double before the layout, as in `ricci layout` (`metric_polish` in the report).
 
 use super::layout::{polished_metric, spinner, PolishedLengths};
+use crate::util::read_surface;
 use crate::util::{print_json, UsageError};
 use ricci::analysis::spectrum::{fuchsian_spectrum, lattice_spectrum};
 use ricci::layout::deck_group;
 use ricci::layout::pipeline::{cut_disk, cut_disk_polished};
 use ricci::layout::place::{layout, layout_dd};
-use ricci::mesh::{io::read_surface, topology};
+use ricci::mesh::topology;
 use ricci::metric::{Euclidean, Geometry, Hyperbolic};
 use serde_json::json;
 use std::path::PathBuf;

@@ -18,9 +18,9 @@
 //! `spline.json` (the report).
 
 use crate::cmd::layout::spinner;
+use crate::util::read_surface;
 use crate::util::{print_json, write_atomic, UsageError};
 use ricci::atlas::{AffineAtlas, AtlasOptions, FlatCharts, Singularity as AtlasSingularity};
-use ricci::mesh::io::read_surface;
 use ricci::spline::dms::multi_indices;
 use ricci::spline::surface::{
     flat_domain, run as run_spline, MeshDistance, Singularity, SplineOptions,
