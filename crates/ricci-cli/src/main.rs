@@ -42,6 +42,8 @@ enum Command {
     Atlas(cmd::atlas::Args),
     /// Manifold triangular B-spline surface with at most one extraordinary point.
     Spline(cmd::spline::Args),
+    /// Partition-of-unity surface over the hyperbolic structure: C∞, no extraordinary point.
+    Pou(cmd::pou::Args),
 }
 
 fn main() {
@@ -58,6 +60,7 @@ fn main() {
         Command::Demo(a) => cmd::demo::run(a),
         Command::Atlas(a) => cmd::atlas::run(a),
         Command::Spline(a) => cmd::spline::run(a),
+        Command::Pou(a) => cmd::pou::run_cmd(a),
     };
     if let Err(e) = result {
         eprintln!("error: {}", util::sentence(&e));
