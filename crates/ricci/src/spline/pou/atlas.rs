@@ -304,15 +304,6 @@ impl HyperbolicAtlas {
             .fold(0.0, f64::max)
     }
 
-    /// Chart positions of the lift of face `f` under `map`.
-    #[inline]
-    fn lift_positions(&self, f: u32, map: &MobiusDd) -> [Complex; 3] {
-        self.cut_mesh.face(f).map(|c| {
-            let w = map.apply(self.global[c as usize]);
-            w.hi() + w.lo()
-        })
-    }
-
     /// Develop the chart of `v` breadth first over face lifts, keeping the lifts for which
     /// `keep(face, positions)` holds (the star is always kept) and expanding only those.
     /// Returns the kept lifts, the star first.
@@ -332,16 +323,28 @@ impl HyperbolicAtlas {
             .position(|&x| x == v)
             .ok_or_else(|| Error::input(format!("vertex {v} is not on face {f0}")))?;
         let cv = self.cut_mesh.face(f0)[k];
-        let start = MobiusDd::to_origin(self.global[cv as usize]);
+        // The distinct maps met (a lift refers to one by index; the same deck element reached
+        // along different paths is one map) and the chart positions of the cut-mesh vertices
+        // under each, computed once.
+        let mut maps: Vec<MobiusDd> = vec![MobiusDd::to_origin(self.global[cv as usize])];
+        let mut cache: HashMap<(u32, u32), Complex> = HashMap::new();
+        let mut lift = |f: u32, mi: u32, maps: &[MobiusDd]| -> [Complex; 3] {
+            self.cut_mesh.face(f).map(|c| {
+                *cache.entry((mi, c)).or_insert_with(|| {
+                    let w = maps[mi as usize].apply(self.global[c as usize]);
+                    w.hi() + w.lo()
+                })
+            })
+        };
         let mut seen: HashMap<u32, Vec<Complex>> = HashMap::new();
         let mut queue = std::collections::VecDeque::new();
-        let z0 = self.lift_positions(f0, &start);
+        let z0 = lift(f0, 0, &maps);
         seen.entry(f0).or_default().push(z0[0]);
-        queue.push_back((f0, start, z0));
+        queue.push_back((f0, 0u32, z0));
         let mut kept = Vec::new();
         let mut star = Vec::new();
         let mut visited = 0usize;
-        while let Some((f, map, z)) = queue.pop_front() {
+        while let Some((f, mi, z)) = queue.pop_front() {
             visited += 1;
             if visited > MAX_DEVELOPED_FACES {
                 return Err(Error::numerical(format!(
@@ -355,9 +358,9 @@ impl HyperbolicAtlas {
                 .zip(&z)
                 .any(|(&x, w)| x == v && w.norm() < 1e-9);
             if at_origin {
-                star.push((f, map, z));
+                star.push((f, maps[mi as usize], z));
             } else if keep(f, &z) {
-                kept.push((f, map, z));
+                kept.push((f, maps[mi as usize], z));
             } else {
                 continue;
             }
@@ -367,28 +370,42 @@ impl HyperbolicAtlas {
                     continue;
                 }
                 let g = m.he_face(t);
-                let gm = match &self.crossing[h as usize] {
-                    Some(s) => map.compose(s).normalized(),
-                    None => map,
+                let gi = match &self.crossing[h as usize] {
+                    Some(s) => {
+                        let gm = maps[mi as usize].compose(s).normalized();
+                        match maps.iter().position(|x| x.distance(&gm) < 1e-20) {
+                            Some(i) => i as u32,
+                            None => {
+                                maps.push(gm);
+                                (maps.len() - 1) as u32
+                            }
+                        }
+                    }
+                    None => mi,
                 };
-                let zg = self.lift_positions(g, &gm);
+                let zg = lift(g, gi, &maps);
                 let lifts = seen.entry(g).or_default();
                 if lifts.iter().any(|w| (w - zg[0]).norm() < 1e-9) {
                     continue;
                 }
                 lifts.push(zg[0]);
-                queue.push_back((g, gm, zg));
+                queue.push_back((g, gi, zg));
             }
         }
         star.extend(kept);
         Ok(star)
     }
 
-    /// Develop every chart (in parallel) far enough for bases of radii `radii` (per vertex):
-    /// a face lift is expanded when one of its vertices `u` is within `ρ₁(v) + r_u + 2 h` of
-    /// the origin (`ρ₁(v)` the star radius, `h` the face's longest edge: the slack for radii
-    /// that change from vertex to vertex), and a control lift `u` is kept when it is within
-    /// `ρ₁(v) + r_u`: exactly the bases that can be non-zero somewhere on the star.
+    /// Develop every chart (in parallel) far enough for bases of radii `radii` (per vertex).
+    /// A control lift `u` is kept when it is within `ρ₁(v) + r_u` of the origin (`ρ₁(v)` the
+    /// star radius): exactly the bases that can be non-zero somewhere on the star. To reach
+    /// them, a face lift is expanded when one of its vertices `u` is within
+    /// `ρ₁(v) + R*_u + 2h` of the origin, `h` the face's longest edge and
+    /// `R*_u = max_c (r_c − d_E(u, c))` the 1-Lipschitz envelope of the radii along edge
+    /// paths (`d_E`): a face on the geodesic from the origin to a reachable lift `c` at
+    /// distance `t` from it has a vertex with `r_c − t ≲ R*_u` even where the radii change
+    /// fast from vertex to vertex (coarse meshes). The chart-independence and continuity
+    /// checks ([`super::measure`]) would see a lift that was missed.
     pub fn develop_charts(&mut self, radii: &[f64], progress: &mut dyn Progress) -> Result<()> {
         use rayon::prelude::*;
         let nv = self.mesh.n_vertices();
@@ -398,6 +415,7 @@ impl HyperbolicAtlas {
                 radii.len()
             )));
         }
+        let envelope = self.radius_envelope(radii);
         progress.report("charts", None, &format!("developing {nv} charts"));
         let charts: Vec<Chart> = (0..nv as u32)
             .into_par_iter()
@@ -409,7 +427,8 @@ impl HyperbolicAtlas {
                     let h = (0..3)
                         .map(|k| disk_distance(z[k], z[(k + 1) % 3]))
                         .fold(0.0, f64::max);
-                    (0..3).any(|k| disk_distance(o, z[k]) < rho + radii[vs[k] as usize] + 2.0 * h)
+                    (0..3)
+                        .any(|k| disk_distance(o, z[k]) < rho + envelope[vs[k] as usize] + 2.0 * h)
                 })?;
                 let mut controls: Vec<ControlLift> = Vec::new();
                 for (f, _, z) in &lifts {
@@ -451,6 +470,47 @@ impl HyperbolicAtlas {
             .collect::<Result<_>>()?;
         self.charts = charts;
         Ok(())
+    }
+
+    /// `R*_u = max_c (r_c − d_E(u, c))` over edge paths (Dijkstra on the max-plus problem:
+    /// every vertex is settled once).
+    pub fn radius_envelope(&self, radii: &[f64]) -> Vec<f64> {
+        use std::cmp::Ordering;
+        use std::collections::BinaryHeap;
+        #[derive(PartialEq)]
+        struct Item(f64, u32);
+        impl Eq for Item {}
+        impl PartialOrd for Item {
+            fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+                Some(self.cmp(o))
+            }
+        }
+        impl Ord for Item {
+            fn cmp(&self, o: &Self) -> Ordering {
+                self.0.total_cmp(&o.0).then(self.1.cmp(&o.1))
+            }
+        }
+        let m = &self.mesh;
+        let mut env = radii.to_vec();
+        let mut done = vec![false; env.len()];
+        let mut heap: BinaryHeap<Item> = (0..env.len() as u32)
+            .map(|v| Item(env[v as usize], v))
+            .collect();
+        while let Some(Item(r, v)) = heap.pop() {
+            if done[v as usize] || r < env[v as usize] {
+                continue;
+            }
+            done[v as usize] = true;
+            for h in m.outgoing(v) {
+                let u = m.he_tip(h);
+                let cand = r - self.lengths[m.he_edge(h) as usize];
+                if !done[u as usize] && cand > env[u as usize] {
+                    env[u as usize] = cand;
+                    heap.push(Item(cand, u));
+                }
+            }
+        }
+        env
     }
 
     /// Index of face `f` in the star of chart `v`.
@@ -510,30 +570,74 @@ impl HyperbolicAtlas {
 
 /// The double cover of a surface with boundary (paper 004 §1, Gu–Yau 2003): the surface and
 /// its mirror image (faces reversed) glued along the boundary, with the same positions.
-/// Returns the closed surface and the number of faces of the first sheet (faces
-/// `0..n_faces` are the input's).
+/// Interior edges whose two end points are on the boundary are split at their midpoint first
+/// (otherwise the two sheets would share them and the cover would not be a manifold).
+/// Returns the closed surface and the number of faces of the first sheet (faces `0..n` are
+/// the input's, after those splits).
 pub fn double_cover(surface: &Surface) -> Result<(Surface, usize)> {
+    use std::collections::HashSet;
     let m = &surface.mesh;
-    let nv = m.n_vertices();
-    let mut index = vec![u32::MAX; nv];
     let mut positions = surface.positions.clone();
-    for v in 0..nv as u32 {
-        index[v as usize] = if m.is_boundary_vertex(v) {
-            v
+    let mut faces: Vec<[u32; 3]> = m.faces().to_vec();
+    let on_boundary: Vec<bool> = (0..m.n_vertices() as u32)
+        .map(|v| m.is_boundary_vertex(v))
+        .collect();
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    let boundary_edges: HashSet<(u32, u32)> = (0..m.n_edges() as u32)
+        .filter(|&e| m.is_boundary_edge(e))
+        .map(|e| {
+            let [a, b] = m.edge_vertices(e);
+            key(a, b)
+        })
+        .collect();
+    let chords: Vec<(u32, u32)> = (0..m.n_edges() as u32)
+        .map(|e| m.edge_vertices(e))
+        .filter(|[a, b]| {
+            on_boundary[*a as usize]
+                && on_boundary[*b as usize]
+                && !boundary_edges.contains(&key(*a, *b))
+        })
+        .map(|[a, b]| (a, b))
+        .collect();
+    for (a, b) in chords {
+        let (pa, pb) = (positions[a as usize], positions[b as usize]);
+        positions.push([0, 1, 2].map(|d| 0.5 * (pa[d] + pb[d])));
+        let mid = (positions.len() - 1) as u32;
+        let mut added = Vec::new();
+        for f in faces.iter_mut() {
+            for k in 0..3 {
+                let (x, y) = (f[k], f[(k + 1) % 3]);
+                if key(x, y) == key(a, b) {
+                    let z = f[(k + 2) % 3];
+                    *f = [x, mid, z];
+                    added.push([mid, y, z]);
+                    break;
+                }
+            }
+        }
+        faces.extend(added);
+    }
+    let nv = positions.len();
+    let nb = on_boundary.len();
+    let mut index = vec![u32::MAX; nv];
+    for v in 0..nv {
+        index[v] = if v < nb && on_boundary[v] {
+            v as u32
         } else {
-            positions.push(surface.positions[v as usize]);
+            positions.push(positions[v]);
             (positions.len() - 1) as u32
         };
     }
-    let mut faces: Vec<[u32; 3]> = m.faces().to_vec();
-    for f in m.faces() {
+    let sheet = faces.len();
+    for k in 0..sheet {
+        let f = faces[k];
         faces.push([
             index[f[0] as usize],
             index[f[2] as usize],
             index[f[1] as usize],
         ]);
     }
-    Ok((Surface::new(positions, faces)?, m.n_faces()))
+    Ok((Surface::new(positions, faces)?, sheet))
 }
 
 #[cfg(test)]
