@@ -35,6 +35,9 @@ pub struct Args {
     /// Random points of the chart-independence check.
     #[arg(long, default_value_t = 2000)]
     pub samples: usize,
+    /// Edges sampled by the continuity check, evenly spaced (0: all).
+    #[arg(long, default_value_t = 3000)]
+    pub continuity_edges: usize,
     /// Output directory.
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -68,7 +71,7 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         },
         tessellation: a.tessellation,
         independence_samples: a.samples,
-        ..PouOptions::default()
+        continuity_edges: a.continuity_edges,
     };
     let (rep, tess, c) = run(&surface, &opts, &mut bar)?;
     bar.0.finish_and_clear();

@@ -31,7 +31,7 @@ use std::time::Instant;
 use crate::error::{Error, Result};
 use crate::flow::{ricci_flow, FlowOptions, TargetSpec};
 use crate::layout::dd::{Cdd, MobiusDd};
-use crate::layout::isometry::{disk_distance, Complex, Isometry, Mobius};
+use crate::layout::isometry::{Complex, Isometry, Mobius};
 use crate::layout::pipeline::{cut_disk_polished, polish_uniformization};
 use crate::layout::{deck_group, layout_dd, DeckGroup};
 use crate::mesh::{topology, Mesh, Surface};
@@ -416,32 +416,42 @@ impl HyperbolicAtlas {
             )));
         }
         let envelope = self.radius_envelope(radii);
+        let face_diameter: Vec<f64> = (0..self.mesh.n_faces() as u32)
+            .map(|f| {
+                self.mesh
+                    .face_halfedges(f)
+                    .iter()
+                    .map(|&h| self.lengths[self.mesh.he_edge(h) as usize])
+                    .fold(0.0, f64::max)
+            })
+            .collect();
         progress.report("charts", None, &format!("developing {nv} charts"));
         let charts: Vec<Chart> = (0..nv as u32)
             .into_par_iter()
             .map(|v| -> Result<Chart> {
                 let rho = self.star_radius(v);
-                let o = Complex::new(0.0, 0.0);
+                // d(0, z) < R ⟺ |z| < tanh(R/2): no distances in the loop.
                 let lifts = self.develop(v, |f, z| {
                     let vs = self.mesh.face(f);
-                    let h = (0..3)
-                        .map(|k| disk_distance(z[k], z[(k + 1) % 3]))
-                        .fold(0.0, f64::max);
-                    (0..3)
-                        .any(|k| disk_distance(o, z[k]) < rho + envelope[vs[k] as usize] + 2.0 * h)
+                    let h = face_diameter[f as usize];
+                    (0..3).any(|k| {
+                        let t = (0.5 * (rho + envelope[vs[k] as usize] + 2.0 * h)).tanh();
+                        z[k].norm_sqr() < t * t
+                    })
                 })?;
                 let mut controls: Vec<ControlLift> = Vec::new();
+                let mut by_vertex: HashMap<u32, Vec<Complex>> = HashMap::new();
                 for (f, _, z) in &lifts {
                     for (k, &u) in self.mesh.face(*f).iter().enumerate() {
-                        if disk_distance(o, z[k]) >= rho + radii[u as usize] {
+                        let t = (0.5 * (rho + radii[u as usize])).tanh();
+                        if z[k].norm_sqr() >= t * t {
                             continue;
                         }
-                        if controls
-                            .iter()
-                            .any(|c| c.vertex == u && (c.z - z[k]).norm() < 1e-9)
-                        {
+                        let known = by_vertex.entry(u).or_default();
+                        if known.iter().any(|w| (w - z[k]).norm() < 1e-9) {
                             continue;
                         }
+                        known.push(z[k]);
                         controls.push(ControlLift { vertex: u, z: z[k] });
                     }
                 }

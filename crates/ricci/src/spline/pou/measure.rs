@@ -309,8 +309,8 @@ pub struct PouOptions {
     pub tessellation: usize,
     /// Random points of the chart-independence check.
     pub independence_samples: usize,
-    /// Every `stride`-th edge is sampled by the continuity check.
-    pub continuity_stride: usize,
+    /// The continuity check samples about this many edges, evenly spaced (0: all).
+    pub continuity_edges: usize,
 }
 
 impl Default for PouOptions {
@@ -320,7 +320,7 @@ impl Default for PouOptions {
             fit: PouFitOptions::default(),
             tessellation: 6,
             independence_samples: 2000,
-            continuity_stride: 1,
+            continuity_edges: 3000,
         }
     }
 }
@@ -332,6 +332,8 @@ pub struct PouContinuity {
     pub relative_jumps: Vec<f64>,
     pub samples: usize,
     pub comparisons: usize,
+    /// Every `edge_stride`-th edge was sampled.
+    pub edge_stride: usize,
     pub tolerance: f64,
     /// Orders ≤ 3 whose jumps are below the tolerance, all of them: "C∞ (orders 0–3 measured)".
     pub class: String,
@@ -441,7 +443,12 @@ pub fn run(
     progress.report("checks", None, "chart independence and continuity");
     let t2 = Instant::now();
     let ci = chart_independence(&s, opts.independence_samples, 0x9e3779b97f4a7c15)?;
-    let cont = continuity(&s, opts.continuity_stride)?;
+    let ne = c.atlas.mesh.n_edges();
+    let stride = match opts.continuity_edges {
+        0 => 1,
+        n => ne.div_ceil(n).max(1),
+    };
+    let cont = continuity(&s, stride)?;
     let seconds_checks = t2.elapsed().as_secs_f64();
     let tol = 1e-10;
     let reached = cont.relative.iter().take_while(|&&j| j <= tol).count();
@@ -473,6 +480,7 @@ pub fn run(
             relative_jumps: cont.relative.clone(),
             samples: cont.samples,
             comparisons: cont.comparisons,
+            edge_stride: stride,
             tolerance: tol,
             class,
         },
