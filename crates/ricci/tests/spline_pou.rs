@@ -333,6 +333,7 @@ fn chart_independence_and_continuity_3holes() {
 }
 
 #[test]
+#[ignore = "the full radius envelope develops charts deep into regions of small triangles: many minutes (run with --ignored)"]
 fn chart_independence_and_continuity_genus3() {
     check_mesh("genus3.off", 3000, 1000);
 }
@@ -343,6 +344,7 @@ fn chart_independence_and_continuity_fertility() {
 }
 
 #[test]
+#[ignore = "the full radius envelope develops charts deep into regions of small triangles: many minutes (run with --ignored)"]
 fn chart_independence_and_continuity_botijo() {
     check_mesh("botijo.off", 2000, 500);
 }
