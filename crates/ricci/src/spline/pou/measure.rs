@@ -67,15 +67,14 @@ fn jets_in(
     Ok(jv.map(|g| compose(&g, &w)))
 }
 
+/// A sample: reference chart, face and `λ` in it, and the other `(chart, face, λ)` that name
+/// the same point.
+type Sample = (u32, u32, [f64; 3], Vec<(u32, u32, [f64; 3])>);
+
 /// Compare evaluations at points: for each `(reference chart u, reference face, λ, others)`,
 /// the jets in every other chart `v` (with the face of `v`'s star that holds the point)
 /// carried to `u`. `diag` scales the values.
-fn compare(
-    s: &PouSurface,
-    points: &[(u32, u32, [f64; 3], Vec<(u32, u32, [f64; 3])>)],
-    order: usize,
-    diag: f64,
-) -> Result<ChartComparison> {
+fn compare(s: &PouSurface, points: &[Sample], order: usize, diag: f64) -> Result<ChartComparison> {
     let atlas = s.basis.atlas;
     type Diffs = (Vec<f64>, Vec<f64>, usize);
     let res: Vec<Diffs> = points
