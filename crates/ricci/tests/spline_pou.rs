@@ -333,7 +333,6 @@ fn chart_independence_and_continuity_3holes() {
 }
 
 #[test]
-#[ignore = "the full radius envelope develops charts deep into regions of small triangles: many minutes (run with --ignored)"]
 fn chart_independence_and_continuity_genus3() {
     check_mesh("genus3.off", 3000, 1000);
 }
