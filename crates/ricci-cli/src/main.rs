@@ -43,6 +43,8 @@ enum Command {
     Spline(cmd::spline::Args),
     /// One subcommand over many meshes in parallel: JSON lines, resumable.
     Batch(cmd::batch::Args),
+    /// Partition-of-unity surface over the hyperbolic structure: C∞, no extraordinary point.
+    Pou(cmd::pou::Args),
 }
 
 fn main() {
@@ -73,6 +75,7 @@ fn main() {
         Command::Atlas(a) => cmd::atlas::run(a),
         Command::Spline(a) => cmd::spline::run(a),
         Command::Batch(a) => cmd::batch::run(a),
+        Command::Pou(a) => cmd::pou::run_cmd(a),
     };
     if let Err(e) = result {
         let sentence = util::sentence(&e);

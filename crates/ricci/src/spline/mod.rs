@@ -16,6 +16,8 @@
 //!   in vertex frames, bases in home charts, chart-independent evaluation, the independent chart
 //!   provider [`manifold::LocalCharts`];
 //! * [`hole`] — the seam around the extraordinary point and the G¹ fill patch;
+//! * [`pou`] — partition-of-unity surfaces over the hyperbolic atlas (paper 004), C∞ without
+//!   extraordinary points;
 //! * [`surface`] — the whole construction (subdivision, fairing, fit, fill), tessellation,
 //!   errors against the input mesh and continuity measurements.
 
@@ -27,6 +29,7 @@ pub mod fit;
 pub mod hole;
 pub mod manifold;
 pub mod poly;
+pub mod pou;
 pub mod quadrature;
 pub mod simplex;
 pub mod space;

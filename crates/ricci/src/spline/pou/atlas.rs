@@ -1,0 +1,676 @@
+//! The hyperbolic atlas of a closed surface with χ < 0 (paper 004 §4.1): the uniformization
+//! metric (hyperbolic Ricci flow, polished to double-double), the canonical cut, the layout of
+//! the fundamental domain in the Poincaré disk in double-double, the Fuchsian side pairings —
+//! and from them one chart per vertex.
+//!
+//! **Charts.** The chart of vertex `v` is the Poincaré-disk coordinate in which one lift of `v`
+//! sits at the origin: `M = τ ∘ γ` maps the fundamental domain's coordinate to it, `τ` the
+//! Möbius map taking the lift of `v` to 0 and `γ` a deck transformation. The chart is
+//! *developed* from the fundamental domain: starting from a face at `v`, faces are reached
+//! breadth first across edges; crossing an edge of the cut composes the map with the side
+//! pairing of that edge (`σ`, computed in double-double from the edge's two end points, and
+//! compared with the deck group's least-squares side map: `max_deck_mismatch`). Faces are
+//! developed as *lifts* to the universal cover: a face met again at another position is a
+//! different lift and is kept (a disk that wraps around a handle meets two lifts of the same
+//! control point). The chart's domain is the open star of `v` (the faces at the origin); its
+//! development reaches as far as the bases that can be non-zero on the star need (see
+//! [`HyperbolicAtlas::develop_charts`]).
+//!
+//! **Points** of the surface are named `(face, λ)` with *hyperboloid barycentric coordinates*
+//! `λ`: the point is `Σ λ_i X_i` normalized onto the hyperboloid, `X_i` the hyperboloid
+//! points of the face's vertices. Isometries act linearly on the hyperboloid, so `(face, λ)`
+//! is the same point in every chart (in the Klein model these are the affine barycentric
+//! coordinates up to the weights `X_i⁰`). [`HyperbolicAtlas::locate`] inverts it in a chart.
+//!
+//! **Transitions** between overlapping charts (adjacent vertices; their stars share two faces)
+//! are `M_v(f) ∘ M_u(f)⁻¹` for a face `f` of both stars, an SU(1,1) matrix.
+
+use std::collections::HashMap;
+use std::time::Instant;
+
+use crate::error::{Error, Result};
+use crate::flow::{ricci_flow, FlowOptions, TargetSpec};
+use crate::layout::dd::{Cdd, MobiusDd};
+use crate::layout::isometry::{Complex, Isometry, Mobius};
+use crate::layout::pipeline::{cut_disk_polished, polish_uniformization};
+use crate::layout::{deck_group, layout_dd, DeckGroup};
+use crate::mesh::{topology, Mesh, Surface};
+use crate::metric::{Geometry, Hyperbolic};
+use crate::progress::Progress;
+
+/// A face of a chart's star: its lift's map from the fundamental domain's coordinate to the
+/// chart, and the chart positions of its vertices (in the order of the mesh's face).
+#[derive(Debug, Clone)]
+pub struct StarFace {
+    pub face: u32,
+    pub map: MobiusDd,
+    pub z: [Complex; 3],
+}
+
+/// A lift of a control point (vertex) in a chart.
+#[derive(Debug, Clone, Copy)]
+pub struct ControlLift {
+    pub vertex: u32,
+    pub z: Complex,
+}
+
+/// The chart of one vertex.
+#[derive(Debug, Clone)]
+pub struct Chart {
+    pub vertex: u32,
+    /// The faces at the origin (the chart's domain is their union).
+    pub star: Vec<StarFace>,
+    /// Every lift of a control point whose disk can reach the star.
+    pub controls: Vec<ControlLift>,
+    /// Face lifts developed to find them.
+    pub developed_faces: usize,
+}
+
+/// What building the atlas measured.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct AtlasReport {
+    pub flow_iterations: usize,
+    pub flow_max_curvature_error: f64,
+    pub polish_residual_dd: f64,
+    pub refined_vertices: usize,
+    pub cut_edges: usize,
+    pub relation_error: Option<f64>,
+    /// Largest distance between an edge's side pairing `σ` (double-double, from the edge's
+    /// end points) and the deck group's side map of its side (Frobenius norm of SU(1,1)).
+    pub max_deck_mismatch: f64,
+    pub seconds: f64,
+}
+
+/// The hyperbolic structure and the charts (module docs).
+pub struct HyperbolicAtlas {
+    /// The closed domain surface (the input, refined where the cut needed it).
+    pub mesh: Mesh,
+    /// Hyperbolic edge lengths of `mesh`.
+    pub lengths: Vec<f64>,
+    /// Positions in R³ of `mesh`'s vertices (refined vertices interpolated on the input's edges).
+    pub positions: Vec<[f64; 3]>,
+    /// For every face of `mesh`, the input face it lies in.
+    pub face_origin: Vec<u32>,
+    /// The fundamental domain (cut mesh: same faces and half-edges as `mesh`).
+    pub cut_mesh: Mesh,
+    /// Double-double positions of the cut mesh's vertices in the Poincaré disk.
+    pub global: Vec<Cdd>,
+    /// Per interior half-edge of `mesh`: the side pairing to compose with when crossing it
+    /// (`None`: the edge is not cut).
+    pub crossing: Vec<Option<MobiusDd>>,
+    /// The Fuchsian group of the fundamental domain.
+    pub deck: DeckGroup<Mobius>,
+    /// One chart per vertex of `mesh` (after [`HyperbolicAtlas::develop_charts`]).
+    pub charts: Vec<Chart>,
+    pub report: AtlasReport,
+}
+
+/// Hyperboloid point `(X₁, X₂, X₀)` of a disk point.
+#[inline]
+pub fn hyperboloid(z: Complex) -> [f64; 3] {
+    let d = 1.0 - z.norm_sqr();
+    [2.0 * z.re / d, 2.0 * z.im / d, (1.0 + z.norm_sqr()) / d]
+}
+
+/// The disk point of `(face, λ)` given the chart positions of the face's vertices.
+#[inline]
+pub fn point_in_face(z: &[Complex; 3], lambda: [f64; 3]) -> Complex {
+    let mut x = [0.0; 3];
+    for k in 0..3 {
+        let h = hyperboloid(z[k]);
+        for d in 0..3 {
+            x[d] += lambda[k] * h[d];
+        }
+    }
+    let q = (x[2] * x[2] - x[0] * x[0] - x[1] * x[1])
+        .max(f64::MIN_POSITIVE)
+        .sqrt();
+    let (x1, x2, x0) = (x[0] / q, x[1] / q, x[2] / q);
+    Complex::new(x1, x2) / (1.0 + x0)
+}
+
+/// Hyperboloid barycentric coordinates of `p` in the triangle `z` (any sign; `None` for a
+/// degenerate triangle).
+pub fn barycentric(z: &[Complex; 3], p: Complex) -> Option<[f64; 3]> {
+    // Klein coordinates: geodesic triangles are straight there.
+    let k = |w: Complex| 2.0 * w / (1.0 + w.norm_sqr());
+    let (a, b, c, q) = (k(z[0]), k(z[1]), k(z[2]), k(p));
+    let det = (b - a).re * (c - a).im - (b - a).im * (c - a).re;
+    if det.abs() < 1e-300 {
+        return None;
+    }
+    let m1 = ((q - a).re * (c - a).im - (q - a).im * (c - a).re) / det;
+    let m2 = ((b - a).re * (q - a).im - (b - a).im * (q - a).re) / det;
+    let mu = [1.0 - m1 - m2, m1, m2];
+    // λ_i ∝ μ_i / X_i⁰.
+    let mut l = [0.0; 3];
+    for i in 0..3 {
+        l[i] = mu[i] / hyperboloid(z[i])[2];
+    }
+    let s: f64 = l.iter().sum();
+    Some(l.map(|x| x / s))
+}
+
+/// Lifts developed per chart at most (a budget against radii far too large for the mesh).
+pub const MAX_DEVELOPED_FACES: usize = 200_000;
+
+impl HyperbolicAtlas {
+    /// Uniformization, cut, double-double layout and deck group of a closed connected surface
+    /// with χ < 0 (module docs). The charts are developed later, when the radii of the bases
+    /// are known ([`HyperbolicAtlas::develop_charts`]).
+    pub fn build(surface: &Surface, progress: &mut dyn Progress) -> Result<HyperbolicAtlas> {
+        let t0 = Instant::now();
+        let mesh = &surface.mesh;
+        let topo = topology(mesh);
+        if topo.components.len() != 1 {
+            return Err(Error::topology(format!(
+                "a hyperbolic atlas needs one connected surface, this mesh has {} components",
+                topo.components.len()
+            )));
+        }
+        if mesh.has_boundary() {
+            return Err(Error::topology(
+                "the hyperbolic atlas is built on closed surfaces; pass the double cover of a \
+                 surface with boundary (spline::pou::double_cover)",
+            ));
+        }
+        let chi = topo.euler_characteristic();
+        if chi >= 0 {
+            return Err(Error::topology(format!(
+                "the surface has Euler characteristic {chi} ≥ 0: it carries no hyperbolic \
+                 structure (genus ≥ 2 is needed)"
+            )));
+        }
+        progress.report("flow", None, "hyperbolic uniformization metric");
+        let opts = FlowOptions {
+            geometry: Geometry::Hyperbolic,
+            target: TargetSpec::Uniform,
+            tolerance: 1e-12,
+            ..FlowOptions::default()
+        };
+        let input = surface.edge_lengths();
+        let flow = ricci_flow(mesh, &input, &opts, progress)?;
+        if !flow.converged {
+            return Err(Error::numerical(format!(
+                "the hyperbolic Ricci flow did not converge (max curvature error {:.3e})",
+                flow.max_curvature_error
+            )));
+        }
+        progress.report("polish", None, "metric to double-double");
+        let pol = polish_uniformization(mesh, &input, &flow)?;
+        progress.report("cut", None, "canonical cut and fundamental domain");
+        let disk = cut_disk_polished(
+            mesh,
+            &pol.lengths,
+            &pol.lengths_lo,
+            Some(&surface.positions),
+            None,
+            progress,
+        )?;
+        let layout =
+            layout_dd::<Hyperbolic>(&disk.mesh, &disk.lengths, Some(&disk.lengths_lo), None)?;
+        if !layout.flipped_faces.is_empty() {
+            return Err(Error::numerical(format!(
+                "the layout of the fundamental domain flipped {} faces (first: face {})",
+                layout.flipped_faces.len(),
+                layout.flipped_faces[0]
+            )));
+        }
+        let deck = deck_group::<Hyperbolic>(&layout, &disk.polygon)?;
+        let refined = &disk.cut.refined;
+        let rm = refined.mesh.clone();
+        let cm = disk.mesh.clone();
+        let mut lengths = vec![0.0; rm.n_edges()];
+        for h in 0..rm.n_corners() as u32 {
+            lengths[rm.he_edge(h) as usize] = disk.lengths[cm.he_edge(h) as usize];
+        }
+        let positions = refined
+            .positions
+            .clone()
+            .ok_or_else(|| Error::input("the cut lost the vertex positions"))?;
+        let global: Vec<Cdd> = (0..layout.positions.len())
+            .map(|v| {
+                let lo = layout
+                    .positions_lo
+                    .get(v)
+                    .copied()
+                    .unwrap_or(Complex::new(0.0, 0.0));
+                Cdd::from_parts(layout.positions[v], lo)
+            })
+            .collect();
+        // Side pairings per cut half-edge.
+        let side_maps: Vec<Mobius> = (0..disk.polygon.sides.len())
+            .filter_map(|s| deck.side_map(s))
+            .collect();
+        let mut crossing = vec![None; rm.n_corners()];
+        let mut cut_edges = 0;
+        let mut mismatch = 0.0f64;
+        for h in 0..rm.n_corners() as u32 {
+            if !cm.is_boundary_halfedge(cm.he_twin(h)) {
+                continue;
+            }
+            cut_edges += 1;
+            let t = rm.he_twin(h);
+            if rm.is_boundary_halfedge(t) {
+                continue;
+            }
+            // h: a → b in face f (copies ca, cb); t: b → a in face g (copies cb', ca').
+            let (ca, cb) = (cm.he_origin(h), cm.he_tip(h));
+            let (cbp, cap) = (cm.he_origin(t), cm.he_tip(t));
+            let s = MobiusDd::from_pairs(
+                global[cap as usize],
+                global[cbp as usize],
+                global[ca as usize],
+                global[cb as usize],
+            );
+            let r = s.round();
+            let best = side_maps
+                .iter()
+                .map(|m| m.distance(&r))
+                .fold(f64::INFINITY, f64::min);
+            mismatch = mismatch.max(best);
+            crossing[h as usize] = Some(s);
+        }
+        let report = AtlasReport {
+            flow_iterations: flow.iterations,
+            flow_max_curvature_error: flow.max_curvature_error,
+            polish_residual_dd: pol.residual_dd,
+            refined_vertices: rm.n_vertices() - mesh.n_vertices(),
+            cut_edges: cut_edges / 2,
+            relation_error: deck.relation_error,
+            max_deck_mismatch: if side_maps.is_empty() { 0.0 } else { mismatch },
+            seconds: t0.elapsed().as_secs_f64(),
+        };
+        Ok(HyperbolicAtlas {
+            mesh: rm,
+            lengths,
+            positions,
+            face_origin: refined.face_origin.clone(),
+            cut_mesh: cm,
+            global,
+            crossing,
+            deck,
+            charts: Vec::new(),
+            report,
+        })
+    }
+
+    /// Largest hyperbolic length of an edge at `v` (the star of `v` lies in the disk of this
+    /// radius around it: the distance from a point is convex on geodesic triangles).
+    pub fn star_radius(&self, v: u32) -> f64 {
+        self.mesh
+            .outgoing(v)
+            .map(|h| self.lengths[self.mesh.he_edge(h) as usize])
+            .fold(0.0, f64::max)
+    }
+
+    /// Develop the chart of `v` breadth first over face lifts, keeping the lifts for which
+    /// `keep(face, positions)` holds (the star is always kept) and expanding only those.
+    /// Returns the kept lifts, the star first.
+    pub fn develop(
+        &self,
+        v: u32,
+        mut keep: impl FnMut(u32, &[Complex; 3]) -> bool,
+    ) -> Result<Vec<(u32, MobiusDd, [Complex; 3])>> {
+        let m = &self.mesh;
+        let f0 = m
+            .vertex_faces(v)
+            .next()
+            .ok_or_else(|| Error::input(format!("vertex {v} has no faces")))?;
+        let k = m
+            .face(f0)
+            .iter()
+            .position(|&x| x == v)
+            .ok_or_else(|| Error::input(format!("vertex {v} is not on face {f0}")))?;
+        let cv = self.cut_mesh.face(f0)[k];
+        // The distinct maps met (a lift refers to one by index; the same deck element reached
+        // along different paths is one map) and the chart positions of the cut-mesh vertices
+        // under each, computed once.
+        let mut maps: Vec<MobiusDd> = vec![MobiusDd::to_origin(self.global[cv as usize])];
+        let mut cache: HashMap<(u32, u32), Complex> = HashMap::new();
+        let mut lift = |f: u32, mi: u32, maps: &[MobiusDd]| -> [Complex; 3] {
+            self.cut_mesh.face(f).map(|c| {
+                *cache.entry((mi, c)).or_insert_with(|| {
+                    let w = maps[mi as usize].apply(self.global[c as usize]);
+                    w.hi() + w.lo()
+                })
+            })
+        };
+        let mut seen: HashMap<u32, Vec<Complex>> = HashMap::new();
+        let mut queue = std::collections::VecDeque::new();
+        let z0 = lift(f0, 0, &maps);
+        seen.entry(f0).or_default().push(z0[0]);
+        queue.push_back((f0, 0u32, z0));
+        let mut kept = Vec::new();
+        let mut star = Vec::new();
+        let mut visited = 0usize;
+        while let Some((f, mi, z)) = queue.pop_front() {
+            visited += 1;
+            if visited > MAX_DEVELOPED_FACES {
+                return Err(Error::numerical(format!(
+                    "chart of vertex {v}: developing more than {MAX_DEVELOPED_FACES} face lifts; \
+                     the radii of the bases are too large for this mesh"
+                )));
+            }
+            let at_origin = m
+                .face(f)
+                .iter()
+                .zip(&z)
+                .any(|(&x, w)| x == v && w.norm() < 1e-9);
+            if at_origin {
+                star.push((f, maps[mi as usize], z));
+            } else if keep(f, &z) {
+                kept.push((f, maps[mi as usize], z));
+            } else {
+                continue;
+            }
+            for h in m.face_halfedges(f) {
+                let t = m.he_twin(h);
+                if m.is_boundary_halfedge(t) {
+                    continue;
+                }
+                let g = m.he_face(t);
+                let gi = match &self.crossing[h as usize] {
+                    Some(s) => {
+                        let gm = maps[mi as usize].compose(s).normalized();
+                        match maps.iter().position(|x| x.distance(&gm) < 1e-20) {
+                            Some(i) => i as u32,
+                            None => {
+                                maps.push(gm);
+                                (maps.len() - 1) as u32
+                            }
+                        }
+                    }
+                    None => mi,
+                };
+                let zg = lift(g, gi, &maps);
+                let lifts = seen.entry(g).or_default();
+                if lifts.iter().any(|w| (w - zg[0]).norm() < 1e-9) {
+                    continue;
+                }
+                lifts.push(zg[0]);
+                queue.push_back((g, gi, zg));
+            }
+        }
+        star.extend(kept);
+        Ok(star)
+    }
+
+    /// Develop every chart (in parallel) far enough for bases of radii `radii` (per vertex).
+    /// A control lift `u` is kept when it is within `ρ₁(v) + r_u` of the origin (`ρ₁(v)` the
+    /// star radius): exactly the bases that can be non-zero somewhere on the star. To reach
+    /// them, a face lift is expanded when one of its vertices `u` is within
+    /// `ρ₁(v) + R*_u + 2h` of the origin, `h` the face's longest edge and
+    /// `R*_u = max_c (r_c − d_E(u, c))` the 1-Lipschitz envelope of the radii along edge
+    /// paths (`d_E`): a face on the geodesic from the origin to a reachable lift `c` at
+    /// distance `t` from it has a vertex with `r_c − t ≲ R*_u` even where the radii change
+    /// fast from vertex to vertex (coarse meshes). The chart-independence and continuity
+    /// checks ([`super::measure`]) would see a lift that was missed.
+    pub fn develop_charts(&mut self, radii: &[f64], progress: &mut dyn Progress) -> Result<()> {
+        use rayon::prelude::*;
+        let nv = self.mesh.n_vertices();
+        if radii.len() != nv {
+            return Err(Error::input(format!(
+                "{} radii for {nv} vertices",
+                radii.len()
+            )));
+        }
+        let envelope = self.radius_envelope(radii);
+        let face_diameter: Vec<f64> = (0..self.mesh.n_faces() as u32)
+            .map(|f| {
+                self.mesh
+                    .face_halfedges(f)
+                    .iter()
+                    .map(|&h| self.lengths[self.mesh.he_edge(h) as usize])
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        progress.report("charts", None, &format!("developing {nv} charts"));
+        let charts: Vec<Chart> = (0..nv as u32)
+            .into_par_iter()
+            .map(|v| -> Result<Chart> {
+                let rho = self.star_radius(v);
+                // d(0, z) < R ⟺ |z| < tanh(R/2): no distances in the loop.
+                let lifts = self.develop(v, |f, z| {
+                    let vs = self.mesh.face(f);
+                    let h = face_diameter[f as usize];
+                    (0..3).any(|k| {
+                        let t = (0.5 * (rho + envelope[vs[k] as usize] + 2.0 * h)).tanh();
+                        z[k].norm_sqr() < t * t
+                    })
+                })?;
+                let mut controls: Vec<ControlLift> = Vec::new();
+                let mut by_vertex: HashMap<u32, Vec<Complex>> = HashMap::new();
+                for (f, _, z) in &lifts {
+                    for (k, &u) in self.mesh.face(*f).iter().enumerate() {
+                        let t = (0.5 * (rho + radii[u as usize])).tanh();
+                        if z[k].norm_sqr() >= t * t {
+                            continue;
+                        }
+                        let known = by_vertex.entry(u).or_default();
+                        if known.iter().any(|w| (w - z[k]).norm() < 1e-9) {
+                            continue;
+                        }
+                        known.push(z[k]);
+                        controls.push(ControlLift { vertex: u, z: z[k] });
+                    }
+                }
+                let star: Vec<StarFace> = lifts
+                    .iter()
+                    .take_while(|(f, _, z)| {
+                        self.mesh
+                            .face(*f)
+                            .iter()
+                            .zip(z)
+                            .any(|(&x, w)| x == v && w.norm() < 1e-9)
+                    })
+                    .map(|(f, map, z)| StarFace {
+                        face: *f,
+                        map: *map,
+                        z: *z,
+                    })
+                    .collect();
+                Ok(Chart {
+                    vertex: v,
+                    star,
+                    controls,
+                    developed_faces: lifts.len(),
+                })
+            })
+            .collect::<Result<_>>()?;
+        self.charts = charts;
+        Ok(())
+    }
+
+    /// `R*_u = max_c (r_c − d_E(u, c))` over edge paths (Dijkstra on the max-plus problem:
+    /// every vertex is settled once).
+    pub fn radius_envelope(&self, radii: &[f64]) -> Vec<f64> {
+        use std::cmp::Ordering;
+        use std::collections::BinaryHeap;
+        #[derive(PartialEq)]
+        struct Item(f64, u32);
+        impl Eq for Item {}
+        impl PartialOrd for Item {
+            fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+                Some(self.cmp(o))
+            }
+        }
+        impl Ord for Item {
+            fn cmp(&self, o: &Self) -> Ordering {
+                self.0.total_cmp(&o.0).then(self.1.cmp(&o.1))
+            }
+        }
+        let m = &self.mesh;
+        let mut env = radii.to_vec();
+        let mut done = vec![false; env.len()];
+        let mut heap: BinaryHeap<Item> = (0..env.len() as u32)
+            .map(|v| Item(env[v as usize], v))
+            .collect();
+        while let Some(Item(r, v)) = heap.pop() {
+            if done[v as usize] || r < env[v as usize] {
+                continue;
+            }
+            done[v as usize] = true;
+            for h in m.outgoing(v) {
+                let u = m.he_tip(h);
+                let cand = r - self.lengths[m.he_edge(h) as usize];
+                if !done[u as usize] && cand > env[u as usize] {
+                    env[u as usize] = cand;
+                    heap.push(Item(cand, u));
+                }
+            }
+        }
+        env
+    }
+
+    /// Index of face `f` in the star of chart `v`.
+    pub fn star_index(&self, v: u32, f: u32) -> Option<usize> {
+        self.charts
+            .get(v as usize)?
+            .star
+            .iter()
+            .position(|s| s.face == f)
+    }
+
+    /// The chart coordinate of the surface point `(f, λ)` in the chart of `v` (`f` must be in
+    /// the star of `v`).
+    pub fn chart_point(&self, v: u32, f: u32, lambda: [f64; 3]) -> Option<Complex> {
+        let i = self.star_index(v, f)?;
+        Some(point_in_face(&self.charts[v as usize].star[i].z, lambda))
+    }
+
+    /// Point location: the face of the star of `v` containing the chart point `z` and its
+    /// hyperboloid barycentric coordinates (`None` outside the star).
+    pub fn locate(&self, v: u32, z: Complex) -> Option<(u32, [f64; 3])> {
+        let chart = self.charts.get(v as usize)?;
+        let mut best: Option<(f64, u32, [f64; 3])> = None;
+        for s in &chart.star {
+            let Some(l) = barycentric(&s.z, z) else {
+                continue;
+            };
+            let worst = l.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+            if best.as_ref().is_none_or(|b| worst > b.0) {
+                best = Some((worst, s.face, l));
+            }
+        }
+        best.filter(|b| b.0 > -1e-12).map(|b| (b.1, b.2))
+    }
+
+    /// The transition from the chart of `from` to the chart of `to` (chart-`to` coordinate as
+    /// a function of the chart-`from` coordinate) as an SU(1,1) matrix, through a face of both
+    /// stars (`None` if the stars share no face, i.e. the charts do not overlap).
+    pub fn transition(&self, from: u32, to: u32) -> Option<Mobius> {
+        let a = self.charts.get(from as usize)?;
+        let b = self.charts.get(to as usize)?;
+        for s in &a.star {
+            if let Some(t) = b.star.iter().find(|t| t.face == s.face) {
+                return Some(t.map.compose(&s.map.inverse()).normalized().round());
+            }
+        }
+        None
+    }
+
+    /// The transition through a given face of both stars.
+    pub fn transition_via(&self, from: u32, to: u32, face: u32) -> Option<Mobius> {
+        let s = &self.charts.get(from as usize)?.star[self.star_index(from, face)?];
+        let t = &self.charts.get(to as usize)?.star[self.star_index(to, face)?];
+        Some(t.map.compose(&s.map.inverse()).normalized().round())
+    }
+}
+
+/// The double cover of a surface with boundary (paper 004 §1, Gu–Yau 2003): the surface and
+/// its mirror image (faces reversed) glued along the boundary, with the same positions.
+/// Interior edges whose two end points are on the boundary are split at their midpoint first
+/// (otherwise the two sheets would share them and the cover would not be a manifold).
+/// Returns the closed surface and the number of faces of the first sheet (faces `0..n` are
+/// the input's, after those splits).
+pub fn double_cover(surface: &Surface) -> Result<(Surface, usize)> {
+    use std::collections::HashSet;
+    let m = &surface.mesh;
+    let mut positions = surface.positions.clone();
+    let mut faces: Vec<[u32; 3]> = m.faces().to_vec();
+    let on_boundary: Vec<bool> = (0..m.n_vertices() as u32)
+        .map(|v| m.is_boundary_vertex(v))
+        .collect();
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    let boundary_edges: HashSet<(u32, u32)> = (0..m.n_edges() as u32)
+        .filter(|&e| m.is_boundary_edge(e))
+        .map(|e| {
+            let [a, b] = m.edge_vertices(e);
+            key(a, b)
+        })
+        .collect();
+    let chords: Vec<(u32, u32)> = (0..m.n_edges() as u32)
+        .map(|e| m.edge_vertices(e))
+        .filter(|[a, b]| {
+            on_boundary[*a as usize]
+                && on_boundary[*b as usize]
+                && !boundary_edges.contains(&key(*a, *b))
+        })
+        .map(|[a, b]| (a, b))
+        .collect();
+    for (a, b) in chords {
+        let (pa, pb) = (positions[a as usize], positions[b as usize]);
+        positions.push([0, 1, 2].map(|d| 0.5 * (pa[d] + pb[d])));
+        let mid = (positions.len() - 1) as u32;
+        let mut added = Vec::new();
+        for f in faces.iter_mut() {
+            for k in 0..3 {
+                let (x, y) = (f[k], f[(k + 1) % 3]);
+                if key(x, y) == key(a, b) {
+                    let z = f[(k + 2) % 3];
+                    *f = [x, mid, z];
+                    added.push([mid, y, z]);
+                    break;
+                }
+            }
+        }
+        faces.extend(added);
+    }
+    let nv = positions.len();
+    let nb = on_boundary.len();
+    let mut index = vec![u32::MAX; nv];
+    for v in 0..nv {
+        index[v] = if v < nb && on_boundary[v] {
+            v as u32
+        } else {
+            positions.push(positions[v]);
+            (positions.len() - 1) as u32
+        };
+    }
+    let sheet = faces.len();
+    for k in 0..sheet {
+        let f = faces[k];
+        faces.push([
+            index[f[0] as usize],
+            index[f[2] as usize],
+            index[f[1] as usize],
+        ]);
+    }
+    Ok((Surface::new(positions, faces)?, sheet))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn barycentric_inverts_point_in_face() {
+        let z = [
+            Complex::new(0.1, 0.2),
+            Complex::new(-0.5, 0.1),
+            Complex::new(0.2, -0.6),
+        ];
+        let l = [0.2, 0.5, 0.3];
+        let p = point_in_face(&z, l);
+        let back = barycentric(&z, p).unwrap();
+        for k in 0..3 {
+            assert!((back[k] - l[k]).abs() < 1e-13);
+        }
+        // Möbius invariance of (face, λ).
+        let m = Mobius::new(Complex::new(1.2, 0.3), Complex::new(0.4, -0.5)).unwrap();
+        let zm = z.map(|w| m.apply(w));
+        let pm = point_in_face(&zm, l);
+        assert!((pm - m.apply(p)).norm() < 1e-13);
+    }
+}
