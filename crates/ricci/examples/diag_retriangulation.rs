@@ -70,8 +70,8 @@ fn main() {
             cases.push((name.to_string(), s));
         }
     }
-    for (big, small, n) in [(1.0, 0.25, 4000), (1.0, 0.5, 4000), (2.0, 1.0, 8000)] {
-        let want: f64 = (big * big - small * small as f64).sqrt() / small;
+    for (big, small, n) in [(1.0f64, 0.25f64, 4000), (1.0, 0.5, 4000), (2.0, 1.0, 8000)] {
+        let want: f64 = (big * big - small * small).sqrt() / small;
         println!("irregular torus R={big} r={small}: exact modulus {want:.5}");
         cases.push((
             format!("irregular R={big} r={small} n={n}"),

@@ -122,7 +122,7 @@ where
         worst_map = worst_map.max(best / unit);
     }
     assert!(
-        (seams > 0) == !bordered,
+        (seams > 0) != bordered,
         "{name}: {seams} seam edges on a {} surface",
         if bordered { "bordered" } else { "closed" }
     );

@@ -7,6 +7,8 @@
 //!
 //! Real-mesh tests read `RICCI_MESHES` and skip with a note when it is unset.
 
+#![allow(clippy::needless_range_loop)]
+
 use ricci::layout::isometry::{disk_distance, Complex, Isometry};
 use ricci::mesh::io::read_surface;
 use ricci::mesh::Surface;
