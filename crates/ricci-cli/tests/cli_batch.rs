@@ -397,7 +397,11 @@ fn batch_over_the_shared_meshes_with_flow() {
     );
 }
 
+/// `$RICCI_MESHES` as a folder (a relative path is taken from the workspace root, as CI
+/// gives it).
 fn ricci_meshes() -> Option<PathBuf> {
-    let d = PathBuf::from(std::env::var_os("RICCI_MESHES")?);
-    d.is_dir().then_some(d)
+    ricci_meshes_dir::ricci_meshes().filter(|d| d.is_dir())
 }
+
+#[path = "../../ricci/tests/ricci_meshes/mod.rs"]
+mod ricci_meshes_dir;

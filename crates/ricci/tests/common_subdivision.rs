@@ -3,6 +3,7 @@
 //! quad's diagonals, and UV maps by projective interpolation (flat grids mapped by a Möbius
 //! transformation, where every quantity has an independent closed form).
 
+mod ricci_meshes;
 use ricci::mesh::{generate, Mesh, Surface};
 use ricci::metric::common_subdivision::{layout_euclidean, CommonSubdivision};
 use ricci::metric::intrinsic::{lambda_of_length, IntrinsicTriangulation};
@@ -544,12 +545,9 @@ fn conformal_flow_on_real_meshes_has_no_flipped_triangle() {
     use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
     use ricci::metric::Scheme;
     use ricci::progress::NoProgress;
-    let dir = match std::env::var("RICCI_MESHES") {
-        Ok(d) => std::path::PathBuf::from(d),
-        Err(_) => {
-            eprintln!("RICCI_MESHES unset: skipping the real meshes");
-            return;
-        }
+    let Some(dir) = ricci_meshes::ricci_meshes().filter(|d| d.is_dir()) else {
+        eprintln!("RICCI_MESHES unset: skipping the real meshes");
+        return;
     };
     for (file, target, disk) in [
         ("face.off", TargetSpec::FreeBoundary, true),
