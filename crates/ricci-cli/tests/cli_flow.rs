@@ -64,7 +64,9 @@ fn hyperbolic_flow_writes_a_usable_metric() {
         assert!(v.get(key).is_some(), "missing key {key}");
     }
     assert_eq!(v["geometry"], "hyperbolic");
-    assert_eq!(v["scheme"], "thurston");
+    // The default scheme: discrete conformal equivalence with intrinsic Delaunay flips.
+    assert_eq!(v["scheme"], "conformal");
+    assert!(v["flips"].as_u64().is_some(), "flips reported");
     assert_eq!(v["converged"], true);
     assert!(v["max_curvature_error"].as_f64().unwrap() <= 1e-11);
     assert_eq!(
@@ -79,6 +81,29 @@ fn hyperbolic_flow_writes_a_usable_metric() {
     assert_eq!(m["u"].as_array().unwrap().len(), n);
     assert_eq!(m["curvature"].as_array().unwrap().len(), n);
     assert_eq!(m["target_curvature"].as_array().unwrap().len(), n);
+    // The metric lives on its intrinsic triangulation, written as `faces` (input vertices
+    // keep their ids): rebuild that mesh and check the edges against it.
+    assert_eq!(m["triangulation"], "intrinsic");
+    let faces: Vec<[u32; 3]> = m["faces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| {
+            let t = t.as_array().unwrap();
+            [0, 1, 2].map(|k| t[k].as_u64().unwrap() as u32)
+        })
+        .collect();
+    let nv = faces
+        .iter()
+        .flatten()
+        .map(|&v| v as usize + 1)
+        .max()
+        .unwrap()
+        .max(n);
+    let tm = ricci::mesh::Mesh::from_triangles(nv, faces).unwrap();
+    let chi =
+        |m: &ricci::mesh::Mesh| m.n_vertices() as i64 - m.n_edges() as i64 + m.n_faces() as i64;
+    assert_eq!(chi(&tm), chi(&s.mesh), "the same surface");
     let ev = m["edge_vertices"].as_array().unwrap();
     let lengths: Vec<f64> = m["lengths"]
         .as_array()
@@ -86,23 +111,24 @@ fn hyperbolic_flow_writes_a_usable_metric() {
         .iter()
         .map(|x| x.as_f64().unwrap())
         .collect();
-    assert_eq!(lengths.len(), s.mesh.n_edges());
+    assert_eq!(lengths.len(), tm.n_edges());
     for (e, pair) in ev.iter().enumerate() {
         let a = pair[0].as_u64().unwrap() as u32;
         let b = pair[1].as_u64().unwrap() as u32;
-        let mut want = s.mesh.edge_vertices(e as u32);
+        let mut want = tm.edge_vertices(e as u32);
         want.sort();
         let mut got = [a, b];
         got.sort();
         assert_eq!(got, want, "edge {e}");
     }
-    // Recompute the curvature of the written lengths: zero everywhere (uniform H² target).
-    let k = metric::curvature(&s.mesh, Geometry::Hyperbolic, &lengths);
+    // Recompute the curvature of the written lengths on that triangulation: zero everywhere
+    // (uniform H² target; vertices added by splits are flat).
+    let k = metric::curvature(&tm, Geometry::Hyperbolic, &lengths);
     assert!(
         k.iter().all(|x| x.abs() < 1e-9),
         "written metric is not hyperbolic"
     );
-    let area = metric::total_area(&s.mesh, Geometry::Hyperbolic, &lengths);
+    let area = metric::total_area(&tm, Geometry::Hyperbolic, &lengths);
     assert!(
         (area - 4.0 * std::f64::consts::PI).abs() < 1e-8,
         "area {area}"
