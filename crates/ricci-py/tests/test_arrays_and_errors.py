@@ -91,12 +91,13 @@ def test_non_manifold_sentence_is_the_librarys(tmp_path):
 
 
 def test_refusals_carry_the_cli_sentence(generated):
-    # A flat metric on a genus-2 surface violates Gauss–Bonnet: the library's sentence.
+    # A flat metric on a genus-2 surface (asked for explicitly: by default the surface gets
+    # its hyperbolic metric) violates Gauss–Bonnet: the library's sentence.
     path = generated["genus"]
-    code, _, stderr = cli("flow", path, check=False)
+    code, _, stderr = cli("flow", path, "--geometry", "euclidean", check=False)
     assert code == 1
     with pytest.raises(ricci.RicciError) as e:
-        ricci.flow(path)
+        ricci.flow(path, geometry="euclidean")
     assert str(e.value) == stderr.strip().removeprefix("error: ")
     assert "Gauss–Bonnet" in str(e.value)
 

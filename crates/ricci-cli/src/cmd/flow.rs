@@ -34,8 +34,8 @@ pub struct Args {
     pub geometry: Option<Geometry>,
     /// Discrete conformal scheme: conformal (vertex scaling with intrinsic Delaunay flips —
     /// the conformal class of the mesh itself; default in E² and H²), thurston (the papers'
-    /// circle packing; default on the sphere), tangential, inversive or yamabe (plain vertex
-    /// scaling on the input's triangulation).
+    /// circle packing; default on the sphere and with --solver gradient), tangential,
+    /// inversive or yamabe (plain vertex scaling on the input's triangulation).
     #[arg(long)]
     pub scheme: Option<Scheme>,
     /// Target curvature: uniform, cone:V=K,..., single-cone:V, free-boundary, round-boundary,
@@ -145,9 +145,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     let options = FlowOptions {
         geometry,
-        scheme: a
-            .scheme
-            .unwrap_or_else(|| ricci::flow::default_scheme(geometry)),
+        // The gradient flow is the papers' method (the conformal scheme is solved by Newton
+        // only): with `--solver gradient` and no scheme, the papers' Thurston packing.
+        scheme: a.scheme.unwrap_or_else(|| match a.solver {
+            Solver::Gradient => Scheme::Thurston,
+            Solver::Newton => ricci::flow::default_scheme(geometry),
+        }),
         target,
         solver: a.solver,
         tolerance: a.tolerance,
