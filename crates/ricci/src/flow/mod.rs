@@ -283,6 +283,31 @@ impl FlowResult {
     }
 }
 
+/// Whether the target holds some (non-isolated) vertex fixed, and the vertex pinned to remove
+/// the E² scale freedom when none is: the interior vertex with the largest valence (ties:
+/// smallest id).
+fn scale_pin(mesh: &Mesh, geometry: Geometry, target: &Target) -> (bool, Vec<u32>) {
+    let has_fixed = target
+        .fixed
+        .iter()
+        .enumerate()
+        .any(|(v, &f)| f && !mesh.is_isolated(v as u32));
+    let mut pinned = Vec::new();
+    if geometry == Geometry::Euclidean && !has_fixed {
+        let v = (0..mesh.n_vertices() as u32)
+            .filter(|&v| !mesh.is_isolated(v))
+            .max_by(|&a, &b| {
+                let ka = (!mesh.is_boundary_vertex(a), mesh.valence(a));
+                let kb = (!mesh.is_boundary_vertex(b), mesh.valence(b));
+                ka.cmp(&kb).then(b.cmp(&a))
+            });
+        if let Some(v) = v {
+            pinned.push(v);
+        }
+    }
+    (has_fixed, pinned)
+}
+
 /// Run discrete Ricci flow on a connected mesh with Euclidean edge `lengths` (by edge id).
 pub fn ricci_flow(
     mesh: &Mesh,
@@ -362,25 +387,7 @@ pub fn ricci_flow(
         .unwrap_or_else(|| vec![0.0; mesh.n_edges()]);
     target::check_chow_luo(mesh, geometry, &target, &phi)?;
 
-    let has_fixed = target
-        .fixed
-        .iter()
-        .enumerate()
-        .any(|(v, &f)| f && !mesh.is_isolated(v as u32));
-    let mut pinned = Vec::new();
-    if geometry == Geometry::Euclidean && !has_fixed {
-        // Pin the interior vertex with the largest valence (ties: smallest id).
-        let v = (0..mesh.n_vertices() as u32)
-            .filter(|&v| !mesh.is_isolated(v))
-            .max_by(|&a, &b| {
-                let ka = (!mesh.is_boundary_vertex(a), mesh.valence(a));
-                let kb = (!mesh.is_boundary_vertex(b), mesh.valence(b));
-                ka.cmp(&kb).then(b.cmp(&a))
-            });
-        if let Some(v) = v {
-            pinned.push(v);
-        }
-    }
+    let (has_fixed, pinned) = scale_pin(mesh, geometry, &target);
     let line_search = if target.is_dynamic() || geometry == Geometry::Spherical {
         newton::LineSearch::Residual
     } else {
@@ -599,24 +606,7 @@ fn conformal_flow(
             "the input metric did not become Delaunay within {flip_budget} flips"
         )));
     }
-    let has_fixed = target
-        .fixed
-        .iter()
-        .enumerate()
-        .any(|(v, &f)| f && !mesh.is_isolated(v as u32));
-    let mut pinned = Vec::new();
-    if geometry == Geometry::Euclidean && !has_fixed {
-        let v = (0..mesh.n_vertices() as u32)
-            .filter(|&v| !mesh.is_isolated(v))
-            .max_by(|&a, &b| {
-                let ka = (!mesh.is_boundary_vertex(a), mesh.valence(a));
-                let kb = (!mesh.is_boundary_vertex(b), mesh.valence(b));
-                ka.cmp(&kb).then(b.cmp(&a))
-            });
-        if let Some(v) = v {
-            pinned.push(v);
-        }
-    }
+    let (has_fixed, pinned) = scale_pin(mesh, geometry, &target);
     let settings = conformal::ConformalSettings {
         geometry,
         tolerance: options.tolerance,
