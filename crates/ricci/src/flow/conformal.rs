@@ -484,8 +484,11 @@ pub fn solve(
             for i in 0..n {
                 trial[i] = u[i] + t * delta[i];
             }
+            // Faces violating the triangle inequality (angles extended by 0, 0, π; the energy
+            // stays convex and C¹) are accepted only if the start had as many: a start outside
+            // the domain can come back, a valid iterate never leaves it.
             if evaluate(tri, geometry, &trial, settings.flip_budget, &mut trial_st)
-                && trial_st.degenerate_faces == 0
+                && trial_st.degenerate_faces <= st.degenerate_faces
             {
                 flips += trial_st.flips;
                 let gt = grad(&trial_st, target);

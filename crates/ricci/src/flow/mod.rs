@@ -24,6 +24,11 @@
 //! * Genus-0 closed surfaces in S²: Newton's method on the spherical energy first; if it does
 //!   not converge, the robust route of [`sphere`] (puncture, flat disk with a round boundary,
 //!   stereographic projection, Möbius centring, spherical Newton polish). `route` says which.
+//!   With [`Scheme::Conformal`] (the default): [`sphere::conformal_sphere`] — the flat
+//!   metric of the surface with one vertex at infinity (vertex scaling with Delaunay flips,
+//!   the link of that vertex kept convex), stereographic projection, Möbius centring of the
+//!   vertex areas; the result is the spherical metric on the final Delaunay triangulation
+//!   (the convex hull of the points), `route` "puncture".
 
 #![allow(clippy::needless_range_loop)]
 
@@ -98,13 +103,10 @@ pub enum SphereRoute {
 
 /// The scheme used when the user names none: [`Scheme::Conformal`] (discrete conformal
 /// equivalence — vertex scaling with intrinsic Delaunay flips: the conformal class of the
-/// user's own mesh) in E² and H²; on the sphere, where the conformal scheme is not
-/// implemented yet, Thurston circle packing with its puncture route.
-pub fn default_scheme(geometry: Geometry) -> Scheme {
-    match geometry {
-        Geometry::Spherical => Scheme::Thurston,
-        _ => Scheme::Conformal,
-    }
+/// user's own mesh) in all three geometries (S² through a puncture,
+/// [`sphere::conformal_sphere`]).
+pub fn default_scheme(_geometry: Geometry) -> Scheme {
+    Scheme::Conformal
 }
 
 /// Options of [`ricci_flow`].
@@ -564,16 +566,13 @@ fn conformal_flow(
 ) -> Result<FlowResult> {
     use crate::metric::intrinsic::IntrinsicTriangulation;
     let geometry = options.geometry;
-    if geometry == Geometry::Spherical {
-        return Err(Error::input(
-            "the conformal scheme supports euclidean and hyperbolic geometry (the sphere \
-             through a puncture is not implemented yet); use --scheme yamabe for spherical",
-        ));
-    }
     if options.solver != Solver::Newton {
         return Err(Error::input(
             "the conformal scheme is solved by Newton's method only (use --solver newton)",
         ));
+    }
+    if geometry == Geometry::Spherical {
+        return conformal_sphere_flow(mesh, lengths, options, target, t0, progress);
     }
     let chi = euler_characteristic(mesh);
     let scaled: Vec<f64> = lengths.iter().map(|&l| l * scale).collect();
@@ -690,6 +689,124 @@ fn conformal_flow(
         initial_length_error: 0.0,
         degenerate_faces: degenerate,
         pinned,
+        seconds: t0.elapsed().as_secs_f64(),
+        notes,
+        triangulation: Some(triangulation),
+    })
+}
+
+/// [`ricci_flow`] for [`Scheme::Conformal`] in S²: [`sphere::conformal_sphere`] (the flat
+/// picture with one vertex at infinity, stereographic projection, Möbius centring), reported
+/// as a spherical metric on the final Delaunay triangulation (the convex hull of the points).
+fn conformal_sphere_flow(
+    mesh: &Mesh,
+    lengths: &[f64],
+    options: &FlowOptions,
+    target: Target,
+    t0: Instant,
+    progress: &mut dyn Progress,
+) -> Result<FlowResult> {
+    let geometry = Geometry::Spherical;
+    let uniform = target
+        .fixed
+        .iter()
+        .zip(&target.curvature)
+        .enumerate()
+        .all(|(v, (&f, &k))| mesh.is_isolated(v as u32) || (!f && k.abs() <= 1e-14));
+    if !uniform {
+        return Err(Error::input(
+            "the conformal scheme reaches the sphere with the uniform target only (every \
+             vertex flat on the round sphere); use --scheme yamabe for other spherical targets",
+        ));
+    }
+    let s = sphere::conformal_sphere(
+        mesh,
+        lengths,
+        options.tolerance.min(1e-11),
+        options.max_iterations.unwrap_or(50),
+        progress,
+    )?;
+    let mut tri = s.triangulation.clone();
+    let flip_budget = 200 * mesh.n_edges() + 10_000;
+    let mut state = conformal::ConformalState::default();
+    if !conformal::evaluate(&mut tri, geometry, &[], flip_budget, &mut state) {
+        return Err(Error::numerical(
+            "the final spherical metric needed too many flips",
+        ));
+    }
+    let mut notes = s.notes.clone();
+    notes.insert(
+        0,
+        format!(
+            "sphere through a puncture: vertex {} at infinity, {} round(s) of the flat disk \
+             ({} Newton steps, max |K| = {:.1e}, link of {} vertices, largest boundary angle − π \
+             = {:.1e}), stereographic projection, Möbius centring of the vertex areas; the \
+             points' chords match the metric to max |Δλ| = {:.1e}",
+            s.puncture,
+            s.rounds,
+            s.iterations,
+            s.flat_error,
+            s.link_vertices,
+            s.convexity_excess,
+            s.conformal_residual
+        ),
+    );
+    if state.flips > 0 {
+        notes.push(format!(
+            "{} cocircular flip(s) on the sphere after the projection",
+            state.flips
+        ));
+    }
+    let max_err = newton::max_error(&state.curvature, &target);
+    let ksum: f64 = state.curvature.iter().sum();
+    let gb = (ksum + state.area - 4.0 * PI).abs();
+    let degenerate = state.degenerate_faces;
+    if degenerate > 0 {
+        notes.push(format!(
+            "{degenerate} face(s) of the final triangulation violate the triangle inequality"
+        ));
+    }
+    if s.inverted_faces > 0 {
+        notes.push(format!(
+            "{} face(s) are not positively oriented in the point positions (chords near \
+             double-precision resolution; the metric is exact)",
+            s.inverted_faces
+        ));
+    }
+    let converged = max_err <= options.tolerance && degenerate == 0;
+    let simplicial = tri.to_simplicial(geometry, &[])?;
+    let triangulation = IntrinsicResult {
+        initial_flips: s.initial_flips,
+        flips: s.flips + state.flips,
+        splits: simplicial.splits,
+        simplicial_vertices: simplicial.mesh.n_vertices(),
+        triangulation: tri,
+        simplicial,
+    };
+    let result_lengths = triangulation.simplicial.lengths.clone();
+    Ok(FlowResult {
+        geometry,
+        scheme: options.scheme,
+        solver: options.solver,
+        route: "puncture".into(),
+        target_description: target.description.clone(),
+        u: s.u,
+        curvature: state.curvature.clone(),
+        target: target.curvature.clone(),
+        fixed: target.fixed.clone(),
+        lengths: result_lengths,
+        iterations: s.iterations,
+        history: s.history,
+        converged,
+        tolerance: options.tolerance,
+        max_curvature_error: max_err,
+        gauss_bonnet_error: gb,
+        area: state.area,
+        input_scale: 1.0,
+        clamped_edges: 0,
+        initial_length_error: 0.0,
+        degenerate_faces: degenerate,
+        pinned: Vec::new(),
         seconds: t0.elapsed().as_secs_f64(),
         notes,
         triangulation: Some(triangulation),
