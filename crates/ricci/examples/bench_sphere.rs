@@ -33,10 +33,11 @@ fn main() {
         let s = ricci::mesh::io::read_surface(&dir.join(&name)).unwrap().0;
         let l = s.edge_lengths();
         let t0 = Instant::now();
+        let c0 = cpu_seconds();
         match conformal_sphere(&s.mesh, &l, 1e-11, 50, &mut Print(verbose)) {
             Ok(c) => {
                 println!(
-                    "{name} | {} | {} | {} | {} | {} | {} | {} | {:.1e} | {:.3}",
+                    "| {name} | {} | {} | {} | {} | {} | {} | {} | {:.1e} | {:.0} | {:.3} | {:.3} |",
                     s.mesh.n_vertices(),
                     s.mesh.n_faces(),
                     c.rounds,
@@ -45,7 +46,9 @@ fn main() {
                     c.flips,
                     c.link_vertices,
                     c.conformal_residual,
-                    t0.elapsed().as_secs_f64()
+                    peak_rss_mb(),
+                    t0.elapsed().as_secs_f64(),
+                    cpu_seconds() - c0
                 );
                 for n in &c.notes {
                     println!("  note: {n}");
@@ -54,4 +57,32 @@ fn main() {
             Err(e) => println!("{name}: error {e}"),
         }
     }
+}
+
+/// CPU time of this thread (`/proc/self/schedstat`): the machine is shared.
+fn cpu_seconds() -> f64 {
+    std::fs::read_to_string("/proc/self/schedstat")
+        .ok()
+        .and_then(|s| {
+            s.split_whitespace()
+                .next()
+                .and_then(|x| x.parse::<f64>().ok())
+        })
+        .map(|ns| ns * 1e-9)
+        .unwrap_or(f64::NAN)
+}
+
+/// Peak resident set size of the process so far (`VmHWM` of `/proc/self/status`), MB.
+fn peak_rss_mb() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| {
+                l.split_whitespace()
+                    .nth(1)
+                    .and_then(|x| x.parse::<f64>().ok())
+            })
+        })
+        .map(|kb| kb / 1024.0)
+        .unwrap_or(f64::NAN)
 }
