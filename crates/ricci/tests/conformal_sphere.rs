@@ -232,6 +232,7 @@ fn shared_genus_zero_meshes_reach_the_sphere() {
         ("sphere.off", Some(1e-9)),
         ("spot.obj", Some(1e-8)),
         ("maxplanck.nf25k.off", Some(1e-8)),
+        ("decimated-knight.off", Some(1e-8)),
         ("horse.ply", None),
     ] {
         let path = d.join(name);

@@ -22,6 +22,17 @@
 //!    exact for vertex scaling when the embedding is valid), then spherical Newton from there:
 //!    the start is close to the solution set with its Möbius freedom already centred.
 
+//!
+//! [`conformal_sphere`] is the sphere of the conformal scheme (discrete conformal equivalence
+//! with intrinsic Delaunay flips, the default): the flat metric of the surface with one vertex
+//! at infinity — link values `u_j = −λ_∞j`, every other vertex flat, the link kept convex
+//! (the KKT conditions of the bound-constrained convex problem `u_w ≥ −λ_∞w` of
+//! Gillespie–Springborn–Crane 2021 §4.3, derived in its doc comment) — then stereographic
+//! projection and Möbius centring of the vertex areas, with the metric carried exactly by
+//! vertex scaling (`λ = λ⁰ + u_i + u_j`, not recomputed from the points). Public API:
+//! [`conformal_sphere`] → [`ConformalSphere`] (final triangulation with its flip log, points,
+//! `u`, diagnostics), [`mobius_centre`].
+
 use super::newton::{self, NewtonSettings, SolveOutcome};
 use super::target::Target;
 use super::FlowOptions;
@@ -559,8 +570,7 @@ fn link_of(t: &IntrinsicTriangulation, inf: u32) -> (Vec<u32>, bool) {
 /// Discrete uniformization of a closed genus-0 surface with Euclidean `lengths` (by edge id
 /// of `mesh`) to the unit sphere, in the discrete conformal class of vertex scaling with
 /// intrinsic Delaunay flips (Bobenko–Pinkall–Springborn 2015 §§5–6, Springborn 2020 §7,
-/// Gillespie–Springborn–Crane 2021 §4.3). See the module docs of [`super::conformal`] and
-/// `docs/notes/wave3-dce2.md`.
+/// Gillespie–Springborn–Crane 2021 §4.3; the solver is [`super::conformal`]).
 ///
 /// **The puncture.** A vertex `∞` goes to infinity. With log Penner coordinates `λ` on the
 /// input's intrinsic Delaunay triangulation, the Euclidean metric of the rest with `∞` at
