@@ -694,7 +694,6 @@ pub fn conformal_sphere(
     let mut flat_error = f64::INFINITY;
     let mut convexity_excess = f64::INFINITY;
     let mut converged = false;
-    let mut final_angles: Option<(IntrinsicTriangulation, Vec<f64>)> = None;
     let t_start = std::time::Instant::now();
     // Short rounds: a vertex pressing against the hull makes the Newton steps crawl, and the
     // next round starts from where this one stopped (the u accumulate in big_u).
@@ -777,7 +776,6 @@ pub fn conformal_sphere(
         let solved = out.converged && out.state.degenerate_faces == 0;
         if solved && reflex.is_empty() {
             converged = true;
-            final_angles = Some((disk, out.state.angles.clone()));
             break;
         }
         let mut changed = 0;
@@ -880,18 +878,14 @@ pub fn conformal_sphere(
             break;
         }
     }
-    let (disk, _) = match final_angles {
-        Some(x) => x,
-        None => {
-            return Err(Error::numerical(format!(
-                "the flat picture with vertex {inf} at infinity did not converge after {rounds} \
-                 round(s) (max |K| = {flat_error:.3e}, largest boundary angle − π = \
-                 {convexity_excess:.3e}){}",
-                notes.last().map(|s| format!("; {s}")).unwrap_or_default()
-            )))
-        }
-    };
-    let _ = converged;
+    if !converged {
+        return Err(Error::numerical(format!(
+            "the flat picture with vertex {inf} at infinity did not converge after {rounds} \
+             round(s) (max |K| = {flat_error:.3e}, largest boundary angle − π = \
+             {convexity_excess:.3e}){}",
+            notes.last().map(|s| format!("; {s}")).unwrap_or_default()
+        )));
+    }
     // 4. Planar layout of the flat disk (lengths from the sphere's triangulation and big_u).
     let plane = layout_delta_disk(&t, inf, &big_u)?;
     let (link, _) = link_of(&t, inf);
@@ -979,7 +973,6 @@ pub fn conformal_sphere(
         })
         .collect();
     let inverted_faces = dets.iter().filter(|&&d| d <= 0.0).count();
-    drop(disk);
     Ok(ConformalSphere {
         triangulation: fin,
         base_lambda,
