@@ -1,0 +1,192 @@
+//! Genus ≥ 2: Riemann's bilinear relations for the period matrix and the holomorphic basis
+//! (periods summed along the loops against areas summed over the faces), the Gauss–Bonnet
+//! count of zeros (2g − 2), and independence of the base vertex of the cut: the period
+//! matrix changes by Sp(2g, Z), the energies of its period lattice do not (the test compares
+//! those, which undoes the action without knowing it).
+
+mod ricci_meshes;
+
+use ricci::analysis::forms::cochain::{on_halfedge, period};
+use ricci::analysis::forms::{holomorphic_forms, FormsOptions, HolomorphicForms};
+use ricci::cut::CutOptions;
+use ricci::mesh::Surface;
+use ricci::progress::NoProgress;
+
+fn forms(s: &Surface, base: Option<u32>) -> HolomorphicForms {
+    let opts = FormsOptions {
+        cut: CutOptions {
+            base,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    holomorphic_forms(
+        &s.mesh,
+        &s.edge_lengths(),
+        Some(&s.positions),
+        &opts,
+        &mut NoProgress,
+    )
+    .unwrap()
+}
+
+/// `∫ α ∧ β` summed over the faces (cup product).
+fn wedge(h: &HolomorphicForms, a: &[f64], b: &[f64]) -> f64 {
+    let m = h.mesh();
+    (0..m.n_faces() as u32)
+        .map(|f| {
+            let (a1, a2) = (on_halfedge(m, a, 3 * f), on_halfedge(m, a, 3 * f + 1));
+            let (b1, b2) = (on_halfedge(m, b, 3 * f), on_halfedge(m, b, 3 * f + 1));
+            0.5 * (a1 * b2 - a2 * b1)
+        })
+        .sum()
+}
+
+/// `Σ_e w_e α_e β_e` (Dirichlet inner product, cotangent weights).
+fn energy(h: &HolomorphicForms, a: &[f64], b: &[f64]) -> f64 {
+    h.weights
+        .iter()
+        .zip(a)
+        .zip(b)
+        .map(|((w, x), y)| w * x * y)
+        .sum()
+}
+
+fn check_surface(name: &str, s: &Surface, other_base: u32) {
+    let h = forms(s, None);
+    let g = h.genus;
+    let r = &h.report;
+    let om = &h.period_matrix;
+    eprintln!(
+        "{name}: genus {g}, {} vertices, star defect {:.1e}, raw asymmetry {:.1e}, {:.2} s",
+        r.vertices, r.star_defect, r.raw_asymmetry, r.seconds
+    );
+    assert!(r.harmonic_residual < 1e-9 && r.closedness < 1e-12, "{r:?}");
+    // Bilinear relations (1): Ω = Ωᵀ and Im Ω > 0.
+    assert!(
+        om.asymmetry() < 1e-8,
+        "{name}: Ω asymmetric by {:e}",
+        om.asymmetry()
+    );
+    let eig = om.im_eigenvalues().unwrap();
+    assert!(eig[0] > 0.0, "{name}: Im Ω not positive definite: {eig:?}");
+    // The least-squares star before its normalization: symmetric up to discretization.
+    assert!(
+        r.raw_asymmetry < 1e-2,
+        "{name}: raw asymmetry {:e}",
+        r.raw_asymmetry
+    );
+    // Periods along the loops (line sums) are the normalization and Ω.
+    let loops = &h.cut.loops;
+    let m = h.mesh();
+    for (i, w) in h.basis.iter().enumerate() {
+        for j in 0..g {
+            let a = &loops[2 * j].halfedges;
+            let b = &loops[2 * j + 1].halfedges;
+            let (ar, ai) = (period(m, &w.re, a), period(m, &w.im, a));
+            let (br, bi) = (period(m, &w.re, b), period(m, &w.im, b));
+            let d = if i == j { 1.0 } else { 0.0 };
+            assert!(
+                (ar - d).abs() < 1e-9 && ai.abs() < 1e-9,
+                "{name}: ∫_a{} ω{} = {ar} + {ai}i",
+                j + 1,
+                i + 1
+            );
+            assert!(
+                (br - om.re[i][j]).abs() < 1e-9 && (bi - om.im[i][j]).abs() < 1e-9,
+                "{name}: ∫_b{} ω{} = {br} + {bi}i vs Ω = {} + {}i",
+                j + 1,
+                i + 1,
+                om.re[i][j],
+                om.im[i][j]
+            );
+        }
+    }
+    // Bilinear relations (2), face sums against periods: ∫ ω_i ∧ ω_j = 0 and
+    // (i/2) ∫ ω_i ∧ ω̄_j = Im Ω_ij; and (3) the Dirichlet energy ½(‖Re ω_i‖² + ‖Im ω_i‖²)
+    // = Im Ω_ii up to the discretization of the Hodge star.
+    for i in 0..g {
+        for j in 0..g {
+            let (wi, wj) = (&h.basis[i], &h.basis[j]);
+            let re = wedge(&h, &wi.re, &wj.re) - wedge(&h, &wi.im, &wj.im);
+            let im = wedge(&h, &wi.re, &wj.im) + wedge(&h, &wi.im, &wj.re);
+            assert!(
+                re.abs() < 1e-9 && im.abs() < 1e-9,
+                "{name}: ∫ ω{} ∧ ω{} = {re} + {im}i",
+                i + 1,
+                j + 1
+            );
+            let area = 0.5 * (wedge(&h, &wi.re, &wj.im) - wedge(&h, &wi.im, &wj.re));
+            assert!(
+                (area - om.im[i][j]).abs() < 1e-9,
+                "{name}: (i/2)∫ω{}∧ω̄{} = {area} vs Im Ω = {}",
+                i + 1,
+                j + 1,
+                om.im[i][j]
+            );
+        }
+        let w = &h.basis[i];
+        let e = 0.5 * (energy(&h, &w.re, &w.re) + energy(&h, &w.im, &w.im));
+        let rel = (e - om.im[i][i]).abs() / om.im[i][i];
+        eprintln!("  energy of ω{} vs Im Ω: {rel:.1e}", i + 1);
+        assert!(
+            rel < 20.0 * r.star_defect.max(1e-6),
+            "{name}: energy {e} vs Im Ω_{i}{i} = {}",
+            om.im[i][i]
+        );
+    }
+    // Zeros: 2g − 2 with multiplicity, no spurious singularity, for ω_1.
+    let z = h.zeros(&h.basis[0]).unwrap();
+    eprintln!("  zeros of ω1: {:?}", z.zeros);
+    assert_eq!(z.total_index, 2 - 2 * g as i64, "{name}: Poincaré–Hopf");
+    assert!(
+        z.spurious.is_empty(),
+        "{name}: positive indices {:?}",
+        z.spurious
+    );
+    assert_eq!(
+        z.count as usize,
+        2 * g - 2,
+        "{name}: zeros of ω1 {:?}",
+        z.zeros
+    );
+    // Another base vertex: another canonical basis, the same period lattice.
+    let h2 = forms(s, Some(other_base));
+    let (e1, e2) = (
+        h.lattice_energies(10).unwrap(),
+        h2.lattice_energies(10).unwrap(),
+    );
+    let worst = e1
+        .iter()
+        .zip(&e2)
+        .map(|(a, b)| (a - b).abs() / a)
+        .fold(0.0, f64::max);
+    eprintln!("  lattice energies {e1:.5?}, base {other_base}: {worst:.1e}");
+    assert!(
+        worst < 1e-3,
+        "{name}: the period lattice changed with the base vertex: {e1:?} vs {e2:?}"
+    );
+}
+
+#[test]
+fn generated_genus_2() {
+    let s = ricci::mesh::generate::genus(2, 20).unwrap();
+    check_surface("genus(2, 20)", &s, 98);
+}
+
+#[test]
+fn shared_meshes() {
+    let Some(dir) = ricci_meshes::ricci_meshes().filter(|d| d.is_dir()) else {
+        eprintln!("RICCI_MESHES not set; skipped");
+        return;
+    };
+    for (m, base) in [
+        ("eight.off", 255),
+        ("3holes.off", 1198),
+        ("genus3.off", 2217),
+        ("fertility.off", 1498),
+    ] {
+        let (s, _) = ricci::mesh::io::read_surface(&dir.join(m)).unwrap();
+        check_surface(m, &s, base);
+    }
+}
