@@ -190,3 +190,44 @@ fn shared_meshes() {
         check_surface(m, &s, base);
     }
 }
+
+/// Paper 002 §4.2.4: up to g − 1 zeros placed at chosen vertices land within one ring of
+/// them, and the form still has 2g − 2 zeros in all.
+fn check_placement(name: &str, s: &Surface, targets: &[u32]) {
+    let h = forms(s, None);
+    let g = h.genus;
+    let (_, w, residual) = ricci::analysis::forms::placement::form_with_zeros(&h, targets).unwrap();
+    let z = h.zeros(&w).unwrap();
+    eprintln!(
+        "{name}: targets {targets:?}, residual {residual:.1e}, zeros {:?}",
+        z.zeros
+    );
+    assert_eq!(z.total_index, 2 - 2 * g as i64);
+    assert_eq!(z.count as usize, 2 * g - 2, "{name}: {:?}", z);
+    let m = h.mesh();
+    for &p in targets {
+        let near = z
+            .zeros
+            .iter()
+            .any(|zz| zz.vertex == p || m.vertex_neighbors(p).any(|q| q == zz.vertex));
+        assert!(
+            near,
+            "{name}: no zero within one ring of vertex {p}: {:?}",
+            z.zeros
+        );
+    }
+}
+
+#[test]
+fn zeros_placed_at_chosen_vertices() {
+    let s = ricci::mesh::generate::genus(2, 20).unwrap();
+    check_placement("genus(2, 20)", &s, &[17]);
+    check_placement("genus(2, 20)", &s, &[400]);
+    let Some(dir) = ricci_meshes::ricci_meshes().filter(|d| d.is_dir()) else {
+        return;
+    };
+    let (s, _) = ricci::mesh::io::read_surface(&dir.join("eight.off")).unwrap();
+    check_placement("eight.off", &s, &[100]);
+    let (s, _) = ricci::mesh::io::read_surface(&dir.join("genus3.off")).unwrap();
+    check_placement("genus3.off", &s, &[1000, 6000]);
+}

@@ -14,13 +14,14 @@
 //! 6. [`period`]: the holomorphic basis `ω_i = α_i + i *α_i` normalized on the a-cycles and the
 //!    period matrix `Ω_ij = ∫_{b_j} ω_i` (genus 1: `τ = Ω`).
 //! 7. [`zeros`]: the `2g − 2` zeros of a holomorphic form; [`net`]: its integral on the cut
-//!    mesh (the conformal net).
+//!    mesh (the conformal net); [`placement`]: forms with zeros at chosen vertices.
 
 pub mod cochain;
 pub mod harmonic;
 pub mod hodge;
 pub mod net;
 pub mod period;
+pub mod placement;
 pub mod small;
 pub mod working;
 pub mod zeros;

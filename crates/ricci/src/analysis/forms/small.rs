@@ -87,3 +87,21 @@ pub fn identity(n: usize) -> Matrix {
         .map(|i| (0..n).map(|j| f64::from(u8::from(i == j))).collect())
         .collect()
 }
+
+/// Eigenvalues (ascending) and eigenvectors (`vectors[k]` belongs to `values[k]`) of a
+/// symmetric matrix.
+pub fn symmetric_eigen(a: &Matrix) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
+    let f = to_faer(a);
+    let evd = f
+        .self_adjoint_eigen(faer::Side::Lower)
+        .map_err(|e| Error::numerical(format!("symmetric eigendecomposition failed: {e:?}")))?;
+    let n = a.len();
+    let s = evd.S().column_vector();
+    let u = evd.U();
+    let values = (0..n).map(|k| s[k]).collect();
+    let vectors = (0..n)
+        .map(|k| (0..n).map(|i| u[(i, k)]).collect())
+        .collect();
+    crate::numeric::simd::clear_upper_state_here();
+    Ok((values, vectors))
+}
