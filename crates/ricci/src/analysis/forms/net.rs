@@ -61,8 +61,8 @@ pub fn integrate(
             if uv[t as usize][0].is_nan() {
                 let p = uv[v as usize];
                 uv[t as usize] = [
-                    p[0] + on_halfedge(refined, re, h),
-                    p[1] + on_halfedge(refined, im, h),
+                    p[0] + value(refined, cut_mesh, re, h),
+                    p[1] + value(refined, cut_mesh, im, h),
                 ];
                 queue.push_back(t);
             }
@@ -86,6 +86,16 @@ pub fn integrate(
         integration_error: err,
         quality,
     })
+}
+
+/// The form on cut-mesh half-edge `h` (boundary half-edges of the cut mesh: minus the value on
+/// their interior twin).
+fn value(refined: &Mesh, cut_mesh: &Mesh, w: &[f64], h: u32) -> f64 {
+    if cut_mesh.is_boundary_halfedge(h) {
+        -on_halfedge(refined, w, cut_mesh.he_twin(h))
+    } else {
+        on_halfedge(refined, w, h)
+    }
 }
 
 fn net_quality(refined: &Mesh, lengths: &[f64], cut_mesh: &Mesh, uv: &[[f64; 2]]) -> NetQuality {
