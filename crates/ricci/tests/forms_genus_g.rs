@@ -231,3 +231,55 @@ fn zeros_placed_at_chosen_vertices() {
     let (s, _) = ricci::mesh::io::read_surface(&dir.join("genus3.off")).unwrap();
     check_placement("genus3.off", &s, &[1000, 6000]);
 }
+
+/// Paper 002 §4.2.1: the most uniform combination has less area distortion than ω₁, its net
+/// covers the surface's area, and it is a local minimum (finite steps in every direction of
+/// the coefficients do not lower the energy).
+#[test]
+fn uniform_combination_is_a_local_minimum() {
+    use ricci::analysis::forms::uniform::{area_distortion, uniform_combination};
+    use ricci::layout::isometry::Complex;
+    let s = ricci::mesh::generate::genus(2, 20).unwrap();
+    let h = forms(&s, None);
+    let (u, w) = uniform_combination(&h, 200).unwrap();
+    eprintln!(
+        "genus(2, 20): area distortion {:.4} (ω1: {:.4}), {} iterations",
+        u.energy, u.energy_first_form, u.iterations
+    );
+    assert!(u.energy < u.energy_first_form);
+    let e0 = area_distortion(&h, &u.coefficients).unwrap();
+    assert!((e0 - u.energy).abs() < 1e-9 * u.energy.max(1.0));
+    // Net area = surface area (the coefficients are scaled for it).
+    let area: f64 = wedge(&h, &w.re, &w.im);
+    let m = h.mesh();
+    let lengths = h.lengths();
+    let surface: f64 = (0..m.n_faces() as u32)
+        .map(|f| {
+            let l = m.face_edges_opposite(f).map(|e| lengths[e as usize]);
+            let p = 0.5 * (l[0] + l[1] + l[2]);
+            (p * (p - l[0]) * (p - l[1]) * (p - l[2])).sqrt()
+        })
+        .sum();
+    assert!(
+        (area - surface).abs() < 1e-9 * surface,
+        "{area} vs {surface}"
+    );
+    for k in 0..2 * h.genus {
+        for sign in [-1.0, 1.0] {
+            let mut c = u.coefficients.clone();
+            let t = 1e-3 * sign;
+            let i = k / 2;
+            c[i] += if k % 2 == 0 {
+                Complex::new(t, 0.0)
+            } else {
+                Complex::new(0.0, t)
+            };
+            let e = area_distortion(&h, &c).unwrap();
+            assert!(
+                e >= u.energy * (1.0 - 1e-9),
+                "a step along coordinate {k} lowers the energy: {e} < {}",
+                u.energy
+            );
+        }
+    }
+}

@@ -5,8 +5,9 @@
 //! conformal net — uv per face corner on the cut mesh (OBJ), a checkerboard picture with the
 //! zeros circled in red.
 //!
-//! The form integrated is `ω_1`, or with `--zeros` the combination with zeros at the given
-//! vertices (at most g − 1 exactly, paper 002 §4.2.4). The OBJ and the picture show the
+//! The form integrated is `ω_1` (`--form K`: `ω_K`), with `--zeros` the combination with zeros
+//! at the given vertices (at most g − 1 exactly, paper 002 §4.2.4), with `--uniform` the
+//! combination of least area distortion (§4.2.1). The OBJ and the picture show the
 //! working triangulation: with `--triangulation delaunay` (default) it is the intrinsic
 //! Delaunay triangulation of the input, drawn with the input positions (`flips` in the JSON
 //! says how many edges differ from the input's); `--triangulation input` keeps the input
@@ -15,6 +16,7 @@
 use super::layout::spinner;
 use crate::util::{print_json, read_surface, write_atomic, UsageError};
 use ricci::analysis::forms::placement::form_with_zeros;
+use ricci::analysis::forms::uniform::uniform_combination;
 use ricci::analysis::forms::{holomorphic_forms, FormsOptions, FormsTriangulation};
 use ricci::cut::CutOptions;
 use ricci::layout::export::obj_with_corner_uv;
@@ -48,6 +50,9 @@ pub struct Args {
     /// Base vertex of the canonical loops.
     #[arg(long)]
     pub base: Option<u32>,
+    /// Integrate the combination of least area distortion (paper 002 §4.2.1) instead of ω_k.
+    #[arg(long, conflicts_with = "zeros")]
+    pub uniform: bool,
     /// Basis form to integrate when no --zeros are given (1-based).
     #[arg(long, default_value_t = 1)]
     pub form: usize,
@@ -91,7 +96,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         &mut bar,
     )?;
     let g = h.genus;
-    let (form, coefficients, placement_residual) = if a.zeros.is_empty() {
+    let mut uniform_report = None;
+    let (form, coefficients, placement_residual) = if a.uniform {
+        let (u, w) = uniform_combination(&h, 200)?;
+        let c = u.coefficients.clone();
+        uniform_report = Some(u);
+        (w, c, None)
+    } else if a.zeros.is_empty() {
         if a.form == 0 || a.form > g {
             return Err(UsageError(format!("--form must be between 1 and the genus {g}")).into());
         }
@@ -196,6 +207,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "coefficients": coefficients.iter().map(|c| [c.re, c.im]).collect::<Vec<_>>(),
             "placed_zeros": a.zeros,
             "placement_residual": placement_residual,
+            "uniform": uniform_report,
         },
         "quality": {
             "star_defect": r.star_defect,

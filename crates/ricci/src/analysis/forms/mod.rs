@@ -14,7 +14,8 @@
 //! 6. [`period`]: the holomorphic basis `ω_i = α_i + i *α_i` normalized on the a-cycles and the
 //!    period matrix `Ω_ij = ∫_{b_j} ω_i` (genus 1: `τ = Ω`).
 //! 7. [`zeros`]: the `2g − 2` zeros of a holomorphic form; [`net`]: its integral on the cut
-//!    mesh (the conformal net); [`placement`]: forms with zeros at chosen vertices.
+//!    mesh (the conformal net); [`placement`]: forms with zeros at chosen vertices;
+//!    [`uniform`]: the combination of least area distortion (§4.2.1).
 
 pub mod cochain;
 pub mod harmonic;
@@ -23,6 +24,7 @@ pub mod net;
 pub mod period;
 pub mod placement;
 pub mod small;
+pub mod uniform;
 pub mod working;
 pub mod zeros;
 
