@@ -52,7 +52,7 @@ pub fn face_cotangents(l: [f64; 3]) -> Option<[f64; 3]> {
     let [a, b, c] = l;
     let s = 0.5 * (a + b + c);
     let area2 = s * (s - a) * (s - b) * (s - c);
-    if !(area2 > 0.0) || !area2.is_finite() {
+    if area2.is_nan() || area2 <= 0.0 || !area2.is_finite() {
         return None;
     }
     let four_area = 4.0 * area2.sqrt();

@@ -74,12 +74,15 @@ impl PeriodMatrix {
     }
 }
 
+/// Coordinates of `Re ω_i`, of `Im ω_i` (both in the `ζ` basis), and the period matrix.
+pub type NormalizedBasis = (Vec<Vec<f64>>, Vec<Vec<f64>>, PeriodMatrix);
+
 /// The normalized holomorphic basis from the complex structure `J` (in the coordinates dual to
 /// `a₁, b₁, …`): for each `i`, the coordinates `x` of `Re ω_i` and `J x` of `Im ω_i`, and the
 /// period matrix.
-pub fn normalized_basis(j: &Matrix) -> Result<(Vec<Vec<f64>>, Vec<Vec<f64>>, PeriodMatrix)> {
+pub fn normalized_basis(j: &Matrix) -> Result<NormalizedBasis> {
     let n = j.len();
-    if n == 0 || n % 2 != 0 {
+    if n == 0 || !n.is_multiple_of(2) {
         return Err(Error::input(format!(
             "a complex structure on H¹ needs an even positive dimension, got {n}"
         )));
@@ -122,7 +125,7 @@ pub fn normalized_basis(j: &Matrix) -> Result<(Vec<Vec<f64>>, Vec<Vec<f64>>, Per
 pub fn lattice_energies(e: &Matrix, count: usize) -> Result<Vec<f64>> {
     let n = e.len();
     let eig = small::symmetric_eigenvalues(e)?;
-    if eig.first().is_none_or(|&l| !(l > 0.0)) {
+    if eig.first().is_none_or(|&l| l.is_nan() || l <= 0.0) {
         return Err(Error::numerical("the energy form is not positive definite"));
     }
     let q = |c: &[i64]| -> f64 {

@@ -145,7 +145,7 @@ pub fn form_with_zeros(
     }
     // E^{-1/2} M E^{-1/2}, smallest eigenvector.
     let (ev, evec) = small::symmetric_eigen(&e)?;
-    if !(ev[0] > 0.0) {
+    if ev[0].is_nan() || ev[0] <= 0.0 {
         return Err(Error::numerical(
             "the energy of the basis is not positive definite",
         ));

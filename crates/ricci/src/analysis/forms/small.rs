@@ -46,7 +46,7 @@ pub fn inverse(a: &Matrix, what: &str) -> Result<Matrix> {
         .flat_map(|i| (0..n).map(move |j| (i, j)))
         .map(|(i, j)| (id[i][j] - if i == j { 1.0 } else { 0.0 }).abs())
         .fold(0.0, f64::max);
-    if !(err < 1e-6) {
+    if err.is_nan() || err >= 1e-6 {
         return Err(Error::numerical(format!(
             "the {what} matrix is singular (‖A A⁻¹ − I‖ = {err:.1e})"
         )));

@@ -47,7 +47,7 @@ fn face_frame(l: [f64; 3]) -> Option<[[f64; 2]; 3]> {
     let [a, b, c] = l;
     let x = (a * a + c * c - b * b) / (2.0 * a);
     let y2 = c * c - x * x;
-    if !(y2 > 0.0) || !(a > 0.0) {
+    if y2.is_nan() || y2 <= 0.0 || a.is_nan() || a <= 0.0 {
         return None;
     }
     let p2 = [x, y2.sqrt()];
