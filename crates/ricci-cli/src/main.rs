@@ -35,6 +35,8 @@ enum Command {
     Layout(cmd::layout::Args),
     /// Geodesic length spectrum of a closed surface of genus ≥ 1.
     Spectrum(cmd::spectrum::Args),
+    /// Holomorphic 1-forms: period matrix, zeros, conformal net (genus ≥ 1).
+    Forms(cmd::forms::Args),
     /// The whole pipeline on the built-in genus-2 surface: pictures, tables, DIR/index.html.
     Demo(cmd::demo::Args),
     /// Affine atlas with a single extraordinary point (flat cone metric, charts, transitions).
@@ -71,6 +73,7 @@ fn main() {
         Command::Flow(a) => cmd::flow::run(a),
         Command::Layout(a) => cmd::layout::run(a),
         Command::Spectrum(a) => cmd::spectrum::run(a),
+        Command::Forms(a) => cmd::forms::run(a),
         Command::Demo(a) => cmd::demo::run(a),
         Command::Atlas(a) => cmd::atlas::run(a),
         Command::Spline(a) => cmd::spline::run(a),

@@ -5,6 +5,7 @@ pub mod batch;
 pub mod cut;
 pub mod demo;
 pub mod flow;
+pub mod forms;
 pub mod generate;
 pub mod info;
 pub mod layout;
