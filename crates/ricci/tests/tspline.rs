@@ -272,3 +272,106 @@ fn bezier_patches_reproduce_the_t_spline_and_it_is_c2() {
         );
     }
 }
+
+/// A torus of revolution sampled on a jittered grid, parameterised over a sheared lattice.
+fn torus_samples(nu: usize, nv: usize, lat: Lattice) -> (Vec<[f64; 3]>, Vec<[f64; 2]>) {
+    let mut rng = Lcg(42);
+    let mut pts = Vec::new();
+    let mut uv = Vec::new();
+    for j in 0..nv {
+        for i in 0..nu {
+            let a = (i as f64 + 0.3 * rng.next()) / nu as f64;
+            let b = (j as f64 + 0.3 * rng.next()) / nv as f64;
+            let (t, p) = (a * std::f64::consts::TAU, b * std::f64::consts::TAU);
+            let r = 2.0 + 0.7 * p.cos() + 0.1 * (3.0 * t).sin() * p.sin();
+            pts.push([r * t.cos(), r * t.sin(), 0.7 * p.sin()]);
+            uv.push([a * lat.width + b * lat.shift, b * lat.height]);
+        }
+    }
+    (pts, uv)
+}
+
+#[test]
+fn adaptive_fit_reaches_the_tolerance_with_t_junctions() {
+    use ricci::spline::tspline::fit::{fit, FitOptions};
+    let lat = Lattice {
+        width: 4.0,
+        height: 1.5,
+        shift: 0.9,
+    };
+    let (pts, uv) = torus_samples(90, 40, lat);
+    let opts = FitOptions {
+        tolerance: 0.002,
+        initial_faces: 24,
+        ..Default::default()
+    };
+    let r = fit(&pts, &uv, lat, &opts, &mut ricci::progress::NoProgress).unwrap();
+    let last = r.steps.last().unwrap();
+    assert!(r.converged, "not converged: {:?}", r.steps);
+    assert!(last.max_error_percent <= 0.2 + 1e-12);
+    assert!(r.steps.len() >= 2, "no refinement happened: {:?}", r.steps);
+    assert!(r.steps[0].max_error_percent > last.max_error_percent);
+    // the errors are measured independently of the fit's bookkeeping
+    let scale = ricci::spline::tspline::fit::bbox_scale(&pts);
+    let worst = pts
+        .iter()
+        .zip(&uv)
+        .map(|(p, q)| {
+            let s = r.spline.point(q[0], q[1]);
+            ((s[0] - p[0]).powi(2) + (s[1] - p[1]).powi(2) + (s[2] - p[2]).powi(2)).sqrt()
+        })
+        .fold(0.0, f64::max);
+    assert!((100.0 * worst / scale - last.max_error_percent).abs() < 1e-9);
+    assert!(r.spline.basis.mesh.is_analysis_suitable());
+    // the refined surface keeps the partition of unity
+    let mut buf = Vec::new();
+    let mut rng = Lcg(3);
+    for _ in 0..500 {
+        r.spline
+            .basis
+            .eval(rng.next() * 4.0, rng.next() * 1.5, &mut buf);
+        let s: f64 = buf.iter().map(|(_, j)| j[0]).sum();
+        assert!((s - 1.0).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn step_and_iges_files_are_well_formed() {
+    use ricci::spline::tspline::export::{iges, obj, step};
+    let ts = random_surface(0.3, 2);
+    let patches = extract(&ts);
+    let s = step(&patches, "t");
+    assert_eq!(s.matches("ADVANCED_FACE(").count(), patches.len());
+    assert_eq!(
+        s.matches("B_SPLINE_SURFACE_WITH_KNOTS(").count(),
+        patches.len()
+    );
+    assert!(s.starts_with("ISO-10303-21;") && s.trim_end().ends_with("END-ISO-10303-21;"));
+    let g = iges(&patches, "t");
+    let lines: Vec<&str> = g.lines().collect();
+    assert!(
+        lines.iter().all(|l| l.len() == 80),
+        "IGES lines must have 80 columns"
+    );
+    let count = |c: char| lines.iter().filter(|l| l.as_bytes()[72] == c as u8).count();
+    assert_eq!(count('D'), 2 * patches.len());
+    let t = lines.last().unwrap();
+    assert!(
+        t.contains(&format!("D{:>7}", count('D'))) && t.contains(&format!("P{:>7}", count('P')))
+    );
+    // parameter data: 128 entity header then 8 + 8 knots, 16 weights, 48 coordinates, 4 bounds
+    let first: String = lines
+        .iter()
+        .filter(|l| l.as_bytes()[72] == b'P' && l[64..72].trim() == "1")
+        .map(|l| l[..64].trim_end())
+        .collect();
+    let toks: Vec<&str> = first.trim_end_matches(';').split(',').collect();
+    assert_eq!(toks.len(), 10 + 16 + 16 + 48 + 4);
+    let x: f64 = toks[10 + 16 + 16].parse().unwrap();
+    assert_eq!(x, patches[0].control[0][0][0]);
+    let o = obj(&patches, 4);
+    assert_eq!(
+        o.lines().filter(|l| l.starts_with("v ")).count(),
+        25 * patches.len()
+    );
+}

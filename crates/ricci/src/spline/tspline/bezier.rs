@@ -10,7 +10,7 @@
 //! Patches also measure the continuity of the surface: the jumps of the partial derivatives of
 //! neighbouring patches across their common side, per order.
 
-use super::surface::TSpline;
+use super::surface::{TBasis, TSpline};
 
 /// A bicubic Bézier patch over `[u0, u1] × [v0, v1]`; `control[i][j]`: `i` along `u`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -102,8 +102,7 @@ fn collocation_inverse() -> [[f64; 4]; 4] {
 }
 
 /// The Bézier elements `[u0, u1, v0, v1]` of the T-spline's domain.
-pub fn elements(ts: &TSpline) -> Vec<[f64; 4]> {
-    let basis = &ts.basis;
+pub fn elements(basis: &TBasis) -> Vec<[f64; 4]> {
     let mut out = Vec::new();
     for f in basis.mesh.faces() {
         let mut us = vec![f.u0, f.u1];
@@ -146,7 +145,7 @@ pub fn elements(ts: &TSpline) -> Vec<[f64; 4]> {
 /// Extract one bicubic Bézier patch per element.
 pub fn extract(ts: &TSpline) -> Vec<BezierPatch> {
     let inv = collocation_inverse();
-    elements(ts)
+    elements(&ts.basis)
         .into_iter()
         .map(|[u0, u1, v0, v1]| {
             let mut f = [[[0.0; 3]; 4]; 4];
