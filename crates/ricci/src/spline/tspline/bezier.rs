@@ -179,14 +179,45 @@ pub fn extract(ts: &TSpline) -> Vec<BezierPatch> {
         .collect()
 }
 
-/// Largest jumps of the partial derivatives of orders 0..=3 across the common sides of
-/// neighbouring patches (max over `samples` points per side and over the partials of each
-/// order, Euclidean norm in R³). C^k means the jumps of orders ≤ k vanish.
+/// Jumps of the partial derivatives across patch sides, per order 0..=3.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Continuity {
+    /// Largest jump (Euclidean norm in R³) over the sampled side points and the partials of
+    /// each order.
+    pub jumps: [f64; 4],
+    /// Largest norm of a partial of each order at the sampled points (the scale of the jumps).
+    pub magnitudes: [f64; 4],
+}
+
+impl Continuity {
+    /// `jumps / magnitudes` per order.
+    pub fn relative(&self) -> [f64; 4] {
+        let mut r = [0.0; 4];
+        for k in 0..4 {
+            r[k] = if self.magnitudes[k] > 0.0 {
+                self.jumps[k] / self.magnitudes[k]
+            } else {
+                0.0
+            };
+        }
+        r
+    }
+
+    /// The largest `k` with relative jumps of orders ≤ k below `threshold` (`None`: the
+    /// values themselves jump).
+    pub fn class(&self, threshold: f64) -> Option<usize> {
+        let r = self.relative();
+        (0..4).take_while(|&k| r[k] < threshold).last()
+    }
+}
+
+/// Jumps of the partial derivatives of orders 0..=3 across the common sides of neighbouring
+/// patches, at `samples` points per side. C^k means the jumps of orders ≤ k vanish.
 pub fn continuity(
     patches: &[BezierPatch],
     lattice: super::tmesh::Lattice,
     samples: usize,
-) -> [f64; 4] {
+) -> Continuity {
     let (w, h) = (lattice.width, lattice.height);
     let n = patches.len().max(1);
     let side = (w * h / n as f64).sqrt();
@@ -213,6 +244,7 @@ pub fn continuity(
             })
     };
     let mut jumps = [0.0f64; 4];
+    let mut mags = [0.0f64; 4];
     for q in patches {
         let dmin = (q.u1 - q.u0).min(q.v1 - q.v0) * 1e-6;
         for s in 0..samples {
@@ -238,10 +270,15 @@ pub fn continuity(
                             ((x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + (x[2] - y[2]).powi(2))
                                 .sqrt();
                         jumps[order] = jumps[order].max(d);
+                        let m = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+                        mags[order] = mags[order].max(m);
                     }
                 }
             }
         }
     }
-    jumps
+    Continuity {
+        jumps,
+        magnitudes: mags,
+    }
 }

@@ -25,6 +25,6 @@ pub mod fit;
 pub mod surface;
 pub mod tmesh;
 
-pub use bezier::{continuity, extract, BezierPatch};
+pub use bezier::{continuity, extract, BezierPatch, Continuity};
 pub use surface::{TBasis, TSpline};
 pub use tmesh::{Anchor, Lattice, TMesh};
