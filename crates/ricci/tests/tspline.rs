@@ -377,3 +377,38 @@ fn step_and_iges_files_are_well_formed() {
         25 * patches.len()
     );
 }
+
+#[test]
+fn torus_of_revolution_domain_has_the_closed_form_modulus_and_fits_c2() {
+    use ricci::spline::tspline::fit::{fit, flat_torus_domain, FitOptions};
+    let (big, small) = (1.0, 0.5);
+    let s = ricci::mesh::generate::torus(big, small, 48).unwrap();
+    let (uv, lat) = flat_torus_domain(&s, &mut ricci::progress::NoProgress).unwrap();
+    // conformal to a rectangle with side ratio r / √(R² − r²) (DESIGN.md §5)
+    let want = small / (big * big - small * small).sqrt();
+    let ratio = lat.width.min(lat.height) / lat.width.max(lat.height);
+    assert!(
+        (ratio / want - 1.0).abs() < 3e-3,
+        "side ratio {ratio} vs {want}"
+    );
+    assert_eq!(
+        lat.shift, 0.0,
+        "a torus of revolution has a rectangular lattice"
+    );
+    let opts = FitOptions {
+        tolerance: 0.005,
+        ..Default::default()
+    };
+    let r = fit(
+        &s.positions,
+        &uv,
+        lat,
+        &opts,
+        &mut ricci::progress::NoProgress,
+    )
+    .unwrap();
+    assert!(r.converged && r.steps.last().unwrap().max_error_percent <= 0.5);
+    let patches = extract(&r.spline);
+    let c = continuity(&patches, lat, 3);
+    assert_eq!(c.class(1e-8), Some(2), "{c:?}");
+}
