@@ -3,6 +3,9 @@
 //! on analysis-suitable T-meshes (with a sheared lattice), derivatives against finite
 //! differences, Bézier extraction, continuity across patch sides.
 
+// Index loops mirror the formulas.
+#![allow(clippy::needless_range_loop)]
+
 use ricci::spline::tspline::{continuity, extract, Lattice, TBasis, TMesh, TSpline};
 
 struct Lcg(u64);

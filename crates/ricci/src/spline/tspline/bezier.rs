@@ -69,9 +69,7 @@ fn collocation_inverse() -> [[f64; 4]; 4] {
     let mut m = [[0.0; 8]; 4];
     for i in 0..4 {
         let b = bernstein(NODES[i])[0];
-        for k in 0..4 {
-            m[i][k] = b[k];
-        }
+        m[i][..4].copy_from_slice(&b);
         m[i][4 + i] = 1.0;
     }
     for c in 0..4 {

@@ -471,7 +471,7 @@ impl TMesh {
         let mut out = Vec::with_capacity(tj.len());
         for (i, t) in tj.iter().enumerate() {
             let dir = if t.missing < 2 { 1.0 } else { -1.0 };
-            if t.missing % 2 == 0 {
+            if t.missing.is_multiple_of(2) {
                 let face = self.ray_u(t.u, t.v, dir, 2);
                 let edge = self.ray_u(t.u, t.v, -dir, 1);
                 if face.len() == 2 && edge.len() == 1 {
@@ -633,7 +633,7 @@ impl TMesh {
         let Some(f) = self.faces.iter().position(|f| f.contains(cu, cv)) else {
             return false;
         };
-        let done = if t.missing % 2 == 0 {
+        let done = if t.missing.is_multiple_of(2) {
             // horizontal edge at the T-junction's row, in the face's copy
             let c = if (cv - t.v).abs() < 2.0 * d { t.v } else { cv };
             self.split_horizontal(f, c)
