@@ -342,7 +342,7 @@ fn adaptive_fit_reaches_the_tolerance_with_t_junctions() {
 
 #[test]
 fn step_and_iges_files_are_well_formed() {
-    use ricci::spline::tspline::export::{iges, obj, step};
+    use ricci::spline::tspline::export::{iges, obj, step, torus_obj};
     let ts = random_surface(0.3, 2);
     let patches = extract(&ts);
     let s = step(&patches, "t");
@@ -379,6 +379,27 @@ fn step_and_iges_files_are_well_formed() {
         o.lines().filter(|l| l.starts_with("v ")).count(),
         25 * patches.len()
     );
+    // the lattice-grid tessellation is a closed torus: V − E + F = 0, every edge in two faces
+    let t = torus_obj(&ts, 12, 9);
+    let faces: Vec<[usize; 3]> = t
+        .lines()
+        .filter(|l| l.starts_with("f "))
+        .map(|l| {
+            let v: Vec<usize> = l[2..].split(' ').map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    let nv = t.lines().filter(|l| l.starts_with("v ")).count();
+    assert_eq!(nv, 12 * 9);
+    let mut edges = std::collections::HashMap::new();
+    for f in &faces {
+        for k in 0..3 {
+            let (a, b) = (f[k].min(f[(k + 1) % 3]), f[k].max(f[(k + 1) % 3]));
+            *edges.entry((a, b)).or_insert(0) += 1;
+        }
+    }
+    assert!(edges.values().all(|&c| c == 2));
+    assert_eq!(nv as i64 - edges.len() as i64 + faces.len() as i64, 0);
 }
 
 #[test]

@@ -6,14 +6,14 @@
 //! sentence naming the missing domain (the holomorphic 1-forms' conformal net, issue 17).
 //!
 //! `--out DIR` writes `tspline.step` (AP214, one `B_SPLINE_SURFACE_WITH_KNOTS` face per Bézier
-//! patch), `tspline.igs` (entity 128 per patch), `surface.obj` (tessellation), `tmesh.svg`
+//! patch), `tspline.igs` (entity 128 per patch), `surface.obj` (closed welded tessellation on a lattice grid), `tmesh.svg`
 //! (the T-mesh in the parameter domain, T-junctions in red), `samples.json` (parameters and
 //! points of our evaluation, to check readers against) and `tspline.json` (the report).
 
 use crate::cmd::layout::spinner;
 use crate::util::{print_json, write_atomic, UsageError};
 use ricci::mesh::io::read_surface;
-use ricci::spline::tspline::export::{iges, obj, step};
+use ricci::spline::tspline::export::{iges, step, torus_obj};
 use ricci::spline::tspline::fit::{fit, flat_torus_domain, FitOptions};
 use ricci::spline::tspline::{continuity, extract, BezierPatch, TSpline};
 use serde_json::json;
@@ -40,7 +40,7 @@ pub struct Args {
     /// Budget: control points.
     #[arg(long, default_value_t = 20_000)]
     pub max_control_points: usize,
-    /// Segments per patch side in surface.obj.
+    /// Segments per patch side (on average) in surface.obj, the lattice-grid tessellation.
     #[arg(long, default_value_t = 4)]
     pub tessellation: usize,
     /// Output directory.
@@ -223,9 +223,13 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
             &dir.join("tspline.igs"),
             iges(&patches, "tspline").as_bytes(),
         )?;
+        // lattice grid with about `tessellation` segments per patch side
+        let per = (patches.len() as f64).sqrt() * a.tessellation as f64;
+        let ratio = (lattice.width / lattice.height).sqrt();
+        let (n, m) = ((per * ratio).ceil() as usize, (per / ratio).ceil() as usize);
         write_atomic(
             &dir.join("surface.obj"),
-            obj(&patches, a.tessellation).as_bytes(),
+            torus_obj(&r.spline, n, m).as_bytes(),
         )?;
         write_atomic(&dir.join("tmesh.svg"), tmesh_svg(&r.spline).as_bytes())?;
         write_atomic(

@@ -309,10 +309,10 @@ pub fn iges(patches: &[BezierPatch], name: &str) -> String {
 }
 
 /// The patches tessellated on a `k × k` grid each, as OBJ (vertices not shared between
-/// patches).
+/// patches; see [`torus_obj`] for one closed welded mesh).
 pub fn obj(patches: &[BezierPatch], k: usize) -> String {
     let k = k.max(1);
-    let mut out = String::from("# ricci T-spline tessellation\n");
+    let mut out = String::from("# ricci T-spline tessellation (per patch)\n");
     let mut base = 1usize;
     for p in patches {
         for j in 0..=k {
@@ -331,6 +331,29 @@ pub fn obj(patches: &[BezierPatch], k: usize) -> String {
             }
         }
         base += (k + 1) * (k + 1);
+    }
+    out
+}
+
+/// The T-spline on the lattice grid `p(i, j) = (i/n) ω₁ + (j/m) ω₂` of the flat torus, as one
+/// closed, welded triangle mesh (a torus: `n m` vertices, `2 n m` triangles), in OBJ.
+pub fn torus_obj(ts: &super::surface::TSpline, n: usize, m: usize) -> String {
+    let (n, m) = (n.max(3), m.max(3));
+    let lat = ts.basis.mesh.lattice;
+    let mut out = String::from("# ricci T-spline tessellation (lattice grid of the flat torus)\n");
+    for j in 0..m {
+        for i in 0..n {
+            let (a, b) = (i as f64 / n as f64, j as f64 / m as f64);
+            let x = ts.point(a * lat.width + b * lat.shift, b * lat.height);
+            let _ = writeln!(out, "v {} {} {}", x[0], x[1], x[2]);
+        }
+    }
+    let id = |i: usize, j: usize| (j % m) * n + (i % n) + 1;
+    for j in 0..m {
+        for i in 0..n {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            let _ = writeln!(out, "f {a} {b} {c}\nf {a} {c} {d}");
+        }
     }
     out
 }
