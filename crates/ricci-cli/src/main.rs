@@ -47,6 +47,8 @@ enum Command {
     Batch(cmd::batch::Args),
     /// Partition-of-unity surface over the hyperbolic structure: C∞, no extraordinary point.
     Pou(cmd::pou::Args),
+    /// Cubic T-spline over the domain manifold, fitted adaptively; STEP / IGES export.
+    Tspline(cmd::tspline::Args),
 }
 
 fn main() {
@@ -79,6 +81,7 @@ fn main() {
         Command::Spline(a) => cmd::spline::run(a),
         Command::Batch(a) => cmd::batch::run(a),
         Command::Pou(a) => cmd::pou::run_cmd(a),
+        Command::Tspline(a) => cmd::tspline::run_cmd(a),
     };
     if let Err(e) = result {
         let sentence = util::sentence(&e);

@@ -13,3 +13,4 @@ pub mod pou;
 pub mod render;
 pub mod spectrum;
 pub mod spline;
+pub mod tspline;

@@ -34,3 +34,4 @@ pub mod quadrature;
 pub mod simplex;
 pub mod space;
 pub mod surface;
+pub mod tspline;

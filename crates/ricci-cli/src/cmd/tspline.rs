@@ -1,0 +1,267 @@
+//! `ricci tspline MESH [--tolerance 0.5%] [--out DIR] [--json]`: a cubic T-spline fitted to the
+//! mesh over its domain manifold (paper 003; `ricci::spline::tspline`), exported for CAD.
+//!
+//! Supported now: closed surfaces of genus 1, over the flat torus of the default conformal flow
+//! (for genus 1 the flat layout is the conformal net). Other topologies are refused with a
+//! sentence naming the missing domain (the holomorphic 1-forms' conformal net, issue 17).
+//!
+//! `--out DIR` writes `tspline.step` (AP214, one `B_SPLINE_SURFACE_WITH_KNOTS` face per Bézier
+//! patch), `tspline.igs` (entity 128 per patch), `surface.obj` (closed welded tessellation on a lattice grid), `tmesh.svg`
+//! (the T-mesh in the parameter domain, T-junctions in red), `samples.json` (parameters and
+//! points of our evaluation, to check readers against) and `tspline.json` (the report).
+
+use crate::cmd::layout::spinner;
+use crate::util::{print_json, write_atomic, UsageError};
+use ricci::mesh::io::read_surface;
+use ricci::spline::tspline::export::{iges, step, torus_obj};
+use ricci::spline::tspline::fit::{fit, flat_torus_domain, FitOptions};
+use ricci::spline::tspline::{continuity, extract, BezierPatch, TSpline};
+use serde_json::json;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Mesh file (OBJ, OFF, PLY, STL); closed genus-1 surfaces for now.
+    pub mesh: PathBuf,
+    /// Fitting tolerance L∞, as a fraction of the longest bounding-box side ("0.5%" or 0.005).
+    #[arg(long, default_value = "0.5%")]
+    pub tolerance: String,
+    /// Weight of the (scale-free) thin-plate fairness term.
+    #[arg(long, default_value_t = 1e-5)]
+    pub smoothing: f64,
+    /// Faces of the initial tensor-product T-mesh (about).
+    #[arg(long, default_value_t = 64)]
+    pub initial_faces: usize,
+    /// Budget: refinement iterations.
+    #[arg(long, default_value_t = 12)]
+    pub max_iterations: usize,
+    /// Budget: control points.
+    #[arg(long, default_value_t = 20_000)]
+    pub max_control_points: usize,
+    /// Segments per patch side (on average) in surface.obj, the lattice-grid tessellation.
+    #[arg(long, default_value_t = 4)]
+    pub tessellation: usize,
+    /// Output directory.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_tolerance(s: &str) -> Result<f64, UsageError> {
+    let t = s.trim();
+    let (num, pct) = match t.strip_suffix('%') {
+        Some(n) => (n.trim(), true),
+        None => (t, false),
+    };
+    let x: f64 = num
+        .parse()
+        .map_err(|_| UsageError(format!("--tolerance {s}: not a number (use 0.5% or 0.005)")))?;
+    let x = if pct { x / 100.0 } else { x };
+    if !(x > 0.0 && x < 1.0) {
+        return Err(UsageError(format!(
+            "--tolerance {s} must be between 0 and 100 %"
+        )));
+    }
+    Ok(x)
+}
+
+/// The T-mesh in the parameter domain as SVG: faces in black, T-junctions in red.
+fn tmesh_svg(ts: &TSpline) -> String {
+    let m = &ts.basis.mesh;
+    let lat = m.lattice;
+    let size = 900.0;
+    let k = size / lat.width.max(lat.height);
+    let (w, h) = (lat.width * k, lat.height * k);
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{:.0}\" height=\"{:.0}\" viewBox=\"-10 -10 {:.1} {:.1}\">",
+        w + 20.0,
+        h + 20.0,
+        w + 20.0,
+        h + 20.0
+    );
+    let _ = writeln!(s, "<rect x=\"0\" y=\"0\" width=\"{w:.2}\" height=\"{h:.2}\" fill=\"white\" stroke=\"black\" stroke-width=\"1.5\"/>");
+    for f in m.faces() {
+        let _ = writeln!(
+            s,
+            "<rect x=\"{:.3}\" y=\"{:.3}\" width=\"{:.3}\" height=\"{:.3}\" fill=\"none\" stroke=\"black\" stroke-width=\"0.6\"/>",
+            f.u0 * k,
+            h - f.v1 * k,
+            (f.u1 - f.u0) * k,
+            (f.v1 - f.v0) * k
+        );
+    }
+    for t in m.t_junctions() {
+        let _ = writeln!(
+            s,
+            "<circle cx=\"{:.3}\" cy=\"{:.3}\" r=\"2.2\" fill=\"red\"/>",
+            t.u * k,
+            h - t.v * k
+        );
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+fn samples_json(ts: &TSpline, patches: &[BezierPatch]) -> serde_json::Value {
+    let mut out = Vec::with_capacity(2 * patches.len());
+    for p in patches {
+        for (a, b) in [(0.31, 0.67), (0.73, 0.22)] {
+            let (u, v) = (p.u0 + a * (p.u1 - p.u0), p.v0 + b * (p.v1 - p.v0));
+            let x = ts.point(u, v);
+            out.push(json!([u, v, x[0], x[1], x[2]]));
+        }
+    }
+    let bounds: Vec<[f64; 4]> = patches.iter().map(|p| [p.u0, p.u1, p.v0, p.v1]).collect();
+    json!({"samples": out, "patches": bounds, "samples_per_patch": 2})
+}
+
+pub fn run_cmd(a: Args) -> anyhow::Result<()> {
+    let t0 = Instant::now();
+    let tolerance = parse_tolerance(&a.tolerance)?;
+    if !(a.smoothing >= 0.0 && a.smoothing.is_finite()) {
+        return Err(UsageError(format!("--smoothing {} must be ≥ 0", a.smoothing)).into());
+    }
+    if !(1..=64).contains(&a.tessellation) {
+        return Err(UsageError(format!(
+            "--tessellation {} is not in 1..=64",
+            a.tessellation
+        ))
+        .into());
+    }
+    if !(4..=100_000).contains(&a.initial_faces) {
+        return Err(UsageError(format!(
+            "--initial-faces {} is not in 4..=100000",
+            a.initial_faces
+        ))
+        .into());
+    }
+    let (surface, _) = read_surface(&a.mesh)?;
+    let topo = ricci::mesh::topology(&surface.mesh);
+    let (comps, genus, loops) = match topo.components.first() {
+        Some(c) => (topo.components.len(), c.genus, c.boundary_loops),
+        None => (0, 0, 0),
+    };
+    if comps != 1 || genus != 1 || loops != 0 {
+        anyhow::bail!(
+            "{}: ricci tspline supports closed genus-1 surfaces for now (domain: the flat torus); this mesh has {comps} component(s), genus {genus} and {loops} boundary loop(s), whose domain manifold needs the conformal net of holomorphic 1-forms (paper 003 §2, issue 17), not built yet",
+            a.mesh.display()
+        );
+    }
+    let mut bar = spinner(a.json);
+    bar.0.set_message("flat metric and layout");
+    let (uv, lattice) = flat_torus_domain(&surface, &mut bar)?;
+    let opts = FitOptions {
+        tolerance,
+        smoothing: a.smoothing,
+        initial_faces: a.initial_faces,
+        max_iterations: a.max_iterations.max(1),
+        max_control_points: a.max_control_points,
+        ..FitOptions::default()
+    };
+    bar.0.set_message("fitting");
+    let r = fit(&surface.positions, &uv, lattice, &opts, &mut bar)?;
+    let fit_seconds = t0.elapsed().as_secs_f64();
+    bar.0.set_message("Bézier extraction");
+    let patches = extract(&r.spline);
+    let jumps = continuity(&patches, lattice, 3);
+    bar.0.finish_and_clear();
+    let rel = jumps.relative();
+    // C^k: jumps of orders ≤ k below 1e-8 of the largest partial of that order (the patches
+    // come from an interpolation at interior nodes: rounding grows with the order)
+    let class = match jumps.class(1e-8) {
+        Some(k) => format!("C{k}"),
+        None => "discontinuous".to_string(),
+    };
+    let last = r.steps.last().cloned();
+    let (rms, max) = last.as_ref().map_or((f64::NAN, f64::NAN), |s| {
+        (s.rms_error_percent, s.max_error_percent)
+    });
+    let mut out = json!({
+        "file": a.mesh.display().to_string(),
+        "domain": "flat torus (genus 1)",
+        "lattice": {"width": lattice.width, "height": lattice.height, "shift": lattice.shift},
+        "control_points": r.spline.control.len(),
+        "faces": r.spline.basis.mesh.faces().len(),
+        "t_junctions": r.spline.basis.mesh.t_junctions().len(),
+        "analysis_suitable": r.spline.basis.mesh.is_analysis_suitable(),
+        "bezier_patches": patches.len(),
+        "rms_error_percent": rms,
+        "max_error_percent": max,
+        "tolerance_percent": 100.0 * tolerance,
+        "converged": r.converged,
+        "iterations": r.steps.len(),
+        "steps": r.steps,
+        "continuity": {"class": class, "jumps": jumps.jumps, "magnitudes": jumps.magnitudes, "relative_jumps": rel,
+                        "orders": [0, 1, 2, 3]},
+        "data_points": surface.positions.len(),
+        "scale": r.scale,
+        "seconds_fit": fit_seconds,
+        "seconds": t0.elapsed().as_secs_f64(),
+    });
+    if !r.converged {
+        eprintln!(
+            "warning: {}: the fit stopped at L∞ {:.3} % above the tolerance {:.3} % (budget: {} iterations, {} control points)",
+            a.mesh.display(),
+            max,
+            100.0 * tolerance,
+            opts.max_iterations,
+            opts.max_control_points
+        );
+    }
+    if let Some(dir) = &a.out {
+        write_atomic(
+            &dir.join("tspline.step"),
+            step(&patches, "tspline").as_bytes(),
+        )?;
+        write_atomic(
+            &dir.join("tspline.igs"),
+            iges(&patches, "tspline").as_bytes(),
+        )?;
+        // lattice grid with about `tessellation` segments per patch side
+        let per = (patches.len() as f64).sqrt() * a.tessellation as f64;
+        let ratio = (lattice.width / lattice.height).sqrt();
+        let (n, m) = ((per * ratio).ceil() as usize, (per / ratio).ceil() as usize);
+        write_atomic(
+            &dir.join("surface.obj"),
+            torus_obj(&r.spline, n, m).as_bytes(),
+        )?;
+        write_atomic(&dir.join("tmesh.svg"), tmesh_svg(&r.spline).as_bytes())?;
+        write_atomic(
+            &dir.join("samples.json"),
+            serde_json::to_string(&samples_json(&r.spline, &patches))?.as_bytes(),
+        )?;
+        out["out"] = json!(dir.display().to_string());
+        out["seconds"] = json!(t0.elapsed().as_secs_f64());
+        write_atomic(
+            &dir.join("tspline.json"),
+            serde_json::to_string_pretty(&out)?.as_bytes(),
+        )?;
+    }
+    if a.json {
+        print_json(&out);
+    } else {
+        println!(
+            "{}: {} control points ({} T-junctions, {} Bézier patches), error rms {:.3}% max {:.3}% of the longest side, {} iterations, {} (jumps {:.1e} {:.1e} {:.1e} {:.1e}), {:.2} s",
+            a.mesh.display(),
+            r.spline.control.len(),
+            r.spline.basis.mesh.t_junctions().len(),
+            patches.len(),
+            rms,
+            max,
+            r.steps.len(),
+            class,
+            rel[0],
+            rel[1],
+            rel[2],
+            rel[3],
+            t0.elapsed().as_secs_f64()
+        );
+    }
+    Ok(())
+}

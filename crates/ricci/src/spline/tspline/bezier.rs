@@ -1,0 +1,282 @@
+//! Bézier extraction of a T-spline (Scott, Borden, Verhoosel, Sederberg, Hughes 2011 in
+//! spirit): the domain is cut into **Bézier elements** on which every blending function is one
+//! bicubic polynomial, and each element becomes a bicubic Bézier patch.
+//!
+//! Elements: every T-mesh face, cut by the knot lines of the (translated) local knot vectors of
+//! the anchors whose supports meet it (for an analysis-suitable T-mesh these are the face
+//! extensions). The patch of an element is found by interpolating the T-spline at the 4×4
+//! tensor nodes `x ∈ {0.05, 0.35, 0.65, 0.95}` of the element — exact up to rounding because the
+//! T-spline restricted to the element is a bicubic polynomial; the extraction test checks it.
+//! Patches also measure the continuity of the surface: the jumps of the partial derivatives of
+//! neighbouring patches across their common side, per order.
+
+use super::surface::{TBasis, TSpline};
+
+/// A bicubic Bézier patch over `[u0, u1] × [v0, v1]`; `control[i][j]`: `i` along `u`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BezierPatch {
+    pub u0: f64,
+    pub u1: f64,
+    pub v0: f64,
+    pub v1: f64,
+    pub control: [[[f64; 3]; 4]; 4],
+}
+
+/// Cubic Bernstein polynomials and their first three derivatives at `t`.
+fn bernstein(t: f64) -> [[f64; 4]; 4] {
+    let s = 1.0 - t;
+    [
+        [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t],
+        [
+            -3.0 * s * s,
+            3.0 * s * s - 6.0 * t * s,
+            6.0 * t * s - 3.0 * t * t,
+            3.0 * t * t,
+        ],
+        [6.0 * s, -12.0 * s + 6.0 * t, 6.0 * s - 12.0 * t, 6.0 * t],
+        [-6.0, 18.0, -18.0, 6.0],
+    ]
+}
+
+impl BezierPatch {
+    /// `∂^{a+b} S / ∂u^a ∂v^b` at `(u, v)` (any point: the polynomial is extended).
+    pub fn partial(&self, u: f64, v: f64, a: usize, b: usize) -> [f64; 3] {
+        let (du, dv) = (self.u1 - self.u0, self.v1 - self.v0);
+        let bu = bernstein((u - self.u0) / du)[a];
+        let bv = bernstein((v - self.v0) / dv)[b];
+        let scale = du.powi(-(a as i32)) * dv.powi(-(b as i32));
+        let mut p = [0.0; 3];
+        for i in 0..4 {
+            for j in 0..4 {
+                let w = bu[i] * bv[j] * scale;
+                for d in 0..3 {
+                    p[d] += w * self.control[i][j][d];
+                }
+            }
+        }
+        p
+    }
+
+    pub fn point(&self, u: f64, v: f64) -> [f64; 3] {
+        self.partial(u, v, 0, 0)
+    }
+}
+
+const NODES: [f64; 4] = [0.05, 0.35, 0.65, 0.95];
+
+/// Inverse of the 4×4 collocation matrix `M[i][k] = b_k(NODES[i])`.
+fn collocation_inverse() -> [[f64; 4]; 4] {
+    let mut m = [[0.0; 8]; 4];
+    for i in 0..4 {
+        let b = bernstein(NODES[i])[0];
+        m[i][..4].copy_from_slice(&b);
+        m[i][4 + i] = 1.0;
+    }
+    for c in 0..4 {
+        let p = (c..4)
+            .max_by(|&a, &b| m[a][c].abs().total_cmp(&m[b][c].abs()))
+            .unwrap_or(c);
+        m.swap(c, p);
+        let d = m[c][c];
+        for k in 0..8 {
+            m[c][k] /= d;
+        }
+        for r in 0..4 {
+            if r != c {
+                let f = m[r][c];
+                for k in 0..8 {
+                    m[r][k] -= f * m[c][k];
+                }
+            }
+        }
+    }
+    let mut inv = [[0.0; 4]; 4];
+    for i in 0..4 {
+        for k in 0..4 {
+            inv[i][k] = m[i][4 + k];
+        }
+    }
+    inv
+}
+
+/// The Bézier elements `[u0, u1, v0, v1]` of the T-spline's domain.
+pub fn elements(basis: &TBasis) -> Vec<[f64; 4]> {
+    let mut out = Vec::new();
+    for f in basis.mesh.faces() {
+        let mut us = vec![f.u0, f.u1];
+        let mut vs = vec![f.v0, f.v1];
+        let span = (f.u1 - f.u0).min(f.v1 - f.v0);
+        let eps = 1e-9 * span;
+        for &(i, du, dv) in &basis.candidates_in(f.u0, f.u1, f.v0, f.v1) {
+            let a = &basis.anchors[i as usize];
+            let overl = a.knots_u[0] + du < f.u1 - eps
+                && a.knots_u[4] + du > f.u0 + eps
+                && a.knots_v[0] + dv < f.v1 - eps
+                && a.knots_v[4] + dv > f.v0 + eps;
+            if !overl {
+                continue;
+            }
+            for k in 0..5 {
+                let x = a.knots_u[k] + du;
+                if x > f.u0 + eps && x < f.u1 - eps {
+                    us.push(x);
+                }
+                let y = a.knots_v[k] + dv;
+                if y > f.v0 + eps && y < f.v1 - eps {
+                    vs.push(y);
+                }
+            }
+        }
+        for xs in [&mut us, &mut vs] {
+            xs.sort_by(f64::total_cmp);
+            xs.dedup_by(|a, b| (*a - *b).abs() <= eps);
+        }
+        for j in 0..vs.len() - 1 {
+            for i in 0..us.len() - 1 {
+                out.push([us[i], us[i + 1], vs[j], vs[j + 1]]);
+            }
+        }
+    }
+    out
+}
+
+/// Extract one bicubic Bézier patch per element.
+pub fn extract(ts: &TSpline) -> Vec<BezierPatch> {
+    let inv = collocation_inverse();
+    elements(&ts.basis)
+        .into_iter()
+        .map(|[u0, u1, v0, v1]| {
+            let mut f = [[[0.0; 3]; 4]; 4];
+            for (a, &x) in NODES.iter().enumerate() {
+                for (b, &y) in NODES.iter().enumerate() {
+                    f[a][b] = ts.point(u0 + x * (u1 - u0), v0 + y * (v1 - v0));
+                }
+            }
+            // C = inv · F · invᵀ
+            let mut control = [[[0.0; 3]; 4]; 4];
+            for i in 0..4 {
+                for j in 0..4 {
+                    for a in 0..4 {
+                        for b in 0..4 {
+                            let w = inv[i][a] * inv[j][b];
+                            for d in 0..3 {
+                                control[i][j][d] += w * f[a][b][d];
+                            }
+                        }
+                    }
+                }
+            }
+            BezierPatch {
+                u0,
+                u1,
+                v0,
+                v1,
+                control,
+            }
+        })
+        .collect()
+}
+
+/// Jumps of the partial derivatives across patch sides, per order 0..=3.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Continuity {
+    /// Largest jump (Euclidean norm in R³) over the sampled side points and the partials of
+    /// each order.
+    pub jumps: [f64; 4],
+    /// Largest norm of a partial of each order at the sampled points (the scale of the jumps).
+    pub magnitudes: [f64; 4],
+}
+
+impl Continuity {
+    /// `jumps / magnitudes` per order.
+    pub fn relative(&self) -> [f64; 4] {
+        let mut r = [0.0; 4];
+        for k in 0..4 {
+            r[k] = if self.magnitudes[k] > 0.0 {
+                self.jumps[k] / self.magnitudes[k]
+            } else {
+                0.0
+            };
+        }
+        r
+    }
+
+    /// The largest `k` with relative jumps of orders ≤ k below `threshold` (`None`: the
+    /// values themselves jump).
+    pub fn class(&self, threshold: f64) -> Option<usize> {
+        let r = self.relative();
+        (0..4).take_while(|&k| r[k] < threshold).last()
+    }
+}
+
+/// Jumps of the partial derivatives of orders 0..=3 across the common sides of neighbouring
+/// patches, at `samples` points per side. C^k means the jumps of orders ≤ k vanish.
+pub fn continuity(
+    patches: &[BezierPatch],
+    lattice: super::tmesh::Lattice,
+    samples: usize,
+) -> Continuity {
+    let (w, h) = (lattice.width, lattice.height);
+    let n = patches.len().max(1);
+    let side = (w * h / n as f64).sqrt();
+    let nx = ((w / side).ceil() as usize).clamp(1, 1024);
+    let ny = ((h / side).ceil() as usize).clamp(1, 1024);
+    let cell =
+        |x: f64, len: f64, k: usize| ((x / len * k as f64).floor().max(0.0) as usize).min(k - 1);
+    let mut grid = vec![Vec::new(); nx * ny];
+    for (p, q) in patches.iter().enumerate() {
+        for iy in cell(q.v0, h, ny)..=cell(q.v1, h, ny) {
+            for ix in cell(q.u0, w, nx)..=cell(q.u1, w, nx) {
+                grid[iy * nx + ix].push(p);
+            }
+        }
+    }
+    let find = |u: f64, v: f64| -> Option<usize> {
+        let (cu, cv) = lattice.canonical(u, v);
+        grid[cell(cv, h, ny) * nx + cell(cu, w, nx)]
+            .iter()
+            .copied()
+            .find(|&p| {
+                let q = &patches[p];
+                cu >= q.u0 && cu < q.u1 && cv >= q.v0 && cv < q.v1
+            })
+    };
+    let mut jumps = [0.0f64; 4];
+    let mut mags = [0.0f64; 4];
+    for q in patches {
+        let dmin = (q.u1 - q.u0).min(q.v1 - q.v0) * 1e-6;
+        for s in 0..samples {
+            let t = (s as f64 + 0.5) / samples as f64;
+            // right side and top side
+            for (u, v, nu, nv) in [
+                (q.u1, q.v0 + t * (q.v1 - q.v0), dmin, 0.0),
+                (q.u0 + t * (q.u1 - q.u0), q.v1, 0.0, dmin),
+            ] {
+                let Some(o) = find(u + nu, v + nv) else {
+                    continue;
+                };
+                let other = &patches[o];
+                // the same point in the neighbour's copy of the domain
+                let (cu, cv) = lattice.canonical(u + nu, v + nv);
+                let (ou, ov) = (cu - nu, cv - nv);
+                for order in 0..4 {
+                    for a in 0..=order {
+                        let b = order - a;
+                        let x = q.partial(u, v, a, b);
+                        let y = other.partial(ou, ov, a, b);
+                        let d =
+                            ((x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + (x[2] - y[2]).powi(2))
+                                .sqrt();
+                        jumps[order] = jumps[order].max(d);
+                        let m = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+                        mags[order] = mags[order].max(m);
+                    }
+                }
+            }
+        }
+    }
+    Continuity {
+        jumps,
+        magnitudes: mags,
+    }
+}

@@ -1,0 +1,474 @@
+//! Fitting a T-spline over the flat torus to mesh points (paper 003 §3.3) and the genus-1
+//! domain (paper 003 §2 for genus one: the flat metric's fundamental domain is the conformal
+//! net).
+//!
+//! **Fit.** Minimise `E(P) = Σ_k |S(u_k) − p_k|² + λ ∫ (|S_uu|² + 2|S_uv|² + |S_vv|²) du dv`
+//! over the control points `P` (paper 003 eq. (3), thin-plate fairness). `E` is quadratic:
+//! `(AᵀA + λF) P = Aᵀp` with `A_ki = B̃_i(u_k)` and `F` the thin-plate Gram matrix, integrated
+//! exactly by 4×4 Gauss points on every Bézier element (the integrand is a polynomial of
+//! degree ≤ 6 per variable there). `λ = smoothing · tr(AᵀA)/tr(F)` keeps the parameter
+//! free of the scale of the domain. The system is solved by conjugate gradients (faer),
+//! symmetrically Jacobi-scaled, warm-started from the previous surface.
+//!
+//! **Refinement** (§3.3): a T-mesh face `I` whose points have `L∞ᴵ > 2ε` is split 1-to-4,
+//! one with `ε < L∞ᴵ ≤ 2ε` 1-to-2 across its longer side; then T-junctions are extended until
+//! the T-mesh is analysis-suitable, and the fit is repeated, until `L∞ ≤ ε` or the budget of
+//! iterations / control points is spent (reported, not hidden).
+
+use super::bezier::elements;
+use super::surface::{TBasis, TSpline};
+use super::tmesh::{Lattice, TMesh};
+use crate::error::{Error, Result};
+use crate::mesh::Surface;
+use crate::progress::Progress;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::matrix_free::conjugate_gradient::{
+    conjugate_gradient, conjugate_gradient_scratch, CgParams,
+};
+use faer::matrix_free::IdentityPrecond;
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{Mat, Par};
+
+/// Options of [`fit`].
+#[derive(Debug, Clone)]
+pub struct FitOptions {
+    /// `ε` as a fraction of the longest side of the bounding box (0.005 = 0.5 %).
+    pub tolerance: f64,
+    /// Thin-plate weight relative to the data term (scale-free).
+    pub smoothing: f64,
+    /// Faces of the initial tensor-product T-mesh (about; the aspect ratio follows the domain).
+    pub initial_faces: usize,
+    pub max_iterations: usize,
+    pub max_control_points: usize,
+    /// Relative residual of the conjugate gradients and their iteration budget.
+    pub cg_tolerance: f64,
+    pub cg_max_iterations: usize,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        FitOptions {
+            tolerance: 0.005,
+            smoothing: 1e-5,
+            initial_faces: 64,
+            max_iterations: 12,
+            max_control_points: 20_000,
+            cg_tolerance: 1e-10,
+            cg_max_iterations: 5000,
+        }
+    }
+}
+
+/// One fit of the refinement loop.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct FitStep {
+    pub control_points: usize,
+    pub faces: usize,
+    pub t_junctions: usize,
+    pub rms_error_percent: f64,
+    pub max_error_percent: f64,
+    pub cg_iterations: usize,
+    pub cg_relative_residual: f64,
+}
+
+/// What [`fit`] reached.
+#[derive(Debug, Clone)]
+pub struct FitResult {
+    pub spline: TSpline,
+    pub steps: Vec<FitStep>,
+    /// Longest side of the bounding box of the data (the 100 % of the error percentages).
+    pub scale: f64,
+    /// Per data point: `|S(u_k) − p_k|`.
+    pub errors: Vec<f64>,
+    pub converged: bool,
+}
+
+const GAUSS: [(f64, f64); 4] = [
+    (0.069_431_844_202_973_71, 0.173_927_422_568_726_93),
+    (0.330_009_478_207_571_87, 0.326_072_577_431_273_07),
+    (0.669_990_521_792_428_1, 0.326_072_577_431_273_07),
+    (0.930_568_155_797_026_3, 0.173_927_422_568_726_93),
+];
+
+/// Least squares with thin-plate fairness over a fixed T-mesh (one step of §3.3).
+/// `guess`: initial control points for the conjugate gradients.
+pub fn fit_fixed(
+    basis: TBasis,
+    points: &[[f64; 3]],
+    params: &[[f64; 2]],
+    smoothing: f64,
+    guess: Option<&[[f64; 3]]>,
+    cg_tolerance: f64,
+    cg_max_iterations: usize,
+) -> Result<(TSpline, usize, f64)> {
+    let n = basis.len();
+    if n == 0 {
+        return Err(Error::input("the T-mesh has no anchors"));
+    }
+    let mut data = Vec::new();
+    let mut fair = Vec::new();
+    let mut rhs = Mat::<f64>::zeros(n, 3);
+    let mut buf = Vec::new();
+    for (p, uv) in points.iter().zip(params) {
+        basis.eval(uv[0], uv[1], &mut buf);
+        for &(i, ji) in &buf {
+            for d in 0..3 {
+                rhs[(i, d)] += ji[0] * p[d];
+            }
+            for &(j, jj) in &buf {
+                data.push(Triplet::new(i, j, ji[0] * jj[0]));
+            }
+        }
+    }
+    for [u0, u1, v0, v1] in elements(&basis) {
+        let area = (u1 - u0) * (v1 - v0);
+        for &(x, wx) in &GAUSS {
+            for &(y, wy) in &GAUSS {
+                basis.eval(u0 + x * (u1 - u0), v0 + y * (v1 - v0), &mut buf);
+                let w = wx * wy * area;
+                for &(i, ji) in &buf {
+                    for &(j, jj) in &buf {
+                        let e = ji[3] * jj[3] + 2.0 * ji[4] * jj[4] + ji[5] * jj[5];
+                        fair.push(Triplet::new(i, j, w * e));
+                    }
+                }
+            }
+        }
+    }
+    let mut tr_a = 0.0;
+    let mut tr_f = 0.0;
+    for t in &data {
+        if t.row == t.col {
+            tr_a += t.val;
+        }
+    }
+    for t in &fair {
+        if t.row == t.col {
+            tr_f += t.val;
+        }
+    }
+    let lambda = if tr_f > 0.0 {
+        smoothing * tr_a / tr_f
+    } else {
+        0.0
+    };
+    let mut diag = vec![0.0; n];
+    for t in &data {
+        if t.row == t.col {
+            diag[t.row] += t.val;
+        }
+    }
+    for t in &fair {
+        if t.row == t.col {
+            diag[t.row] += lambda * t.val;
+        }
+    }
+    if let Some(i) = diag.iter().position(|&d| !(d > 0.0)) {
+        return Err(Error::numerical(format!(
+            "the fitting system has an empty row for control point {i} (no data and no fairness)"
+        )));
+    }
+    let s: Vec<f64> = diag.iter().map(|d| 1.0 / d.sqrt()).collect();
+    let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(data.len() + fair.len());
+    trip.extend(
+        data.iter()
+            .map(|t| Triplet::new(t.row, t.col, t.val * s[t.row] * s[t.col])),
+    );
+    trip.extend(
+        fair.iter()
+            .map(|t| Triplet::new(t.row, t.col, lambda * t.val * s[t.row] * s[t.col])),
+    );
+    let k = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip)
+        .map_err(|e| Error::numerical(format!("could not assemble the fitting system: {e:?}")))?;
+    for i in 0..n {
+        for d in 0..3 {
+            rhs[(i, d)] *= s[i];
+        }
+    }
+    // unknowns y = D^{1/2} x
+    let mut x = Mat::<f64>::zeros(n, 3);
+    if let Some(g) = guess {
+        for i in 0..n.min(g.len()) {
+            for d in 0..3 {
+                x[(i, d)] = g[i][d] / s[i];
+            }
+        }
+    }
+    let precond = IdentityPrecond { dim: n };
+    let params_cg = CgParams {
+        rel_tolerance: cg_tolerance,
+        max_iters: cg_max_iterations,
+        ..Default::default()
+    };
+    let mut mem = MemBuffer::new(conjugate_gradient_scratch(precond, k.as_ref(), 3, Par::Seq));
+    let info = conjugate_gradient(
+        x.as_mut(),
+        precond,
+        k.as_ref(),
+        rhs.as_ref(),
+        params_cg,
+        |_| {},
+        Par::Seq,
+        MemStack::new(&mut mem),
+    );
+    let (iters, resid) = match info {
+        Ok(i) => (i.iter_count, i.rel_residual),
+        Err(e) => {
+            return Err(Error::numerical(format!(
+                "the conjugate gradients of the T-spline fit broke down: {e:?}"
+            )))
+        }
+    };
+    let control: Vec<[f64; 3]> = (0..n)
+        .map(|i| [x[(i, 0)] * s[i], x[(i, 1)] * s[i], x[(i, 2)] * s[i]])
+        .collect();
+    if control.iter().any(|c| c.iter().any(|x| !x.is_finite())) {
+        return Err(Error::numerical(
+            "the T-spline fit produced non-finite control points",
+        ));
+    }
+    Ok((TSpline { basis, control }, iters, resid))
+}
+
+fn errors_of(ts: &TSpline, points: &[[f64; 3]], params: &[[f64; 2]]) -> Vec<f64> {
+    points
+        .iter()
+        .zip(params)
+        .map(|(p, uv)| {
+            let q = ts.point(uv[0], uv[1]);
+            ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) + (q[2] - p[2]).powi(2)).sqrt()
+        })
+        .collect()
+}
+
+/// Longest side of the bounding box.
+pub fn bbox_scale(points: &[[f64; 3]]) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for d in 0..3 {
+            lo[d] = lo[d].min(p[d]);
+            hi[d] = hi[d].max(p[d]);
+        }
+    }
+    (0..3).map(|d| hi[d] - lo[d]).fold(0.0, f64::max)
+}
+
+/// Adaptive fit over the flat torus `lattice` (points with parameters in any representative).
+pub fn fit(
+    points: &[[f64; 3]],
+    params: &[[f64; 2]],
+    lattice: Lattice,
+    opts: &FitOptions,
+    progress: &mut dyn Progress,
+) -> Result<FitResult> {
+    if points.len() != params.len() || points.is_empty() {
+        return Err(Error::input(format!(
+            "the fit needs one parameter per point ({} points, {} parameters)",
+            points.len(),
+            params.len()
+        )));
+    }
+    if let Some(k) = points
+        .iter()
+        .zip(params)
+        .position(|(p, q)| p.iter().chain(q.iter()).any(|x| !x.is_finite()))
+    {
+        return Err(Error::input(format!(
+            "data point {k} or its parameter is not finite"
+        )));
+    }
+    let scale = bbox_scale(points);
+    if !(scale > 0.0) {
+        return Err(Error::input("the data points have an empty bounding box"));
+    }
+    let eps = opts.tolerance * scale;
+    let aspect = lattice.width / lattice.height;
+    let nv = ((opts.initial_faces as f64 / aspect).sqrt().round() as usize).max(4);
+    let nu = ((opts.initial_faces as f64 / nv as f64).round() as usize).max(4);
+    let mut mesh = TMesh::uniform(lattice, nu, nv)?;
+    mesh.make_analysis_suitable(10_000)?;
+    let params: Vec<[f64; 2]> = params
+        .iter()
+        .map(|p| {
+            let (u, v) = lattice.canonical(p[0], p[1]);
+            [u, v]
+        })
+        .collect();
+    let mut steps = Vec::new();
+    let mut prev: Option<TSpline> = None;
+    let mut iteration = 0;
+    loop {
+        iteration += 1;
+        progress.report("tspline", None, &format!("T-spline fit {iteration}"));
+        let tj = mesh.t_junctions().len();
+        let faces = mesh.faces().len();
+        let basis = TBasis::new(mesh.clone())?;
+        let guess: Option<Vec<[f64; 3]>> = prev
+            .as_ref()
+            .map(|p| basis.anchors.iter().map(|a| p.point(a.u, a.v)).collect());
+        let (ts, cg_it, cg_res) = fit_fixed(
+            basis,
+            points,
+            &params,
+            opts.smoothing,
+            guess.as_deref(),
+            opts.cg_tolerance,
+            opts.cg_max_iterations,
+        )?;
+        let errors = errors_of(&ts, points, &params);
+        let max = errors.iter().cloned().fold(0.0, f64::max);
+        let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+        steps.push(FitStep {
+            control_points: ts.control.len(),
+            faces,
+            t_junctions: tj,
+            rms_error_percent: 100.0 * rms / scale,
+            max_error_percent: 100.0 * max / scale,
+            cg_iterations: cg_it,
+            cg_relative_residual: cg_res,
+        });
+        let converged = max <= eps;
+        if converged
+            || iteration >= opts.max_iterations
+            || ts.control.len() >= opts.max_control_points
+        {
+            return Ok(FitResult {
+                spline: ts,
+                steps,
+                scale,
+                errors,
+                converged,
+            });
+        }
+        // per-face L∞
+        let mut face_err = vec![0.0f64; mesh.faces().len()];
+        for (k, uv) in params.iter().enumerate() {
+            if errors[k] > eps {
+                if let Some(f) = mesh.locate(uv[0], uv[1]) {
+                    face_err[f] = face_err[f].max(errors[k]);
+                }
+            }
+        }
+        let marks: Vec<(usize, bool)> = face_err
+            .iter()
+            .enumerate()
+            .filter(|(_, &e)| e > eps)
+            .map(|(f, &e)| (f, e > 2.0 * eps))
+            .collect();
+        if marks.is_empty() {
+            return Ok(FitResult {
+                spline: ts,
+                steps,
+                scale,
+                errors,
+                converged,
+            });
+        }
+        mesh.refine_faces(&marks);
+        mesh.make_analysis_suitable(50_000)?;
+        prev = Some(ts);
+    }
+}
+
+/// The genus-1 domain: flat metric (default conformal flow), cut along a canonical basis, flat
+/// layout; the deck translations span the lattice, reduced (Gauss) and rotated so that
+/// `ω₁ = (W, 0)`, `ω₂ = (s, H)`. Returns one parameter per input vertex and the lattice.
+pub fn flat_torus_domain(
+    surface: &Surface,
+    progress: &mut dyn Progress,
+) -> Result<(Vec<[f64; 2]>, Lattice)> {
+    use crate::layout::deck::deck_group;
+    use crate::layout::pipeline::cut_disk;
+    use crate::layout::place::layout;
+    use crate::metric::{Euclidean, Geometry};
+    let t = crate::mesh::topology(&surface.mesh);
+    let c = t.components.first();
+    if t.components.len() != 1 || c.map(|c| (c.genus, c.boundary_loops)) != Some((1, 0)) {
+        return Err(Error::topology(format!(
+            "the flat-torus domain needs one closed surface of genus 1; this mesh has {} component(s), genus {} and {} boundary loop(s)",
+            t.components.len(),
+            c.map_or(0, |c| c.genus),
+            c.map_or(0, |c| c.boundary_loops)
+        )));
+    }
+    let opts = crate::flow::FlowOptions {
+        geometry: Geometry::Euclidean,
+        scheme: crate::flow::default_scheme(Geometry::Euclidean),
+        target: crate::flow::TargetSpec::Uniform,
+        tolerance: 1e-11,
+        ..Default::default()
+    };
+    let r = crate::flow::ricci_flow(&surface.mesh, &surface.edge_lengths(), &opts, progress)?;
+    if !r.converged {
+        return Err(Error::numerical(format!(
+            "the flat-metric flow did not converge (max curvature error {:.3e} after {} iterations)",
+            r.max_curvature_error, r.iterations
+        )));
+    }
+    let work = r
+        .triangulation
+        .as_ref()
+        .map(|t| t.simplicial.mesh.clone())
+        .unwrap_or_else(|| surface.mesh.clone());
+    let disk = cut_disk(&work, &r.lengths, Geometry::Euclidean, None, None, progress)?;
+    let l = layout::<Euclidean>(&disk.mesh, &disk.lengths, None)?;
+    let g = deck_group::<Euclidean>(&l, &disk.polygon)?;
+    let gens = g.named_generators();
+    if gens.len() != 2 {
+        return Err(Error::numerical(format!(
+            "expected two deck translations of the flat torus, found {}",
+            gens.len()
+        )));
+    }
+    let (mut w1, mut w2) = (gens[0].1.t, gens[1].1.t);
+    // Gauss reduction
+    for _ in 0..100 {
+        if w2.norm() < w1.norm() {
+            std::mem::swap(&mut w1, &mut w2);
+        }
+        let m = ((w2 * w1.conj()).re / w1.norm_sqr()).round();
+        if m == 0.0 {
+            break;
+        }
+        w2 -= w1 * m;
+    }
+    let rot = w1.conj() / w1.norm();
+    let mut b = w2 * rot;
+    if b.im < 0.0 {
+        b = -b;
+    }
+    // A shift below 1e-7 W is the flow's rounding on a rectangular lattice (a symmetric torus):
+    // kept, it would cut 1e-10-wide sliver elements along every column.
+    let shift = if b.re.abs() < 1e-7 * w1.norm() {
+        0.0
+    } else {
+        b.re
+    };
+    let lattice = Lattice {
+        width: w1.norm(),
+        height: b.im,
+        shift,
+    };
+    if !(lattice.height > 1e-12 * lattice.width) {
+        return Err(Error::numerical(
+            "the deck translations of the flat torus are parallel",
+        ));
+    }
+    let n = surface.mesh.n_vertices();
+    let mut uv = vec![[f64::NAN; 2]; n];
+    for (cv, &orig) in disk.vertex_origin.iter().enumerate() {
+        let o = orig as usize;
+        if o < n && uv[o][0].is_nan() {
+            let z = l.positions[cv] * rot;
+            let (u, v) = lattice.canonical(z.re, z.im);
+            uv[o] = [u, v];
+        }
+    }
+    if let Some(v) = uv.iter().position(|p| p[0].is_nan()) {
+        return Err(Error::numerical(format!(
+            "vertex {v} got no position in the flat layout"
+        )));
+    }
+    Ok((uv, lattice))
+}

@@ -1,0 +1,438 @@
+//! T-splines over the flat torus (issue 18): blending functions against an independent de Boor
+//! evaluation of periodic tensor-product B-splines, partition of unity and linear independence
+//! on analysis-suitable T-meshes (with a sheared lattice), derivatives against finite
+//! differences, Bézier extraction, continuity across patch sides.
+
+// Index loops mirror the formulas.
+#![allow(clippy::needless_range_loop)]
+
+use ricci::spline::tspline::{continuity, extract, Lattice, TBasis, TMesh, TSpline};
+
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// De Boor's algorithm for a periodic cubic B-spline curve with columns `c` (period `w`) and
+/// control values `p[i]` attached to the function centred at column `i`.
+fn de_boor_periodic(c: &[f64], w: f64, p: &[f64], x: f64) -> f64 {
+    let n = c.len() as i64;
+    let t = |k: i64| -> f64 {
+        let q = k.div_euclid(n);
+        c[k.rem_euclid(n) as usize] + q as f64 * w
+    };
+    let x = x - (x / w).floor() * w;
+    // span k: t_k ≤ x < t_{k+1}
+    let mut k = 0i64;
+    while !(t(k) <= x && x < t(k + 1)) {
+        k += 1;
+    }
+    // functions j = k-3..=k have support [t_j, t_{j+4}] ∋ x; function j is centred at t_{j+2}
+    let mut d: Vec<f64> = (0..4)
+        .map(|r| {
+            let j = k - 3 + r;
+            p[(j + 2).rem_euclid(n) as usize]
+        })
+        .collect();
+    for r in 1..=3 {
+        for jj in (r..=3).rev() {
+            let i = k - 3 + jj as i64;
+            let a = (x - t(i)) / (t(i + 4 - r as i64) - t(i));
+            d[jj] = (1.0 - a) * d[jj - 1] + a * d[jj];
+        }
+    }
+    d[3]
+}
+
+fn random_as_mesh(shift_frac: f64, seed: u64, refinements: usize) -> TMesh {
+    let lat = Lattice {
+        width: 3.0,
+        height: 2.0,
+        shift: shift_frac * 3.0,
+    };
+    let mut m = TMesh::uniform(lat, 6, 5).unwrap();
+    let mut rng = Lcg(seed);
+    for _ in 0..refinements {
+        let f = (rng.next() * m.faces().len() as f64) as usize;
+        let quad = rng.next() < 0.5;
+        m.refine_face(f.min(m.faces().len() - 1), quad);
+        m.make_analysis_suitable(2000).unwrap();
+    }
+    m
+}
+
+#[test]
+fn regular_t_mesh_equals_periodic_tensor_product_bsplines() {
+    let lat = Lattice {
+        width: 4.0,
+        height: 3.0,
+        shift: 0.0,
+    };
+    let us = [0.0, 0.5, 1.4, 1.9, 2.7, 3.3];
+    let vs = [0.0, 0.8, 1.1, 2.0, 2.4];
+    let mesh = TMesh::grid(lat, &us, &vs).unwrap();
+    assert!(mesh.t_junctions().is_empty());
+    let basis = TBasis::new(mesh).unwrap();
+    assert_eq!(basis.len(), us.len() * vs.len());
+    let mut rng = Lcg(7);
+    let net: Vec<Vec<f64>> = (0..us.len())
+        .map(|_| (0..vs.len()).map(|_| rng.next()).collect())
+        .collect();
+    let control: Vec<[f64; 3]> = basis
+        .anchors
+        .iter()
+        .map(|a| {
+            let i = us.iter().position(|&x| (x - a.u).abs() < 1e-12).unwrap();
+            let j = vs.iter().position(|&y| (y - a.v).abs() < 1e-12).unwrap();
+            [net[i][j], 0.0, 0.0]
+        })
+        .collect();
+    let ts = TSpline { basis, control };
+    for _ in 0..400 {
+        let (u, v) = (rng.next() * 4.0, rng.next() * 3.0);
+        // tensor product: de Boor in v for every column, then in u
+        let col: Vec<f64> = (0..us.len())
+            .map(|i| de_boor_periodic(&vs, 3.0, &net[i], v))
+            .collect();
+        let want = de_boor_periodic(&us, 4.0, &col, u);
+        let got = ts.point(u, v)[0];
+        assert!((got - want).abs() < 1e-13, "({u}, {v}): {got} vs {want}");
+    }
+}
+
+#[test]
+fn analysis_suitable_t_meshes_give_partition_of_unity_and_independent_functions() {
+    for (shift, seed) in [(0.0, 3u64), (0.37, 11), (0.5, 5)] {
+        let mesh = random_as_mesh(shift, seed, 12);
+        assert!(mesh.is_analysis_suitable());
+        let tj = mesh.t_junctions().len();
+        assert!(tj > 0 || shift != 0.0, "refinement made no T-junctions");
+        let basis = TBasis::new(mesh).unwrap();
+        let n = basis.len();
+        let mut rng = Lcg(seed + 100);
+        let mut buf = Vec::new();
+        let m = 6 * n;
+        let mut rows = faer::Mat::<f64>::zeros(m, n);
+        for r in 0..m {
+            let (u, v) = (rng.next() * 3.0, rng.next() * 2.0);
+            basis.eval(u, v, &mut buf);
+            let mut s = [0.0; 6];
+            for (i, j) in &buf {
+                for k in 0..6 {
+                    s[k] += j[k];
+                }
+                assert!(j[0] >= -1e-15);
+                rows[(r, *i)] = j[0];
+            }
+            assert!(
+                (s[0] - 1.0).abs() < 1e-12,
+                "shift {shift}: Σ B = {} at ({u}, {v})",
+                s[0]
+            );
+            for k in 1..6 {
+                assert!(
+                    s[k].abs() < 1e-9,
+                    "shift {shift}: Σ ∂B = {} at ({u}, {v})",
+                    s[k]
+                );
+            }
+        }
+        let gram = rows.transpose() * &rows;
+        let ev = gram.self_adjoint_eigenvalues(faer::Side::Lower).unwrap();
+        let (lo, hi) = (ev[0], ev[ev.len() - 1]);
+        assert!(
+            lo / hi > 1e-10,
+            "shift {shift}: Gram eigenvalues {lo} .. {hi}: dependent blending functions"
+        );
+    }
+}
+
+#[test]
+fn non_suitable_meshes_are_detected_and_closed() {
+    // two neighbouring 1-to-4 splits leave T-junction extensions that cross
+    let lat = Lattice {
+        width: 8.0,
+        height: 8.0,
+        shift: 0.0,
+    };
+    let mut m = TMesh::uniform(lat, 8, 8).unwrap();
+    let f = m.locate(3.5, 3.5).unwrap();
+    m.refine_face(f, true);
+    let g = m.locate(4.5, 4.5).unwrap();
+    m.refine_face(g, true);
+    assert!(!m.intersecting_extensions().is_empty());
+    let splits = m.make_analysis_suitable(1000).unwrap();
+    assert!(splits > 0);
+    assert!(m.is_analysis_suitable());
+    let basis = TBasis::new(m).unwrap();
+    let mut buf = Vec::new();
+    let mut rng = Lcg(9);
+    for _ in 0..2000 {
+        let (u, v) = (rng.next() * 8.0, rng.next() * 8.0);
+        basis.eval(u, v, &mut buf);
+        let s: f64 = buf.iter().map(|(_, j)| j[0]).sum();
+        assert!((s - 1.0).abs() < 1e-12);
+    }
+}
+
+fn random_surface(shift: f64, seed: u64) -> TSpline {
+    let basis = TBasis::new(random_as_mesh(shift, seed, 10)).unwrap();
+    let mut rng = Lcg(seed ^ 77);
+    let control = basis
+        .anchors
+        .iter()
+        .map(|a| {
+            let (t, p) = (
+                a.u / 3.0 * std::f64::consts::TAU,
+                a.v / 2.0 * std::f64::consts::TAU,
+            );
+            let r = 2.0 + 0.7 * p.cos() + 0.05 * rng.next();
+            [r * t.cos(), r * t.sin(), 0.7 * p.sin() + 0.05 * rng.next()]
+        })
+        .collect();
+    TSpline { basis, control }
+}
+
+#[test]
+fn derivatives_match_finite_differences() {
+    let ts = random_surface(0.29, 21);
+    let mut rng = Lcg(5);
+    let h = 1e-5;
+    for _ in 0..300 {
+        let (u, v) = (rng.next() * 3.0, rng.next() * 2.0);
+        let j = ts.jet(u, v);
+        let fd = |k: usize, du: f64, dv: f64| -> [f64; 3] {
+            let a = ts.jet(u + du, v + dv)[k];
+            let b = ts.jet(u - du, v - dv)[k];
+            [
+                (a[0] - b[0]) / (2.0 * h),
+                (a[1] - b[1]) / (2.0 * h),
+                (a[2] - b[2]) / (2.0 * h),
+            ]
+        };
+        // (derivative index, base index, direction): S_u, S_v from S; S_uu, S_uv from S_u; S_vv from S_v
+        for (k, base, du, dv) in [
+            (1, 0, h, 0.0),
+            (2, 0, 0.0, h),
+            (3, 1, h, 0.0),
+            (4, 1, 0.0, h),
+            (5, 2, 0.0, h),
+        ] {
+            let f = fd(base, du, dv);
+            for d in 0..3 {
+                let scale = 1.0 + j[k][d].abs();
+                assert!(
+                    (j[k][d] - f[d]).abs() < 1e-4 * scale,
+                    "partial {k} at ({u}, {v}): {} vs {}",
+                    j[k][d],
+                    f[d]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn bezier_patches_reproduce_the_t_spline_and_it_is_c2() {
+    for (shift, seed) in [(0.0, 4u64), (0.41, 8)] {
+        let ts = random_surface(shift, seed);
+        let patches = extract(&ts);
+        assert!(patches.len() >= ts.basis.mesh.faces().len());
+        let mut rng = Lcg(seed + 1);
+        let mut worst = 0.0f64;
+        for p in &patches {
+            for _ in 0..4 {
+                let (u, v) = (
+                    p.u0 + rng.next() * (p.u1 - p.u0),
+                    p.v0 + rng.next() * (p.v1 - p.v0),
+                );
+                let a = p.point(u, v);
+                let b = ts.point(u, v);
+                for d in 0..3 {
+                    worst = worst.max((a[d] - b[d]).abs());
+                }
+            }
+        }
+        assert!(
+            worst < 1e-12,
+            "shift {shift}: Bézier patches differ from the T-spline by {worst}"
+        );
+        let c = continuity(&patches, ts.basis.mesh.lattice, 3);
+        let jumps = c.relative();
+        assert!(
+            jumps[0] < 1e-13 && jumps[1] < 1e-11 && jumps[2] < 1e-9,
+            "shift {shift}: jumps {jumps:?}"
+        );
+        // third derivatives do jump (cubic pieces): the measurement sees a real discontinuity
+        assert!(
+            jumps[3] > 1e-3,
+            "shift {shift}: third derivatives do not jump: {jumps:?}"
+        );
+        assert_eq!(c.class(1e-8), Some(2));
+    }
+}
+
+/// A torus of revolution sampled on a jittered grid, parameterised over a sheared lattice.
+fn torus_samples(nu: usize, nv: usize, lat: Lattice) -> (Vec<[f64; 3]>, Vec<[f64; 2]>) {
+    let mut rng = Lcg(42);
+    let mut pts = Vec::new();
+    let mut uv = Vec::new();
+    for j in 0..nv {
+        for i in 0..nu {
+            let a = (i as f64 + 0.3 * rng.next()) / nu as f64;
+            let b = (j as f64 + 0.3 * rng.next()) / nv as f64;
+            let (t, p) = (a * std::f64::consts::TAU, b * std::f64::consts::TAU);
+            let r = 2.0 + 0.7 * p.cos() + 0.1 * (3.0 * t).sin() * p.sin();
+            pts.push([r * t.cos(), r * t.sin(), 0.7 * p.sin()]);
+            uv.push([a * lat.width + b * lat.shift, b * lat.height]);
+        }
+    }
+    (pts, uv)
+}
+
+#[test]
+fn adaptive_fit_reaches_the_tolerance_with_t_junctions() {
+    use ricci::spline::tspline::fit::{fit, FitOptions};
+    let lat = Lattice {
+        width: 4.0,
+        height: 1.5,
+        shift: 0.9,
+    };
+    let (pts, uv) = torus_samples(90, 40, lat);
+    let opts = FitOptions {
+        tolerance: 0.002,
+        initial_faces: 24,
+        ..Default::default()
+    };
+    let r = fit(&pts, &uv, lat, &opts, &mut ricci::progress::NoProgress).unwrap();
+    let last = r.steps.last().unwrap();
+    assert!(r.converged, "not converged: {:?}", r.steps);
+    assert!(last.max_error_percent <= 0.2 + 1e-12);
+    assert!(r.steps.len() >= 2, "no refinement happened: {:?}", r.steps);
+    assert!(r.steps[0].max_error_percent > last.max_error_percent);
+    // the errors are measured independently of the fit's bookkeeping
+    let scale = ricci::spline::tspline::fit::bbox_scale(&pts);
+    let worst = pts
+        .iter()
+        .zip(&uv)
+        .map(|(p, q)| {
+            let s = r.spline.point(q[0], q[1]);
+            ((s[0] - p[0]).powi(2) + (s[1] - p[1]).powi(2) + (s[2] - p[2]).powi(2)).sqrt()
+        })
+        .fold(0.0, f64::max);
+    assert!((100.0 * worst / scale - last.max_error_percent).abs() < 1e-9);
+    assert!(r.spline.basis.mesh.is_analysis_suitable());
+    // the refined surface keeps the partition of unity
+    let mut buf = Vec::new();
+    let mut rng = Lcg(3);
+    for _ in 0..500 {
+        r.spline
+            .basis
+            .eval(rng.next() * 4.0, rng.next() * 1.5, &mut buf);
+        let s: f64 = buf.iter().map(|(_, j)| j[0]).sum();
+        assert!((s - 1.0).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn step_and_iges_files_are_well_formed() {
+    use ricci::spline::tspline::export::{iges, obj, step, torus_obj};
+    let ts = random_surface(0.3, 2);
+    let patches = extract(&ts);
+    let s = step(&patches, "t");
+    assert_eq!(s.matches("ADVANCED_FACE(").count(), patches.len());
+    assert_eq!(
+        s.matches("B_SPLINE_SURFACE_WITH_KNOTS(").count(),
+        patches.len()
+    );
+    assert!(s.starts_with("ISO-10303-21;") && s.trim_end().ends_with("END-ISO-10303-21;"));
+    let g = iges(&patches, "t");
+    let lines: Vec<&str> = g.lines().collect();
+    assert!(
+        lines.iter().all(|l| l.len() == 80),
+        "IGES lines must have 80 columns"
+    );
+    let count = |c: char| lines.iter().filter(|l| l.as_bytes()[72] == c as u8).count();
+    assert_eq!(count('D'), 2 * patches.len());
+    let t = lines.last().unwrap();
+    assert!(
+        t.contains(&format!("D{:>7}", count('D'))) && t.contains(&format!("P{:>7}", count('P')))
+    );
+    // parameter data: 128 entity header then 8 + 8 knots, 16 weights, 48 coordinates, 4 bounds
+    let first: String = lines
+        .iter()
+        .filter(|l| l.as_bytes()[72] == b'P' && l[64..72].trim() == "1")
+        .map(|l| l[..64].trim_end())
+        .collect();
+    let toks: Vec<&str> = first.trim_end_matches(';').split(',').collect();
+    assert_eq!(toks.len(), 10 + 16 + 16 + 48 + 4);
+    let x: f64 = toks[10 + 16 + 16].parse().unwrap();
+    assert_eq!(x, patches[0].control[0][0][0]);
+    let o = obj(&patches, 4);
+    assert_eq!(
+        o.lines().filter(|l| l.starts_with("v ")).count(),
+        25 * patches.len()
+    );
+    // the lattice-grid tessellation is a closed torus: V − E + F = 0, every edge in two faces
+    let t = torus_obj(&ts, 12, 9);
+    let faces: Vec<[usize; 3]> = t
+        .lines()
+        .filter(|l| l.starts_with("f "))
+        .map(|l| {
+            let v: Vec<usize> = l[2..].split(' ').map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    let nv = t.lines().filter(|l| l.starts_with("v ")).count();
+    assert_eq!(nv, 12 * 9);
+    let mut edges = std::collections::HashMap::new();
+    for f in &faces {
+        for k in 0..3 {
+            let (a, b) = (f[k].min(f[(k + 1) % 3]), f[k].max(f[(k + 1) % 3]));
+            *edges.entry((a, b)).or_insert(0) += 1;
+        }
+    }
+    assert!(edges.values().all(|&c| c == 2));
+    assert_eq!(nv as i64 - edges.len() as i64 + faces.len() as i64, 0);
+}
+
+#[test]
+fn torus_of_revolution_domain_has_the_closed_form_modulus_and_fits_c2() {
+    use ricci::spline::tspline::fit::{fit, flat_torus_domain, FitOptions};
+    let (big, small) = (1.0, 0.5);
+    let s = ricci::mesh::generate::torus(big, small, 48).unwrap();
+    let (uv, lat) = flat_torus_domain(&s, &mut ricci::progress::NoProgress).unwrap();
+    // conformal to a rectangle with side ratio r / √(R² − r²) (DESIGN.md §5)
+    let want = small / (big * big - small * small).sqrt();
+    let ratio = lat.width.min(lat.height) / lat.width.max(lat.height);
+    assert!(
+        (ratio / want - 1.0).abs() < 3e-3,
+        "side ratio {ratio} vs {want}"
+    );
+    assert_eq!(
+        lat.shift, 0.0,
+        "a torus of revolution has a rectangular lattice"
+    );
+    let opts = FitOptions {
+        tolerance: 0.005,
+        ..Default::default()
+    };
+    let r = fit(
+        &s.positions,
+        &uv,
+        lat,
+        &opts,
+        &mut ricci::progress::NoProgress,
+    )
+    .unwrap();
+    assert!(r.converged && r.steps.last().unwrap().max_error_percent <= 0.5);
+    let patches = extract(&r.spline);
+    let c = continuity(&patches, lat, 3);
+    assert_eq!(c.class(1e-8), Some(2), "{c:?}");
+}
