@@ -74,14 +74,14 @@ pub const STAGES: &[Stage] = &[
     Stage {
         id: "flow",
         title: "Hyperbolic uniformization",
-        reference: "Thurston circle packing Ricci flow in H², Newton (paper 001 §V, paper 002 §4.3)",
+        reference: "discrete conformal equivalence in H² (the default scheme; Gu–Luo–Sun–Wu 2018), Newton; the uniformization of paper 001 §V, paper 002 §4.3",
         needs: &["surface"],
         run: stages::hyperbolic_flow,
     },
     Stage {
         id: "cone",
         title: "Flat metric with a single cone",
-        reference: "Euclidean Ricci flow with all curvature 2πχ on one vertex (paper 000 §4 Steps 2–3)",
+        reference: "Euclidean Ricci flow (Thurston circle packing, the papers' scheme) with all curvature 2πχ on one vertex (paper 000 §4 Steps 2–3)",
         needs: &["surface"],
         run: stages::single_cone,
     },
@@ -109,14 +109,14 @@ pub const STAGES: &[Stage] = &[
     Stage {
         id: "atlas",
         title: "Affine atlas with one extraordinary point",
-        reference: "singularity placement, connectivity modification, flat cone metric, charts and transitions (paper 000 §4 Steps 1–5, paper 002 §5.2)",
+        reference: "singularity placement, connectivity modification, flat cone metric (Thurston circle packing, the papers' scheme), charts and transitions (paper 000 §4 Steps 1–5, paper 002 §5.2)",
         needs: &["surface"],
         run: stages::atlas,
     },
     Stage {
         id: "spline",
         title: "Manifold spline with one extraordinary point",
-        reference: "manifold triangular B-splines (DMS) over the affine structure, fairing, G¹ hole filling (paper 000 §5)",
+        reference: "manifold triangular B-splines (DMS) over the affine structure (flat cone metric by Thurston circle packing, the papers' scheme), fairing, G¹ hole filling (paper 000 §5)",
         needs: &["surface"],
         run: stages::spline,
     },
