@@ -81,11 +81,17 @@ pub struct Args {
     /// Circles instead of checks (conformal maps keep small circles round).
     #[arg(long)]
     pub circles: bool,
-    /// Colormap: viridis or coolwarm (default: coolwarm for signed fields, viridis otherwise).
+    /// Colormap: viridis, coolwarm or grays (default: coolwarm for signed fields, viridis
+    /// otherwise).
     #[arg(long, value_name = "NAME")]
     pub colormap: Option<String>,
     /// Colour range: `auto` (clip the 1% extremes), `full` (min to max) or `LO,HI`.
-    #[arg(long, value_name = "auto|full|LO,HI", default_value = "auto")]
+    #[arg(
+        long,
+        value_name = "auto|full|LO,HI",
+        default_value = "auto",
+        allow_hyphen_values = true
+    )]
     pub range: String,
     /// Number of isolines of the scalar field.
     #[arg(long, value_name = "N", default_value_t = 0)]
