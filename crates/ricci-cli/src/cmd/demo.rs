@@ -43,7 +43,8 @@ pub struct Args {
     #[arg(long, short = 'o')]
     pub out: PathBuf,
     /// Edges around each handle of the built-in genus-2 surface (12 to 200).
-    #[arg(long, short = 'n', default_value_t = 40)]
+    #[arg(long, short = 'n', default_value_t = 40, allow_hyphen_values = true,
+          value_parser = clap::value_parser!(u32).range(12..=200))]
     pub resolution: u32,
     /// Print one JSON object on stdout (per-stage summaries and the file list).
     #[arg(long)]
