@@ -210,11 +210,13 @@ pub fn check_vertex(flag: &str, v: u32, n_vertices: usize) -> Result<(), UsageEr
 
 /// Progress for long commands: the spinner on a terminal, and when stderr is not a terminal
 /// (a log file, a batch, CI) one line per stage on stderr, `ricci: [  12.3 s] stage: message`,
-/// and at most one line every 10 s within a stage.
+/// and at most one line every 10 s within a stage — from 2 s on (`RICCI_PROGRESS_AFTER`
+/// seconds), so that a command that fails at once still prints one sentence.
 pub struct Reporter {
     pub bar: crate::cmd::layout::Bar,
     lines: bool,
     t0: std::time::Instant,
+    after: f64,
     last: Option<std::time::Instant>,
     last_stage: String,
 }
@@ -229,6 +231,10 @@ impl Reporter {
                 && CAPTURE.with(|c| c.borrow().is_none())
                 && std::env::var_os("RICCI_NO_PROGRESS_LINES").is_none(),
             t0: std::time::Instant::now(),
+            after: std::env::var("RICCI_PROGRESS_AFTER")
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(2.0),
             last: None,
             last_stage: String::new(),
         }
@@ -250,7 +256,7 @@ impl Reporter {
 impl ricci::progress::Progress for Reporter {
     fn report(&mut self, stage: &str, fraction: Option<f64>, message: &str) {
         self.bar.report(stage, fraction, message);
-        if !self.lines {
+        if !self.lines || self.t0.elapsed().as_secs_f64() < self.after {
             return;
         }
         let due = self

@@ -43,9 +43,10 @@ pub struct Args {
     #[arg(long, short = 'o')]
     pub out: PathBuf,
     /// Edges around each handle of the built-in genus-2 surface (12 to 200).
-    #[arg(long, short = 'n', default_value_t = 40, allow_hyphen_values = true,
-          value_parser = clap::value_parser!(u32).range(12..=200))]
-    pub resolution: u32,
+    // Read as a signed number so that a negative value gets the range check of `run`, not
+    // clap's "not in 0..=4294967295".
+    #[arg(long, short = 'n', default_value_t = 40, allow_hyphen_values = true)]
+    pub resolution: i64,
     /// Print one JSON object on stdout (per-stage summaries and the file list).
     #[arg(long)]
     pub json: bool,
@@ -247,7 +248,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let mut out = Out::new(&a.out)?;
     let mut bar = StageBar::new(a.json);
-    let mut ctx = Ctx::new(a.resolution);
+    let mut ctx = Ctx::new(a.resolution as u32);
     let mut sections: Vec<Section> = Vec::new();
     let n = STAGES.len();
     for (k, st) in STAGES.iter().enumerate() {

@@ -108,17 +108,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         check_vertex("--singularity", v, surface.mesh.n_vertices())?;
     }
     let mut bar = Reporter::new(a.json);
-    if a.out.is_none() {
-        let stem = a
-            .mesh
-            .file_stem()
-            .map_or("spline".into(), |s| s.to_string_lossy().into_owned());
-        bar.line(&format!(
-            "warning: no --out: the spline is computed and only its numbers are reported; to \
-             keep the surface, try: ricci spline {} --out {stem}-spline",
-            a.mesh.display()
-        ));
-    }
+    let stem = a
+        .mesh
+        .file_stem()
+        .map_or("spline".into(), |s| s.to_string_lossy().into_owned());
+    let no_out = format!(
+        "warning: no --out: the spline was computed and only its numbers are reported; to keep \
+         the surface, try: ricci spline {} --out {stem}-spline",
+        a.mesh.display()
+    );
     // An estimate up front: the cost grows with the faces and the square of the basis
     // functions per face (the fit's and the fairing's dense blocks); measured: 2 432 faces
     // at degree 3 with --fit take ~13 CPU-seconds, ~0.6 GB (BENCHMARKS.md).
@@ -129,11 +127,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if est_seconds > 30.0 {
         bar.line(&format!(
             "estimate: {} faces at degree {}: roughly {:.0} CPU-seconds and {:.1} GB of memory \
-             (scaled from 13 s / 0.6 GB for 2 432 faces at degree 3); progress follows",
+             (scaled from 13 s / 0.6 GB for 2 432 faces at degree 3); progress follows{}",
             surface.mesh.n_faces(),
             a.degree,
             est_seconds,
-            est_gb
+            est_gb,
+            if a.out.is_none() {
+                " (no --out: nothing will be written)"
+            } else {
+                ""
+            }
         ));
     }
     let t_ricci = Instant::now();
@@ -294,6 +297,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let total = t0.elapsed().as_secs_f64();
     out["seconds_total"] = json!(total);
     out["seconds"] = json!(total);
+    // After the work (a failure stays one sentence on stderr): the result was not kept.
+    if a.out.is_none() {
+        eprintln!("{no_out}");
+    }
     if a.json {
         print_json(&out);
     } else {

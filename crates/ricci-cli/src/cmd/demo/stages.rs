@@ -701,6 +701,11 @@ pub fn single_cone(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "K = {k_at_cone:.6} at vertex {v} (valence {valence_before} → {valence_after}), |K| ≤ {max_elsewhere:.1e} elsewhere; {} Newton steps",
         r.iterations
     );
+    // (`--scheme thurston` on the unrefined surface is the refusal quoted above.)
+    sec.commands = vec![
+        format!("ricci flow surface.off --target single-cone:{v} --out cone-conformal.json"),
+        format!("ricci atlas surface.off --singularity {v} --out atlas-{v}"),
+    ];
     let mut summary = flow_summary(&r);
     summary["cone_vertex"] = json!(v);
     summary["refused_without_refinement"] = json!(refusal);
@@ -1537,7 +1542,7 @@ pub fn spline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     let tris = &tess.triangles;
     let pos = &tess.positions;
     // The extraordinary point: the tessellation vertex nearest the centroid of the fill
-    // patch (vertex_face < 0), ringed in the pictures, which look at it along its normal.
+    // patch (vertex_face < 0), ringed in orange in the pictures, which look at it along its normal.
     let fill: Vec<usize> = (0..pos.len())
         .filter(|&i| tess.vertex_face.get(i).is_some_and(|&f| f < 0))
         .collect();
@@ -1572,7 +1577,9 @@ pub fn spline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     let ep_ring: Vec<Polyline> = ep
         .map(|i| {
             let mut r = base_marker(pos, tris, i as u32);
-            r.color = [0.05, 0.05, 0.05];
+            // Orange: visible on the zebra's black and white stripes and on grey.
+            r.color = [1.0, 0.5, 0.0];
+            r.width = 4.0;
             r
         })
         .into_iter()
@@ -1588,7 +1595,7 @@ pub fn spline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         (
             "spline-zebra-back.png",
             ep_view,
-            "Looking at the extraordinary point (black ring): the G¹ fill patch is the small disk inside the ring. Around it the domain was refined (valence raised, neighbourhood graded), so the stripes bend at the scale of its small triangles.",
+            "Looking at the extraordinary point (orange ring): the G¹ fill patch is the small disk inside the ring. Around it the domain was refined (valence raised, neighbourhood graded), so the stripes bend at the scale of its small triangles.",
         ),
     ] {
         let st = Style {
@@ -1634,7 +1641,7 @@ pub fn spline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         env,
         "spline-patches.png",
         &img.image,
-        "Patch boundaries seen from above the extraordinary point (black ring): images of the domain triangles' edges (grey, dense where the domain was graded towards the point) and the seam of the G¹ fill patch (red).",
+        "Patch boundaries seen from above the extraordinary point (orange ring): images of the domain triangles' edges (grey, dense where the domain was graded towards the point) and the seam of the G¹ fill patch (red).",
     )?);
 
     // The tessellated surface as OBJ (the fill patch as group `fill`).
