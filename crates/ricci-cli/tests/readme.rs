@@ -261,6 +261,8 @@ fn examples_run() {
         eprintln!("RICCI_MESHES not set: README examples not run");
         return;
     };
+    // Absolute, so that the links below point at the meshes from any folder.
+    let meshes = std::fs::canonicalize(&meshes).unwrap_or(meshes);
     let all = std::env::var_os("RICCI_README_ALL").is_some();
     let dir = std::env::temp_dir().join(format!("ricci-readme-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
