@@ -66,6 +66,11 @@ fn main() {
             e.exit()
         }
     };
+    // For the README test (crates/ricci-cli/tests/readme.rs): check that a command line
+    // parses, without running it.
+    if std::env::var_os("RICCI_PARSE_ONLY").is_some() {
+        return;
+    }
     let result = match cli.command {
         Command::Info(a) => cmd::info::run(a),
         Command::Generate(a) => cmd::generate::run(a),

@@ -65,6 +65,12 @@ pub fn read_surface(path: &Path) -> ricci::Result<(Surface, BuildReport)> {
     });
     match given {
         Some(x) => Ok(x),
+        None if path.is_dir() => Err(ricci::Error::input(format!(
+            "{}: this is a folder, not a mesh file (.obj, .off, .ply or .stl); to run a \
+             subcommand on every mesh of a folder, try: ricci batch {} --out runs -- info",
+            path.display(),
+            path.display()
+        ))),
         None => ricci::mesh::io::read_surface(path),
     }
 }
@@ -188,4 +194,82 @@ pub fn print_error_json(sentence: &str) {
         return;
     }
     println!("{}", serde_json::json!({ "error": sentence }));
+}
+
+/// A vertex id given on the command line (`flag` e.g. `--base`) must exist: a bad argument
+/// (exit code 2), with the valid range.
+pub fn check_vertex(flag: &str, v: u32, n_vertices: usize) -> Result<(), UsageError> {
+    if (v as usize) < n_vertices {
+        return Ok(());
+    }
+    Err(UsageError(format!(
+        "{flag} {v}: the mesh has only {n_vertices} vertices (ids 0 to {})",
+        n_vertices.saturating_sub(1)
+    )))
+}
+
+/// Progress for long commands: the spinner on a terminal, and when stderr is not a terminal
+/// (a log file, a batch, CI) one line per stage on stderr, `ricci: [  12.3 s] stage: message`,
+/// and at most one line every 10 s within a stage — from 2 s on (`RICCI_PROGRESS_AFTER`
+/// seconds), so that a command that fails at once still prints one sentence.
+pub struct Reporter {
+    pub bar: crate::cmd::layout::Bar,
+    lines: bool,
+    t0: std::time::Instant,
+    after: f64,
+    last: Option<std::time::Instant>,
+    last_stage: String,
+}
+
+impl Reporter {
+    /// `json`: no spinner (lines still go to stderr when it is not a terminal).
+    pub fn new(json: bool) -> Reporter {
+        use std::io::IsTerminal;
+        Reporter {
+            bar: crate::cmd::layout::spinner(json),
+            lines: !std::io::stderr().is_terminal()
+                && CAPTURE.with(|c| c.borrow().is_none())
+                && std::env::var_os("RICCI_NO_PROGRESS_LINES").is_none(),
+            t0: std::time::Instant::now(),
+            after: std::env::var("RICCI_PROGRESS_AFTER")
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(2.0),
+            last: None,
+            last_stage: String::new(),
+        }
+    }
+
+    /// A line on stderr (when lines are on) regardless of throttling, e.g. an estimate.
+    pub fn line(&mut self, message: &str) {
+        if self.lines {
+            eprintln!(
+                "ricci: [{:7.1} s] {message}",
+                self.t0.elapsed().as_secs_f64()
+            );
+        } else {
+            self.bar.0.println(message);
+        }
+    }
+}
+
+impl ricci::progress::Progress for Reporter {
+    fn report(&mut self, stage: &str, fraction: Option<f64>, message: &str) {
+        self.bar.report(stage, fraction, message);
+        if !self.lines || self.t0.elapsed().as_secs_f64() < self.after {
+            return;
+        }
+        let due = self
+            .last
+            .is_none_or(|t| t.elapsed() >= std::time::Duration::from_secs(10));
+        if stage != self.last_stage || due {
+            let pct = fraction.map_or(String::new(), |f| format!(" ({:.0}%)", 100.0 * f));
+            eprintln!(
+                "ricci: [{:7.1} s] {stage}{pct}: {message}",
+                self.t0.elapsed().as_secs_f64()
+            );
+            self.last = Some(std::time::Instant::now());
+            self.last_stage = stage.to_string();
+        }
+    }
 }

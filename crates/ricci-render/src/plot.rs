@@ -225,10 +225,11 @@ impl Figure {
                     };
                     let _ = writeln!(
                         s,
-                        r#"<text x="{}" y="{}" font-size="{}" fill="{}" text-anchor="{anchor}" dominant-baseline="middle"{}>{}</text>"#,
+                        r#"<text x="{}" y="{}" font-size="{}" font-family="{}" fill="{}" text-anchor="{anchor}" dominant-baseline="middle"{}>{}</text>"#,
                         num(at[0]),
                         num(at[1]),
                         num(*size),
+                        font::SVG_FONT_FAMILY,
                         color::to_hex(*c),
                         if *bold { r#" font-weight="bold""# } else { "" },
                         escape(text)
@@ -371,10 +372,10 @@ impl Figure {
                 size,
                 color: c,
                 anchor,
-                ..
+                bold,
             } = t
             {
-                let fs = ((size * scale / 8.0 + 0.25).floor() as u32).max(1);
+                let fs = (size * scale) as f32;
                 let tw = font::text_width(text, fs);
                 let x = (at[0] * scale).round() as i64
                     - match anchor {
@@ -384,6 +385,10 @@ impl Figure {
                     };
                 let y = (at[1] * scale).round() as i64 - font::text_height(fs) / 2;
                 font::draw_text(&mut img, x, y, fs, text, *c);
+                if *bold {
+                    // No bold face is embedded: a second pass one pixel to the right.
+                    font::draw_text(&mut img, x + 1, y, fs, text, *c);
+                }
             }
         }
         Ok(img)
@@ -483,6 +488,83 @@ pub struct LayoutPlot<'a> {
     pub title: String,
     /// Size of the longer side of the picture in pixels.
     pub size: f64,
+    /// A colour bar at the right for the copies' `face_colors` (the same map and range).
+    pub colorbar: Option<ColorBar>,
+}
+
+/// A vertical colour bar: what the colours of a picture mean.
+#[derive(Debug, Clone)]
+pub struct ColorBar {
+    pub colormap: Colormap,
+    /// Values at the bottom and the top of the bar.
+    pub range: (f64, f64),
+    /// What is coloured (shown above the bar), e.g. "log(flat area / R³ area)".
+    pub label: String,
+}
+
+/// Width of the strip a [`ColorBar`] adds at the right of a layout figure.
+const COLORBAR_STRIP: f64 = 96.0;
+
+/// Draw `bar` into `fig` in the strip `[x, x + COLORBAR_STRIP] × [top, bottom]`.
+fn draw_colorbar(fig: &mut Figure, bar: &ColorBar, x: f64, top: f64, bottom: f64) {
+    let ink = [0.15; 3];
+    let bw = 16.0;
+    let (y0, y1) = (top + 30.0, bottom - 10.0);
+    if y1 <= y0 {
+        return;
+    }
+    let steps = 96;
+    for k in 0..steps {
+        let (a, b) = (k as f64 / steps as f64, (k + 1) as f64 / steps as f64);
+        let (ya, yb) = (y1 - a * (y1 - y0), y1 - b * (y1 - y0));
+        fig.items.push(Item::Polygons {
+            polygons: vec![vec![
+                [x, ya + 0.5],
+                [x + bw, ya + 0.5],
+                [x + bw, yb],
+                [x, yb],
+            ]],
+            fill: Some(bar.colormap.eval(0.5 * (a + b))),
+            stroke: None,
+            stroke_width: 0.0,
+            class: "colorbar",
+        });
+    }
+    fig.items.push(Item::Polyline {
+        points: vec![[x, y0], [x + bw, y0], [x + bw, y1], [x, y1]],
+        color: ink,
+        width: 1.0,
+        dash: None,
+        closed: true,
+        class: "colorbar",
+    });
+    let (lo, hi) = bar.range;
+    let mut ticks = vec![lo, hi];
+    if bar.colormap.is_diverging() && lo < 0.0 && hi > 0.0 {
+        ticks.push(0.0);
+    } else {
+        ticks.push(0.5 * (lo + hi));
+    }
+    for t in ticks {
+        let f = if hi > lo { (t - lo) / (hi - lo) } else { 0.5 };
+        let y = y1 - f * (y1 - y0);
+        fig.line(vec![[x + bw, y], [x + bw + 4.0, y]], ink, 1.0, "colorbar");
+        fig.text(
+            [x + bw + 7.0, y],
+            font::format_number(t).replace('-', "−"),
+            12.0,
+            ink,
+            Anchor::Start,
+        );
+    }
+    let size = font::fit_size(&bar.label, 12.0, (COLORBAR_STRIP - 6.0) as f32, 7.0) as f64;
+    fig.text(
+        [x + COLORBAR_STRIP - 4.0, top + 14.0],
+        bar.label.clone(),
+        size,
+        ink,
+        Anchor::End,
+    );
 }
 
 impl<'a> LayoutPlot<'a> {
@@ -493,6 +575,7 @@ impl<'a> LayoutPlot<'a> {
             disk: false,
             title: String::new(),
             size: 800.0,
+            colorbar: None,
         }
     }
 }
@@ -601,7 +684,12 @@ pub fn layout_figure(plot: &LayoutPlot) -> Result<Figure> {
         ox: 0.5 * w - scale * cx,
         oy: title_h + 0.5 * (h - title_h) + scale * cy,
     };
-    let mut fig = Figure::new(w.round(), h.round());
+    let strip = if plot.colorbar.is_some() {
+        COLORBAR_STRIP
+    } else {
+        0.0
+    };
+    let mut fig = Figure::new((w + strip).round(), h.round());
     if plot.disk {
         fig.items.push(Item::Circle {
             center: frame.map([0.0, 0.0]),
@@ -704,16 +792,34 @@ pub fn layout_figure(plot: &LayoutPlot) -> Result<Figure> {
             id: Some("unit-circle"),
         });
     }
+    if let Some(bar) = &plot.colorbar {
+        draw_colorbar(&mut fig, bar, w, title_h, h - pad);
+    }
     if !plot.title.is_empty() {
+        // Fitted to the figure's width (a narrow chart must not clip its title).
+        let fw = (w + strip - 16.0) as f32;
         fig.text(
-            [0.5 * w, 20.0],
+            [0.5 * (w + strip), 20.0],
             plot.title.clone(),
-            16.0,
+            font::fit_size(&plot.title, 16.0, fw, 8.0) as f64,
             [0.1; 3],
             Anchor::Middle,
         );
     }
     Ok(fig)
+}
+
+/// `10⁻¹¹`-style label of a power of ten (superscript digits, U+2212 minus).
+fn power_of_ten(k: i32) -> String {
+    const SUP: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    let mut s = String::from("10");
+    if k < 0 {
+        s.push('⁻');
+    }
+    for d in k.unsigned_abs().to_string().bytes() {
+        s.push(SUP[(d - b'0') as usize]);
+    }
+    s
 }
 
 fn polyline_midpoint(p: &[[f64; 2]]) -> [f64; 2] {
@@ -809,7 +915,7 @@ impl Axes {
             let p = self.py(y);
             fig.line(vec![[self.x0, p], [self.x1, p]], grid, 1.0, "grid");
             let label = if self.log_y {
-                format!("1e{}", y.log10().round() as i32)
+                power_of_ten(y.log10().round() as i32)
             } else {
                 font::format_number(y)
             };
@@ -835,10 +941,11 @@ impl Axes {
             class: "axes",
         });
         if !title.is_empty() {
+            let fw = (fig.width - 12.0) as f32;
             fig.text(
-                [0.5 * (self.x0 + self.x1), 18.0],
+                [0.5 * fig.width, 18.0],
                 title,
-                15.0,
+                font::fit_size(title, 15.0, fw, 8.0) as f64,
                 [0.05; 3],
                 Anchor::Middle,
             );

@@ -1291,13 +1291,14 @@ impl Legend {
         if range.1 > range.0 {
             labels.push((range.0, font::format_number(range.0)));
         }
+        let px = Legend::px(scale);
         let label_w = labels
             .iter()
-            .map(|l| font::text_width(&l.1, scale))
+            .map(|l| font::text_width(&l.1, px))
             .max()
             .unwrap_or(0);
         let bar = 14 * scale as i64;
-        let title_w = font::text_width(&s.label, scale);
+        let title_w = font::text_width(&s.label, px);
         let want = (bar + 6 * scale as i64 + label_w).max(title_w) + 12 * scale as i64;
         let strip_width = (want as u32).min(width / 2);
         Legend {
@@ -1306,6 +1307,11 @@ impl Legend {
             range,
             labels,
         }
+    }
+
+    /// Text size in pixels at a legend scale.
+    fn px(scale: u32) -> f32 {
+        13.0 * scale as f32
     }
 
     fn draw(&self, img: &mut Image, s: &Scalar, bg: Background) {
@@ -1337,7 +1343,8 @@ impl Legend {
         img.fill_rect(x0 - 1, bot + 1, bar_w + 2, 1, frame, 1.0);
         img.fill_rect(x0 - 1, top - 1, 1, bot - top + 3, frame, 1.0);
         img.fill_rect(x0 + bar_w, top - 1, 1, bot - top + 3, frame, 1.0);
-        let th = font::text_height(self.scale);
+        let px = Legend::px(self.scale);
+        let th = font::text_height(px);
         for (value, label) in &self.labels {
             let t = normalize(*value, self.range.0, self.range.1);
             let y = bot - ((bot - top) as f64 * t).round() as i64;
@@ -1346,16 +1353,16 @@ impl Legend {
                 img,
                 x0 + bar_w + 6 * sc,
                 y - th / 2,
-                self.scale,
-                label,
+                px,
+                &label.replace('-', "−"),
                 text,
                 halo,
             );
         }
         if !s.label.is_empty() {
-            let tw = font::text_width(&s.label, self.scale);
+            let tw = font::text_width(&s.label, px);
             let tx = (x0 - 4 * sc).min(w - tw - 2).max(0);
-            font::draw_text_halo(img, tx, top - th - 8 * sc, self.scale, &s.label, text, halo);
+            font::draw_text_halo(img, tx, top - th - 8 * sc, px, &s.label, text, halo);
         }
     }
 }

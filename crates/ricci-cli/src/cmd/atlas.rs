@@ -69,12 +69,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let (s, _) = read_surface(&a.mesh)?;
     let nv = s.mesh.n_vertices() as u32;
     if let Singularity::Vertex(v) = singularity {
-        if v >= nv {
-            return Err(UsageError(format!(
-                "--singularity {v}: the mesh has only {nv} vertices"
-            ))
-            .into());
-        }
+        crate::util::check_vertex("--singularity", v, nv as usize)?;
     }
     if let Some(c) = &cones {
         if let Some(&(v, _)) = c.iter().find(|c| c.0 >= nv) {

@@ -43,8 +43,10 @@ pub struct Args {
     #[arg(long, short = 'o')]
     pub out: PathBuf,
     /// Edges around each handle of the built-in genus-2 surface (12 to 200).
-    #[arg(long, short = 'n', default_value_t = 40)]
-    pub resolution: u32,
+    // Read as a signed number so that a negative value gets the range check of `run`, not
+    // clap's "not in 0..=4294967295".
+    #[arg(long, short = 'n', default_value_t = 40, allow_hyphen_values = true)]
+    pub resolution: i64,
     /// Print one JSON object on stdout (per-stage summaries and the file list).
     #[arg(long)]
     pub json: bool,
@@ -74,14 +76,14 @@ pub const STAGES: &[Stage] = &[
     Stage {
         id: "flow",
         title: "Hyperbolic uniformization",
-        reference: "Thurston circle packing Ricci flow in H², Newton (paper 001 §V, paper 002 §4.3)",
+        reference: "discrete conformal equivalence in H² (the default scheme; Gu–Luo–Sun–Wu 2018), Newton; the uniformization of paper 001 §V, paper 002 §4.3",
         needs: &["surface"],
         run: stages::hyperbolic_flow,
     },
     Stage {
         id: "cone",
         title: "Flat metric with a single cone",
-        reference: "Euclidean Ricci flow with all curvature 2πχ on one vertex (paper 000 §4 Steps 2–3)",
+        reference: "Euclidean Ricci flow (Thurston circle packing, the papers' scheme) with all curvature 2πχ on one vertex (paper 000 §4 Steps 2–3)",
         needs: &["surface"],
         run: stages::single_cone,
     },
@@ -109,14 +111,14 @@ pub const STAGES: &[Stage] = &[
     Stage {
         id: "atlas",
         title: "Affine atlas with one extraordinary point",
-        reference: "singularity placement, connectivity modification, flat cone metric, charts and transitions (paper 000 §4 Steps 1–5, paper 002 §5.2)",
+        reference: "singularity placement, connectivity modification, flat cone metric (Thurston circle packing, the papers' scheme), charts and transitions (paper 000 §4 Steps 1–5, paper 002 §5.2)",
         needs: &["surface"],
         run: stages::atlas,
     },
     Stage {
         id: "spline",
         title: "Manifold spline with one extraordinary point",
-        reference: "manifold triangular B-splines (DMS) over the affine structure, fairing, G¹ hole filling (paper 000 §5)",
+        reference: "manifold triangular B-splines (DMS) over the affine structure (flat cone metric by Thurston circle packing, the papers' scheme), fairing, G¹ hole filling (paper 000 §5)",
         needs: &["surface"],
         run: stages::spline,
     },
@@ -246,7 +248,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let mut out = Out::new(&a.out)?;
     let mut bar = StageBar::new(a.json);
-    let mut ctx = Ctx::new(a.resolution);
+    let mut ctx = Ctx::new(a.resolution as u32);
     let mut sections: Vec<Section> = Vec::new();
     let n = STAGES.len();
     for (k, st) in STAGES.iter().enumerate() {

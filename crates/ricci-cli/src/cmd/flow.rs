@@ -47,7 +47,7 @@ pub struct Args {
     #[arg(long, default_value = "newton")]
     pub solver: Solver,
     /// Stop when max |K − K̄| is at most this.
-    #[arg(long, default_value_t = 1e-10)]
+    #[arg(long, default_value_t = 1e-10, allow_hyphen_values = true)]
     pub tolerance: f64,
     /// Iteration limit (default 30 for Newton, 200000 for the gradient flow).
     #[arg(long)]
@@ -120,6 +120,13 @@ pub fn not_converged_reason(r: &FlowResult) -> String {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    if !(a.tolerance.is_finite() && a.tolerance > 0.0) {
+        return Err(crate::util::UsageError(format!(
+            "--tolerance {} must be a positive number (the largest |K − K̄| accepted, e.g. 1e-10)",
+            a.tolerance
+        ))
+        .into());
+    }
     let (surface, _report) = read_surface(&a.mesh)?;
     let bordered = surface.mesh.has_boundary();
     // Targets that name a flat metric (cones, free or round boundary) or a hyperbolic one.

@@ -30,23 +30,24 @@ pub struct Args {
     /// Genus for the kind `genus`.
     #[arg(long)]
     pub genus: Option<u32>,
-    /// Resolution: segments around the major circle (torus), on the outer boundary (disk,
-    /// annulus, pants), edges around each handle (genus); subdivisions for the sphere.
+    /// Resolution: segments around the major circle (torus, default 48), on the outer boundary
+    /// (disk, annulus, pants, default 64), edges around each handle (genus, default 40);
+    /// subdivisions for the sphere (default 3).
     #[arg(long, short = 'n')]
     pub resolution: Option<u32>,
-    /// Icosphere subdivision levels (sphere only).
+    /// Icosphere subdivision levels (sphere only) [default: 3].
     #[arg(long)]
     pub subdivisions: Option<u32>,
-    /// Major radius, centre of the tube (torus only).
+    /// Major radius, centre of the tube (torus only) [default: 1].
     #[arg(long)]
     pub major: Option<f64>,
-    /// Minor radius of the tube (torus only).
+    /// Minor radius of the tube (torus only) [default: 0.5].
     #[arg(long)]
     pub minor: Option<f64>,
-    /// Inner radius (annulus only).
+    /// Inner radius (annulus only) [default: 0.5].
     #[arg(long)]
     pub inner: Option<f64>,
-    /// Outer radius (annulus only).
+    /// Outer radius (annulus only) [default: 1].
     #[arg(long)]
     pub outer: Option<f64>,
     /// Output mesh file (.obj, .off, .ply, .stl).

@@ -463,6 +463,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         return Err(UsageError("--tiling needs at least one copy".into()).into());
     }
     let (surface, _) = read_surface(&a.mesh)?;
+    if let Some(b) = a.base {
+        crate::util::check_vertex("--base", b, surface.mesh.n_vertices())?;
+    }
     let mut bar = spinner(a.json);
     let PolishedLengths {
         geometry,

@@ -75,17 +75,24 @@ pub struct Args {
     /// Samples per pixel along each axis (anti-aliasing).
     #[arg(long, value_name = "S", default_value_t = 3)]
     pub supersample: u32,
-    /// Checks per UV unit of the checkerboard (or circles per unit).
-    #[arg(long, value_name = "F", default_value_t = 16.0)]
-    pub checker: f64,
+    /// Checks across the layout: N checks (or circles) along the longer side of the UVs'
+    /// bounding box, whatever the layout's scale [default: 16].
+    #[arg(long, value_name = "N")]
+    pub checker: Option<f64>,
     /// Circles instead of checks (conformal maps keep small circles round).
     #[arg(long)]
     pub circles: bool,
-    /// Colormap: viridis or coolwarm (default: coolwarm for signed fields, viridis otherwise).
+    /// Colormap: viridis, coolwarm or grays (default: coolwarm for signed fields, viridis
+    /// otherwise).
     #[arg(long, value_name = "NAME")]
     pub colormap: Option<String>,
     /// Colour range: `auto` (clip the 1% extremes), `full` (min to max) or `LO,HI`.
-    #[arg(long, value_name = "auto|full|LO,HI", default_value = "auto")]
+    #[arg(
+        long,
+        value_name = "auto|full|LO,HI",
+        default_value = "auto",
+        allow_hyphen_values = true
+    )]
     pub range: String,
     /// Number of isolines of the scalar field.
     #[arg(long, value_name = "N", default_value_t = 0)]
@@ -191,11 +198,27 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             a.supersample
         )));
     }
-    if !(a.checker.is_finite() && a.checker > 0.0) {
+    let checks = a.checker.unwrap_or(16.0);
+    if !(checks.is_finite() && checks > 0.0) {
         return Err(usage(format!(
-            "--checker {} must be a positive number",
-            a.checker
+            "--checker {checks} must be a positive number of checks across the layout"
         )));
+    }
+    // The folder of the output file must exist (nothing is created outside it).
+    if let Some(dir) = a.out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        if !a
+            .out
+            .to_string_lossy()
+            .starts_with(crate::util::MEMORY_PREFIX)
+            && !dir.is_dir()
+        {
+            return Err(usage(format!(
+                "--out {}: the folder {} does not exist; try: mkdir -p {}",
+                a.out.display(),
+                dir.display(),
+                dir.display()
+            )));
+        }
     }
     let projection = match a.perspective {
         None => Projection::Orthographic,
@@ -248,6 +271,28 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         },
     };
 
+    // Checks per UV unit: `--checker N` across the longer side of the UVs' bounding box (a
+    // layout in the Poincaré disk spans ~2, a flat one any size: ±84 on face.off).
+    let uv_extent = uvs.as_ref().map_or(1.0, |u| {
+        let pts: &[[f64; 2]] = match u {
+            FoundUvs::PerVertex(v) | FoundUvs::PerCorner(v) => v,
+        };
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in pts.iter().filter(|p| p[0].is_finite() && p[1].is_finite()) {
+            for k in 0..2 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        let e = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+        if e.is_finite() && e > 0.0 {
+            e
+        } else {
+            1.0
+        }
+    });
+    let frequency = checks / uv_extent;
+
     // The scalar field, if any: values, where they live, its name and whether it is signed.
     let scalar = match &a.scalar {
         None => None,
@@ -285,11 +330,21 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     } else if let Some(u) = &uvs {
         if a.circles {
             paint_name = "circles";
-            Paint::Circles(Circles::new(u.as_uvs(), a.checker))
+            Paint::Circles(Circles::new(u.as_uvs(), frequency))
         } else {
             paint_name = "checker";
-            Paint::Checker(Checker::new(u.as_uvs(), a.checker))
+            Paint::Checker(Checker::new(u.as_uvs(), frequency))
         }
+    } else if a.checker.is_some() || a.circles {
+        return Err(anyhow::anyhow!(
+            "{}: no texture coordinates to draw {} with: the file has no `vt` and no --uv \
+             FILE was given (a spherical layout's uv.obj holds positions on the unit sphere, \
+             not UVs); try: ricci render {} --scalar z --out {}",
+            a.uv.as_ref().unwrap_or(&a.mesh).display(),
+            if a.circles { "--circles" } else { "--checker" },
+            a.mesh.display(),
+            a.out.display()
+        ));
     } else {
         paint_name = "solid";
         Paint::default()
@@ -325,6 +380,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "faces": triangles.len(),
         "paint": paint_name,
         "uv": uvs.as_ref().map(|u| match u { FoundUvs::PerVertex(_) => "per-vertex", FoundUvs::PerCorner(_) => "per-corner" }),
+        "uv_extent": uvs.as_ref().map(|_| uv_extent),
+        "checks_across": checks,
     });
     if let Some(sf) = &scalar {
         let finite: Vec<f64> = sf
@@ -402,7 +459,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 triangles,
                 &gltf::GlbOptions {
                     uvs: uvs.as_ref().map(|u| u.as_uvs()),
-                    checker_frequency: Some(a.checker),
+                    checker_frequency: Some(frequency),
                     colors: colors.as_deref(),
                     name: a.mesh.file_stem().map(|s| s.to_string_lossy().to_string()),
                 },

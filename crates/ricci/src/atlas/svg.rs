@@ -128,7 +128,7 @@ pub fn overview_svg(atlas: &AffineAtlas, size: f64) -> String {
     }
     let _ = writeln!(
         out,
-        "<text x=\"8\" y=\"20\" font-family=\"sans-serif\" font-size=\"14\">{} charts: central chart (blue); each cut or local chart's home faces (colours) placed by its transition on one face — across the cut they appear displaced by the deck motion</text>\n</svg>",
+        "<text x=\"8\" y=\"18\" font-family=\"sans-serif\" font-size=\"13\"><tspan x=\"8\">{} charts: central chart (blue); each cut or local chart's home faces (colours)</tspan><tspan x=\"8\" dy=\"16\">placed by its transition on one face — across the cut they appear displaced by the deck motion</tspan></text>\n</svg>",
         atlas.n_charts()
     );
     out

@@ -614,8 +614,10 @@ pub fn check_chow_luo(mesh: &Mesh, geometry: Geometry, target: &Target, phi: &[f
             return Err(Error::input(format!(
                 "target curvature is not admissible (Chow–Luo condition, paper 000 eq. 7) at \
                  {label}: Σ K̄ = {sum:.6} must exceed −Σ(π − φ) + 2πχ(F_I) = {bound:.6} (short by \
-                 {:.3e}); a cone this strong needs higher valence around it (connectivity \
-                 modification, atlas issue) or a less concentrated target",
+                 {:.3e}): circle packing cannot give these vertices their target on this \
+                 triangulation (too few neighbours for the curvature asked; `ricci atlas` \
+                 raises the valence around a cone); try: --scheme conformal (the default), \
+                 which has no such condition",
                 bound - sum
             )));
         }

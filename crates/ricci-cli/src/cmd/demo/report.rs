@@ -208,7 +208,7 @@ caption { text-align:left; font-weight:600; padding:4px 0; color:var(--ink); }
 th, td { padding:4px 12px 4px 0; border-bottom:1px solid var(--line); text-align:left; vertical-align:top; }
 th { color:var(--muted); font-weight:600; }
 td.num { font-variant-numeric: tabular-nums; font-family: ui-monospace, "SF Mono", Menlo, Consolas, monospace; font-size:13px; }
-.tables { display:flex; flex-wrap:wrap; gap:0 36px; }
+.tables { display:flex; flex-wrap:wrap; gap:0 36px; align-items:flex-start; }
 ul.files { font-size:14px; padding-left:18px; }
 ul.files a { color:var(--accent); font-family: ui-monospace, Menlo, Consolas, monospace; }
 .placeholder { color:var(--muted); border:1px dashed var(--line); border-radius:8px; padding:14px 20px; margin:22px 0; }

@@ -20,8 +20,8 @@ use ricci::mesh::{generate, quality::angle_stats, topology, Surface};
 use ricci::metric::{euler_characteristic, Geometry, Hyperbolic, Scheme};
 use ricci::progress::NoProgress;
 use ricci_render::plot::{
-    face_colors, layout_figure, line_plot_figure, Figure, Item, LayoutCopy, LayoutPlot, LinePlot,
-    Series, Side,
+    face_colors, layout_figure, line_plot_figure, ColorBar, Figure, Item, LayoutCopy, LayoutPlot,
+    LinePlot, Series, Side,
 };
 use ricci_render::render::Uvs;
 use ricci_render::{
@@ -151,7 +151,7 @@ fn residual_plot(r: &FlowResult, title: &str) -> anyhow::Result<Figure> {
     Ok(line_plot_figure(
         &[
             Series {
-                name: "max |K - Kbar|".into(),
+                name: "max |K − K̄|".into(),
                 points: pts,
                 color: color::categorical(0),
             },
@@ -412,14 +412,32 @@ pub fn surface(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
 pub fn hyperbolic_flow(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     let mut sec = Section::new("flow", "", "");
     let s = ctx.surface()?;
+    // The default scheme of `ricci flow` (discrete conformal equivalence): the conformal
+    // class of the surface's own polyhedral metric.
     let opts_flow = FlowOptions {
         geometry: Geometry::Hyperbolic,
-        scheme: Scheme::Thurston,
+        scheme: Scheme::Conformal,
         target: TargetSpec::Uniform,
         tolerance: FLOW_TOLERANCE,
         ..FlowOptions::default()
     };
     let r = ricci_flow(&s.mesh, &s.edge_lengths(), &opts_flow, env.bar)?;
+    // The later stages cut and lay out the surface with these lengths, on its own faces: the
+    // intrinsic Delaunay triangulation must be the input's (no flip, no split; so it is on
+    // the isotropic built-in surface).
+    let (flips, splits) = r
+        .triangulation
+        .as_ref()
+        .map_or((0, 0), |t| (t.initial_flips + t.flips, t.splits));
+    if let Some(t) = &r.triangulation {
+        if t.simplicial.mesh.faces() != s.mesh.faces() {
+            anyhow::bail!(
+                "the conformal flow's intrinsic Delaunay triangulation differs from the surface's \
+                 ({flips} flips, {splits} splits), and the later stages need the metric on the \
+                 surface's own triangles; try: ricci demo with another --resolution"
+            );
+        }
+    }
     if !r.converged {
         sec.status = Status::Warning(format!(
             "the flow did not converge: max |K − K̄| = {:.3e} > {:.0e} after {} steps",
@@ -428,13 +446,18 @@ pub fn hyperbolic_flow(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> 
     }
     env.bar.step("pictures");
     sec.paragraphs.push(format!(
-        "Thurston circle packing in the hyperbolic plane, solved by Newton's method (sparse \
-         Cholesky) down to max |K − K̄| ≤ {:.0e}: every vertex gets angle sum 2π, so the \
-         hyperbolic area is −2πχ = {:.6} by Gauss–Bonnet.",
+        "Scheme: discrete conformal equivalence (`conformal`, the default of `ricci flow`; \
+         Gu–Luo–Sun–Wu 2018): vertex scaling sinh(l/2) = e^((u_i+u_j)/2) sinh(l⁰/2) of the \
+         surface's own edge lengths on the intrinsic Delaunay triangulation of the current \
+         metric ({flips} flips and {splits} splits were needed here: the isotropic surface is \
+         Delaunay throughout), solved by Newton's method (sparse Cholesky) down to \
+         max |K − K̄| ≤ {:.0e}. Every vertex gets angle sum 2π, so the hyperbolic area is \
+         −2πχ = {:.6} by Gauss–Bonnet. (The papers' Thurston circle packing computes the \
+         structure of a nearby surface; `--scheme thurston` runs it.)",
         r.tolerance,
         -2.0 * PI * ctx.chi as f64
     ));
-    let plot = residual_plot(&r, "H^2 flow: max |K - Kbar| (rad)")?;
+    let plot = residual_plot(&r, "H² flow (conformal scheme): max |K − K̄| (rad)")?;
     sec.pictures.push(figure(
         env,
         "flow-residuals",
@@ -494,7 +517,7 @@ pub fn hyperbolic_flow(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> 
             ),
             ("hyperbolic area", num(r.area)),
             ("area − 4π", format!("{:.3e}", r.area - 4.0 * PI)),
-            ("clamped Thurston angles", r.clamped_edges.to_string()),
+            ("intrinsic flips / splits", format!("{flips} / {splits}")),
             ("time (s)", format!("{:.3}", r.seconds)),
         ],
     ));
@@ -504,7 +527,7 @@ pub fn hyperbolic_flow(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> 
         "the metric: u, K, K̄ per vertex, lengths per edge (as `ricci flow --out` writes it)".into(),
     )];
     sec.commands = vec![
-        format!("ricci flow surface.off --geometry hyperbolic --tolerance {FLOW_TOLERANCE:.0e} --out hyperbolic-metric.json"),
+        format!("ricci flow surface.off --tolerance {FLOW_TOLERANCE:.0e} --out hyperbolic-metric.json"),
         "ricci render surface.off --scalar angle-defect --out curvature-before.png".into(),
         "ricci render surface.off --scalar hyperbolic-metric.json:curvature --out curvature-after.png".into(),
     ];
@@ -597,6 +620,12 @@ pub fn single_cone(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         4.0 - 2.0 * k_cone / PI,
         raised + graded
     ));
+    sec.paragraphs.push(
+        "Scheme: Thurston circle packing, the papers' scheme (paper 000 §4), on purpose: this \
+         stage shows its Chow–Luo condition and the refinement that meets it. (The default \
+         `conformal` scheme, which flips edges instead, has no such condition.)"
+            .into(),
+    );
     sec.paragraphs.push(match &refusal {
         Some(e) => format!(
             "On the unrefined surface, `ricci flow surface.off --target single-cone:{v}` \
@@ -607,7 +636,7 @@ pub fn single_cone(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
              refinement is done all the same.)"
         ),
     });
-    let plot = residual_plot(&r, "E^2 one cone: max |K - Kbar| (rad)")?;
+    let plot = residual_plot(&r, "E² with one cone (Thurston): max |K − K̄| (rad)")?;
     sec.pictures.push(figure(
         env,
         "cone-residuals",
@@ -672,6 +701,11 @@ pub fn single_cone(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "K = {k_at_cone:.6} at vertex {v} (valence {valence_before} → {valence_after}), |K| ≤ {max_elsewhere:.1e} elsewhere; {} Newton steps",
         r.iterations
     );
+    // (`--scheme thurston` on the unrefined surface is the refusal quoted above.)
+    sec.commands = vec![
+        format!("ricci flow surface.off --target single-cone:{v} --out cone-conformal.json"),
+        format!("ricci atlas surface.off --singularity {v} --out atlas-{v}"),
+    ];
     let mut summary = flow_summary(&r);
     summary["cone_vertex"] = json!(v);
     summary["refused_without_refinement"] = json!(refusal);
@@ -971,7 +1005,7 @@ pub fn layout(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         (
             "checker.png",
             View::default(),
-            "Checkerboard of the Poincaré-disk coordinates on the surface: conformal, so the checks stay square (they shrink where the layout nears the unit circle).",
+            "Checkerboard of the Poincaré-disk coordinates on the surface. The map is conformal: in the small the checks are squares (angles are kept), but their size follows the conformal factor — they grow on the surface where the polygon's spikes reach towards the unit circle, which the disk model compresses.",
         ),
         ("checker-back.png", back_view(), "The same texture from behind."),
     ] {
@@ -1012,7 +1046,9 @@ pub fn layout(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     sec.paragraphs.push(format!(
         "The cut mesh is laid out face by face in the Poincaré disk with the hyperbolic edge \
          lengths; the Möbius maps pairing its sides generate the deck group, a Fuchsian group. \
-         Its relation a1 b1 a1⁻¹ b1⁻¹ a2 b2 a2⁻¹ b2⁻¹ = id holds to {relation_error:.1e}."
+         Its relation a1 b1 a1⁻¹ b1⁻¹ a2 b2 a2⁻¹ b2⁻¹ = id holds to {relation_error:.1e} \
+         (double-precision layout; `ricci layout` without `--no-polish` polishes the metric \
+         and the layout in double-double and reaches ~1e-28)."
     ));
     let mut gt = Table::new(
         "Deck generators z ↦ (az + b)/(b̄z + ā)",
@@ -1084,8 +1120,11 @@ pub fn layout(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "boundary_word": d.polygon.word(),
     });
     sec.commands = vec![
-        "ricci layout surface.off --out uv.obj --svg polygon.svg".into(),
-        format!("ricci layout surface.off --tiling {TILES} --svg tiling.svg"),
+        // The same metric and the same double-precision layout (without --no-polish the
+        // command polishes the metric and the layout in double-double: relation error
+        // ~1e-28 instead of the ~1e-12 shown here).
+        "ricci layout surface.off --metric hyperbolic-metric.json --no-polish --out uv.obj --svg polygon.svg".into(),
+        format!("ricci layout surface.off --metric hyperbolic-metric.json --no-polish --tiling {TILES} --svg tiling.svg"),
     ];
     sec.headline = format!(
         "relation error {relation_error:.1e}, {flipped} flipped faces, {} copies tiled",
@@ -1270,6 +1309,11 @@ pub fn atlas(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     ));
     copy.edges = None;
     let mut plot = LayoutPlot::new(copy);
+    plot.colorbar = Some(ColorBar {
+        colormap: Colormap::CoolWarm,
+        range: (-spread, spread),
+        label: "log(flat / R³ area)".into(),
+    });
     plot.title = "Central chart (flat, cone at the corners)".into();
     plot.size = 720.0;
     let fig = layout_figure(&plot)?;
@@ -1278,7 +1322,7 @@ pub fn atlas(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "atlas-chart",
         &fig,
         &format!(
-            "The central chart: the surface cut through the cone vertex and laid out with its flat metric; every corner of the polygon is the cone. Colour: log of the area ratio flat / R³ (centred on the median; blue = shrunk, red = enlarged; range ±{spread:.2}, the 98th percentile)."
+            "The central chart: the surface cut through the cone vertex and laid out with its flat metric; every corner of the polygon is the cone. Colour (bar at the right): log of the area ratio flat / R³, centred on the median; blue = shrunk, red = enlarged, clamped at ±{spread:.2} (the 98th percentile: the faces at the cone shrink to a point)."
         ),
         true,
     )?);
@@ -1471,7 +1515,10 @@ pub fn spline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     let s = ctx.surface()?;
     env.bar
         .step("flat domain: cone placement, valence, grading, Euclidean flow");
+    let t_domain = std::time::Instant::now();
     let dom = flat_domain(s, Singularity::Auto, &mut NoProgress)?;
+    let seconds_domain = t_domain.elapsed().as_secs_f64();
+    let t_run = std::time::Instant::now();
     env.bar
         .step("knots, bases, fairing, fill patch, tessellation");
     let dist = MeshDistance::new(&s.positions, s.mesh.faces());
@@ -1488,11 +1535,55 @@ pub fn spline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         SPLINE_TESSELLATION,
         &mut NoProgress,
     )?;
+    let seconds_run = t_run.elapsed().as_secs_f64();
     let c = &rep.continuity;
 
     env.bar.step("spline pictures");
     let tris = &tess.triangles;
     let pos = &tess.positions;
+    // The extraordinary point: the tessellation vertex nearest the centroid of the fill
+    // patch (vertex_face < 0), ringed in orange in the pictures, which look at it along its normal.
+    let fill: Vec<usize> = (0..pos.len())
+        .filter(|&i| tess.vertex_face.get(i).is_some_and(|&f| f < 0))
+        .collect();
+    let ep = (!fill.is_empty()).then(|| {
+        let n = fill.len() as f64;
+        let m = fill.iter().fold([0.0; 3], |a, &i| {
+            [
+                a[0] + pos[i][0] / n,
+                a[1] + pos[i][1] / n,
+                a[2] + pos[i][2] / n,
+            ]
+        });
+        let d = |i: usize| (0..3).map(|k| (pos[i][k] - m[k]).powi(2)).sum::<f64>();
+        fill.iter()
+            .copied()
+            .min_by(|&a, &b| d(a).total_cmp(&d(b)))
+            .unwrap_or(fill[0])
+    });
+    let ep_view = match ep {
+        Some(i) => {
+            let n = ricci_render::render::vertex_normals(pos, tris)
+                .get(i)
+                .copied()
+                .unwrap_or([0.0, 0.0, 1.0]);
+            View {
+                eye_direction: [n[0] + 0.25, n[1] + 0.2, n[2]],
+                ..View::default()
+            }
+        }
+        None => back_view(),
+    };
+    let ep_ring: Vec<Polyline> = ep
+        .map(|i| {
+            let mut r = base_marker(pos, tris, i as u32);
+            // Orange: visible on the zebra's black and white stripes and on grey.
+            r.color = [1.0, 0.5, 0.0];
+            r.width = 4.0;
+            r
+        })
+        .into_iter()
+        .collect();
     // Zebra stripes: reflection lines bend smoothly on a C² surface and stay continuous
     // across the seam of the G¹ fill.
     for (file, view, caption) in [
@@ -1503,8 +1594,8 @@ pub fn spline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         ),
         (
             "spline-zebra-back.png",
-            back_view(),
-            "From behind, around the extraordinary point (centre): there the domain was refined (valence raised, neighbourhood graded) and the stripes show facets at the scale of its small triangles — the surface is C² there, but with r = 1 it follows the control net closely; the fill patch is the small disk at the centre.",
+            ep_view,
+            "Looking at the extraordinary point (orange ring): the G¹ fill patch is the small disk inside the ring. Around it the domain was refined (valence raised, neighbourhood graded), so the stripes bend at the scale of its small triangles.",
         ),
     ] {
         let st = Style {
@@ -1512,6 +1603,7 @@ pub fn spline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
                 stripes: 8.0,
                 ..ricci_render::Zebra::default()
             }),
+            polylines: ep_ring.clone(),
             ..Style::default()
         };
         let img = render(pos, tris, &st, &opts(view))?;
@@ -1538,16 +1630,18 @@ pub fn spline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
             }
         })
         .collect();
+    let mut lines = lines;
+    lines.extend(ep_ring.iter().cloned());
     let st = Style {
         polylines: lines,
         ..Style::default()
     };
-    let img = render(pos, tris, &st, &opts(View::default()))?;
+    let img = render(pos, tris, &st, &opts(ep_view))?;
     sec.pictures.push(png(
         env,
         "spline-patches.png",
         &img.image,
-        "Patch boundaries: images of the domain triangles' edges (grey) and the seam of the fill patch around the extraordinary point (red).",
+        "Patch boundaries seen from above the extraordinary point (orange ring): images of the domain triangles' edges (grey, dense where the domain was graded towards the point) and the seam of the G¹ fill patch (red).",
     )?);
 
     // The tessellated surface as OBJ (the fill patch as group `fill`).
@@ -1638,10 +1732,16 @@ pub fn spline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
                 ),
             ),
             (
-                "time (knots, fairing, fill; total)",
+                "time (s): flat domain, knots, fairing, fit, fill, measuring; total",
                 format!(
-                    "{:.2}, {:.2}, {:.2}; {:.2} s",
-                    rep.seconds_knots, rep.seconds_fairing, rep.seconds_fill, rep.seconds
+                    "{:.2}, {:.2}, {:.2}, {:.2}, {:.2}, {:.2}; {:.2}",
+                    seconds_domain,
+                    rep.seconds_knots,
+                    rep.seconds_fairing,
+                    rep.seconds_fit,
+                    rep.seconds_fill,
+                    (seconds_run - rep.seconds).max(0.0),
+                    seconds_domain + seconds_run
                 ),
             ),
         ],
@@ -1674,7 +1774,12 @@ pub fn spline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "tessellation_vertices": pos.len(),
         "tessellation_triangles": tris.len(),
         "fill_triangles": tris.len() - tess.spline_triangles,
-        "seconds": rep.seconds,
+        "seconds": seconds_domain + seconds_run,
+        "timings": {
+            "domain": seconds_domain, "knots": rep.seconds_knots,
+            "fairing": rep.seconds_fairing, "fit": rep.seconds_fit,
+            "fill": rep.seconds_fill, "measure": (seconds_run - rep.seconds).max(0.0),
+        },
     });
     Ok(sec)
 }
