@@ -78,6 +78,28 @@ pub const fn per_triangle(n: usize) -> usize {
     (n + 1) * (n + 2) / 2
 }
 
+/// The edges of the control net of one degree-`n` triangle, as pairs of positions in
+/// [`multi_indices`] order: `β` is joined to `β − e_a + e_b` for `(a, b)` = (0, 1), (0, 2),
+/// (1, 2) — the `3n(n+1)/2` edges of the B-patch's net.
+pub fn control_net_edges(n: usize) -> Vec<(usize, usize)> {
+    let betas = multi_indices(n);
+    let mut out = Vec::with_capacity(3 * n * (n + 1) / 2);
+    for (k, b) in betas.iter().enumerate() {
+        for (from, to) in [(0, 1), (0, 2), (1, 2)] {
+            if b[from] == 0 {
+                continue;
+            }
+            let mut q = *b;
+            q[from] -= 1;
+            q[to] += 1;
+            if let Some(j) = betas.iter().position(|x| *x == q) {
+                out.push((k, j));
+            }
+        }
+    }
+    out
+}
+
 #[inline]
 fn sub(a: Point, b: Point) -> Point {
     [a[0] - b[0], a[1] - b[1]]
