@@ -583,16 +583,6 @@ const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
         "to split: header, ascii, binary",
     ),
     (
-        "crates/ricci/src/atlas/placement.rs",
-        "estimate",
-        "to split: linearized ranking",
-    ),
-    (
-        "crates/ricci/src/atlas/placement.rs",
-        "place",
-        "to split: confirmation flows",
-    ),
-    (
         "crates/ricci/src/spline/fit.rs",
         "fair",
         "to split: constraints, solve",
@@ -601,11 +591,6 @@ const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
         "crates/ricci/src/spline/fit.rs",
         "fit",
         "to split: normal equations, solve",
-    ),
-    (
-        "crates/ricci/src/spline/hole.rs",
-        "new",
-        "to split: seam, patch",
     ),
 ];
 
