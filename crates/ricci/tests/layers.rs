@@ -857,7 +857,9 @@ fn all_files(dir: &Path, out: &mut Vec<PathBuf>) {
         } else if p
             .extension()
             .is_some_and(|e| ["rs", "py", "toml", "md"].contains(&e.to_str().unwrap_or("")))
-            || p.parent().is_some_and(|d| d.ends_with(".ci"))
+            || p.parent()
+                .and_then(Path::file_name)
+                .is_some_and(|n| n == ".ci")
         {
             out.push(p);
         }
