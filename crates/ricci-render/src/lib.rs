@@ -15,6 +15,7 @@
 //!   Fig. 7d) and line plots (residual vs. iteration, log scale).
 //! * [`gltf`] — glTF 2.0 binary (`.glb`) with positions, normals, UVs and an embedded checker
 //!   texture.
+//! * [`loops`] — closed curves on a surface as an SVG sketch (the canonical cut's loops).
 //! * [`fields`] — per-vertex and per-face quantities worth looking at (angle defect, mean
 //!   curvature, area distortion, angle ratios), computed from the same plain slices.
 //!
@@ -29,6 +30,7 @@ pub mod fields;
 mod font;
 pub mod gltf;
 pub mod image;
+pub mod loops;
 pub mod plot;
 pub mod render;
 pub mod shapes;

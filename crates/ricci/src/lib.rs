@@ -1,7 +1,7 @@
 //! # ricci
 //!
 //! Discrete surface Ricci flow and the structures and splines built on it, following
-//! Gu, Jin, Luo et al. (see `shared/papers` and `DESIGN.md`).
+//! Gu, Jin, Luo et al. (see `shared/papers` and `docs/DESIGN.md`).
 //!
 //! The pipeline, one module per stage, each using only the stages before it:
 //!

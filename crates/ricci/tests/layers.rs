@@ -12,6 +12,12 @@
 //! (it keeps old paths compiling for code written against them), nothing else is.
 //!
 //! A violation is reported with file and line.
+//!
+//! The same file checks two more rules of `docs/DESIGN.md` §2 on the workspace's non-test code
+//! (`crates/*/src`): **size** — no file over [`MAX_FILE_LINES`] lines and no function over
+//! [`MAX_FN_LINES`] lines, inline `#[cfg(test)]` modules not counted, except the entries of
+//! [`SIZE_ALLOWED`] — and **citations** — every `docs/…` path cited anywhere under `crates/` or
+//! in `.ci/` exists.
 
 use std::path::{Path, PathBuf};
 
@@ -484,4 +490,429 @@ pub use crate::analysis::spectrum;
     assert!(allowed("analysis", "layout") && !allowed("layout", "analysis"));
     assert!(allowed("numeric", "error") && !allowed("numeric", "mesh"));
     assert!(!allowed("error", "numeric"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Size: files and functions
+
+/// Longest non-test source file (lines).
+const MAX_FILE_LINES: usize = 900;
+/// Longest non-test function (lines from `fn` to its closing brace).
+const MAX_FN_LINES: usize = 150;
+
+/// Exceptions to the size rules, to be removed as the files are split: `(path or path prefix
+/// from the workspace root, function name or "" for the whole file/prefix, why)`. An entry
+/// that is no longer needed is printed (not a failure, so that branches that split a file do
+/// not collide with the one that edits this list).
+const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
+    // Rewritten on other branches right now (issue 21 wave 2); tighten after they merge.
+    (
+        "crates/ricci/src/cut/",
+        "",
+        "cut: being rewritten on another branch",
+    ),
+    (
+        "crates/ricci/src/layout/",
+        "",
+        "layout: being rewritten on another branch",
+    ),
+    (
+        "crates/ricci/src/analysis/",
+        "",
+        "analysis: being rewritten on another branch",
+    ),
+    (
+        "crates/ricci/src/flow/",
+        "",
+        "flow: being rewritten on another branch",
+    ),
+    (
+        "crates/ricci/src/metric/intrinsic.rs",
+        "",
+        "being rewritten on another branch",
+    ),
+    (
+        "crates/ricci/src/metric/common_subdivision.rs",
+        "",
+        "being rewritten on another branch",
+    ),
+    (
+        "crates/ricci/src/spline/pou/",
+        "",
+        "pou: being rewritten on another branch",
+    ),
+    (
+        "crates/ricci-cli/src/cmd/demo",
+        "",
+        "demo: one file per stage on another branch",
+    ),
+    (
+        "crates/ricci-cli/src/cmd/flow.rs",
+        "run",
+        "CLI flow: being rewritten on another branch",
+    ),
+    (
+        "crates/ricci-cli/src/cmd/render.rs",
+        "run",
+        "CLI render: being rewritten on another branch",
+    ),
+    (
+        "crates/ricci-render/src/plot.rs",
+        "",
+        "ricci-render: being edited on another branch",
+    ),
+    (
+        "crates/ricci-render/src/render.rs",
+        "",
+        "ricci-render: being edited on another branch",
+    ),
+    (
+        "crates/ricci-render/src/gltf.rs",
+        "glb_build",
+        "ricci-render: being edited on another branch",
+    ),
+    // Not split yet (issue 21, next step).
+    (
+        "crates/ricci/src/mesh/io/obj.rs",
+        "parse_obj",
+        "to split: per record kind",
+    ),
+    (
+        "crates/ricci/src/mesh/io/ply.rs",
+        "parse_ply",
+        "to split: header, ascii, binary",
+    ),
+    (
+        "crates/ricci/src/spline/fit.rs",
+        "fair",
+        "to split: constraints, solve",
+    ),
+    (
+        "crates/ricci/src/spline/fit.rs",
+        "fit",
+        "to split: normal equations, solve",
+    ),
+];
+
+/// Byte ranges of the inline `#[cfg(test)] mod … { … }` blocks of stripped code.
+fn test_modules(code: &str) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let mut i = 0;
+    while let Some(k) = code[i..].find("#[cfg(test)]") {
+        let p = i + k;
+        i = p + "#[cfg(test)]".len();
+        let rest = code[i..].trim_start();
+        let rest = rest.strip_prefix("pub ").unwrap_or(rest).trim_start();
+        let Some(rest) = rest.strip_prefix("mod ") else {
+            continue;
+        };
+        let (_, after) = ident_at(rest, 0);
+        if !rest[after..].trim_start().starts_with('{') {
+            continue; // `mod tests;` in another file
+        }
+        let open = i + (code[i..].len() - rest.len()) + after + rest[after..].find('{').unwrap();
+        let close = matching_brace(code, open);
+        out.push((p, close));
+        i = close;
+    }
+    out
+}
+
+/// Position of the `}` matching the `{` at byte `open` (end of the text if unbalanced).
+fn matching_brace(code: &str, open: usize) -> usize {
+    let mut depth = 0usize;
+    for (j, c) in code[open..].char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' => {
+                depth -= 1;
+                if depth == 0 {
+                    return open + j;
+                }
+            }
+            _ => {}
+        }
+    }
+    code.len()
+}
+
+/// Functions with a body outside test modules: `(name, first line, number of lines)`.
+fn functions(code: &str, tests: &[(usize, usize)]) -> Vec<(String, usize, usize)> {
+    let line_of = |pos: usize| code[..pos].matches('\n').count() + 1;
+    let bytes = code.as_bytes();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while let Some(k) = code[i..].find("fn ") {
+        let p = i + k;
+        i = p + 3;
+        if p > 0 && is_ident(bytes[p - 1] as char) {
+            continue;
+        }
+        if tests.iter().any(|&(a, b)| a <= p && p <= b) {
+            continue;
+        }
+        let (name, after) = ident_at(code, i);
+        if name.is_empty() {
+            continue; // `fn(u32) -> bool`, a pointer type
+        }
+        // The body: the first `{` outside parentheses and brackets; a `;` first means none.
+        let mut depth = 0i32;
+        let mut body = None;
+        for (j, c) in code[after..].char_indices() {
+            match c {
+                '(' | '[' => depth += 1,
+                ')' | ']' => depth -= 1,
+                ';' if depth <= 0 => break,
+                '{' if depth <= 0 => {
+                    body = Some(after + j);
+                    break;
+                }
+                _ => {}
+            }
+        }
+        let Some(open) = body else {
+            continue;
+        };
+        let close = matching_brace(code, open);
+        let first = line_of(p);
+        out.push((name.to_string(), first, line_of(close) - first + 1));
+    }
+    out
+}
+
+/// Size violations of one file (`rel`: path from the workspace root) before the allow-list:
+/// `(function name or "", message)`.
+fn size_findings(rel: &str, src: &str) -> Vec<(String, String)> {
+    let code = strip(src);
+    let tests = test_modules(&code);
+    let test_lines: usize = tests
+        .iter()
+        .map(|&(a, b)| code[a..=b.min(code.len() - 1)].matches('\n').count() + 1)
+        .sum();
+    let lines = src.lines().count().saturating_sub(test_lines);
+    let mut out = Vec::new();
+    if lines > MAX_FILE_LINES {
+        out.push((
+            String::new(),
+            format!("{rel}: {lines} lines outside tests (at most {MAX_FILE_LINES})"),
+        ));
+    }
+    for (name, line, n) in functions(&code, &tests) {
+        if n > MAX_FN_LINES {
+            out.push((
+                name.clone(),
+                format!("{rel}:{line}: fn `{name}` has {n} lines (at most {MAX_FN_LINES})"),
+            ));
+        }
+    }
+    out
+}
+
+/// Whether a finding `(fn name or "" for the file)` in `rel` is on the allow-list; marks the
+/// entry used.
+fn size_allowed(rel: &str, name: &str, used: &mut [bool]) -> bool {
+    for (k, &(path, func, _)) in SIZE_ALLOWED.iter().enumerate() {
+        let whole = func.is_empty();
+        if rel.starts_with(path) && (whole || (func == name && !name.is_empty())) {
+            used[k] = true;
+            return true;
+        }
+    }
+    false
+}
+
+fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+#[test]
+fn no_file_over_900_lines_and_no_function_over_150_lines() {
+    let root = workspace_root();
+    let mut files = Vec::new();
+    for krate in ["ricci", "ricci-render", "ricci-cli"] {
+        rust_files(&root.join("crates").join(krate).join("src"), &mut files);
+    }
+    assert!(files.len() > 40, "found only {} source files", files.len());
+    let mut used = vec![false; SIZE_ALLOWED.len()];
+    let mut violations = Vec::new();
+    let mut allowed = 0;
+    for path in &files {
+        let rel = path
+            .strip_prefix(&root)
+            .unwrap()
+            .to_string_lossy()
+            .replace('\\', "/");
+        let src = std::fs::read_to_string(path).unwrap();
+        for (name, msg) in size_findings(&rel, &src) {
+            if size_allowed(&rel, &name, &mut used) {
+                allowed += 1;
+            } else {
+                violations.push(msg);
+            }
+        }
+    }
+    eprintln!("{allowed} size finding(s) on the allow-list");
+    for (k, &(path, func, _)) in SIZE_ALLOWED.iter().enumerate() {
+        if !used[k] {
+            eprintln!("allow-list entry no longer needed: {path} {func}");
+        }
+    }
+    assert!(
+        violations.is_empty(),
+        "{} file(s)/function(s) too long (split them along their jobs, docs/DESIGN.md §2):\n{}",
+        violations.len(),
+        violations.join("\n")
+    );
+}
+
+#[test]
+fn the_size_check_counts_functions_and_files_without_tests() {
+    let mut src = String::from("//! fn in a comment { {\nfn short() -> u32 {\n    1\n}\n");
+    src += "trait T {\n    fn declared(&self) -> [u8; 2];\n}\n";
+    src += "pub fn long(x: &[f64; 3], f: fn(u32) -> bool) -> Vec<u32> {\n";
+    for _ in 0..150 {
+        src += "    let s = \"}\";\n";
+    }
+    src += "    vec![]\n}\n";
+    src += "#[cfg(test)]\nmod tests {\n    fn also_long() {\n";
+    src += &"        let _ = 1;\n".repeat(2000);
+    src += "    }\n}\n";
+    let code = strip(&src);
+    let tests = test_modules(&code);
+    assert_eq!(tests.len(), 1);
+    let fns = functions(&code, &tests);
+    let names: Vec<(&str, usize, usize)> =
+        fns.iter().map(|(n, a, b)| (n.as_str(), *a, *b)).collect();
+    assert_eq!(names, vec![("short", 2, 3), ("long", 8, 153)]);
+    let found = size_findings("x.rs", &src);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(
+        found[0].1.starts_with("x.rs:8: fn `long` has 153 lines"),
+        "{found:?}"
+    );
+    // The test module's 2000 lines do not count; 900 lines of code do.
+    let big = "fn f() {}\n".repeat(MAX_FILE_LINES + 1);
+    assert_eq!(size_findings("big.rs", &big).len(), 1);
+    assert!(size_findings("big.rs", &(big.clone() + &src)).len() == 2);
+    let mut used = vec![false; SIZE_ALLOWED.len()];
+    assert!(size_allowed("crates/ricci/src/cut/mod.rs", "", &mut used));
+    assert!(size_allowed(
+        "crates/ricci/src/spline/fit.rs",
+        "fair",
+        &mut used
+    ));
+    assert!(!size_allowed(
+        "crates/ricci/src/spline/fit.rs",
+        "",
+        &mut used
+    ));
+    assert!(!size_allowed(
+        "crates/ricci/src/spline/fit.rs",
+        "other",
+        &mut used
+    ));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Citations of `docs/`
+
+/// The `docs/…` paths cited in a text: a `docs/` not preceded by a path or identifier
+/// character, up to the first character that cannot be part of a path; a trailing `.` or `,`
+/// (end of a sentence) is dropped.
+fn cited_docs(text: &str) -> Vec<(usize, String)> {
+    let mut out = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let mut i = 0;
+        while let Some(k) = line[i..].find("docs/") {
+            let p = i + k;
+            i = p + "docs/".len();
+            let prev = line[..p].chars().next_back();
+            if prev.is_some_and(|c| is_ident(c) || c == '/' || c == '.' || c == '-') {
+                continue;
+            }
+            let len = line[p..]
+                .find(|c: char| !(is_ident(c) || matches!(c, '/' | '.' | '-')))
+                .unwrap_or(line.len() - p);
+            let path = line[p..p + len].trim_end_matches(['.', ',']);
+            if path.len() > "docs/".len() {
+                out.push((n + 1, path.to_string()));
+            }
+        }
+    }
+    out
+}
+
+fn all_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        let name = p.file_name().unwrap_or_default().to_string_lossy();
+        if name.starts_with('.') && name != ".ci" || name == "target" {
+            continue;
+        }
+        if p.is_dir() {
+            all_files(&p, out);
+        } else if p
+            .extension()
+            .is_some_and(|e| ["rs", "py", "toml", "md"].contains(&e.to_str().unwrap_or("")))
+            || p.parent()
+                .and_then(Path::file_name)
+                .is_some_and(|n| n == ".ci")
+        {
+            out.push(p);
+        }
+    }
+}
+
+#[test]
+fn every_docs_path_cited_in_the_code_exists() {
+    let root = workspace_root();
+    let mut files = Vec::new();
+    all_files(&root.join("crates"), &mut files);
+    all_files(&root.join(".ci"), &mut files);
+    let mut cited = 0;
+    let mut missing = Vec::new();
+    for path in &files {
+        let Ok(text) = std::fs::read_to_string(path) else {
+            continue;
+        };
+        for (line, doc) in cited_docs(&text) {
+            cited += 1;
+            if !root.join(&doc).exists() {
+                let rel = path.strip_prefix(&root).unwrap_or(path);
+                missing.push(format!(
+                    "{}:{line}: cites {doc}, which is not there",
+                    rel.display()
+                ));
+            }
+        }
+    }
+    assert!(
+        cited > 0,
+        "no docs/ citation found under {}",
+        root.display()
+    );
+    assert!(
+        missing.is_empty(),
+        "{} citation(s) of missing docs:\n{}",
+        missing.len(),
+        missing.join("\n")
+    );
+}
+
+#[test]
+fn the_citation_check_reads_paths_and_leaves_other_words() {
+    let d = concat!("do", "cs/");
+    let text = format!(
+        "//! see {d}DESIGN.md §3, and ({d}notes/wave2-arch.md).\n// not a citation: mydocs/x.md, ../{d}y\nlet s = \"{d}a-b_c.md,\";\n"
+    );
+    let got: Vec<(usize, String)> = cited_docs(&text);
+    let want = [
+        (1, format!("{d}DESIGN.md")),
+        (1, format!("{d}notes/wave2-arch.md")),
+        (3, format!("{d}a-b_c.md")),
+    ];
+    assert_eq!(got, want.to_vec());
 }

@@ -768,3 +768,28 @@ fn knot_quality_is_translation_invariant() {
     let clouds: Vec<&[Point]> = moved.chunks(4).collect();
     ricci::spline::dms::TriangleBasis::new(3, [clouds[0], clouds[1], clouds[2]]).unwrap();
 }
+
+/// The control net of a degree-`n` B-patch: `3n(n+1)/2` edges (n² sub-triangles of the net,
+/// `n(n+1)/2` pointing up, each side shared or on the boundary: `(3n² + 3n)/2`), each joining
+/// two multi-indices that differ by moving one unit between two coordinates, none twice.
+#[test]
+fn control_net_edges_join_neighbouring_multi_indices() {
+    use ricci::spline::dms::{control_net_edges, multi_indices};
+    for n in 1..=6 {
+        let betas = multi_indices(n);
+        let edges = control_net_edges(n);
+        assert_eq!(edges.len(), 3 * n * (n + 1) / 2, "degree {n}");
+        let mut seen = std::collections::HashSet::new();
+        for &(k, j) in &edges {
+            let (a, b) = (betas[k], betas[j]);
+            let diff: Vec<i64> = (0..3).map(|i| a[i] as i64 - b[i] as i64).collect();
+            let mut sorted = diff.clone();
+            sorted.sort();
+            assert_eq!(sorted, vec![-1, 0, 1], "degree {n}: {a:?} – {b:?}");
+            assert!(
+                seen.insert((k.min(j), k.max(j))),
+                "degree {n}: edge {k}–{j} twice"
+            );
+        }
+    }
+}

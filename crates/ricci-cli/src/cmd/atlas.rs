@@ -14,7 +14,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use ricci::atlas::{svg, AffineAtlas, AtlasOptions, FlatCharts, Singularity};
 use ricci::flow::TargetSpec;
 use serde_json::{json, Value};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 #[derive(clap::Args)]
@@ -45,47 +45,9 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
-    let singularity = match a.singularity.trim() {
-        "auto" => Singularity::Auto,
-        v => Singularity::Vertex(v.parse::<u32>().map_err(|_| {
-            UsageError(format!("--singularity '{v}': expected auto or a vertex id"))
-        })?),
-    };
-    let cones = match &a.cones {
-        None => None,
-        Some(list) => match format!("cone:{list}").parse::<TargetSpec>() {
-            Ok(TargetSpec::Cones(c)) => Some(c),
-            Ok(_) => None,
-            Err(e) => return Err(UsageError(format!("--cones: {e}")).into()),
-        },
-    };
-    let scheme = a
-        .scheme
-        .parse()
-        .map_err(|e: String| UsageError(format!("--scheme: {e}")))?;
-    if !(a.tolerance > 0.0 && a.tolerance.is_finite()) {
-        return Err(UsageError(format!("--tolerance {} must be positive", a.tolerance)).into());
-    }
+    let options = parse_options(&a)?;
     let (s, _) = read_surface(&a.mesh)?;
-    let nv = s.mesh.n_vertices() as u32;
-    if let Singularity::Vertex(v) = singularity {
-        crate::util::check_vertex("--singularity", v, nv as usize)?;
-    }
-    if let Some(c) = &cones {
-        if let Some(&(v, _)) = c.iter().find(|c| c.0 >= nv) {
-            return Err(UsageError(format!(
-                "--cones: vertex {v}: the mesh has only {nv} vertices"
-            ))
-            .into());
-        }
-    }
-    let options = AtlasOptions {
-        singularity,
-        cones,
-        scheme,
-        tolerance: a.tolerance,
-        ..AtlasOptions::default()
-    };
+    check_vertices(&options, s.mesh.n_vertices() as u32)?;
     let bar = ProgressBar::new(100);
     bar.set_style(
         ProgressStyle::with_template("{spinner} atlas {prefix:>9} [{bar:30}] {msg}")
@@ -148,6 +110,74 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "out": a.out.display().to_string(),
         "seconds": 0.0,
     });
+    write_files(&a.out, &atlas, &v)?;
+    if !r.flow_converged {
+        eprintln!(
+            "warning: the Ricci flow did not converge (max |K − K̄| = {:.3e})",
+            r.max_curvature_error
+        );
+    }
+    v["seconds"] = json!(t0.elapsed().as_secs_f64());
+    if a.json {
+        print_json(&v);
+    } else {
+        print_summary(&a, &atlas);
+    }
+    Ok(())
+}
+
+/// The atlas options from the arguments (usage errors before the mesh is read).
+fn parse_options(a: &Args) -> anyhow::Result<AtlasOptions> {
+    let singularity = match a.singularity.trim() {
+        "auto" => Singularity::Auto,
+        v => Singularity::Vertex(v.parse::<u32>().map_err(|_| {
+            UsageError(format!("--singularity '{v}': expected auto or a vertex id"))
+        })?),
+    };
+    let cones = match &a.cones {
+        None => None,
+        Some(list) => match format!("cone:{list}").parse::<TargetSpec>() {
+            Ok(TargetSpec::Cones(c)) => Some(c),
+            Ok(_) => None,
+            Err(e) => return Err(UsageError(format!("--cones: {e}")).into()),
+        },
+    };
+    let scheme = a
+        .scheme
+        .parse()
+        .map_err(|e: String| UsageError(format!("--scheme: {e}")))?;
+    if !(a.tolerance > 0.0 && a.tolerance.is_finite()) {
+        return Err(UsageError(format!("--tolerance {} must be positive", a.tolerance)).into());
+    }
+    let options = AtlasOptions {
+        singularity,
+        cones,
+        scheme,
+        tolerance: a.tolerance,
+        ..AtlasOptions::default()
+    };
+    Ok(options)
+}
+
+/// The vertices named by `--singularity` and `--cones` exist (`nv` vertices).
+fn check_vertices(options: &AtlasOptions, nv: u32) -> anyhow::Result<()> {
+    if let Singularity::Vertex(v) = options.singularity {
+        crate::util::check_vertex("--singularity", v, nv as usize)?;
+    }
+    if let Some(c) = &options.cones {
+        if let Some(&(v, _)) = c.iter().find(|c| c.0 >= nv) {
+            return Err(UsageError(format!(
+                "--cones: vertex {v}: the mesh has only {nv} vertices"
+            ))
+            .into());
+        }
+    }
+    Ok(())
+}
+
+/// `atlas.json` (the report `v` with every chart's faces and corner coordinates, the home
+/// charts, positions and triangles), `overview.svg` and `chart-K.svg` in `out`.
+fn write_files(out: &Path, atlas: &AffineAtlas, v: &Value) -> anyhow::Result<()> {
     // Files: the report with the charts, and the pictures.
     let charts: Vec<Value> = (0..atlas.n_charts() as u32)
         .map(|c| {
@@ -163,52 +193,46 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     file["positions"] = json!(atlas.positions());
     file["triangles"] = json!(atlas.mesh().faces());
     write_atomic(
-        &a.out.join("atlas.json"),
+        &out.join("atlas.json"),
         serde_json::to_string(&file)?.as_bytes(),
     )?;
     write_atomic(
-        &a.out.join("overview.svg"),
-        svg::overview_svg(&atlas, 900.0).as_bytes(),
+        &out.join("overview.svg"),
+        svg::overview_svg(atlas, 900.0).as_bytes(),
     )?;
     for c in 0..atlas.n_charts() as u32 {
-        if let Some(pic) = svg::chart_svg(&atlas, c, 700.0) {
-            write_atomic(&a.out.join(format!("chart-{c}.svg")), pic.as_bytes())?;
+        if let Some(pic) = svg::chart_svg(atlas, c, 700.0) {
+            write_atomic(&out.join(format!("chart-{c}.svg")), pic.as_bytes())?;
         }
     }
-    if !r.flow_converged {
-        eprintln!(
-            "warning: the Ricci flow did not converge (max |K − K̄| = {:.3e})",
-            r.max_curvature_error
-        );
-    }
-    v["seconds"] = json!(t0.elapsed().as_secs_f64());
-    if a.json {
-        print_json(&v);
-    } else {
-        let sing = if r.singular_vertices.is_empty() {
-            "no singular vertex".to_string()
-        } else {
-            format!("singular vertices {:?}", r.singular_vertices)
-        };
-        println!(
-            "{}: genus {}, {} boundary loops, {sing} ({})",
-            a.mesh.display(),
-            r.genus,
-            r.boundary_loops,
-            r.target
-        );
-        println!(
-            "  flow ({}): converged {}, max |K − K̄| = {:.2e}; area distortion {:.4}",
-            r.scheme, r.flow_converged, r.max_curvature_error, r.area_distortion
-        );
-        println!(
-            "  {} charts, {} flipped faces, max transition error {:.2e}, {} faces without home chart",
-            atlas.n_charts(),
-            r.flipped_faces,
-            r.max_transition_error,
-            r.faces_without_home
-        );
-        println!("  wrote {}", a.out.display());
-    }
     Ok(())
+}
+
+/// The human-readable summary on stdout.
+fn print_summary(a: &Args, atlas: &AffineAtlas) {
+    let r = &atlas.report;
+    let sing = if r.singular_vertices.is_empty() {
+        "no singular vertex".to_string()
+    } else {
+        format!("singular vertices {:?}", r.singular_vertices)
+    };
+    println!(
+        "{}: genus {}, {} boundary loops, {sing} ({})",
+        a.mesh.display(),
+        r.genus,
+        r.boundary_loops,
+        r.target
+    );
+    println!(
+        "  flow ({}): converged {}, max |K − K̄| = {:.2e}; area distortion {:.4}",
+        r.scheme, r.flow_converged, r.max_curvature_error, r.area_distortion
+    );
+    println!(
+        "  {} charts, {} flipped faces, max transition error {:.2e}, {} faces without home chart",
+        atlas.n_charts(),
+        r.flipped_faces,
+        r.max_transition_error,
+        r.faces_without_home
+    );
+    println!("  wrote {}", a.out.display());
 }

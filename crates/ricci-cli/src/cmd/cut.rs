@@ -18,6 +18,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use ricci::cut::{canonical_cut, CanonicalCut, CutOptions};
 use ricci::mesh::Surface;
 use ricci::metric::Geometry;
+use ricci_render::loops::{loops_svg, SurfaceLoop};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -85,95 +86,24 @@ pub fn cut_obj(c: &CanonicalCut) -> String {
     t
 }
 
-/// Orthographic picture along the shortest bounding-box axis: front faces shaded, loops on top.
-fn svg(c: &CanonicalCut) -> String {
-    let m = &c.refined.mesh;
-    let p = c.refined.positions.clone().unwrap_or_default();
-    let mut t = String::new();
-    if p.is_empty() {
-        return "<svg xmlns=\"http://www.w3.org/2000/svg\"/>\n".into();
-    }
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for q in &p {
-        for k in 0..3 {
-            lo[k] = lo[k].min(q[k]);
-            hi[k] = hi[k].max(q[k]);
-        }
-    }
-    let ext = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
-    let z = (0..3)
-        .min_by(|&a, &b| ext[a].total_cmp(&ext[b]))
-        .unwrap_or(2);
-    let (x, y) = ((z + 1) % 3, (z + 2) % 3);
-    let size = 900.0;
-    let s = size / ext[x].max(ext[y]).max(1e-300);
-    let (w, h) = (ext[x] * s + 20.0, ext[y] * s + 20.0);
-    let proj = |q: [f64; 3]| ((q[x] - lo[x]) * s + 10.0, (hi[y] - q[y]) * s + 10.0);
-    let _ = writeln!(
-        t,
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w:.0}\" height=\"{h:.0}\" viewBox=\"0 0 {w:.0} {h:.0}\">"
-    );
-    let _ = writeln!(t, "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>");
-    let mut faces: Vec<(f64, u32, f64)> = Vec::new();
-    for f in 0..m.n_faces() as u32 {
-        let [a, b, cc] = m.face(f).map(|v| p[v as usize]);
-        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let v = [cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]];
-        let n = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-300);
-        if n[z] <= 0.0 {
-            continue;
-        }
-        faces.push(((a[z] + b[z] + cc[z]) / 3.0, f, n[z] / len));
-    }
-    faces.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for (_, f, shade) in faces {
-        let g = (150.0 + 100.0 * shade) as u8;
-        let pts: Vec<String> = m
-            .face(f)
-            .iter()
-            .map(|&v| {
-                let (px, py) = proj(p[v as usize]);
-                format!("{px:.1},{py:.1}")
-            })
-            .collect();
-        let _ = writeln!(
-            t,
-            "<polygon points=\"{}\" fill=\"rgb({g},{g},{g})\"/>",
-            pts.join(" ")
-        );
-    }
-    let colours = [
-        "#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf",
-    ];
-    for (i, l) in c.loops.iter().enumerate() {
-        let pts: Vec<String> = l
-            .vertices
-            .iter()
-            .map(|&v| {
-                let (px, py) = proj(p[v as usize]);
-                format!("{px:.1},{py:.1}")
-            })
-            .collect();
-        let _ = writeln!(
-            t,
-            "<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"2.5\"><title>{}</title></polyline>",
-            pts.join(" "),
-            colours[(i / 2) % colours.len()],
-            l.label
-        );
-    }
-    let (bx, by) = proj(p[c.base as usize]);
-    let _ = writeln!(
-        t,
-        "<circle cx=\"{bx:.1}\" cy=\"{by:.1}\" r=\"5\" fill=\"black\"/>"
-    );
-    t.push_str("</svg>\n");
-    t
+/// Orthographic picture along the shortest bounding-box axis: front faces shaded, loops on top
+/// ([`ricci_render::loops::loops_svg`]).
+fn svg(c: &CanonicalCut) -> anyhow::Result<String> {
+    let positions = c.refined.positions.clone().unwrap_or_default();
+    let loops: Vec<SurfaceLoop<'_>> = c
+        .loops
+        .iter()
+        .map(|l| SurfaceLoop {
+            label: &l.label,
+            vertices: &l.vertices,
+        })
+        .collect();
+    Ok(loops_svg(
+        &positions,
+        c.refined.mesh.faces(),
+        &loops,
+        Some(c.base),
+    )?)
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -232,7 +162,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let c = c?;
     let obj = cut_obj(&c);
-    let pic = a.svg.as_ref().map(|_| svg(&c));
+    let pic = a.svg.as_ref().map(|_| svg(&c)).transpose()?;
     write_atomic(&a.out, obj.as_bytes())?;
     if let (Some(path), Some(pic)) = (&a.svg, pic) {
         write_atomic(path, pic.as_bytes())?;

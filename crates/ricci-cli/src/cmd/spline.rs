@@ -20,9 +20,10 @@
 use crate::util::read_surface;
 use crate::util::{check_vertex, print_json, write_atomic, Reporter, UsageError};
 use ricci::atlas::{AffineAtlas, AtlasOptions, FlatCharts, Singularity as AtlasSingularity};
-use ricci::spline::dms::multi_indices;
+use ricci::spline::dms::control_net_edges;
 use ricci::spline::surface::{
-    flat_domain, run as run_spline, MeshDistance, Singularity, SplineOptions,
+    flat_domain, run as run_spline, MeshDistance, Singularity, SplineOptions, SplineReport,
+    Tessellation,
 };
 use serde_json::json;
 use std::fmt::Write as _;
@@ -67,37 +68,7 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
-    if !(2..=5).contains(&a.degree) {
-        return Err(UsageError(format!("--degree {} is not in 2..=5", a.degree)).into());
-    }
-    if a.fairness >= a.degree {
-        return Err(UsageError(format!(
-            "--fairness {} must be between 0 and n − 1 = {}",
-            a.fairness,
-            a.degree - 1
-        ))
-        .into());
-    }
-    if !(1..=64).contains(&a.tessellation) {
-        return Err(UsageError(format!(
-            "--tessellation {} is not in 1..=64",
-            a.tessellation
-        ))
-        .into());
-    }
-    if let Some(l) = a.fit {
-        if !(l >= 0.0 && l.is_finite()) {
-            return Err(UsageError(format!("--fit {l} must be a finite weight ≥ 0")).into());
-        }
-    }
-    let singularity = match a.singularity.as_str() {
-        "auto" => Singularity::Auto,
-        v => Singularity::Vertex(v.parse().map_err(|_| {
-            UsageError(format!(
-                "--singularity must be auto or a vertex id, not '{v}'"
-            ))
-        })?),
-    };
+    let singularity = check_args(&a)?;
     let use_atlas = match a.charts.as_str() {
         "atlas" => true,
         "local" => false,
@@ -193,95 +164,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "tessellation": {"vertices": tess.positions.len(), "triangles": tess.triangles.len(), "spline_triangles": tess.spline_triangles},
     });
     if let Some(dir) = &a.out {
-        // surface.obj
-        let mut s = String::new();
-        let _ = writeln!(
-            s,
-            "# ricci spline: degree {} fairness {} ({} spline + {} fill triangles)",
-            rep.degree,
-            rep.fairness,
-            tess.spline_triangles,
-            tess.triangles.len() - tess.spline_triangles
-        );
-        for p in &tess.positions {
-            let _ = writeln!(s, "v {} {} {}", p[0], p[1], p[2]);
-        }
-        let _ = writeln!(s, "g spline");
-        for (k, t) in tess.triangles.iter().enumerate() {
-            if k == tess.spline_triangles {
-                let _ = writeln!(s, "g fill");
-            }
-            let _ = writeln!(s, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
-        }
+        let surface_obj = surface_obj(&rep, &tess);
         let side = json!({"face": tess.vertex_face, "chart": tess.vertex_chart});
-        // control_net.obj: control points of the active triangles and their nets.
-        let mesh = charts.mesh();
-        let n = rep.degree;
-        let nb = (n + 1) * (n + 2) / 2;
-        let betas = multi_indices(n);
-        let pos = |b: [usize; 3]| betas.iter().position(|x| *x == b);
-        let mut c = String::new();
-        let _ = writeln!(
-            c,
-            "# ricci spline control net: {} control points",
-            rep.control_points
-        );
-        let mut index = vec![0usize; mesh.n_faces()];
-        let mut next = 1;
-        for f in 0..mesh.n_faces() {
-            let active = mesh
-                .face(f as u32)
-                .iter()
-                .all(|v| !charts.singular_vertices().contains(v));
-            if !active {
-                continue;
-            }
-            index[f] = next;
-            for k in 0..nb {
-                let p = &control[(f * nb + k) * 3..(f * nb + k) * 3 + 3];
-                let _ = writeln!(c, "v {} {} {}", p[0], p[1], p[2]);
-            }
-            next += nb;
-        }
-        for &first in &index {
-            if first == 0 {
-                continue;
-            }
-            for (k, b) in betas.iter().enumerate() {
-                // Net edges to β − e_0 + e_1 and β − e_0 + e_2 and β − e_1 + e_2.
-                for (from, to) in [(0, 1), (0, 2), (1, 2)] {
-                    if b[from] == 0 {
-                        continue;
-                    }
-                    let mut q = *b;
-                    q[from] -= 1;
-                    q[to] += 1;
-                    if let Some(j) = pos(q) {
-                        let _ = writeln!(c, "l {} {}", first + k, first + j);
-                    }
-                }
-            }
-        }
-        // boundaries.obj
-        let mut bo = String::new();
-        let _ = writeln!(
-            bo,
-            "# ricci spline patch boundaries: {} polylines",
-            tess.boundaries.len()
-        );
-        let mut vi = 1;
-        for line in &tess.boundaries {
-            for p in line {
-                let _ = writeln!(bo, "v {} {} {}", p[0], p[1], p[2]);
-            }
-            let ids: Vec<String> = (vi..vi + line.len()).map(|i| i.to_string()).collect();
-            let _ = writeln!(bo, "l {}", ids.join(" "));
-            vi += line.len();
-        }
+        let c = control_net_obj(charts, &control, rep.degree, rep.control_points);
+        let bo = boundaries_obj(&tess);
         out["out"] = json!(dir.display().to_string());
         out["seconds_total"] = json!(t0.elapsed().as_secs_f64());
         out["seconds"] = out["seconds_total"].clone();
-        write_atomic(&dir.join("surface.obj"), s.as_bytes())?;
+        write_atomic(&dir.join("surface.obj"), surface_obj.as_bytes())?;
         write_atomic(
             &dir.join("surface_vertices.json"),
             serde_json::to_string(&side)?.as_bytes(),
@@ -325,4 +215,129 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// The ranges of the numeric arguments, and the singular vertex.
+fn check_args(a: &Args) -> anyhow::Result<Singularity> {
+    if !(2..=5).contains(&a.degree) {
+        return Err(UsageError(format!("--degree {} is not in 2..=5", a.degree)).into());
+    }
+    if a.fairness >= a.degree {
+        return Err(UsageError(format!(
+            "--fairness {} must be between 0 and n − 1 = {}",
+            a.fairness,
+            a.degree - 1
+        ))
+        .into());
+    }
+    if !(1..=64).contains(&a.tessellation) {
+        return Err(UsageError(format!(
+            "--tessellation {} is not in 1..=64",
+            a.tessellation
+        ))
+        .into());
+    }
+    if let Some(l) = a.fit {
+        if !(l >= 0.0 && l.is_finite()) {
+            return Err(UsageError(format!("--fit {l} must be a finite weight ≥ 0")).into());
+        }
+    }
+    let singularity = match a.singularity.as_str() {
+        "auto" => Singularity::Auto,
+        v => Singularity::Vertex(v.parse().map_err(|_| {
+            UsageError(format!(
+                "--singularity must be auto or a vertex id, not '{v}'"
+            ))
+        })?),
+    };
+    Ok(singularity)
+}
+
+/// `surface.obj`: the tessellation, the fill patches as group `fill`.
+fn surface_obj(rep: &SplineReport, tess: &Tessellation) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# ricci spline: degree {} fairness {} ({} spline + {} fill triangles)",
+        rep.degree,
+        rep.fairness,
+        tess.spline_triangles,
+        tess.triangles.len() - tess.spline_triangles
+    );
+    for p in &tess.positions {
+        let _ = writeln!(s, "v {} {} {}", p[0], p[1], p[2]);
+    }
+    let _ = writeln!(s, "g spline");
+    for (k, t) in tess.triangles.iter().enumerate() {
+        if k == tess.spline_triangles {
+            let _ = writeln!(s, "g fill");
+        }
+        let _ = writeln!(s, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    s
+}
+
+/// `control_net.obj`: the control points of the active triangles (those not at a singular
+/// vertex) and their nets ([`control_net_edges`]).
+fn control_net_obj(
+    charts: &(dyn FlatCharts + Sync),
+    control: &[f64],
+    n: usize,
+    control_points: usize,
+) -> String {
+    let mesh = charts.mesh();
+    let nb = (n + 1) * (n + 2) / 2;
+    let mut c = String::new();
+    let _ = writeln!(
+        c,
+        "# ricci spline control net: {} control points",
+        control_points
+    );
+    let mut index = vec![0usize; mesh.n_faces()];
+    let mut next = 1;
+    for f in 0..mesh.n_faces() {
+        let active = mesh
+            .face(f as u32)
+            .iter()
+            .all(|v| !charts.singular_vertices().contains(v));
+        if !active {
+            continue;
+        }
+        index[f] = next;
+        for k in 0..nb {
+            let p = &control[(f * nb + k) * 3..(f * nb + k) * 3 + 3];
+            let _ = writeln!(c, "v {} {} {}", p[0], p[1], p[2]);
+        }
+        next += nb;
+    }
+    let net = control_net_edges(n);
+    for &first in &index {
+        if first == 0 {
+            continue;
+        }
+        for &(k, j) in &net {
+            let _ = writeln!(c, "l {} {}", first + k, first + j);
+        }
+    }
+    c
+}
+
+/// `boundaries.obj`: the images of the domain edges and the seams as polylines.
+fn boundaries_obj(tess: &Tessellation) -> String {
+    let mut bo = String::new();
+    let _ = writeln!(
+        bo,
+        "# ricci spline patch boundaries: {} polylines",
+        tess.boundaries.len()
+    );
+    let mut vi = 1;
+    for line in &tess.boundaries {
+        for p in line {
+            let _ = writeln!(bo, "v {} {} {}", p[0], p[1], p[2]);
+        }
+        let ids: Vec<String> = (vi..vi + line.len()).map(|i| i.to_string()).collect();
+        let _ = writeln!(bo, "l {}", ids.join(" "));
+        vi += line.len();
+    }
+    bo
 }

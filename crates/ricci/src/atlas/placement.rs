@@ -178,36 +178,14 @@ pub fn estimate(
         out
     };
     let _ = n;
-    // P: per face, ∂ log A_f / ∂u at its three corners.
-    let l = &ev.ws.lengths;
-    let dl = &ev.ws.dlengths;
-    let edges = &ev.data.edges;
-    let mut p = vec![[0.0f64; 3]; nf];
-    let mut d = vec![0.0; nf];
-    for f in 0..nf as u32 {
-        let fv = mesh.face(f);
-        let e = mesh.face_edges_opposite(f);
-        let s = e.map(|e| l[e as usize]);
-        let a0 = super::heron(s);
-        let a_in = super::heron(e.map(|e| lengths[e as usize]));
-        if !(a0 > 0.0 && a_in > 0.0) {
-            continue;
-        }
-        d[f as usize] = a0.ln() - a_in.ln();
-        for i in 0..3 {
-            let (a, b, c) = (s[i], s[(i + 1) % 3], s[(i + 2) % 3]);
-            let dlog = a * (b * b + c * c - a * a) / (8.0 * a0 * a0);
-            let ed = e[i] as usize;
-            let [x, y] = edges[ed];
-            for (j, &w) in fv.iter().enumerate() {
-                if w == x {
-                    p[f as usize][j] += dlog * dl[ed][0];
-                } else if w == y {
-                    p[f as usize][j] += dlog * dl[ed][1];
-                }
-            }
-        }
-    }
+    // P: per face, ∂ log A_f / ∂u at its three corners; d: log A_f − log A_f(input).
+    let (p, d) = log_area_derivatives(
+        mesh,
+        lengths,
+        &ev.ws.lengths,
+        &ev.ws.dlengths,
+        &ev.data.edges,
+    );
     let apply_p = |x: &[f64]| -> Vec<f64> {
         (0..nf)
             .map(|f| {
@@ -286,6 +264,47 @@ pub fn estimate(
         r = r.div_ceil(2);
     }
     Ok((out, "sampled"))
+}
+
+/// Per face `f`: `∂ log A_f / ∂u` at its three corners (`A_f` by Heron from the current
+/// lengths `l`, whose derivatives along the edge's two end variables are `dl`), and
+/// `log A_f − log A_f(input)`; faces of zero area get zeros.
+#[allow(clippy::type_complexity)]
+fn log_area_derivatives(
+    mesh: &Mesh,
+    lengths: &[f64],
+    l: &[f64],
+    dl: &[[f64; 2]],
+    edges: &[[u32; 2]],
+) -> (Vec<[f64; 3]>, Vec<f64>) {
+    let nf = mesh.n_faces();
+    let mut p = vec![[0.0f64; 3]; nf];
+    let mut d = vec![0.0; nf];
+    for f in 0..nf as u32 {
+        let fv = mesh.face(f);
+        let e = mesh.face_edges_opposite(f);
+        let s = e.map(|e| l[e as usize]);
+        let a0 = super::heron(s);
+        let a_in = super::heron(e.map(|e| lengths[e as usize]));
+        if !(a0 > 0.0 && a_in > 0.0) {
+            continue;
+        }
+        d[f as usize] = a0.ln() - a_in.ln();
+        for i in 0..3 {
+            let (a, b, c) = (s[i], s[(i + 1) % 3], s[(i + 2) % 3]);
+            let dlog = a * (b * b + c * c - a * a) / (8.0 * a0 * a0);
+            let ed = e[i] as usize;
+            let [x, y] = edges[ed];
+            for (j, &w) in fv.iter().enumerate() {
+                if w == x {
+                    p[f as usize][j] += dlog * dl[ed][0];
+                } else if w == y {
+                    p[f as usize][j] += dlog * dl[ed][1];
+                }
+            }
+        }
+    }
+    (p, d)
 }
 
 /// Farthest-point sample of `count` vertices among `candidates` by edge hops, and the
@@ -642,36 +661,13 @@ pub fn place(
         .min_by(|a, b| a.measured.total_cmp(&b.measured))
         .map(|c| c.vertex)
     else {
-        let best = rejected
-            .iter()
-            .filter_map(|r| r.best_error.map(|e| (e, r.vertex)))
-            .min_by(|a, b| a.0.total_cmp(&b.0));
-        let tried: Vec<String> = rejected.iter().map(|r| r.vertex.to_string()).collect();
-        return Err(Error::numerical(format!(
-            "no candidate cone vertex gave a converged flat metric: tried {} of the {} ranked \
-             vertices ({}) with the {} scheme, then inversive and tangential packing, on the mesh \
-             with the cone's valence raised{}, at most {} Newton iterations per scheme and {} in \
-             all{}; {:.1} s — choose the singular vertex (CLI: --singularity V) or the cones \
-             yourself",
-            rejected.len(),
+        return Err(no_candidate_error(
+            &rejected,
             order.len(),
-            tried.join(", "),
-            options.scheme.name(),
-            if po.grade {
-                " and then graded around it"
-            } else {
-                ""
-            },
-            po.candidate_iterations.max(1),
+            options,
             budget_iterations,
-            match best {
-                Some((e, v)) => {
-                    format!("; the best reached max |K − K̄| = {e:.3e} (vertex {v}, tolerance 1e-9)")
-                }
-                None => String::new(),
-            },
             t0.elapsed().as_secs_f64(),
-        )));
+        ));
     };
     Ok(Placement {
         chosen,
@@ -683,6 +679,48 @@ pub fn place(
         estimate_seconds,
         confirm_seconds: t1.elapsed().as_secs_f64(),
     })
+}
+
+/// The error when no candidate converged: the vertices tried, the budgets, the best residual
+/// reached and the time spent (`n_ranked` ranked vertices, `seconds`).
+fn no_candidate_error(
+    rejected: &[RejectedCandidate],
+    n_ranked: usize,
+    options: &AtlasOptions,
+    budget_iterations: usize,
+    seconds: f64,
+) -> Error {
+    let po = &options.placement;
+    let best = rejected
+        .iter()
+        .filter_map(|r| r.best_error.map(|e| (e, r.vertex)))
+        .min_by(|a, b| a.0.total_cmp(&b.0));
+    let tried: Vec<String> = rejected.iter().map(|r| r.vertex.to_string()).collect();
+    Error::numerical(format!(
+        "no candidate cone vertex gave a converged flat metric: tried {} of the {} ranked \
+         vertices ({}) with the {} scheme, then inversive and tangential packing, on the mesh \
+         with the cone's valence raised{}, at most {} Newton iterations per scheme and {} in \
+         all{}; {:.1} s — choose the singular vertex (CLI: --singularity V) or the cones \
+         yourself",
+        rejected.len(),
+        n_ranked,
+        tried.join(", "),
+        options.scheme.name(),
+        if po.grade {
+            " and then graded around it"
+        } else {
+            ""
+        },
+        po.candidate_iterations.max(1),
+        budget_iterations,
+        match best {
+            Some((e, v)) => {
+                format!("; the best reached max |K − K̄| = {e:.3e} (vertex {v}, tolerance 1e-9)")
+            }
+            None => String::new(),
+        },
+        seconds,
+    ))
 }
 
 /// The paper's brute force: [`measured_distortion`] of every vertex in `candidates`

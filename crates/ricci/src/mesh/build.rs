@@ -175,7 +175,6 @@ pub fn build_surface(soup: PolygonSoup) -> Result<(Surface, BuildReport)> {
     };
     let nv_in = soup.positions.len();
     let vline = |v: usize| at_line(&soup.vertex_lines, v);
-    let pline = |p: usize| at_line(&soup.polygon_lines, p);
     if soup.polygons.is_empty() {
         return Err(Error::invalid_mesh("the file contains no faces"));
     }
@@ -193,127 +192,12 @@ pub fn build_surface(soup: PolygonSoup) -> Result<(Surface, BuildReport)> {
             )));
         }
     }
-    // Triangulate, check indices and degenerate polygons.
-    let n_tris: usize = soup
-        .polygons
-        .iter()
-        .map(|p| p.len().saturating_sub(2))
-        .sum();
-    if 3 * n_tris >= (NONE as usize) / 2 {
-        return Err(Error::input("mesh too large for 32-bit indices"));
-    }
-    let mut tris: Vec<[u32; 3]> = Vec::with_capacity(n_tris);
-    let mut tri_src: Vec<u32> = Vec::with_capacity(n_tris);
-    for (pi, poly) in soup.polygons.iter().enumerate() {
-        if let Some(&v) = poly.iter().find(|&&v| v as usize >= nv_in) {
-            return Err(Error::invalid_mesh(format!(
-                "face {pi}{} refers to vertex {v}, but the file has only {nv_in} vertices",
-                pline(pi)
-            )));
-        }
-        if poly.len() < 3 {
-            return Err(Error::invalid_mesh(format!(
-                "face {pi}{} has only {} corners; a face needs at least three",
-                pline(pi),
-                poly.len()
-            )));
-        }
-        if let Some(v) = repeated_vertex(poly) {
-            let corners: Vec<String> = poly.iter().map(|v| v.to_string()).collect();
-            return Err(Error::invalid_mesh(format!(
-                "face {pi}{} uses vertex {v} more than once (corners {}); a face needs distinct vertices",
-                pline(pi),
-                corners.join(" ")
-            )));
-        }
-        if poly.len() > 3 {
-            report.triangulated_polygons += 1;
-        }
-        for k in 1..poly.len() - 1 {
-            tris.push([poly[0], poly[k], poly[k + 1]]);
-            tri_src.push(pi as u32);
-        }
-    }
-    if report.triangulated_polygons > 0 {
-        report.notes.push(format!(
-            "{} polygons with more than three corners were fan-triangulated",
-            report.triangulated_polygons
-        ));
-    }
-    let src = |f: u32| tri_src[f as usize] as usize;
+    let (mut tris, tri_src) = triangulate(&soup, &mut report)?;
     let groups = group_edges(nv_in, &tris);
-    if let Some((f, g)) = groups.duplicate {
-        let (a, b) = (src(f), src(g));
-        let mut k = tris[f as usize];
-        k.sort_unstable();
-        // Two faces with the same vertices meet on all three of their edges.
-        let more = match groups.n_duplicates / 3 {
-            0 | 1 => String::new(),
-            n => format!("; {n} pairs of duplicate faces in all"),
-        };
-        return Err(Error::invalid_mesh(format!(
-            "faces {a}{} and {b}{} are duplicates (both use vertices {}, {}, {}){more}",
-            pline(a),
-            pline(b),
-            k[0],
-            k[1],
-            k[2]
-        )));
-    }
-    if let Some((a, b, faces)) = &groups.non_manifold {
-        let list: Vec<String> = faces.iter().map(|&f| src(f).to_string()).collect();
-        let more = match groups.n_non_manifold {
-            1 => String::new(),
-            n => format!("; {n} non-manifold edges in all"),
-        };
-        return Err(Error::invalid_mesh(format!(
-            "non-manifold edge between vertices {a}{} and {b}{}: it is shared by {} faces ({}){more}",
-            vline(*a as usize),
-            vline(*b as usize),
-            faces.len(),
-            list.join(", ")
-        )));
-    }
+    check_edge_groups(&groups, &tris, &tri_src, &soup)?;
     // Orientation: propagate over faces through their edges, flipping where needed.
     let nf = tris.len();
-    let origin = |h: u32| tris[h as usize / 3][h as usize % 3];
-    let mut state = vec![0u8; nf]; // 0 unvisited, 1 keep, 2 flip
-    let mut stack = Vec::new();
-    // Nothing to do when no two neighbours disagree (the usual case).
-    let seeds = if groups.n_same_direction == 0 { 0 } else { nf };
-    for seed in 0..seeds {
-        if state[seed] != 0 {
-            continue;
-        }
-        state[seed] = 1;
-        stack.push(seed as u32);
-        while let Some(f) = stack.pop() {
-            let f_flipped = state[f as usize] == 2;
-            for h in 3 * f..3 * f + 3 {
-                let g = groups.partner[h as usize];
-                if g == NONE {
-                    continue;
-                }
-                // Consistent iff the two faces traverse the edge in opposite directions.
-                let same = origin(h) == origin(g);
-                let want = if same ^ f_flipped { 2 } else { 1 };
-                let gf = (g / 3) as usize;
-                if state[gf] == 0 {
-                    state[gf] = want;
-                    stack.push(gf as u32);
-                } else if state[gf] != want {
-                    let (a, b) = (origin(h), tris[h as usize / 3][(h as usize % 3 + 1) % 3]);
-                    return Err(Error::invalid_mesh(format!(
-                        "the surface is not orientable: going around it through faces {} and {} \
-                         (along the edge between vertices {a} and {b}) reverses the orientation",
-                        src(f),
-                        src(g / 3)
-                    )));
-                }
-            }
-        }
-    }
-    drop(stack);
+    let state = orientation(&tris, &groups, &tri_src)?;
     let flipped = |f: usize| state[f] == 2;
     report.reoriented_faces = state.iter().filter(|&&s| s == 2).count();
     let n_edges = groups.n_edges;
@@ -394,35 +278,7 @@ pub fn build_surface(soup: PolygonSoup) -> Result<(Surface, BuildReport)> {
             vline(orig)
         ))
     })?;
-    // Zero-area faces: area at most ZERO_AREA_RELATIVE × (bounding-box diagonal)², or
-    // collinear corners to rounding (cross product ≤ 1e-14 × longest side²).
-    let diag2 = {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for p in &positions {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
-        (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>()
-    };
-    for (f, t) in mesh.faces().iter().enumerate() {
-        let [a, b, c] = t.map(|v| positions[v as usize]);
-        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        let n = [
-            u[1] * w[2] - u[2] * w[1],
-            u[2] * w[0] - u[0] * w[2],
-            u[0] * w[1] - u[1] * w[0],
-        ];
-        let area2 = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        let scale =
-            (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).max(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-        if area2 <= 1e-14 * scale || 0.5 * area2 <= ZERO_AREA_RELATIVE * diag2 {
-            report.zero_area_faces.push(f as u32);
-        }
-    }
+    report.zero_area_faces = zero_area_faces(&mesh, &positions);
     if !report.zero_area_faces.is_empty() {
         let first: Vec<String> = report
             .zero_area_faces
@@ -446,6 +302,187 @@ pub fn build_surface(soup: PolygonSoup) -> Result<(Surface, BuildReport)> {
         },
         report,
     ))
+}
+
+/// Fan-triangulate the polygons, checking their indices (against the `positions`), their
+/// size and repeated corners; returns the triangles and the polygon of each.
+#[allow(clippy::type_complexity)]
+fn triangulate(soup: &PolygonSoup, report: &mut BuildReport) -> Result<(Vec<[u32; 3]>, Vec<u32>)> {
+    let nv_in = soup.positions.len();
+    let pline = |p: usize| at_line(&soup.polygon_lines, p);
+    let n_tris: usize = soup
+        .polygons
+        .iter()
+        .map(|p| p.len().saturating_sub(2))
+        .sum();
+    if 3 * n_tris >= (NONE as usize) / 2 {
+        return Err(Error::input("mesh too large for 32-bit indices"));
+    }
+    let mut tris: Vec<[u32; 3]> = Vec::with_capacity(n_tris);
+    let mut tri_src: Vec<u32> = Vec::with_capacity(n_tris);
+    for (pi, poly) in soup.polygons.iter().enumerate() {
+        if let Some(&v) = poly.iter().find(|&&v| v as usize >= nv_in) {
+            return Err(Error::invalid_mesh(format!(
+                "face {pi}{} refers to vertex {v}, but the file has only {nv_in} vertices",
+                pline(pi)
+            )));
+        }
+        if poly.len() < 3 {
+            return Err(Error::invalid_mesh(format!(
+                "face {pi}{} has only {} corners; a face needs at least three",
+                pline(pi),
+                poly.len()
+            )));
+        }
+        if let Some(v) = repeated_vertex(poly) {
+            let corners: Vec<String> = poly.iter().map(|v| v.to_string()).collect();
+            return Err(Error::invalid_mesh(format!(
+                "face {pi}{} uses vertex {v} more than once (corners {}); a face needs distinct vertices",
+                pline(pi),
+                corners.join(" ")
+            )));
+        }
+        if poly.len() > 3 {
+            report.triangulated_polygons += 1;
+        }
+        for k in 1..poly.len() - 1 {
+            tris.push([poly[0], poly[k], poly[k + 1]]);
+            tri_src.push(pi as u32);
+        }
+    }
+    if report.triangulated_polygons > 0 {
+        report.notes.push(format!(
+            "{} polygons with more than three corners were fan-triangulated",
+            report.triangulated_polygons
+        ));
+    }
+    Ok((tris, tri_src))
+}
+
+/// Duplicate faces and non-manifold edges found by [`group_edges`], as errors naming the
+/// input polygons and vertices with their lines.
+fn check_edge_groups(
+    groups: &EdgeGroups,
+    tris: &[[u32; 3]],
+    tri_src: &[u32],
+    soup: &PolygonSoup,
+) -> Result<()> {
+    let vline = |v: usize| at_line(&soup.vertex_lines, v);
+    let pline = |p: usize| at_line(&soup.polygon_lines, p);
+    let src = |f: u32| tri_src[f as usize] as usize;
+    if let Some((f, g)) = groups.duplicate {
+        let (a, b) = (src(f), src(g));
+        let mut k = tris[f as usize];
+        k.sort_unstable();
+        // Two faces with the same vertices meet on all three of their edges.
+        let more = match groups.n_duplicates / 3 {
+            0 | 1 => String::new(),
+            n => format!("; {n} pairs of duplicate faces in all"),
+        };
+        return Err(Error::invalid_mesh(format!(
+            "faces {a}{} and {b}{} are duplicates (both use vertices {}, {}, {}){more}",
+            pline(a),
+            pline(b),
+            k[0],
+            k[1],
+            k[2]
+        )));
+    }
+    if let Some((a, b, faces)) = &groups.non_manifold {
+        let list: Vec<String> = faces.iter().map(|&f| src(f).to_string()).collect();
+        let more = match groups.n_non_manifold {
+            1 => String::new(),
+            n => format!("; {n} non-manifold edges in all"),
+        };
+        return Err(Error::invalid_mesh(format!(
+            "non-manifold edge between vertices {a}{} and {b}{}: it is shared by {} faces ({}){more}",
+            vline(*a as usize),
+            vline(*b as usize),
+            faces.len(),
+            list.join(", ")
+        )));
+    }
+    Ok(())
+}
+
+/// Orientation: propagate over faces through their edges; per face 1 (keep) or 2 (flip), or
+/// all 0 when no two neighbours disagree. A surface that cannot be oriented is an error naming
+/// two input polygons and their edge.
+fn orientation(tris: &[[u32; 3]], groups: &EdgeGroups, tri_src: &[u32]) -> Result<Vec<u8>> {
+    let src = |f: u32| tri_src[f as usize] as usize;
+    let nf = tris.len();
+    let origin = |h: u32| tris[h as usize / 3][h as usize % 3];
+    let mut state = vec![0u8; nf]; // 0 unvisited, 1 keep, 2 flip
+    let mut stack = Vec::new();
+    // Nothing to do when no two neighbours disagree (the usual case).
+    let seeds = if groups.n_same_direction == 0 { 0 } else { nf };
+    for seed in 0..seeds {
+        if state[seed] != 0 {
+            continue;
+        }
+        state[seed] = 1;
+        stack.push(seed as u32);
+        while let Some(f) = stack.pop() {
+            let f_flipped = state[f as usize] == 2;
+            for h in 3 * f..3 * f + 3 {
+                let g = groups.partner[h as usize];
+                if g == NONE {
+                    continue;
+                }
+                // Consistent iff the two faces traverse the edge in opposite directions.
+                let same = origin(h) == origin(g);
+                let want = if same ^ f_flipped { 2 } else { 1 };
+                let gf = (g / 3) as usize;
+                if state[gf] == 0 {
+                    state[gf] = want;
+                    stack.push(gf as u32);
+                } else if state[gf] != want {
+                    let (a, b) = (origin(h), tris[h as usize / 3][(h as usize % 3 + 1) % 3]);
+                    return Err(Error::invalid_mesh(format!(
+                        "the surface is not orientable: going around it through faces {} and {} \
+                         (along the edge between vertices {a} and {b}) reverses the orientation",
+                        src(f),
+                        src(g / 3)
+                    )));
+                }
+            }
+        }
+    }
+    Ok(state)
+}
+
+/// Zero-area faces: area at most [`ZERO_AREA_RELATIVE`] × (bounding-box diagonal)², or
+/// collinear corners to rounding (cross product ≤ 1e-14 × longest side²).
+fn zero_area_faces(mesh: &Mesh, positions: &[[f64; 3]]) -> Vec<u32> {
+    let mut out = Vec::new();
+    let diag2 = {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in positions {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>()
+    };
+    for (f, t) in mesh.faces().iter().enumerate() {
+        let [a, b, c] = t.map(|v| positions[v as usize]);
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let n = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
+        let area2 = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        let scale =
+            (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).max(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+        if area2 <= 1e-14 * scale || 0.5 * area2 <= ZERO_AREA_RELATIVE * diag2 {
+            out.push(f as u32);
+        }
+    }
+    out
 }
 
 /// A vertex that occurs twice in the polygon, if any.

@@ -1,6 +1,6 @@
 //! Half-edge connectivity of an oriented 2-manifold triangle mesh, possibly with boundary.
 //!
-//! Flat index arrays, no positions (see DESIGN.md §2: connectivity, metric and embedding are
+//! Flat index arrays, no positions (see docs/DESIGN.md §2: connectivity, metric and embedding are
 //! kept apart). Conventions:
 //!
 //! * Face `f` has vertices `faces[f] = [v0, v1, v2]` in counter-clockwise order.

@@ -2,7 +2,7 @@
 //!
 //! A [`Surface`] is what a mesh file describes: [`Mesh`] connectivity plus vertex positions in
 //! R³. Algorithms that only need connectivity take a `&Mesh`; intrinsic algorithms (Ricci flow)
-//! take a `&Mesh` and edge lengths and never look at positions (DESIGN.md §2).
+//! take a `&Mesh` and edge lengths and never look at positions (docs/DESIGN.md §2).
 
 pub mod build;
 pub mod connectivity;

@@ -4,7 +4,7 @@
 //!   [`LowerCsc`]): AMD ordering and the symbolic Cholesky factorization are computed once
 //!   and reused for every numeric factorization (LLᵀ for positive definite matrices such as
 //!   the E² and H² Hessians of the flows, LDLᵀ for the indefinite S² Hessian).
-//!   Single-threaded factorization (DESIGN.md §2 measured no gain from two threads on this
+//!   Single-threaded factorization (docs/DESIGN.md §2 measured no gain from two threads on this
 //!   machine).
 //! * [`SparseLu`] — general square matrices assembled from triplets with the same pattern at
 //!   every call: the symbolic LU analysis is computed once.

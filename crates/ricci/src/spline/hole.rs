@@ -246,10 +246,27 @@ impl Hole {
             min_clearance: 0.0,
         };
         let _ = link_ids;
-        // Seam: Fourier smoothing of the link's radial function, shifted outwards.
+        let last_err = hole.fit_seam(d);
+        if hole.min_clearance <= 0.0 {
+            return Err(Error::numerical(format!(
+                "hole filling at singular vertex {s}: no smooth seam fits between its link and the two-ring ({last_err})"
+            )));
+        }
+        hole.fit_profile(space, control)?;
+        hole.center = hole.profile[0][0][0];
+        Ok(hole)
+    }
+
+    /// The seam: a Fourier smoothing of the link's radial function (at most 24 harmonics,
+    /// fewer if the seam leaves the two-ring), shifted outwards by the smallest margin that
+    /// keeps it outside the link and inside the active faces (`d` link vertices). Sets
+    /// `fourier`, `shift` and `min_clearance` (≤ 0 when no seam fits); returns why the last
+    /// attempt failed.
+    fn fit_seam(&mut self, d: usize) -> String {
+        let theta = self.cone_angle;
         const M: usize = 1024;
         let rl: Vec<f64> = (0..M)
-            .map(|j| hole.r_link(theta * j as f64 / M as f64))
+            .map(|j| self.r_link(theta * j as f64 / M as f64))
             .collect();
         let mut last_err = String::new();
         'outer: for harmonics in [d.min(24), d.min(12), d.min(6), 3] {
@@ -264,38 +281,43 @@ impl Hole {
                 let w = if h == 0 { 1.0 } else { 2.0 } / M as f64;
                 fourier.push((a * w, b * w));
             }
-            hole.fourier = fourier;
-            hole.shift = 0.0;
+            self.fourier = fourier;
+            self.shift = 0.0;
             let mut over = f64::NEG_INFINITY;
             for (j, r) in rl.iter().enumerate() {
-                over = over.max(r.ln() - hole.radius(2.0 * PI * j as f64 / M as f64).ln());
+                over = over.max(r.ln() - self.radius(2.0 * PI * j as f64 / M as f64).ln());
             }
             'margin: for margin in [0.06, 0.03, 0.015] {
-                hole.shift = over + margin;
+                self.shift = over + margin;
                 // Check: seam outside the link and inside active faces.
                 let mut clearance = f64::INFINITY;
                 for (j, r) in rl.iter().enumerate() {
                     let psi = 2.0 * PI * j as f64 / M as f64;
-                    let rr = hole.radius(psi);
+                    let rr = self.radius(psi);
                     clearance = clearance.min(rr / r - 1.0);
-                    if hole.locate(rr, theta * psi / (2.0 * PI)).is_none() {
+                    if self.locate(rr, theta * psi / (2.0 * PI)).is_none() {
                         last_err = format!(
-                            "the seam point at angle {:.3} rad (radius {rr:.3e}) leaves the two-ring",
-                            theta * psi / (2.0 * PI)
-                        );
+                        "the seam point at angle {:.3} rad (radius {rr:.3e}) leaves the two-ring",
+                        theta * psi / (2.0 * PI)
+                    );
                         continue 'margin;
                     }
                 }
-                hole.min_clearance = clearance;
+                self.min_clearance = clearance;
                 break 'outer;
             }
         }
-        if hole.min_clearance <= 0.0 {
-            return Err(Error::numerical(format!(
-                "hole filling at singular vertex {s}: no smooth seam fits between its link and the two-ring ({last_err})"
-            )));
-        }
-        // Fourier modes of the seam data (module docs, *Fill*).
+        last_err
+    }
+
+    /// The fill's profile from the Fourier modes of the seam data (module docs, *Fill*).
+    fn fit_profile<A: FlatCharts + Sync + ?Sized>(
+        &mut self,
+        space: &ManifoldSpace<'_, A>,
+        control: &[f64],
+    ) -> Result<()> {
+        let d = self.link.len();
+        const M: usize = 1024;
         let ns = 4 * M.min(64 * d).max(256) / 4;
         let modes = (ns / 8).min(FILL_MODES);
         let mut cm = vec![[[0.0; 3]; 2]; modes + 1];
@@ -303,7 +325,7 @@ impl Hole {
         let mut ws = Workspace::default();
         for j in 0..ns {
             let psi = 2.0 * PI * j as f64 / ns as f64;
-            let (c, dd, _) = hole.seam_data(space, control, psi, &mut ws)?;
+            let (c, dd, _) = self.seam_data(space, control, psi, &mut ws)?;
             for k in 0..=modes {
                 let w = if k == 0 { 1.0 } else { 2.0 } / ns as f64;
                 let (co, si) = ((k as f64 * psi).cos() * w, (k as f64 * psi).sin() * w);
@@ -316,7 +338,7 @@ impl Hole {
             }
         }
         // α_k + β_k = C_k and k α_k + (k + 2) β_k = D_k.
-        hole.profile = cm
+        self.profile = cm
             .iter()
             .zip(&dm)
             .enumerate()
@@ -328,8 +350,7 @@ impl Hole {
                 [alpha, beta]
             })
             .collect();
-        hole.center = hole.profile[0][0][0];
-        Ok(hole)
+        Ok(())
     }
 
     /// Radial distance from the cone to its link at unrolled angle `phi` (mod Θ).

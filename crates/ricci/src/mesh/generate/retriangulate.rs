@@ -1,5 +1,5 @@
 //! Re-triangulations of one surface, for checking that conformal invariants belong to the
-//! surface and not to its triangulation (DESIGN.md §5 "Re-triangulation"), and irregular
+//! surface and not to its triangulation (docs/DESIGN.md §5 "Re-triangulation"), and irregular
 //! meshes of a surface with a known conformal structure.
 //!
 //! * [`midpoint_subdivision`] — every face split 1 → 4 at its edge midpoints: the same

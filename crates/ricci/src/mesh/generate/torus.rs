@@ -4,7 +4,7 @@
 //! `ds² = λ² du² + r² dv²`, `λ = R + r cos v`. With `dw = r dv / λ` it becomes
 //! `ds² = λ² (du² + dw²)`: the coordinates `(u, w)` are conformal and fill the rectangle
 //! `[0, 2π) × [0, W)`, `W = 2π r / √(R² − r²)`. So the torus is conformal to a flat torus with
-//! side ratio `W / 2π = r / √(R² − r²)` (DESIGN.md §5), and an equilateral triangle grid in
+//! side ratio `W / 2π = r / √(R² − r²)` (docs/DESIGN.md §5), and an equilateral triangle grid in
 //! `(u, w)` maps to triangles that are close to equilateral in R³ (the conformal factor `λ`
 //! changes by a relative `|sin v|·Δw` across a row). Integrating,
 //! `w(v) = (2r/c) atan(k tan(v/2))`, `c = √(R² − r²)`, `k = √((R − r)/(R + r))`, with inverse
