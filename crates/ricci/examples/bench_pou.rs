@@ -62,9 +62,15 @@ fn main() {
     }
     let edges = take("--edges", &mut args).map_or(opts.continuity_edges, |e| e as usize);
     if args.is_empty() {
-        args = ["eight.off", "genus3.off", "3holes.off", "fertility.off", "botijo.off"]
-            .map(String::from)
-            .to_vec();
+        args = [
+            "eight.off",
+            "genus3.off",
+            "3holes.off",
+            "fertility.off",
+            "botijo.off",
+        ]
+        .map(String::from)
+        .to_vec();
     }
     println!(
         "| mesh | faces | local degree | atlas | charts | fit | tessellation | error | checks | total (wall / CPU s) | rms / max % | controls per chart | chart independence 0/1/2 | jumps 0/1/2/3 (samples) |"

@@ -522,12 +522,6 @@ impl HyperbolicAtlas {
                 // of u in the chart is a function of the two maps.
                 let mut done: std::collections::HashSet<(u32, u32, u32), FastHash> =
                     Default::default();
-                // The lift of u in the fundamental domain's coordinate, per map.
-                let pu: Vec<Cdd> = d
-                    .maps
-                    .iter()
-                    .map(|m| m.inverse().apply(Cdd::ZERO))
-                    .collect();
                 for &(f, mi, _) in &d.lifts {
                     let map = &d.maps[mi as usize];
                     for &v in self.mesh.face(f).iter() {
@@ -537,8 +531,10 @@ impl HyperbolicAtlas {
                         if !done.insert((v, mi, sv.map_id)) {
                             continue;
                         }
-                        let c = sv.map.apply(pu[mi as usize]);
-                        let c = c.hi() + c.lo();
+                        // T = M ∘ M_v(f)⁻¹ (chart v → this lift's chart of u); the lift sits
+                        // at T⁻¹(0) = −b/a.
+                        let tm = map.compose(&sv.map.inverse()).normalized().round();
+                        let c = -tm.b / tm.a;
                         let t = (0.5 * (rho[v as usize] + ru)).tanh();
                         if c.norm_sqr() >= t * t {
                             continue;
@@ -548,13 +544,12 @@ impl HyperbolicAtlas {
                             continue;
                         }
                         seen.push(c);
-                        let map = map.compose(&sv.map.inverse()).normalized().round();
                         out.push((
                             v,
                             ControlLift {
                                 vertex: u,
                                 z: c,
-                                map,
+                                map: tm,
                             },
                         ));
                     }
