@@ -178,10 +178,39 @@ fn diag_of(p: &[[f64; 3]]) -> f64 {
 
 /// Jumps of orders 0..=3 across chart boundaries on every `stride`-th edge (module docs).
 pub fn continuity(s: &PouSurface, stride: usize) -> Result<ChartComparison> {
+    let edges: Vec<u32> = (0..s.basis.atlas.mesh.n_edges() as u32)
+        .step_by(stride.max(1))
+        .collect();
+    continuity_on_edges(s, &edges)
+}
+
+/// The edges of the faces that touch the one-ring of vertex `v` (where a manifold spline
+/// with its extraordinary point at `v` has its fill patch and seam).
+pub fn edges_near_vertex(s: &PouSurface, v: u32) -> Vec<u32> {
+    let m = &s.basis.atlas.mesh;
+    let mut ring: Vec<u32> = m.vertex_neighbors(v).collect();
+    ring.push(v);
+    let mut edges: Vec<u32> = ring
+        .iter()
+        .flat_map(|&u| m.vertex_faces(u).collect::<Vec<_>>())
+        .flat_map(|f| m.face_halfedges(f).map(|h| m.he_edge(h)))
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+}
+
+/// Jumps of orders 0..=3 across chart boundaries at three points of each of `edges`.
+pub fn continuity_on_edges(s: &PouSurface, edges: &[u32]) -> Result<ChartComparison> {
     let atlas = s.basis.atlas;
     let m = &atlas.mesh;
     let mut pts = Vec::new();
-    for e in (0..m.n_edges() as u32).step_by(stride.max(1)) {
+    for &e in edges {
+        if e as usize >= m.n_edges() {
+            return Err(Error::input(format!(
+                "edge {e} is not an edge of the domain"
+            )));
+        }
         let h = m.edge_halfedge(e);
         let t = m.he_twin(h);
         if m.is_boundary_halfedge(h) || m.is_boundary_halfedge(t) {
