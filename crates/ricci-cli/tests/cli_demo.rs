@@ -146,7 +146,7 @@ fn every_link_of_the_page_is_a_local_non_empty_file() {
         .collect();
     assert_eq!(
         order,
-        ["surface", "flow", "cone", "loops", "layout", "spectrum", "atlas", "spline"]
+        ["surface", "flow", "cone", "loops", "layout", "spectrum", "atlas", "spline", "pou"]
     );
     let mut at = 0;
     for id in order {
@@ -666,6 +666,35 @@ fn spline_is_c2_with_a_g1_fill_and_close_to_the_surface() {
     let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
     let imgs = img_tags(&html);
     for want in ["spline-zebra.png", "spline-patches.png"] {
+        assert!(imgs.iter().any(|t| t["src"] == want), "no picture {want}");
+    }
+}
+
+#[test]
+fn pou_surface_has_no_jumps_and_stays_close_to_the_surface() {
+    // The partition-of-unity stage (paper 004): derivatives of orders 0–3 agree across chart
+    // boundaries at rounding level (the spline's order-3 jump is O(1), see above), and the
+    // surface is as close to the mesh as the spline.
+    let (dir, v) = demo();
+    let s = stage(v, "pou");
+    let jumps: Vec<f64> = s["continuity"]["relative_jumps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(f)
+        .collect();
+    assert_eq!(jumps.len(), 4);
+    assert!(jumps.iter().all(|&j| j <= 1e-10), "{s}");
+    assert!(
+        f(&s["rms_error_percent"]) < 1.0 && f(&s["max_error_percent"]) < 3.0,
+        "{s}"
+    );
+    let obj = std::fs::read_to_string(dir.join("pou.obj")).unwrap();
+    let nv = obj.lines().filter(|l| l.starts_with("v ")).count() as u64;
+    assert_eq!(nv, s["tessellation_vertices"].as_u64().unwrap());
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    let imgs = img_tags(&html);
+    for want in ["pou-zebra.png", "pou-zebra-back.png"] {
         assert!(imgs.iter().any(|t| t["src"] == want), "no picture {want}");
     }
 }

@@ -76,8 +76,8 @@ fn parse<A: clap::Args + clap::FromArgMatches>(name: &str, argv: &[String]) -> R
 }
 
 /// The subcommands the package runs, by name.
-const COMMANDS: [&str; 9] = [
-    "info", "flow", "layout", "spectrum", "cut", "atlas", "spline", "render", "generate",
+const COMMANDS: [&str; 10] = [
+    "info", "flow", "layout", "spectrum", "cut", "atlas", "spline", "pou", "render", "generate",
 ];
 
 fn dispatch(command: &str, argv: &[String]) -> Result<(), Failure> {
@@ -89,6 +89,7 @@ fn dispatch(command: &str, argv: &[String]) -> Result<(), Failure> {
         "cut" => cmd::cut::run(parse(command, argv)?),
         "atlas" => cmd::atlas::run(parse(command, argv)?),
         "spline" => cmd::spline::run(parse(command, argv)?),
+        "pou" => cmd::pou::run_cmd(parse(command, argv)?),
         "render" => cmd::render::run(parse(command, argv)?),
         "generate" => cmd::generate::run(parse(command, argv)?),
         _ => {

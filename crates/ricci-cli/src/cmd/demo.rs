@@ -19,6 +19,7 @@
 //! [`stages`], put what later stages need into [`Ctx`], and add one line to [`STAGES`] (the
 //! marked places below); remove its entry from [`PLACEHOLDERS`].
 
+mod pou;
 mod report;
 mod stages;
 
@@ -121,6 +122,13 @@ pub const STAGES: &[Stage] = &[
         reference: "manifold triangular B-splines (DMS) over the affine structure (flat cone metric by Thurston circle packing, the papers' scheme), fairing, G¹ hole filling (paper 000 §5)",
         needs: &["surface"],
         run: stages::spline,
+    },
+    Stage {
+        id: "pou",
+        title: "Partition-of-unity surface without extraordinary points",
+        reference: "C∞ radial bumps on hyperbolic disks blending local quadratics over the hyperbolic structure (paper 004 §4)",
+        needs: &["surface"],
+        run: pou::pou,
     },
 ];
 

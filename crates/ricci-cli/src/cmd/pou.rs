@@ -1,7 +1,9 @@
-//! `ricci pou MESH [--radius R] [--smoothing L] [--tessellation K] [--out DIR] [--json]`: the
+//! `ricci pou MESH [--radius R] [--local-degree D] [--smoothing L] [--tessellation K] [--out DIR]
+//! [--json]`: the
 //! partition-of-unity surface over the hyperbolic structure (paper 004;
 //! `ricci::spline::pou`): one control point per vertex, C∞ radial bumps on hyperbolic disks
-//! covering the two-rings (`--radius` scales them: larger is smoother and less local),
+//! covering the two-rings (`--radius` scales them: larger is smoother and less local), each
+//! carrying a local quadratic fitted to the mesh around its vertex (`--local-degree`),
 //! control points fitted to the mesh with a thin-plate fairness term (`--smoothing`).
 //! Surfaces with boundary are handled through their double cover.
 //!
@@ -26,6 +28,10 @@ pub struct Args {
     /// Disk radius as a multiple of the two-ring radius (≥ 1).
     #[arg(long, default_value_t = 1.0)]
     pub radius: f64,
+    /// Degree of the local polynomial carried by each basis (0: constant control points,
+    /// 1: affine, 2: quadratic).
+    #[arg(long, default_value_t = 2)]
+    pub local_degree: usize,
     /// Weight of the (scale-free) thin-plate fairness term of the fit.
     #[arg(long, default_value_t = 1e-4)]
     pub smoothing: f64,
@@ -54,6 +60,13 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
     if !(a.smoothing >= 0.0 && a.smoothing.is_finite()) {
         return Err(UsageError(format!("--smoothing {} must be ≥ 0", a.smoothing)).into());
     }
+    if a.local_degree > 2 {
+        return Err(UsageError(format!(
+            "--local-degree {} is not 0, 1 or 2",
+            a.local_degree
+        ))
+        .into());
+    }
     if !(1..=64).contains(&a.tessellation) {
         return Err(UsageError(format!(
             "--tessellation {} is not in 1..=64",
@@ -65,6 +78,7 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
     let mut bar = spinner(a.json);
     let opts = PouOptions {
         radius: a.radius,
+        local_degree: a.local_degree,
         fit: PouFitOptions {
             smoothing: a.smoothing,
             ..PouFitOptions::default()

@@ -44,6 +44,9 @@ use crate::progress::Progress;
 pub struct StarFace {
     pub face: u32,
     pub map: MobiusDd,
+    /// Index of `map` among the distinct maps of the star (faces with the same index have
+    /// the same map).
+    pub map_id: u32,
     pub z: [Complex; 3],
 }
 
@@ -51,8 +54,43 @@ pub struct StarFace {
 #[derive(Debug, Clone, Copy)]
 pub struct ControlLift {
     pub vertex: u32,
+    /// Its position in the chart.
     pub z: Complex,
+    /// The map from this chart to the chart of `vertex` that takes this lift to the origin
+    /// (SU(1,1)): `|map(z)|² = tanh²(d/2)` and `map(z)` is the local coordinate of the basis.
+    pub map: Mobius,
 }
+
+/// Face lifts developed from a chart ([`HyperbolicAtlas::develop_indexed`]).
+pub struct Developed {
+    /// The distinct maps from the fundamental domain's coordinate to the chart.
+    pub maps: Vec<MobiusDd>,
+    /// `(face, index of its map, chart positions of its vertices)`, the star first.
+    pub lifts: Vec<(u32, u32, [Complex; 3])>,
+}
+
+/// A fast hasher for small integer keys (FNV-1a over the key's bytes is enough here and
+/// much cheaper than SipHash).
+#[derive(Default, Clone, Copy)]
+pub struct FastHasher(u64);
+impl std::hash::Hasher for FastHasher {
+    #[inline]
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    #[inline]
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ b as u64).wrapping_mul(0x100000001b3);
+        }
+    }
+    #[inline]
+    fn write_u32(&mut self, x: u32) {
+        self.0 = (self.0.rotate_left(29) ^ x as u64).wrapping_mul(0x9e3779b97f4a7c15);
+    }
+}
+/// [`FastHasher`] as a `BuildHasher`.
+pub type FastHash = std::hash::BuildHasherDefault<FastHasher>;
 
 /// The chart of one vertex.
 #[derive(Debug, Clone)]
@@ -62,7 +100,7 @@ pub struct Chart {
     pub star: Vec<StarFace>,
     /// Every lift of a control point whose disk can reach the star.
     pub controls: Vec<ControlLift>,
-    /// Face lifts developed to find them.
+    /// Face lifts developed for the basis of this vertex (its support, conservatively).
     pub developed_faces: usize,
 }
 
@@ -310,8 +348,23 @@ impl HyperbolicAtlas {
     pub fn develop(
         &self,
         v: u32,
-        mut keep: impl FnMut(u32, &[Complex; 3]) -> bool,
+        keep: impl FnMut(u32, &[Complex; 3]) -> bool,
     ) -> Result<Vec<(u32, MobiusDd, [Complex; 3])>> {
+        let d = self.develop_indexed(v, keep)?;
+        Ok(d.lifts
+            .into_iter()
+            .map(|(f, mi, z)| (f, d.maps[mi as usize], z))
+            .collect())
+    }
+
+    /// [`HyperbolicAtlas::develop`] with the distinct maps met listed once and the lifts
+    /// referring to them by index (the same deck element reached along different paths is one
+    /// map).
+    pub fn develop_indexed(
+        &self,
+        v: u32,
+        mut keep: impl FnMut(u32, &[Complex; 3]) -> bool,
+    ) -> Result<Developed> {
         let m = &self.mesh;
         let f0 = m
             .vertex_faces(v)
@@ -327,7 +380,7 @@ impl HyperbolicAtlas {
         // along different paths is one map) and the chart positions of the cut-mesh vertices
         // under each, computed once.
         let mut maps: Vec<MobiusDd> = vec![MobiusDd::to_origin(self.global[cv as usize])];
-        let mut cache: HashMap<(u32, u32), Complex> = HashMap::new();
+        let mut cache: HashMap<(u32, u32), Complex, FastHash> = HashMap::default();
         let mut lift = |f: u32, mi: u32, maps: &[MobiusDd]| -> [Complex; 3] {
             self.cut_mesh.face(f).map(|c| {
                 *cache.entry((mi, c)).or_insert_with(|| {
@@ -336,7 +389,7 @@ impl HyperbolicAtlas {
                 })
             })
         };
-        let mut seen: HashMap<u32, Vec<Complex>> = HashMap::new();
+        let mut seen: HashMap<u32, Vec<Complex>, FastHash> = HashMap::default();
         let mut queue = std::collections::VecDeque::new();
         let z0 = lift(f0, 0, &maps);
         seen.entry(f0).or_default().push(z0[0]);
@@ -358,9 +411,9 @@ impl HyperbolicAtlas {
                 .zip(&z)
                 .any(|(&x, w)| x == v && w.norm() < 1e-9);
             if at_origin {
-                star.push((f, maps[mi as usize], z));
+                star.push((f, mi, z));
             } else if keep(f, &z) {
-                kept.push((f, maps[mi as usize], z));
+                kept.push((f, mi, z));
             } else {
                 continue;
             }
@@ -393,19 +446,25 @@ impl HyperbolicAtlas {
             }
         }
         star.extend(kept);
-        Ok(star)
+        Ok(Developed { maps, lifts: star })
     }
 
-    /// Develop every chart (in parallel) far enough for bases of radii `radii` (per vertex).
-    /// A control lift `u` is kept when it is within `ρ₁(v) + r_u` of the origin (`ρ₁(v)` the
-    /// star radius): exactly the bases that can be non-zero somewhere on the star. To reach
-    /// them, a face lift is expanded when one of its vertices `u` is within
-    /// `ρ₁(v) + R*_u + 2h` of the origin, `h` the face's longest edge and
-    /// `R*_u = max_c (r_c − d_E(u, c))` the 1-Lipschitz envelope of the radii along edge
-    /// paths (`d_E`): a face on the geodesic from the origin to a reachable lift `c` at
-    /// distance `t` from it has a vertex with `r_c − t ≲ R*_u` even where the radii change
-    /// fast from vertex to vertex (coarse meshes). The chart-independence and continuity
-    /// checks ([`super::measure`]) would see a lift that was missed.
+    /// Develop every chart (in parallel) for bases of radii `radii` (per vertex).
+    ///
+    /// The control lifts are found from the bases' side, not the charts': the basis of `u`
+    /// is developed in its own chart over the face lifts that can meet its disk
+    /// `D(0, r_u)` — a face lift with vertices `z_k` and longest edge `h` is expanded while
+    /// `min_k d(0, z_k) < r_u + h` (every point of the face is within `h` of each vertex;
+    /// the faces meeting a geodesic disk are connected across edges because the disk is
+    /// convex). Every face lift `f` found names, for each vertex `v` of `f`, one lift of `u`
+    /// in the chart of `v`: `T⁻¹(0)` with `T = M ∘ M_v(f)⁻¹` the map from chart `v` to this
+    /// lift's chart of `u` (`M` the lift's map, `M_v(f)` the star map of `f` in chart `v`),
+    /// composed in double-double. A lift of `u` whose disk meets the star of `v` meets one of
+    /// its faces, so it is found; it is kept when within `ρ₁(v) + r_u` of the origin (`ρ₁(v)`
+    /// the star radius), the bases that can be non-zero on the star. The work is the sum of
+    /// the bases' supports (what evaluation touches anyway), however fast the radii vary.
+    /// The chart-independence and continuity checks ([`super::measure`]) would see a lift
+    /// that was missed.
     pub fn develop_charts(&mut self, radii: &[f64], progress: &mut dyn Progress) -> Result<()> {
         use rayon::prelude::*;
         let nv = self.mesh.n_vertices();
@@ -415,7 +474,12 @@ impl HyperbolicAtlas {
                 radii.len()
             )));
         }
-        let envelope = self.radius_envelope(radii);
+        if let Some(v) = (0..nv).find(|&v| !(radii[v] > 0.0 && radii[v].is_finite())) {
+            return Err(Error::input(format!(
+                "the radius {} of vertex {v} is not a positive number",
+                radii[v]
+            )));
+        }
         let face_diameter: Vec<f64> = (0..self.mesh.n_faces() as u32)
             .map(|f| {
                 self.mesh
@@ -425,102 +489,95 @@ impl HyperbolicAtlas {
                     .fold(0.0, f64::max)
             })
             .collect();
-        progress.report("charts", None, &format!("developing {nv} charts"));
-        let charts: Vec<Chart> = (0..nv as u32)
+        progress.report("charts", None, &format!("developing {nv} stars"));
+        let stars: Vec<Vec<StarFace>> = (0..nv as u32)
             .into_par_iter()
-            .map(|v| -> Result<Chart> {
-                let rho = self.star_radius(v);
-                // d(0, z) < R ⟺ |z| < tanh(R/2): no distances in the loop.
-                let lifts = self.develop(v, |f, z| {
-                    let vs = self.mesh.face(f);
-                    let h = face_diameter[f as usize];
-                    (0..3).any(|k| {
-                        let t = (0.5 * (rho + envelope[vs[k] as usize] + 2.0 * h)).tanh();
-                        z[k].norm_sqr() < t * t
+            .map(|v| -> Result<Vec<StarFace>> {
+                let d = self.develop_indexed(v, |_, _| false)?;
+                Ok(d.lifts
+                    .into_iter()
+                    .map(|(face, mi, z)| StarFace {
+                        face,
+                        map: d.maps[mi as usize],
+                        map_id: mi,
+                        z,
                     })
-                })?;
-                let mut controls: Vec<ControlLift> = Vec::new();
-                let mut by_vertex: HashMap<u32, Vec<Complex>> = HashMap::new();
-                for (f, _, z) in &lifts {
-                    for (k, &u) in self.mesh.face(*f).iter().enumerate() {
-                        let t = (0.5 * (rho + radii[u as usize])).tanh();
-                        if z[k].norm_sqr() >= t * t {
-                            continue;
-                        }
-                        let known = by_vertex.entry(u).or_default();
-                        if known.iter().any(|w| (w - z[k]).norm() < 1e-9) {
-                            continue;
-                        }
-                        known.push(z[k]);
-                        controls.push(ControlLift { vertex: u, z: z[k] });
-                    }
-                }
-                let star: Vec<StarFace> = lifts
-                    .iter()
-                    .take_while(|(f, _, z)| {
-                        self.mesh
-                            .face(*f)
-                            .iter()
-                            .zip(z)
-                            .any(|(&x, w)| x == v && w.norm() < 1e-9)
-                    })
-                    .map(|(f, map, z)| StarFace {
-                        face: *f,
-                        map: *map,
-                        z: *z,
-                    })
-                    .collect();
-                Ok(Chart {
-                    vertex: v,
-                    star,
-                    controls,
-                    developed_faces: lifts.len(),
-                })
+                    .collect())
             })
             .collect::<Result<_>>()?;
-        self.charts = charts;
-        Ok(())
-    }
-
-    /// `R*_u = max_c (r_c − d_E(u, c))` over edge paths (Dijkstra on the max-plus problem:
-    /// every vertex is settled once).
-    pub fn radius_envelope(&self, radii: &[f64]) -> Vec<f64> {
-        use std::cmp::Ordering;
-        use std::collections::BinaryHeap;
-        #[derive(PartialEq)]
-        struct Item(f64, u32);
-        impl Eq for Item {}
-        impl PartialOrd for Item {
-            fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-                Some(self.cmp(o))
-            }
-        }
-        impl Ord for Item {
-            fn cmp(&self, o: &Self) -> Ordering {
-                self.0.total_cmp(&o.0).then(self.1.cmp(&o.1))
-            }
-        }
-        let m = &self.mesh;
-        let mut env = radii.to_vec();
-        let mut done = vec![false; env.len()];
-        let mut heap: BinaryHeap<Item> = (0..env.len() as u32)
-            .map(|v| Item(env[v as usize], v))
-            .collect();
-        while let Some(Item(r, v)) = heap.pop() {
-            if done[v as usize] || r < env[v as usize] {
-                continue;
-            }
-            done[v as usize] = true;
-            for h in m.outgoing(v) {
-                let u = m.he_tip(h);
-                let cand = r - self.lengths[m.he_edge(h) as usize];
-                if !done[u as usize] && cand > env[u as usize] {
-                    env[u as usize] = cand;
-                    heap.push(Item(cand, u));
+        let rho: Vec<f64> = (0..nv as u32).map(|v| self.star_radius(v)).collect();
+        progress.report("charts", None, &format!("developing {nv} basis supports"));
+        // Per basis u: (chart v, lift) pairs, deduplicated per chart.
+        let per_basis: Vec<(Vec<(u32, ControlLift)>, usize)> = (0..nv as u32)
+            .into_par_iter()
+            .map(|u| -> Result<(Vec<(u32, ControlLift)>, usize)> {
+                let ru = radii[u as usize];
+                let d = self.develop_indexed(u, |f, z| {
+                    let t = (0.5 * (ru + face_diameter[f as usize])).tanh();
+                    z.iter().any(|w| w.norm_sqr() < t * t)
+                })?;
+                let mut out: Vec<(u32, ControlLift)> = Vec::new();
+                let mut known: HashMap<u32, Vec<Complex>, FastHash> = HashMap::default();
+                // (chart, map of the lift, map of the star face) already handled: the lift
+                // of u in the chart is a function of the two maps.
+                let mut done: std::collections::HashSet<(u32, u32, u32), FastHash> =
+                    Default::default();
+                for &(f, mi, _) in &d.lifts {
+                    let map = &d.maps[mi as usize];
+                    for &v in self.mesh.face(f).iter() {
+                        let Some(sv) = stars[v as usize].iter().find(|s| s.face == f) else {
+                            continue;
+                        };
+                        if !done.insert((v, mi, sv.map_id)) {
+                            continue;
+                        }
+                        // T = M ∘ M_v(f)⁻¹ (chart v → this lift's chart of u); the lift sits
+                        // at T⁻¹(0) = −b/a.
+                        let tm = map.compose(&sv.map.inverse()).normalized().round();
+                        let c = -tm.b / tm.a;
+                        let t = (0.5 * (rho[v as usize] + ru)).tanh();
+                        if c.norm_sqr() >= t * t {
+                            continue;
+                        }
+                        let seen = known.entry(v).or_default();
+                        if seen.iter().any(|x| (x - c).norm() < 1e-9) {
+                            continue;
+                        }
+                        seen.push(c);
+                        out.push((
+                            v,
+                            ControlLift {
+                                vertex: u,
+                                z: c,
+                                map: tm,
+                            },
+                        ));
+                    }
                 }
+                Ok((out, d.lifts.len()))
+            })
+            .collect::<Result<_>>()?;
+        let mut controls: Vec<Vec<ControlLift>> = vec![Vec::new(); nv];
+        let mut support = vec![0usize; nv];
+        for (u, (list, n)) in per_basis.into_iter().enumerate() {
+            support[u] = n;
+            for (v, c) in list {
+                controls[v as usize].push(c);
             }
         }
-        env
+        self.charts = stars
+            .into_iter()
+            .zip(controls)
+            .zip(support)
+            .enumerate()
+            .map(|(v, ((star, controls), developed_faces))| Chart {
+                vertex: v as u32,
+                star,
+                controls,
+                developed_faces,
+            })
+            .collect();
+        Ok(())
     }
 
     /// Index of face `f` in the star of chart `v`.

@@ -23,7 +23,8 @@ use crate::error::{Error, Result};
 use crate::layout::isometry::Complex;
 
 use super::atlas::point_in_face;
-use super::surface::PouBasis;
+use super::local::LocalPolynomial;
+use super::surface::{PouBasis, PouSurface};
 
 /// Options of [`fit`].
 #[derive(Debug, Clone, Copy)]
@@ -76,7 +77,15 @@ fn merge(mut r: Row) -> Row {
 }
 
 /// Fit the control points (module docs). Returns the control points and the report.
-pub fn fit(basis: &PouBasis, opts: &PouFitOptions) -> Result<(Vec<[f64; 3]>, PouFitReport)> {
+///
+/// With local polynomials `Qᵢ` ([`super::local`]; empty for none) the unknowns are still the
+/// constants `Pᵢ`: `G = Σ wᵢ Qᵢ` is fixed, so the data targets become `x_k − G(p_k)` and the
+/// thin-plate rows get the right-hand side `−∂²G` (the fairness acts on the whole `F`).
+pub fn fit(
+    basis: &PouBasis,
+    local: &[LocalPolynomial],
+    opts: &PouFitOptions,
+) -> Result<(Vec<[f64; 3]>, PouFitReport)> {
     let t0 = Instant::now();
     let atlas = basis.atlas;
     let m = &atlas.mesh;
@@ -85,14 +94,35 @@ pub fn fit(basis: &PouBasis, opts: &PouFitOptions) -> Result<(Vec<[f64; 3]>, Pou
         return Err(Error::input("pou fit: smoothing must be ≥ 0 and ridge > 0"));
     }
     let pos = &atlas.positions;
+    if !local.is_empty() && local.len() != nv {
+        return Err(Error::input(format!(
+            "pou fit: {} local polynomials for {nv} vertices",
+            local.len()
+        )));
+    }
+    // G = Σ wᵢ Qᵢ: the surface with zero constants.
+    let g = PouSurface {
+        basis: PouBasis::new(atlas, basis.radii.clone()),
+        control: vec![[0.0; 3]; nv],
+        local: local.to_vec(),
+    };
+    let has_local = !local.is_empty();
     // Data rows: vertices, then face centres.
     let data: Vec<(Row, [f64; 3])> = (0..nv + nf)
         .into_par_iter()
         .map(|k| -> Result<(Row, [f64; 3])> {
             let mut w = Vec::new();
+            let minus_g = |v: u32, z: Complex, x: [f64; 3]| -> Result<[f64; 3]> {
+                if !has_local {
+                    return Ok(x);
+                }
+                let gv = g.value(v, z, &mut Vec::new())?;
+                Ok([x[0] - gv[0], x[1] - gv[1], x[2] - gv[2]])
+            };
             if k < nv {
-                basis.weights(k as u32, Complex::new(0.0, 0.0), &mut w)?;
-                Ok((merge(w), pos[k]))
+                let z = Complex::new(0.0, 0.0);
+                basis.weights(k as u32, z, &mut w)?;
+                Ok((merge(w), minus_g(k as u32, z, pos[k])?))
             } else {
                 let f = (k - nv) as u32;
                 let vs = m.face(f);
@@ -106,14 +136,15 @@ pub fn fit(basis: &PouBasis, opts: &PouFitOptions) -> Result<(Vec<[f64; 3]>, Pou
                         x[d] += pos[v as usize][d] / 3.0;
                     }
                 }
-                Ok((merge(w), x))
+                Ok((merge(w), minus_g(vs[0], z, x)?))
             }
         })
         .collect::<Result<_>>()?;
     // Fairness rows: three per face, with the chart area and the scale.
-    let fair: Vec<([Row; 3], f64, f64)> = (0..nf as u32)
+    type Fair = ([Row; 3], [[f64; 3]; 3], f64, f64);
+    let fair: Vec<Fair> = (0..nf as u32)
         .into_par_iter()
-        .map(|f| -> Result<([Row; 3], f64, f64)> {
+        .map(|f| -> Result<Fair> {
             let v = m.face(f)[0];
             let i = atlas
                 .star_index(v, f)
@@ -130,13 +161,23 @@ pub fn fit(basis: &PouBasis, opts: &PouFitOptions) -> Result<(Vec<[f64; 3]>, Pou
             let mut w = Vec::new();
             basis.weight_jets(v, z, 2, &mut w)?;
             let s2 = std::f64::consts::SQRT_2;
-            let rows = [(2, 0, 1.0), (1, 1, s2), (0, 2, 1.0)]
+            let terms = [(2, 0, 1.0), (1, 1, s2), (0, 2, 1.0)];
+            let rows = terms
                 .map(|(a, b, s)| merge(w.iter().map(|(c, j)| (*c, s * j.partial(a, b))).collect()));
-            Ok((rows, area, edges))
+            let mut targets = [[0.0; 3]; 3];
+            if has_local {
+                let gj = g.jets(v, z, 2)?;
+                for (t, (a, b, s)) in targets.iter_mut().zip(terms) {
+                    for d in 0..3 {
+                        t[d] = -s * gj[d].partial(a, b);
+                    }
+                }
+            }
+            Ok((rows, targets, area, edges))
         })
         .collect::<Result<_>>()?;
-    let area: f64 = fair.iter().map(|f| f.1).sum();
-    let hbar = fair.iter().map(|f| f.2).sum::<f64>() / (3 * nf).max(1) as f64;
+    let area: f64 = fair.iter().map(|f| f.2).sum();
+    let hbar = fair.iter().map(|f| f.3).sum::<f64>() / (3 * nf).max(1) as f64;
     let kdata = data.len() as f64;
     let lam = opts.smoothing * hbar * hbar / area.max(1e-300);
     // Weighted rows of the stacked system.
@@ -152,9 +193,14 @@ pub fn fit(basis: &PouBasis, opts: &PouFitOptions) -> Result<(Vec<[f64; 3]>, Pou
         rows.push(r.iter().map(|&(c, v)| (c, v * sd)).collect());
     }
     let n_data_rows = rows.len();
-    for (rs, a, _) in &fair {
+    for (rs, ts, a, _) in &fair {
         let s = (lam * a).sqrt();
-        for r in rs {
+        for (r, t) in rs.iter().zip(ts) {
+            for &(c, v) in r {
+                for d in 0..3 {
+                    rhs[c as usize][d] += v * t[d] * lam * a;
+                }
+            }
             rows.push(r.iter().map(|&(c, v)| (c, v * s)).collect());
         }
     }

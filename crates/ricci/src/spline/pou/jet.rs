@@ -48,6 +48,49 @@ pub fn exponents(i: usize) -> (usize, usize) {
 
 const FACT: [f64; 4] = [1.0, 1.0, 2.0, 6.0];
 
+/// Pairs of monomials `(i, j)` with their product's index `k`, ordered by the product's total
+/// degree, so that the pairs of a product truncated at order `n` are the first
+/// `PRODUCT_LEN[n]`.
+const PRODUCT_PAIRS: usize = 35;
+const PRODUCT: [(u8, u8, u8); PRODUCT_PAIRS] = product_table();
+const PRODUCT_LEN: [usize; MAX_ORDER + 1] = [1, 5, 15, 35];
+
+const fn product_table() -> [(u8, u8, u8); PRODUCT_PAIRS] {
+    const E: [(usize, usize); N_COEFFS] = [
+        (0, 0),
+        (1, 0),
+        (0, 1),
+        (2, 0),
+        (1, 1),
+        (0, 2),
+        (3, 0),
+        (2, 1),
+        (1, 2),
+        (0, 3),
+    ];
+    let mut t = [(0u8, 0u8, 0u8); PRODUCT_PAIRS];
+    let mut n = 0;
+    let mut deg = 0;
+    while deg <= MAX_ORDER {
+        let mut i = 0;
+        while i < N_COEFFS {
+            let mut j = 0;
+            while j < N_COEFFS {
+                let (a, b) = (E[i].0 + E[j].0, E[i].1 + E[j].1);
+                if a + b == deg {
+                    let k = (a + b) * (a + b + 1) / 2 + b;
+                    t[n] = (i as u8, j as u8, k as u8);
+                    n += 1;
+                }
+                j += 1;
+            }
+            i += 1;
+        }
+        deg += 1;
+    }
+    t
+}
+
 /// A bivariate Taylor polynomial truncated at `order`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Jet {
@@ -130,21 +173,14 @@ impl Jet {
             self.c[i] += s * o.c[i];
         }
     }
-    /// The truncated product.
+    /// The truncated product (the pairs of monomials of total degree ≤ the order come from a
+    /// table built at compile time).
     #[inline]
     pub fn mul(&self, o: &Jet) -> Jet {
         let n = self.order;
         let mut c = [0.0; N_COEFFS];
-        for i in 0..n_coeffs(n) {
-            let (a1, b1) = exponents(i);
-            let x = self.c[i];
-            if x == 0.0 {
-                continue;
-            }
-            for j in 0..n_coeffs(n - a1 - b1) {
-                let (a2, b2) = exponents(j);
-                c[index(a1 + a2, b1 + b2)] += x * o.c[j];
-            }
+        for &(i, j, k) in &PRODUCT[..PRODUCT_LEN[n.min(MAX_ORDER)]] {
+            c[k as usize] += self.c[i as usize] * o.c[j as usize];
         }
         Jet { c, order: n }
     }
@@ -242,6 +278,47 @@ impl CJet {
             im: p.im.mul(&n),
         }
     }
+}
+
+/// The complex jet of a holomorphic function given its complex Taylor coefficients
+/// `t[k] = g⁽ᵏ⁾(z0)/k!`: `(x + iy)ᵏ = Σ_b C(k, b) iᵇ xᵏ⁻ᵇ yᵇ`, no products needed.
+#[inline]
+pub fn holomorphic_jet(t: &[C; MAX_ORDER + 1], order: usize) -> CJet {
+    const BINOM: [[f64; 4]; 4] = [
+        [1.0, 0.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0, 0.0],
+        [1.0, 2.0, 1.0, 0.0],
+        [1.0, 3.0, 3.0, 1.0],
+    ];
+    let mut re = Jet::constant(t[0].re, order);
+    let mut im = Jet::constant(t[0].im, order);
+    for k in 1..=order.min(MAX_ORDER) {
+        let mut ib = C::new(1.0, 0.0);
+        for b in 0..=k {
+            let c = t[k] * ib * BINOM[k][b];
+            let i = index(k - b, b);
+            re.c[i] = c.re;
+            im.c[i] = c.im;
+            ib *= C::new(0.0, 1.0);
+        }
+    }
+    CJet { re, im }
+}
+
+/// The jet of the Möbius map `z ↦ (a z + b)/(b̄ z + ā)` (`|a|² − |b|² = 1`) at `z0`, from its
+/// closed-form derivatives `T⁽ᵏ⁾/k! = (−b̄)ᵏ⁻¹ / (b̄ z0 + ā)ᵏ⁺¹`.
+#[inline]
+pub fn su11_jet(a: C, b: C, z0: C, order: usize) -> CJet {
+    let d = b.conj() * z0 + a.conj();
+    let inv = 1.0 / d;
+    let mut t = [C::new(0.0, 0.0); MAX_ORDER + 1];
+    t[0] = (a * z0 + b) * inv;
+    let mut p = inv * inv;
+    for tk in t.iter_mut().skip(1) {
+        *tk = p;
+        p *= -b.conj() * inv;
+    }
+    holomorphic_jet(&t, order)
 }
 
 /// The jet of the Möbius map `z ↦ (a z + b)/(b̄ z + ā)` at `z0`.
@@ -342,6 +419,21 @@ mod tests {
         let composed = compose(&g, &w);
         for i in 0..n_coeffs(3) {
             assert!((direct.c[i] - composed.c[i]).abs() < 1e-12 * (1.0 + direct.c[i].abs()));
+        }
+    }
+
+    #[test]
+    fn su11_jet_matches_the_quotient_of_jets() {
+        // Closed-form derivatives of an SU(1,1) map against the jet arithmetic of the quotient.
+        let (a, b) = (C::new(1.3, 0.2), C::new(0.5, -0.6));
+        let s = (a.norm_sqr() - b.norm_sqr()).sqrt();
+        let (a, b) = (a / s, b / s);
+        let z0 = C::new(-0.3, 0.45);
+        let q = mobius_jet(a, b, z0, 3);
+        let h = su11_jet(a, b, z0, 3);
+        for i in 0..n_coeffs(3) {
+            assert!((q.re.c[i] - h.re.c[i]).abs() < 1e-12 * (1.0 + q.re.c[i].abs()));
+            assert!((q.im.c[i] - h.im.c[i]).abs() < 1e-12 * (1.0 + q.im.c[i].abs()));
         }
     }
 }

@@ -20,12 +20,14 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::layout::isometry::{Complex, Mobius};
 use crate::mesh::Surface;
+use crate::numeric::vec3::{dot, sub};
 use crate::progress::Progress;
-use crate::spline::surface::{error_percent, MeshDistance};
+use crate::spline::surface::point_triangle_distance;
 
 use super::atlas::{double_cover, AtlasReport, HyperbolicAtlas};
 use super::fit::{fit, PouFitOptions, PouFitReport};
 use super::jet::{compose, exponents, mobius_jet, n_coeffs, Jet};
+use super::local::{local_fits, LocalPolynomial};
 use super::surface::{two_ring_radii, PouBasis, PouSurface};
 
 /// Largest relative differences per order between evaluations in different charts.
@@ -176,10 +178,39 @@ fn diag_of(p: &[[f64; 3]]) -> f64 {
 
 /// Jumps of orders 0..=3 across chart boundaries on every `stride`-th edge (module docs).
 pub fn continuity(s: &PouSurface, stride: usize) -> Result<ChartComparison> {
+    let edges: Vec<u32> = (0..s.basis.atlas.mesh.n_edges() as u32)
+        .step_by(stride.max(1))
+        .collect();
+    continuity_on_edges(s, &edges)
+}
+
+/// The edges of the faces that touch the one-ring of vertex `v` (where a manifold spline
+/// with its extraordinary point at `v` has its fill patch and seam).
+pub fn edges_near_vertex(s: &PouSurface, v: u32) -> Vec<u32> {
+    let m = &s.basis.atlas.mesh;
+    let mut ring: Vec<u32> = m.vertex_neighbors(v).collect();
+    ring.push(v);
+    let mut edges: Vec<u32> = ring
+        .iter()
+        .flat_map(|&u| m.vertex_faces(u).collect::<Vec<_>>())
+        .flat_map(|f| m.face_halfedges(f).map(|h| m.he_edge(h)))
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+}
+
+/// Jumps of orders 0..=3 across chart boundaries at three points of each of `edges`.
+pub fn continuity_on_edges(s: &PouSurface, edges: &[u32]) -> Result<ChartComparison> {
     let atlas = s.basis.atlas;
     let m = &atlas.mesh;
     let mut pts = Vec::new();
-    for e in (0..m.n_edges() as u32).step_by(stride.max(1)) {
+    for &e in edges {
+        if e as usize >= m.n_edges() {
+            return Err(Error::input(format!(
+                "edge {e} is not an edge of the domain"
+            )));
+        }
         let h = m.edge_halfedge(e);
         let t = m.he_twin(h);
         if m.is_boundary_halfedge(h) || m.is_boundary_halfedge(t) {
@@ -303,6 +334,9 @@ pub fn tessellate(s: &PouSurface, faces: &[u32], k: usize) -> Result<PouTessella
 pub struct PouOptions {
     /// Disk radius as a multiple of the two-ring radius (≥ 1).
     pub radius: f64,
+    /// Degree of the local polynomials (0: constant control points, 1: affine, 2: quadratic;
+    /// [`super::local`]).
+    pub local_degree: usize,
     pub fit: PouFitOptions,
     /// Segments per domain edge in the tessellation.
     pub tessellation: usize,
@@ -316,6 +350,7 @@ impl Default for PouOptions {
     fn default() -> Self {
         PouOptions {
             radius: 1.0,
+            local_degree: 2,
             fit: PouFitOptions::default(),
             tessellation: 6,
             independence_samples: 2000,
@@ -345,6 +380,7 @@ pub struct PouReport {
     pub domain_faces: usize,
     pub double_cover: bool,
     pub radius_factor: f64,
+    pub local_degree: usize,
     pub radius_min: f64,
     pub radius_max: f64,
     pub mean_controls_per_chart: f64,
@@ -356,7 +392,10 @@ pub struct PouReport {
     pub fit: PouFitReport,
     pub seconds_atlas: f64,
     pub seconds_charts: f64,
+    /// Local polynomial fits and the global least squares.
     pub seconds_fit: f64,
+    /// Distances of the tessellation to the input mesh (the errors).
+    pub seconds_error: f64,
     pub seconds_tessellation: f64,
     pub seconds_checks: f64,
     pub seconds: f64,
@@ -368,12 +407,16 @@ pub struct PouConstruction {
     pub atlas: HyperbolicAtlas,
     pub radii: Vec<f64>,
     pub control: Vec<[f64; 3]>,
+    /// Local polynomials (empty for degree 0).
+    pub local: Vec<LocalPolynomial>,
+    pub local_degree: usize,
     pub fit: PouFitReport,
     /// Faces of the domain on the input's sheet (all faces for a closed input).
     pub sheet_faces: Vec<u32>,
     pub double_cover: bool,
     pub seconds_atlas: f64,
     pub seconds_charts: f64,
+    pub seconds_fit: f64,
 }
 
 impl PouConstruction {
@@ -382,6 +425,7 @@ impl PouConstruction {
         PouSurface {
             basis: PouBasis::new(&self.atlas, self.radii.clone()),
             control: self.control.clone(),
+            local: self.local.clone(),
         }
     }
 }
@@ -407,8 +451,11 @@ pub fn construct(
     atlas.develop_charts(&radii, progress)?;
     let seconds_charts = t1.elapsed().as_secs_f64();
     progress.report("fit", None, "least squares with thin-plate fairness");
+    let t2 = Instant::now();
     let basis = PouBasis::new(&atlas, radii.clone());
-    let (control, fit_report) = fit(&basis, &opts.fit)?;
+    let local = local_fits(&basis, opts.local_degree)?;
+    let (control, fit_report) = fit(&basis, &local, &opts.fit)?;
+    let seconds_fit = t2.elapsed().as_secs_f64();
     let sheet_faces: Vec<u32> = (0..atlas.mesh.n_faces() as u32)
         .filter(|&f| (atlas.face_origin[f as usize] as usize) < sheet)
         .collect();
@@ -416,11 +463,14 @@ pub fn construct(
         atlas,
         radii,
         control,
+        local,
+        local_degree: opts.local_degree,
         fit: fit_report,
         sheet_faces,
         double_cover: bordered,
         seconds_atlas,
         seconds_charts,
+        seconds_fit,
     })
 }
 
@@ -437,8 +487,10 @@ pub fn run(
     let t1 = Instant::now();
     let tess = tessellate(&s, &c.sheet_faces, opts.tessellation)?;
     let seconds_tessellation = t1.elapsed().as_secs_f64();
-    let dist = MeshDistance::new(&input.positions, input.mesh.faces());
-    let (rms, max) = error_percent(&dist, &tess.positions);
+    let t3 = Instant::now();
+    let dist = NearestTriangle::new(&input.positions, input.mesh.faces());
+    let (rms, max) = dist.error_percent(&tess.positions);
+    let seconds_error = t3.elapsed().as_secs_f64();
     progress.report("checks", None, "chart independence and continuity");
     let t2 = Instant::now();
     let ci = chart_independence(&s, opts.independence_samples, 0x9e3779b97f4a7c15)?;
@@ -464,6 +516,7 @@ pub fn run(
         domain_faces: c.atlas.mesh.n_faces(),
         double_cover: c.double_cover,
         radius_factor: opts.radius,
+        local_degree: c.local_degree,
         radius_min: c.radii.iter().copied().fold(f64::INFINITY, f64::min),
         radius_max: c.radii.iter().copied().fold(0.0, f64::max),
         mean_controls_per_chart: c
@@ -488,7 +541,8 @@ pub fn run(
         fit: c.fit.clone(),
         seconds_atlas: c.seconds_atlas,
         seconds_charts: c.seconds_charts,
-        seconds_fit: c.fit.seconds,
+        seconds_fit: c.seconds_fit,
+        seconds_error,
         seconds_tessellation,
         seconds_checks,
         seconds: 0.0,
@@ -502,4 +556,169 @@ pub fn run(
 /// Partials of the jets as rows (for tests and reports): `out[d][i]` for coefficient `i`.
 pub fn partials(j: &[Jet; 3]) -> [Vec<f64>; 3] {
     [j[0].partials(), j[1].partials(), j[2].partials()]
+}
+
+/// Exact distances from points to a triangle mesh: a uniform grid of cell `≈` the mean edge
+/// length; a query scans its own cell for a first bound `δ`, then every cell meeting the box
+/// `p ± δ` (a triangle closer than `δ` is registered in one of them). Points near the surface
+/// (a fitted surface's samples) touch a few cells.
+pub struct NearestTriangle {
+    tris: Vec<[[f64; 3]; 3]>,
+    lo: [f64; 3],
+    cell: f64,
+    dims: [usize; 3],
+    start: Vec<u32>,
+    items: Vec<u32>,
+    /// Bounding-box diagonal of the mesh.
+    pub diagonal: f64,
+}
+
+impl NearestTriangle {
+    pub fn new(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> NearestTriangle {
+        let tris: Vec<[[f64; 3]; 3]> = triangles
+            .iter()
+            .map(|t| t.map(|v| positions[v as usize]))
+            .collect();
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        let mut mean = 0.0;
+        for t in &tris {
+            for p in t {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+            mean += dot(sub(t[1], t[0]), sub(t[1], t[0])).sqrt();
+        }
+        if tris.is_empty() {
+            lo = [0.0; 3];
+            hi = [0.0; 3];
+        }
+        mean /= tris.len().max(1) as f64;
+        let diagonal = dot(sub(hi, lo), sub(hi, lo)).sqrt();
+        // About the mean edge, but never more than ~4 cells per triangle.
+        let volume: f64 = (0..3)
+            .map(|k| (hi[k] - lo[k]).max(diagonal / 256.0))
+            .product();
+        let cell = mean
+            .max(diagonal / 256.0)
+            .max((volume / (4.0 * tris.len().max(1) as f64)).cbrt())
+            .max(1e-300);
+        let dims: [usize; 3] =
+            std::array::from_fn(|k| (((hi[k] - lo[k]) / cell).floor() as usize + 1).min(512));
+        let ncell = dims[0] * dims[1] * dims[2];
+        let mut grid = NearestTriangle {
+            tris,
+            lo,
+            cell,
+            dims,
+            start: vec![0; ncell + 1],
+            items: Vec::new(),
+            diagonal,
+        };
+        let ranges: Vec<[usize; 6]> = grid
+            .tris
+            .iter()
+            .map(|t| {
+                let mut r = [0usize; 6];
+                for k in 0..3 {
+                    let a = t.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+                    let b = t.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
+                    r[2 * k] = grid.index(a, k);
+                    r[2 * k + 1] = grid.index(b, k);
+                }
+                r
+            })
+            .collect();
+        let mut count = vec![0u32; ncell + 1];
+        for r in &ranges {
+            grid.for_cells(r, |c| count[c + 1] += 1);
+        }
+        for k in 1..count.len() {
+            count[k] += count[k - 1];
+        }
+        let mut fill = count.clone();
+        let mut items = vec![0u32; count[ncell] as usize];
+        for (ti, r) in ranges.iter().enumerate() {
+            grid.for_cells(r, |c| {
+                items[fill[c] as usize] = ti as u32;
+                fill[c] += 1;
+            });
+        }
+        grid.start = count;
+        grid.items = items;
+        grid
+    }
+
+    #[inline]
+    fn index(&self, x: f64, k: usize) -> usize {
+        (((x - self.lo[k]) / self.cell).floor().max(0.0) as usize).min(self.dims[k] - 1)
+    }
+
+    #[inline]
+    fn for_cells(&self, r: &[usize; 6], mut f: impl FnMut(usize)) {
+        for z in r[4]..=r[5] {
+            for y in r[2]..=r[3] {
+                for x in r[0]..=r[1] {
+                    f((z * self.dims[1] + y) * self.dims[0] + x);
+                }
+            }
+        }
+    }
+
+    fn scan(&self, p: [f64; 3], r: &[usize; 6], best: &mut f64) {
+        self.for_cells(r, |c| {
+            for &t in &self.items[self.start[c] as usize..self.start[c + 1] as usize] {
+                *best = best.min(point_triangle_distance(p, &self.tris[t as usize]));
+            }
+        });
+    }
+
+    /// Distance from `p` to the mesh (`∞` for an empty mesh).
+    pub fn distance(&self, p: [f64; 3]) -> f64 {
+        if self.tris.is_empty() {
+            return f64::INFINITY;
+        }
+        let c: [usize; 3] = std::array::from_fn(|k| self.index(p[k], k));
+        let mut best = f64::INFINITY;
+        // A first bound: the own cell, then growing boxes of cells until a triangle is met.
+        let mut grow = 0usize;
+        while !best.is_finite() {
+            let r: [usize; 6] = std::array::from_fn(|i| {
+                let k = i / 2;
+                if i % 2 == 0 {
+                    c[k].saturating_sub(grow)
+                } else {
+                    (c[k] + grow).min(self.dims[k] - 1)
+                }
+            });
+            self.scan(p, &r, &mut best);
+            if r.chunks(2)
+                .enumerate()
+                .all(|(k, x)| x[0] == 0 && x[1] == self.dims[k] - 1)
+            {
+                break;
+            }
+            grow = 2 * grow + 1;
+        }
+        // Every triangle within `best` is registered in a cell meeting the box p ± best.
+        let r: [usize; 6] = std::array::from_fn(|i| {
+            let k = i / 2;
+            let x = if i % 2 == 0 { p[k] - best } else { p[k] + best };
+            self.index(x, k)
+        });
+        self.scan(p, &r, &mut best);
+        best
+    }
+
+    /// RMS and maximum distance of `points` to the mesh, in percent of its bounding-box
+    /// diagonal.
+    pub fn error_percent(&self, points: &[[f64; 3]]) -> (f64, f64) {
+        let d: Vec<f64> = points.par_iter().map(|&p| self.distance(p)).collect();
+        let rms = (d.iter().map(|x| x * x).sum::<f64>() / d.len().max(1) as f64).sqrt();
+        let max = d.iter().fold(0.0f64, |a, &b| a.max(b));
+        let s = 100.0 / self.diagonal.max(1e-300);
+        (rms * s, max * s)
+    }
 }

@@ -15,6 +15,8 @@
 //! * [`surface`] — radii, the bump `exp(1 − 1/(1 − τ))` of `τ = tanh²(d/2)/tanh²(r/2)`,
 //!   weights, evaluation with partials up to order 3 (what we chose, and why, is documented
 //!   there);
+//! * [`local`] — local quadratic (or affine) approximants per basis, so the blend reproduces
+//!   polynomials and its reflection lines follow the surface;
 //! * [`fit`] — least squares on the vertices and face centres with a thin-plate fairness term,
 //!   solved by faer's sparse Cholesky;
 //! * [`measure`] — chart independence, jumps across chart boundaries, tessellation, and the
@@ -23,6 +25,7 @@
 pub mod atlas;
 pub mod fit;
 pub mod jet;
+pub mod local;
 pub mod measure;
 pub mod surface;
 

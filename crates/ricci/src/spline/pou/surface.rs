@@ -24,8 +24,9 @@
 use crate::error::{Error, Result};
 use crate::layout::isometry::Complex;
 
-use super::atlas::{point_in_face, Chart, HyperbolicAtlas};
-use super::jet::{CJet, Jet};
+use super::atlas::{point_in_face, Chart, ControlLift, HyperbolicAtlas};
+use super::jet::{su11_jet, CJet, Jet};
+use super::local::LocalPolynomial;
 
 /// `r_i = factor · R₂(c_i)` (module docs).
 pub fn two_ring_radii(atlas: &HyperbolicAtlas, factor: f64) -> Result<Vec<f64>> {
@@ -52,20 +53,28 @@ pub fn two_ring_radii(atlas: &HyperbolicAtlas, factor: f64) -> Result<Vec<f64>> 
     Ok(radii)
 }
 
-/// The bump's Taylor coefficients in `τ`: `f(τ) = exp(1 − 1/(1 − τ))`, as a function applied
-/// to a jet of `τ` (0 outside the disk).
+/// The bump of a jet of `τ`: `f(τ) = exp(1 − 1/(1 − τ))` composed through its Taylor
+/// coefficients (`g = 1/(1 − τ)`: `f′ = −g² f`, `f″ = (g⁴ − 2g³) f`,
+/// `f‴ = (−g⁶ + 6g⁵ − 6g⁴) f`); `None` outside the disk.
 #[inline]
 fn bump_of_tau(tau: &Jet) -> Option<Jet> {
     let t0 = tau.value();
     if !(t0 < 1.0) {
         return None;
     }
-    let e0 = (1.0 - 1.0 / (1.0 - t0)).exp();
-    if e0 == 0.0 {
+    let g = 1.0 / (1.0 - t0);
+    let f = (1.0 - g).exp();
+    if f == 0.0 {
         return None;
     }
-    let u = tau.scale(-1.0).add_const(1.0).recip();
-    Some(u.scale(-1.0).add_const(1.0).exp())
+    let (g2, g3) = (g * g, g * g * g);
+    let (g4, g5, g6) = (g3 * g, g3 * g2, g3 * g3);
+    Some(tau.compose_univariate(&[
+        f,
+        -g2 * f,
+        0.5 * (g4 - 2.0 * g3) * f,
+        (-g6 + 6.0 * g5 - 6.0 * g4) * f / 6.0,
+    ]))
 }
 
 /// The scalar bump at `s = tanh²(d/2)` for `σ = tanh²(r/2)`.
@@ -85,9 +94,24 @@ pub fn pseudo_distance_sqr(z: Complex, c: Complex) -> f64 {
     (z - c).norm_sqr() / (one - c.conj() * z).norm_sqr()
 }
 
-/// The jet of `b` at the chart point `z` (jets of the coordinate `x`, `y` in `zj`).
+/// The local coordinate `W = T(z)` of a control lift (`T` its map to the basis' chart).
 #[inline]
-fn bump_jet(zj: &CJet, c: Complex, sigma: f64) -> Option<Jet> {
+fn local_coordinate(c: &ControlLift, z: Complex) -> Complex {
+    (c.map.a * z + c.map.b) / (c.map.b.conj() * z + c.map.a.conj())
+}
+
+/// A basis' contribution at a point of a chart, as jets: `b` and its local coordinate.
+pub struct BumpJet {
+    pub vertex: u32,
+    pub bump: Jet,
+    /// `W/s` (real and imaginary parts), `s = tanh(r/2)`.
+    pub local: CJet,
+}
+
+/// The jet of `b` at the chart point `z` (jets of the coordinate `x`, `y` in `zj`) from the
+/// lift's position `c`, by the arithmetic of jets (the independent reference of the
+/// closed-form [`PouBasis::bump_jets`] in the tests).
+pub fn bump_jet(zj: &CJet, c: Complex, sigma: f64) -> Option<Jet> {
     let x = &zj.re;
     let y = &zj.im;
     let dx = x.add_const(-c.re);
@@ -133,7 +157,10 @@ impl<'a> PouBasis<'a> {
         let chart = self.chart(v)?;
         let mut sum = 0.0;
         for c in &chart.controls {
-            let b = bump(pseudo_distance_sqr(z, c.z), self.sigma[c.vertex as usize]);
+            let b = bump(
+                local_coordinate(c, z).norm_sqr(),
+                self.sigma[c.vertex as usize],
+            );
             if b > 0.0 {
                 out.push((c.vertex, b));
                 sum += b;
@@ -150,6 +177,48 @@ impl<'a> PouBasis<'a> {
         Ok(())
     }
 
+    /// The bumps (not normalized) that are non-zero at the chart point `z` of chart `v`, with
+    /// their local coordinates, as jets of order `order` (≤ 3); returns `Σ b`. The local
+    /// coordinate's jet comes from the SU(1,1) map's closed-form derivatives and
+    /// `τ = |W|²/σ`, so a bump costs five jet products.
+    pub fn bump_jets(
+        &self,
+        v: u32,
+        z: Complex,
+        order: usize,
+        out: &mut Vec<BumpJet>,
+    ) -> Result<Jet> {
+        out.clear();
+        let chart = self.chart(v)?;
+        let mut sum = Jet::constant(0.0, order);
+        for c in &chart.controls {
+            let sigma = self.sigma[c.vertex as usize];
+            if local_coordinate(c, z).norm_sqr() >= sigma {
+                continue;
+            }
+            let w = su11_jet(c.map.a, c.map.b, z, order);
+            let tau = w.re.mul(&w.re).add(&w.im.mul(&w.im)).scale(1.0 / sigma);
+            if let Some(b) = bump_of_tau(&tau) {
+                sum = sum.add(&b);
+                let s = 1.0 / sigma.sqrt();
+                out.push(BumpJet {
+                    vertex: c.vertex,
+                    bump: b,
+                    local: CJet {
+                        re: w.re.scale(s),
+                        im: w.im.scale(s),
+                    },
+                });
+            }
+        }
+        if !(sum.value() > 0.0) {
+            return Err(Error::numerical(format!(
+                "no basis covers the point {z} of the chart of vertex {v}"
+            )));
+        }
+        Ok(sum)
+    }
+
     /// Weights with their partials up to `order` (≤ 3) in the chart coordinate.
     pub fn weight_jets(
         &self,
@@ -158,62 +227,102 @@ impl<'a> PouBasis<'a> {
         order: usize,
         out: &mut Vec<(u32, Jet)>,
     ) -> Result<()> {
-        out.clear();
-        let chart = self.chart(v)?;
-        let zj = CJet::variable(z, order);
-        let mut sum = Jet::constant(0.0, order);
-        for c in &chart.controls {
-            if pseudo_distance_sqr(z, c.z) >= self.sigma[c.vertex as usize] {
-                continue;
-            }
-            if let Some(b) = bump_jet(&zj, c.z, self.sigma[c.vertex as usize]) {
-                sum = sum.add(&b);
-                out.push((c.vertex, b));
-            }
-        }
-        if !(sum.value() > 0.0) {
-            return Err(Error::numerical(format!(
-                "no basis covers the point {z} of the chart of vertex {v}"
-            )));
-        }
+        let mut b = Vec::new();
+        let sum = self.bump_jets(v, z, order, &mut b)?;
         let inv = sum.recip();
-        for w in out.iter_mut() {
-            w.1 = w.1.mul(&inv);
-        }
+        out.clear();
+        out.extend(b.iter().map(|x| (x.vertex, x.bump.mul(&inv))));
         Ok(())
     }
 }
 
-/// A partition-of-unity surface: bases and control points (one per vertex).
+/// A partition-of-unity surface: bases, control points (one per vertex) and, optionally,
+/// local polynomials (one per vertex, [`super::local`]; empty: constants only).
 pub struct PouSurface<'a> {
     pub basis: PouBasis<'a>,
     pub control: Vec<[f64; 3]>,
+    pub local: Vec<LocalPolynomial>,
+}
+
+/// `Q(X, Y)` of a local polynomial.
+#[inline]
+fn local_value(q: &[f64; 5], x: f64, y: f64) -> f64 {
+    q[0] * x + q[1] * y + q[2] * x * x + q[3] * x * y + q[4] * y * y
 }
 
 impl<'a> PouSurface<'a> {
     /// `F` at the chart point `z` of chart `v`.
     pub fn value(&self, v: u32, z: Complex, scratch: &mut Vec<(u32, f64)>) -> Result<[f64; 3]> {
-        self.basis.weights(v, z, scratch)?;
+        let chart = self.basis.chart(v)?;
         let mut p = [0.0; 3];
-        for &(i, w) in scratch.iter() {
+        let mut sum = 0.0;
+        scratch.clear();
+        for c in &chart.controls {
+            let i = c.vertex as usize;
+            let w = local_coordinate(c, z);
+            let b = bump(w.norm_sqr(), self.basis.sigma[i]);
+            if b <= 0.0 {
+                continue;
+            }
+            sum += b;
+            let l = self.local_at(i, w);
             for d in 0..3 {
-                p[d] += w * self.control[i as usize][d];
+                p[d] += b * l[d];
             }
         }
-        Ok(p)
+        if !(sum > 0.0) {
+            return Err(Error::numerical(format!(
+                "no basis covers the point {z} of the chart of vertex {v}"
+            )));
+        }
+        Ok(p.map(|x| x / sum))
+    }
+
+    /// `Lᵢ(W)` for the local coordinate `W` of a lift of vertex `i`.
+    #[inline]
+    fn local_at(&self, i: usize, w: Complex) -> [f64; 3] {
+        let mut l = self.control[i];
+        if let Some(q) = self.local.get(i) {
+            let s = 1.0 / self.basis.sigma[i].sqrt();
+            let (x, y) = (w.re * s, w.im * s);
+            for d in 0..3 {
+                l[d] += local_value(&q[d], x, y);
+            }
+        }
+        l
     }
 
     /// `F` and its partials up to `order` at the chart point `z` of chart `v`.
     pub fn jets(&self, v: u32, z: Complex, order: usize) -> Result<[Jet; 3]> {
-        let mut w = Vec::new();
-        self.basis.weight_jets(v, z, order, &mut w)?;
-        let mut out = [Jet::constant(0.0, order); 3];
-        for (i, j) in &w {
-            for d in 0..3 {
-                out[d].axpy(self.control[*i as usize][d], j);
+        let mut b = Vec::new();
+        let sum = self.basis.bump_jets(v, z, order, &mut b)?;
+        let mut acc = [Jet::constant(0.0, order); 3];
+        for x in &b {
+            let i = x.vertex as usize;
+            let p = self.control[i];
+            match self.local.get(i) {
+                None => {
+                    for d in 0..3 {
+                        acc[d].axpy(p[d], &x.bump);
+                    }
+                }
+                Some(q) => {
+                    let (lx, ly) = (&x.local.re, &x.local.im);
+                    let mono = [*lx, *ly, lx.mul(lx), lx.mul(ly), ly.mul(ly)];
+                    for d in 0..3 {
+                        let mut l = Jet::constant(p[d], order);
+                        for k in 0..5 {
+                            if q[d][k] != 0.0 {
+                                l.axpy(q[d][k], &mono[k]);
+                            }
+                        }
+                        acc[d] = acc[d].add(&x.bump.mul(&l));
+                    }
+                }
             }
         }
-        Ok(out)
+        let inv = sum.recip();
+        Ok(acc.map(|a| a.mul(&inv)))
     }
 
     /// `F` at the surface point `(f, λ)` (evaluated in the chart of the face's first vertex).
