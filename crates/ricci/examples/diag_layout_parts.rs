@@ -65,7 +65,10 @@ fn main() {
     let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &f).unwrap();
     clock.lap(
         "polish",
-        format!("({} steps, {:.1e} → {:.1e})", p.steps, p.residual_start, p.residual_dd),
+        format!(
+            "({} steps, {:.1e} → {:.1e})",
+            p.steps, p.residual_start, p.residual_dd
+        ),
     );
     let pos = f.triangulation.is_none().then_some(&s.positions[..]);
     let d =
@@ -100,18 +103,16 @@ fn main() {
         "deck",
         format!(
             "(relation error {:.1e}, edge spread {:.1e}, matrix spread {:.1e})",
-            g.relation_error.unwrap_or(f64::NAN), g.max_edge_spread, g.max_edge_spread_matrix
+            g.relation_error.unwrap_or(f64::NAN),
+            g.max_edge_spread,
+            g.max_edge_spread_matrix
         ),
     );
     let u =
         input_face_uvs::<Hyperbolic>(&s.mesh, &l.positions, &d.vertex_origin, Some(&g)).unwrap();
     clock.lap(
         "input uv",
-        format!(
-            "(flipped {}, seam {})",
-            u.flipped_faces.len(),
-            u.seam_faces
-        ),
+        format!("(flipped {}, seam {})", u.flipped_faces.len(), u.seam_faces),
     );
     println!("total    wall {:6.2} s  cpu {:6.2} s", clock.2, clock.3);
 }
