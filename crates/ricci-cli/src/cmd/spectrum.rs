@@ -1,20 +1,24 @@
 //! `ricci spectrum MESH --count N [--metric METRIC.json] [--base V] [--json]`: geodesic length
 //! spectrum of a closed surface of genus ≥ 1 (paper 002 §6.3.3): uniformization metric (E² for
-//! genus 1, H² for genus ≥ 2; or the given metric), canonical cut, layout, deck group, then
-//! the `N` shortest free homotopy classes (unoriented, powers included), sorted. Genus 1
-//! lengths are normalized by the shortest (paper 002 Table 2); hyperbolic lengths are absolute
-//! (curvature −1, Tables 3–4) and also given normalized. Hyperbolic metrics are polished to
-//! double-double before the layout, as in `ricci layout` (`metric_polish` in the report).
+//! genus 1, H² for genus ≥ 2; or the given metric), then the `N` shortest free homotopy
+//! classes (unoriented, powers included), sorted. Genus 1: canonical cut, layout, deck group,
+//! lattice vectors; lengths are normalized by the shortest (paper 002 Table 2). Genus ≥ 2: the
+//! metric is polished to double-double (as in `ricci layout`, `metric_polish` in the report)
+//! and the search runs on a compact fundamental domain grown from a central vertex (`--base`
+//! chooses it) with a budget of 2 000 000 tiles (`ricci::analysis::spectrum::surface_spectrum`;
+//! `details` gives the domain's radius, the tiles and the bound `complete_up_to`); lengths are
+//! absolute (curvature −1, Tables 3–4) and also given normalized. A metric that did not
+//! converge is refused.
 
 use super::layout::{polished_metric, spinner, PolishedLengths};
 use crate::util::read_surface;
 use crate::util::{print_json, UsageError};
-use ricci::analysis::spectrum::{fuchsian_spectrum, lattice_spectrum};
+use ricci::analysis::spectrum::{lattice_spectrum, surface_spectrum};
 use ricci::layout::deck_group;
-use ricci::layout::pipeline::{cut_disk, cut_disk_polished};
-use ricci::layout::place::{layout, layout_dd};
+use ricci::layout::pipeline::cut_disk;
+use ricci::layout::place::layout;
 use ricci::mesh::topology;
-use ricci::metric::{Euclidean, Geometry, Hyperbolic};
+use ricci::metric::{Euclidean, Geometry};
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -33,7 +37,8 @@ pub struct Args {
     /// Metric from `ricci flow --out` (flat for genus 1, hyperbolic otherwise).
     #[arg(long)]
     pub metric: Option<PathBuf>,
-    /// Base vertex of the canonical loops.
+    /// Base vertex of the canonical loops (genus 1) or centre of the compact fundamental
+    /// domain (genus ≥ 2).
     #[arg(long)]
     pub base: Option<u32>,
     /// Print one JSON object on stdout.
@@ -88,7 +93,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         lengths,
         lengths_lo,
         report: metric_report,
-        polish: mut polish_report,
+        polish: polish_report,
     } = polished_metric(
         &surface,
         Some(want),
@@ -100,17 +105,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     )
     .map_err(|e| anyhow::anyhow!("{}: {}", a.mesh.display(), crate::util::sentence(&e)))?;
     let work = own_mesh.as_ref().unwrap_or(&surface.mesh);
-    bar.0.set_message("cutting along canonical loops");
-    let disk = match &lengths_lo {
-        Some(lo) => {
-            let d = cut_disk_polished(work, &lengths, lo, None, a.base, &mut bar)?;
-            polish_report["refined"] = json!(d.refined_polish);
-            d
-        }
-        None => cut_disk(work, &lengths, geometry, None, a.base, &mut bar)?,
-    };
-    bar.0.set_message("layout, deck group and spectrum");
-    let (abs, extra) = if geometry == Geometry::Euclidean {
+    let (abs, extra, word) = if geometry == Geometry::Euclidean {
+        bar.0.set_message("cutting along canonical loops");
+        let disk = cut_disk(work, &lengths, geometry, None, a.base, &mut bar)?;
+        bar.0.set_message("layout, deck group and spectrum");
         let l = layout::<Euclidean>(&disk.mesh, &disk.lengths, None)?;
         let g = deck_group::<Euclidean>(&l, &disk.polygon)?;
         let gens = g.named_generators();
@@ -122,16 +120,28 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         (
             sp,
             json!({"relation_error": g.relation_error, "modulus": [tau.0, tau.1]}),
+            Some(disk.polygon.word()),
         )
     } else {
-        let lo = (!disk.lengths_lo.is_empty()).then_some(&disk.lengths_lo[..]);
-        let l = layout_dd::<Hyperbolic>(&disk.mesh, &disk.lengths, lo, None)?;
-        let g = deck_group::<Hyperbolic>(&l, &disk.polygon)?;
-        let sp = fuchsian_spectrum(&l, &disk.polygon, &g, a.count, 2_000_000)?;
+        // A compact fundamental domain grown from a central vertex (no canonical cut needed;
+        // `ricci::analysis::spectrum::surface_spectrum`), searched with a tile budget.
+        bar.0.set_message("compact fundamental domain and spectrum");
+        let (sp, dom) = surface_spectrum(
+            work,
+            &lengths,
+            lengths_lo.as_deref(),
+            a.base,
+            a.count,
+            2_000_000,
+        )
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?;
         (
             sp.lengths(),
-            json!({"relation_error": g.relation_error, "complete_up_to": sp.complete_up_to,
-                   "tiles": sp.tiles, "unmatched_links": sp.unmatched_links}),
+            json!({"method": "compact fundamental domain", "complete_up_to": sp.complete_up_to,
+                   "tiles": sp.tiles, "unmatched_links": sp.unmatched_links,
+                   "domain": {"radius": dom.radius, "faces": dom.faces,
+                              "boundary_edges": dom.boundary_edges, "generators": dom.generators}}),
+            None,
         )
     };
     bar.0.finish_and_clear();
@@ -153,7 +163,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "metric_polish": polish_report,
         "modulus": extra.get("modulus").cloned(),
         "details": extra,
-        "boundary_word": disk.polygon.word(),
+        "boundary_word": word,
         "seconds": t0.elapsed().as_secs_f64(),
     });
     if a.json {

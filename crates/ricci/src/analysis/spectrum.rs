@@ -480,6 +480,355 @@ pub fn fuchsian_spectrum(
         .unwrap_or_else(|| Error::numerical("the spectrum search did not find enough classes")))
 }
 
+/// What [`surface_spectrum`] did besides the lengths.
+#[derive(Debug, Clone)]
+pub struct CompactDomain {
+    /// Radius of the compact fundamental domain around its centre (the bound of the search
+    /// is `L + 2·radius`).
+    pub radius: f64,
+    /// Faces of the domain and edges on its boundary (each edge twice).
+    pub faces: usize,
+    pub boundary_edges: usize,
+    /// Distinct side pairings of the domain (a generating set of the deck group).
+    pub generators: usize,
+}
+
+/// Length spectrum of a closed hyperbolic surface given by a triangulation with a hyperbolic
+/// metric (`lengths` + optional double-double low parts `lengths_lo`, curvature 0 at every
+/// vertex; `centre`: the vertex the domain grows from, default a central one), through a **compact fundamental domain** instead of the canonical polygon.
+///
+/// The domain `F` is the development of the surface along a spanning tree of the dual graph
+/// grown in the order of the (edge-path) distance from a central vertex (Prim on faces): the
+/// surface is sliced along the edges the tree does not cross (a disk) and laid out in
+/// double-double with the central face at the centre. Its side pairings (one per sliced
+/// edge, deduplicated) generate the deck group. Because the faces were added nearest first,
+/// `F` stays within about the surface's radius of its centre `o` (`radius`, measured on the
+/// layout: the largest distance from `o` to a vertex of `F`; faces are geodesic triangles, so
+/// `F ⊂ B(o, radius)`), whereas the canonical polygon of a genus-4 or genus-5 mesh reaches 12
+/// or more, which made the search of [`fuchsian_spectrum`] visit millions of tiles.
+///
+/// Completeness (the argument of the module docs with this `F`): every class of length
+/// `ℓ ≤ L` has a conjugate `γ` whose axis meets `F`; then `d(o, γo) ≤ ℓ + 2·radius`. The
+/// tiles `gF` at distance ≤ L from `F` are connected under side adjacency, and all of them
+/// satisfy `d(o, go) ≤ L + 2·radius`, so a breadth-first search through the side pairings
+/// that keeps the tiles with `d(o, go) ≤ L + 2·radius` (widened by 1e-9 relative) finds every
+/// such `γ`. Classes are formed as in [`fuchsian_spectrum`] (the pieces of one closed geodesic
+/// are linked through the sides its axis crosses). `L` starts at the shortest side pairing's
+/// translation length and grows by 1.25 until `count` classes are complete.
+///
+/// Budgets: at most `max_tiles` tiles per search and 16 enlargements of `L`; exceeding either
+/// is an error that says so.
+pub fn surface_spectrum(
+    mesh: &crate::mesh::Mesh,
+    lengths: &[f64],
+    lengths_lo: Option<&[f64]>,
+    centre: Option<u32>,
+    count: usize,
+    max_tiles: usize,
+) -> Result<(HyperbolicSpectrum, CompactDomain)> {
+    use crate::layout::dd::{Cdd, MobiusDd};
+    use crate::layout::place::layout_dd;
+    use crate::metric::Hyperbolic;
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+    let ne = mesh.n_edges();
+    if lengths.len() != ne || lengths_lo.is_some_and(|l| l.len() != ne) {
+        return Err(Error::input(format!(
+            "{} edge lengths for a mesh with {ne} edges",
+            lengths.len()
+        )));
+    }
+    if mesh.has_boundary() || mesh.n_faces() == 0 {
+        return Err(Error::topology(
+            "the length spectrum needs a closed surface (the mesh has a boundary or no faces)",
+        ));
+    }
+    // Centre: a central vertex (double sweep), and edge-path distances from it.
+    let o = match centre {
+        Some(v) if (v as usize) < mesh.n_vertices() => v,
+        Some(v) => {
+            return Err(Error::input(format!(
+                "centre vertex {v} does not exist (the mesh has {} vertices)",
+                mesh.n_vertices()
+            )))
+        }
+        None => crate::cut::central_vertex(mesh, lengths)?,
+    };
+    let dist = crate::cut::distances(mesh, lengths, &[o]);
+    let key = |f: u32| -> f64 {
+        mesh.face(f)
+            .iter()
+            .map(|&v| dist[v as usize])
+            .fold(0.0, f64::max)
+    };
+    // Prim on the dual graph, nearest faces first.
+    let nf = mesh.n_faces();
+    let seed = mesh
+        .outgoing(o)
+        .map(|h| mesh.he_face(h))
+        .find(|&f| f != crate::mesh::NONE)
+        .ok_or_else(|| Error::topology(format!("vertex {o} has no face")))?;
+    let mut developed = vec![false; nf];
+    let mut crossed = vec![false; ne];
+    // Entries: (face key, key of the shared edge, face, edge): a face is attached across
+    // its edge nearest to the centre.
+    type Entry = (Reverse<u64>, Reverse<u64>, u32, u32);
+    let mut heap: BinaryHeap<Entry> = BinaryHeap::new();
+    heap.push((Reverse(0), Reverse(0), seed, u32::MAX));
+    while let Some((_, _, f, via)) = heap.pop() {
+        if developed[f as usize] {
+            continue;
+        }
+        developed[f as usize] = true;
+        if via != u32::MAX {
+            crossed[via as usize] = true;
+        }
+        for h in mesh.face_halfedges(f) {
+            let g = mesh.he_face(mesh.he_twin(h));
+            if g != crate::mesh::NONE && !developed[g as usize] {
+                let [a, b] = mesh.edge_vertices(mesh.he_edge(h));
+                let ek = dist[a as usize].max(dist[b as usize]);
+                heap.push((
+                    Reverse(key(g).to_bits()),
+                    Reverse(ek.to_bits()),
+                    g,
+                    mesh.he_edge(h),
+                ));
+            }
+        }
+    }
+    if developed.iter().any(|&d| !d) {
+        return Err(Error::topology("the surface is not connected"));
+    }
+    let cut: Vec<bool> = crossed.iter().map(|&c| !c).collect();
+    let (cm, _origin) = crate::cut::slice(mesh, &cut)?;
+    let mut cl = vec![0.0; cm.n_edges()];
+    let mut cl_lo = vec![0.0; cm.n_edges()];
+    for h in 0..cm.n_corners() as u32 {
+        let e = mesh.he_edge(h) as usize;
+        cl[cm.he_edge(h) as usize] = lengths[e];
+        cl_lo[cm.he_edge(h) as usize] = lengths_lo.map_or(0.0, |l| l[e]);
+    }
+    let lay = layout_dd::<Hyperbolic>(&cm, &cl, Some(&cl_lo), Some(seed))?;
+    if !lay.flipped_faces.is_empty() {
+        return Err(Error::numerical(format!(
+            "the compact fundamental domain has {} flipped faces (face {}); is the metric \
+             hyperbolic and converged?",
+            lay.flipped_faces.len(),
+            lay.flipped_faces[0]
+        )));
+    }
+    let pos = |v: u32| Cdd::from_parts(lay.positions[v as usize], lay.positions_lo[v as usize]);
+    // Side pairings: the sliced edge h (face f) and its twin t (face f') are two sides; the
+    // map S_h takes F onto the tile across h, i.e. t's copy onto h's copy, reversed.
+    let loops = cm.boundary_loop_halfedges();
+    if loops.len() != 1 {
+        return Err(Error::numerical(format!(
+            "internal error: the sliced surface has {} boundary loops",
+            loops.len()
+        )));
+    }
+    let bloop = &loops[0];
+    let mut gens: Vec<Mobius> = Vec::new();
+    let mut gen_index = TileIndex::new();
+    let o_pt = {
+        let pts: Vec<Complex> = bloop
+            .iter()
+            .map(|&h| lay.positions[cm.he_origin(h) as usize])
+            .collect();
+        crate::layout::place::minimax_centre::<Hyperbolic>(&pts)
+    };
+    let o_h = poincare_to_hyperboloid(o_pt);
+    let mut bnd: Vec<(Complex, usize)> = Vec::with_capacity(bloop.len());
+    for &h in bloop {
+        let t = mesh.he_twin(h);
+        let m = MobiusDd::from_pairs(
+            pos(cm.he_origin(t)),
+            pos(cm.he_tip(t)),
+            pos(cm.he_tip(h)),
+            pos(cm.he_origin(h)),
+        )
+        .round();
+        let go = apply_h(&m.klein_matrix(), o_h);
+        let k = match gen_index.find(go) {
+            Some(k) => k,
+            None => {
+                gens.push(m);
+                gen_index.insert(go)
+            }
+        };
+        bnd.push((lay.positions[cm.he_origin(h) as usize], k));
+    }
+    let radius = bnd
+        .iter()
+        .map(|b| disk_distance(o_pt, b.0))
+        .fold(0.0, f64::max);
+    let domain = CompactDomain {
+        radius,
+        faces: nf,
+        boundary_edges: bnd.len(),
+        generators: gens.len(),
+    };
+    let nb = bnd.len();
+    let mut l = gens
+        .iter()
+        .map(|g| g.translation_length())
+        .filter(|x| *x > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    if !l.is_finite() {
+        return Err(Error::numerical(
+            "the side pairings are not hyperbolic isometries (is the metric hyperbolic?)",
+        ));
+    }
+    let hdist = |x: [f64; 3], y: [f64; 3]| -> f64 {
+        TileIndex::dist(&TileIndex::entry(x), &TileIndex::entry(y))
+    };
+    for _round in 0..16 {
+        let bound = (l + 2.0 * radius) * (1.0 + 1e-9) + 1e-9;
+        let mut index = TileIndex::new();
+        let mut elems: Vec<Mobius> = vec![Mobius::identity()];
+        index.insert(o_h);
+        let mut queue = VecDeque::from([0usize]);
+        while let Some(t) = queue.pop_front() {
+            for sm in &gens {
+                let g = elems[t].compose(sm).normalized();
+                let go = apply_h(&g.klein_matrix(), o_h);
+                if hdist(o_h, go) > bound || index.find(go).is_some() {
+                    continue;
+                }
+                index.insert(go);
+                elems.push(g);
+                queue.push_back(elems.len() - 1);
+                if elems.len() > max_tiles {
+                    return Err(Error::numerical(format!(
+                        "the spectrum search exceeded its budget of {max_tiles} tiles of the \
+                         universal cover at length bound {l:.3} (domain radius {radius:.2}); \
+                         ask for fewer lengths"
+                    )));
+                }
+            }
+        }
+        // Candidates: hyperbolic, ℓ ≤ L, axis meets F (crosses ∂F).
+        let tol = 1e-8;
+        let mut cand: Vec<usize> = Vec::new();
+        let mut crossings: Vec<Vec<usize>> = Vec::new();
+        for (i, g) in elems.iter().enumerate().skip(1) {
+            let len = g.translation_length();
+            if !(len > 0.0 && len <= l) {
+                continue;
+            }
+            let Some(fr) = axis_frame(g) else { continue };
+            // The axis is the real diameter in the frame: skip it when it passes farther
+            // than the domain's radius from o (sinh d = 2|Im w|/(1 − |w|²)).
+            let w = fr.apply(o_pt);
+            let sinh_d = 2.0 * w.im.abs() / (1.0 - w.norm_sqr()).max(1e-300);
+            if sinh_d.asinh() > radius * (1.0 + 1e-9) + 1e-9 {
+                continue;
+            }
+            let ims: Vec<f64> = bnd.iter().map(|b| fr.apply(b.0).im).collect();
+            let mut sides = Vec::new();
+            for e in 0..nb {
+                let (a, b) = (ims[e], ims[(e + 1) % nb]);
+                if a * b <= 0.0 || a.abs() < tol || b.abs() < tol {
+                    let s = bnd[e].1;
+                    if !sides.contains(&s) {
+                        sides.push(s);
+                    }
+                }
+            }
+            if !sides.is_empty() {
+                cand.push(i);
+                crossings.push(sides);
+            }
+        }
+        let classes = group_classes(&elems, &cand, &crossings, &gens, &index, o_h);
+        let (mut classes, unmatched) = classes;
+        classes.sort_by(|a, b| a.length.total_cmp(&b.length));
+        if classes.len() >= count {
+            classes.truncate(count);
+            return Ok((
+                HyperbolicSpectrum {
+                    classes,
+                    complete_up_to: l,
+                    tiles: elems.len(),
+                    unmatched_links: unmatched,
+                },
+                domain,
+            ));
+        }
+        l *= 1.25;
+    }
+    Err(Error::numerical(format!(
+        "the spectrum search did not find {count} classes within its budget of 16 \
+         enlargements of the length bound (last bound {l:.3})"
+    )))
+}
+
+/// Union of candidates into classes (see [`fuchsian_spectrum`]): each candidate is joined
+/// with its inverse and with its conjugates by the side pairings of the sides its axis
+/// crosses. Returns the classes and the number of links to tiles that were not enumerated.
+fn group_classes(
+    elems: &[Mobius],
+    cand: &[usize],
+    crossings: &[Vec<usize>],
+    side_maps: &[Mobius],
+    index: &TileIndex,
+    o_h: [f64; 3],
+) -> (Vec<GeodesicClass>, usize) {
+    let mut pos_of: HashMap<usize, usize> = HashMap::new();
+    for (c, &i) in cand.iter().enumerate() {
+        pos_of.insert(i, c);
+    }
+    let mut parent: Vec<usize> = (0..cand.len()).collect();
+    fn find(p: &mut [usize], x: usize) -> usize {
+        let mut r = x;
+        while p[r] != r {
+            r = p[r];
+        }
+        let mut y = x;
+        while p[y] != r {
+            let nx = p[y];
+            p[y] = r;
+            y = nx;
+        }
+        r
+    }
+    let mut unmatched = 0;
+    for (c, &i) in cand.iter().enumerate() {
+        let g = elems[i];
+        let mut links = vec![g.inverse()];
+        for &s in &crossings[c] {
+            let sm = side_maps[s];
+            links.push(sm.inverse().compose(&g).compose(&sm).normalized());
+        }
+        for h in links {
+            match index.find(apply_h(&h.klein_matrix(), o_h)) {
+                Some(i) => {
+                    if let Some(&d) = pos_of.get(&i) {
+                        let (a, b) = (find(&mut parent, c), find(&mut parent, d));
+                        if a != b {
+                            parent[a.max(b)] = a.min(b);
+                        }
+                    }
+                }
+                None => unmatched += 1,
+            }
+        }
+    }
+    let mut classes: HashMap<usize, GeodesicClass> = HashMap::new();
+    for (c, &i) in cand.iter().enumerate() {
+        let r = find(&mut parent, c);
+        let g = elems[i];
+        let e = classes.entry(r).or_insert(GeodesicClass {
+            length: g.translation_length(),
+            representative: g,
+            pieces: 0,
+        });
+        e.pieces += 1;
+    }
+    (classes.into_values().collect(), unmatched)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -621,7 +621,8 @@ pub fn layout_dd<S: Space>(
         }
         None => central_face(mesh),
     };
-    let first = layout_unchecked::<S>(mesh, lengths, lengths_lo, seed);
+    let canonical = canonical_triangles::<S>(mesh, lengths, lengths_lo);
+    let first = layout_from::<S>(mesh, lengths, &canonical, seed);
     if seed_face.is_some() || !mesh.has_boundary() {
         return Ok(first);
     }
@@ -639,7 +640,7 @@ pub fn layout_dd<S: Space>(
     if best == seed {
         return Ok(first);
     }
-    Ok(layout_unchecked::<S>(mesh, lengths, lengths_lo, best))
+    Ok(layout_from::<S>(mesh, lengths, &canonical, best))
 }
 
 fn boundary_points<P: Copy>(mesh: &Mesh, pos: &[P]) -> Vec<P> {
@@ -668,11 +669,29 @@ pub fn minimax_centre<S: Space>(points: &[S::Point]) -> S::Point {
     c
 }
 
-/// Breadth-first placement from `seed` (inputs already validated).
-pub(crate) fn layout_unchecked<S: Space>(
+/// The canonical triangle of every face in the working precision of the space
+/// ([`Space::seed_ext`]; double-double transcendentals in H², so computed once per layout).
+fn canonical_triangles<S: Space>(
     mesh: &Mesh,
     lengths: &[f64],
     lengths_lo: Option<&[f64]>,
+) -> Vec<[ExtPoint<S>; 3]> {
+    let len = |h: u32| lengths[mesh.he_edge(h) as usize];
+    let lo = |h: u32| lengths_lo.map_or(0.0, |l| l[mesh.he_edge(h) as usize]);
+    (0..mesh.n_faces() as u32)
+        .map(|f| {
+            let [a, b, c] = mesh.face_halfedges(f);
+            S::seed_ext([len(a), len(b), len(c)], [lo(a), lo(b), lo(c)])
+        })
+        .collect()
+}
+
+/// Breadth-first placement from `seed` with the faces' canonical triangles
+/// ([`canonical_triangles`]).
+fn layout_from<S: Space>(
+    mesh: &Mesh,
+    lengths: &[f64],
+    canonical: &[[ExtPoint<S>; 3]],
     seed: u32,
 ) -> Layout<S::Point> {
     use std::cmp::Reverse;
@@ -695,14 +714,6 @@ pub(crate) fn layout_unchecked<S: Space>(
     // computed near the base point from the metric alone; positions are frames applied to
     // canonical triangles. So no direction is ever taken from the difference of two nearby
     // far-away points (in the Poincaré disk those lose ~1e-16·e^r / l of accuracy).
-    let lo = |h: u32| lengths_lo.map_or(0.0, |l| l[mesh.he_edge(h) as usize]);
-    // Computed once per face (double-double transcendentals in H²).
-    let canonical: Vec<[ExtPoint<S>; 3]> = (0..nf as u32)
-        .map(|f| {
-            let [a, b, c] = mesh.face_halfedges(f);
-            S::seed_ext([len(a), len(b), len(c)], [lo(a), lo(b), lo(c)])
-        })
-        .collect();
     let canon = |f: u32| canonical[f as usize];
     // Frames are composed in the working precision of the space (double-double in H²,
     // see [`Frame`]); the relative placements are computed near the base point in double

@@ -79,6 +79,18 @@ impl Dd {
         let (s, t) = quick_two_sum(x, r / (2.0 * x));
         Dd { hi: s, lo: t }
     }
+    /// `self / b` for a double `b` (two quotient digits with the exact remainder, relative
+    /// accuracy ~1e-32; no double-double multiplication).
+    #[inline]
+    pub fn div_f64(self, b: f64) -> Dd {
+        let q1 = self.hi / b;
+        let (p1, p2) = two_prod(q1, b);
+        let (s, e) = two_sum(self.hi, -p1);
+        let e = e + self.lo - p2;
+        let q2 = (s + e) / b;
+        let (hi, lo) = quick_two_sum(q1, q2);
+        Dd { hi, lo }
+    }
     #[inline]
     pub fn abs(self) -> Dd {
         if self.hi < 0.0 {
@@ -120,7 +132,7 @@ impl Dd {
         let mut term = s;
         let mut sum = s;
         for n in 2..=12 {
-            term = term * s / Dd::new(n as f64);
+            term = (term * s).div_f64(n as f64);
             sum = sum + term;
             if term.hi.abs() < 1e-36 {
                 break;
@@ -149,20 +161,35 @@ impl Dd {
     /// Hyperbolic sine.
     pub fn sinh(self) -> Dd {
         if self.hi.abs() < 0.5 {
-            let x2 = self.sqr();
-            let mut term = self;
-            let mut sum = self;
-            for n in 1..30 {
-                term = term * x2 / Dd::new(((2 * n) * (2 * n + 1)) as f64);
-                sum = sum + term;
-                if term.hi.abs() < 1e-34 * sum.hi.abs() {
-                    break;
-                }
-            }
-            return sum;
+            return self.sinh_series();
         }
         let e = self.exp();
         (e - Dd::ONE / e) * Dd::new(0.5)
+    }
+    /// Taylor series of `sinh` (for `|x| < 1/2`: no cancellation near 0).
+    fn sinh_series(self) -> Dd {
+        let x2 = self.sqr();
+        let mut term = self;
+        let mut sum = self;
+        for n in 1..30 {
+            term = (term * x2).div_f64(((2 * n) * (2 * n + 1)) as f64);
+            sum = sum + term;
+            if term.hi.abs() < 1e-34 * sum.hi.abs() {
+                break;
+            }
+        }
+        sum
+    }
+    /// `(sinh x, cosh x)` with one exponential (below 1/2: the series of `sinh` and
+    /// `cosh = √(1 + sinh²)`, which has no cancellation there).
+    pub fn sinh_cosh(self) -> (Dd, Dd) {
+        if self.hi.abs() < 0.5 {
+            let s = self.sinh_series();
+            return (s, (Dd::ONE + s.sqr()).sqrt());
+        }
+        let e = self.exp();
+        let inv = Dd::ONE / e;
+        ((e - inv) * Dd::new(0.5), (e + inv) * Dd::new(0.5))
     }
     /// Hyperbolic cosine.
     pub fn cosh(self) -> Dd {
@@ -173,15 +200,16 @@ impl Dd {
     /// value).
     pub fn asinh(self) -> Dd {
         let y = Dd::new(self.hi.asinh());
-        let c = y.cosh();
-        y + (self - y.sinh()) / c
+        let (s, c) = y.sinh_cosh();
+        y + (self - s) / c
     }
     /// `tanh(x)` as `sinh x / cosh x` (relative accuracy ~1e-31 also near 0).
     pub fn tanh(self) -> Dd {
         if self.hi.abs() > 40.0 {
             return Dd::new(self.hi.signum());
         }
-        self.sinh() / self.cosh()
+        let (s, c) = self.sinh_cosh();
+        s / c
     }
 }
 
