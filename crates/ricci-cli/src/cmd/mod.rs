@@ -8,6 +8,7 @@ pub mod flow;
 pub mod generate;
 pub mod info;
 pub mod layout;
+pub mod param;
 pub mod pou;
 pub mod render;
 pub mod spectrum;
