@@ -76,8 +76,8 @@ fn parse<A: clap::Args + clap::FromArgMatches>(name: &str, argv: &[String]) -> R
 }
 
 /// The subcommands the package runs, by name.
-const COMMANDS: [&str; 9] = [
-    "info", "flow", "layout", "spectrum", "cut", "atlas", "spline", "render", "generate",
+const COMMANDS: [&str; 10] = [
+    "info", "flow", "layout", "spectrum", "cut", "atlas", "spline", "render", "generate", "param",
 ];
 
 fn dispatch(command: &str, argv: &[String]) -> Result<(), Failure> {
@@ -91,6 +91,7 @@ fn dispatch(command: &str, argv: &[String]) -> Result<(), Failure> {
         "spline" => cmd::spline::run(parse(command, argv)?),
         "render" => cmd::render::run(parse(command, argv)?),
         "generate" => cmd::generate::run(parse(command, argv)?),
+        "param" => cmd::param::run(parse(command, argv)?),
         _ => {
             return Err(Failure::Usage(format!(
                 "unknown command {command:?}; the package runs {}",

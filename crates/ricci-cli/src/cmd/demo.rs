@@ -19,6 +19,7 @@
 //! [`stages`], put what later stages need into [`Ctx`], and add one line to [`STAGES`] (the
 //! marked places below); remove its entry from [`PLACEHOLDERS`].
 
+mod param_stage;
 mod report;
 mod stages;
 
@@ -120,6 +121,7 @@ pub const STAGES: &[Stage] = &[
         needs: &["surface"],
         run: stages::spline,
     },
+    Stage { id: "param", title: "Conformal UV map with cones", reference: "ricci param: greedy cones (Ben-Chen–Gotsman–Bunin 2008), conformal flow with intrinsic Delaunay flips, cut, UVs on the input's faces", needs: &["surface"], run: param_stage::param },
 ];
 
 /// Stages announced in the page but not built yet (title, sentence).
