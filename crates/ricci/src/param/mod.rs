@@ -101,7 +101,7 @@ pub struct ParamOptions {
     pub boundary: BoundaryMode,
     /// Cone curvatures rounded to multiples of π/2 (module docs).
     pub seamless: bool,
-    /// Max |K − K̄| of the flow (default 1e-10: seams then match to ~1e-10 relative).
+    /// Max |K − K̄| of the flow (default 1e-9: seams then match to ~1e-9 relative).
     pub tolerance: f64,
     /// Margin of the packing in `[0, 1]²` (default 0.01).
     pub margin: f64,
@@ -115,7 +115,7 @@ impl Default for ParamOptions {
             cones: ConeSpec::Default,
             boundary: BoundaryMode::Free,
             seamless: false,
-            tolerance: 1e-10,
+            tolerance: 1e-9,
             margin: 0.01,
             max_cones: 64,
         }
@@ -166,6 +166,10 @@ pub struct Chart {
     /// Largest distance of a transition's rotation from a multiple of π/2.
     pub quarter_turn_error: f64,
     pub flow_seconds: f64,
+    /// Cones moved to a neighbour because the flow flipped away all their input edges (the
+    /// cut runs on kept input edges), and flows run.
+    pub moved_cones: usize,
+    pub flow_runs: usize,
     pub seconds: f64,
 }
 
@@ -409,60 +413,151 @@ fn chart_uv(
             TargetSpec::Cones(cone_list.clone())
         }
     };
-    progress.report("flow", None, "conformal flow with intrinsic Delaunay flips");
-    let fo = FlowOptions {
-        geometry: Geometry::Euclidean,
-        scheme: Scheme::Conformal,
-        target: target.clone(),
-        tolerance: opts.tolerance,
-        ..FlowOptions::default()
-    };
-    let r = ricci_flow(mesh, &lengths, &fo, progress)?;
-    if !r.converged {
-        return Err(Error::numerical(format!(
-            "component {component}: the conformal flow did not converge (max |K − K̄| = \
-             {:.3e} after {} iterations{})",
-            r.max_curvature_error,
-            r.iterations,
-            if r.notes.is_empty() {
-                String::new()
-            } else {
-                format!("; {}", r.notes.join("; "))
+    // The flow, and the cut on input edges the final triangulation kept. A cone whose input
+    // edges were all flipped away cannot be reached by the cut: it moves to the neighbour
+    // with the most kept edges and the flow runs again (at most `CONE_MOVES` rounds).
+    const CONE_MOVES: usize = 3;
+    let mut moved_cones = 0usize;
+    let mut round = 0usize;
+    let (r, cut) = loop {
+        round += 1;
+        let target = if cone_list.is_empty() {
+            target.clone()
+        } else {
+            TargetSpec::Cones(cone_list.clone())
+        };
+        progress.report("flow", None, "conformal flow with intrinsic Delaunay flips");
+        let fo = FlowOptions {
+            geometry: Geometry::Euclidean,
+            scheme: Scheme::Conformal,
+            target,
+            tolerance: opts.tolerance,
+            ..FlowOptions::default()
+        };
+        let r = ricci_flow(mesh, &lengths, &fo, progress)?;
+        if !r.converged {
+            return Err(Error::numerical(format!(
+                "component {component}: the conformal flow did not converge (max |K − K̄| = \
+                 {:.3e} after {} iterations{})",
+                r.max_curvature_error,
+                r.iterations,
+                if r.notes.is_empty() {
+                    String::new()
+                } else {
+                    format!("; {}", r.notes.join("; "))
+                }
+            )));
+        }
+        let tr = r
+            .triangulation
+            .as_ref()
+            .ok_or_else(|| Error::numerical("the conformal flow returned no triangulation"))?;
+        let t_mesh = &tr.simplicial.mesh;
+        // Edges the cut may use: input edges never flipped and not doubled in the Δ-complex.
+        let mut flipped = vec![false; mesh.n_edges()];
+        for &e in &tr.triangulation.flip_log {
+            flipped[e as usize] = true;
+        }
+        let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
+        for e in 0..tr.triangulation.n_edges() as u32 {
+            let [a, b] = tr.triangulation.edge_vertices(e);
+            *pairs.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+        let allowed: Vec<bool> = (0..mesh.n_edges() as u32)
+            .map(|e| {
+                let [a, b] = mesh.edge_vertices(e);
+                !flipped[e as usize]
+                    && pairs.get(&(a.min(b), a.max(b))) == Some(&1)
+                    && t_mesh.halfedge_between(a, b).is_some()
+            })
+            .collect();
+        if round <= CONE_MOVES && !cone_list.is_empty() {
+            // Components of the graph of kept interior edges; every cone must lie in the
+            // largest one (the cut reaches it without flipped edges). Cones outside move to
+            // the nearest vertex inside (breadth first over the input mesh).
+            let nv = mesh.n_vertices();
+            let mut parent: Vec<u32> = (0..nv as u32).collect();
+            fn find(p: &mut [u32], mut x: u32) -> u32 {
+                while p[x as usize] != x {
+                    p[x as usize] = p[p[x as usize] as usize];
+                    x = p[x as usize];
+                }
+                x
             }
-        )));
-    }
+            for e in 0..mesh.n_edges() as u32 {
+                if allowed[e as usize] && !mesh.is_boundary_edge(e) {
+                    let [a, b] = mesh.edge_vertices(e);
+                    let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+                    if ra != rb {
+                        parent[ra as usize] = rb;
+                    }
+                }
+            }
+            let mut size = vec![0usize; nv];
+            for v in 0..nv as u32 {
+                let r = find(&mut parent, v);
+                size[r as usize] += 1;
+            }
+            let main = (0..nv).max_by_key(|&v| size[v]).unwrap_or(0) as u32;
+            let mut in_main = vec![false; nv];
+            for v in 0..nv as u32 {
+                in_main[v as usize] = find(&mut parent, v) == main;
+            }
+            let mut is_cone = vec![false; nv];
+            for c in &cone_list {
+                is_cone[c.0 as usize] = true;
+            }
+            let mut moved = false;
+            for k in 0..cone_list.len() {
+                let c = cone_list[k].0;
+                if in_main[c as usize] {
+                    continue;
+                }
+                let mut seen = vec![false; nv];
+                let mut queue = std::collections::VecDeque::from([c]);
+                seen[c as usize] = true;
+                let mut found = None;
+                while let Some(v) = queue.pop_front() {
+                    if in_main[v as usize] && !is_cone[v as usize] && !mesh.is_boundary_vertex(v) {
+                        found = Some(v);
+                        break;
+                    }
+                    for w in mesh.vertex_neighbors(v) {
+                        if !seen[w as usize] {
+                            seen[w as usize] = true;
+                            queue.push_back(w);
+                        }
+                    }
+                }
+                if let Some(w) = found {
+                    is_cone[c as usize] = false;
+                    is_cone[w as usize] = true;
+                    cone_list[k].0 = w;
+                    moved = true;
+                    moved_cones += 1;
+                }
+            }
+            if moved {
+                continue;
+            }
+        }
+        let cone_vertices: Vec<u32> = cone_list.iter().map(|c| c.0).collect();
+        let needs_cut = comp.boundary_loops != 1 || comp.genus > 0 || !cone_vertices.is_empty();
+        let cut = if needs_cut {
+            progress.report("cut", None, "cut graph through the cones and the handles");
+            seams::cut_graph(mesh, &lengths, &allowed, &cone_vertices)
+                .map_err(|e| Error::numerical(format!("component {component}: {e}")))?
+        } else {
+            vec![false; mesh.n_edges()]
+        };
+        break (r, cut);
+    };
     let flow_seconds = r.seconds;
     let tr = r
         .triangulation
         .as_ref()
         .ok_or_else(|| Error::numerical("the conformal flow returned no triangulation"))?;
     let t_mesh = &tr.simplicial.mesh;
-    // Edges the cut may use: input edges never flipped and not doubled in the Δ-complex.
-    let mut flipped = vec![false; mesh.n_edges()];
-    for &e in &tr.triangulation.flip_log {
-        flipped[e as usize] = true;
-    }
-    let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
-    for e in 0..tr.triangulation.n_edges() as u32 {
-        let [a, b] = tr.triangulation.edge_vertices(e);
-        *pairs.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-    }
-    let allowed: Vec<bool> = (0..mesh.n_edges() as u32)
-        .map(|e| {
-            let [a, b] = mesh.edge_vertices(e);
-            !flipped[e as usize]
-                && pairs.get(&(a.min(b), a.max(b))) == Some(&1)
-                && t_mesh.halfedge_between(a, b).is_some()
-        })
-        .collect();
-    let cone_vertices: Vec<u32> = cone_list.iter().map(|c| c.0).collect();
-    let needs_cut = comp.boundary_loops != 1 || comp.genus > 0 || !cone_vertices.is_empty();
-    let cut = if needs_cut {
-        progress.report("cut", None, "cut graph through the cones and the handles");
-        seams::cut_graph(mesh, &lengths, &allowed, &cone_vertices)?
-    } else {
-        vec![false; mesh.n_edges()]
-    };
     let mut t_cut = vec![false; t_mesh.n_edges()];
     for e in 0..mesh.n_edges() as u32 {
         if cut[e as usize] {
@@ -570,6 +665,8 @@ fn chart_uv(
         transition_angles: angles,
         quarter_turn_error: qerr,
         flow_seconds,
+        moved_cones,
+        flow_runs: round,
         seconds: t0.elapsed().as_secs_f64(),
     };
     Ok(ChartUv {

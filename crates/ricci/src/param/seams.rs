@@ -14,7 +14,7 @@
 //!
 //! What remains is a cut graph through every cone and every homology generator; slicing along
 //! it leaves a disk. Edges that are not allowed enter `P` only where nothing else reaches
-//! (length × 10⁶) and are normally pruned; when one would have to stay cut the function
+//! (their length plus the total length of all edges) and are normally pruned; when one would have to stay cut the function
 //! says so.
 
 use crate::error::{Error, Result};
@@ -38,6 +38,7 @@ pub fn cut_graph(
         }
         c
     };
+    let penalty: f64 = 1.0 + lengths.iter().sum::<f64>();
     let mut dj = Dijkstra::new(n);
     let boundary = mesh.has_boundary();
     if boundary {
@@ -62,8 +63,8 @@ pub fn cut_graph(
                     let e = mesh.he_edge(h) as usize;
                     // Edges the cut may not use only where nothing else reaches (pruned
                     // away below unless a cone needs them).
-                    let w = if allowed[e] { 1.0 } else { 1e6 };
-                    (mesh.he_tip(h), w * lengths[e])
+                    let w = if allowed[e] { 0.0 } else { penalty };
+                    (mesh.he_tip(h), lengths[e] + w)
                 })
                 .collect::<Vec<_>>()
         },
