@@ -64,7 +64,7 @@ pub struct Args {
 
 fn cone_spec(a: &Args, surface: &ricci::mesh::Surface) -> anyhow::Result<ConeSpec> {
     let bound = a.max_area_distortion.unwrap_or(1.0);
-    if !(bound > 0.0) {
+    if bound.is_nan() || bound <= 0.0 {
         return Err(UsageError("--max-area-distortion must be positive".into()).into());
     }
     let Some(c) = a.cones.as_deref() else {

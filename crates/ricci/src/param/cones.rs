@@ -71,7 +71,7 @@ fn laplacian(mesh: &Mesh, lengths: &[f64]) -> Result<Laplacian> {
             .map(|&h| lengths[mesh.he_edge(h) as usize])
             .collect();
         let a = crate::numeric::vec3::heron([l[0], l[1], l[2]]);
-        if !(a > 0.0) {
+        if a.is_nan() || a <= 0.0 {
             return Err(Error::numerical(format!(
                 "face {f} has zero area in the input metric; cones cannot be placed"
             )));

@@ -508,8 +508,8 @@ fn chart_uv(
                 is_cone[c.0 as usize] = true;
             }
             let mut moved = false;
-            for k in 0..cone_list.len() {
-                let c = cone_list[k].0;
+            for cone in cone_list.iter_mut() {
+                let c = cone.0;
                 if in_main[c as usize] {
                     continue;
                 }
@@ -532,7 +532,7 @@ fn chart_uv(
                 if let Some(w) = found {
                     is_cone[c as usize] = false;
                     is_cone[w as usize] = true;
-                    cone_list[k].0 = w;
+                    cone.0 = w;
                     moved = true;
                     moved_cones += 1;
                 }
