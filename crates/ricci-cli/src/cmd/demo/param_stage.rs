@@ -34,18 +34,6 @@ pub fn param(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "param-uv.svg",
         uv_svg(&s.mesh, &p.corner_uv, &p.seam, &cones, 720.0, 300_000).as_bytes(),
     )?;
-    sec.pictures.push(Picture {
-        file: "param-uv.svg".into(),
-        caption: format!(
-            "The UV map in [0, 1]²: {} cones (red), seams (blue) through every cone and both \
-             handles; every face is one of the surface's own, none flipped ({} flipped).",
-            c.cones.len(),
-            p.stats.flipped_faces
-        ),
-        width: 720,
-        height: 720,
-        alternatives: Vec::new(),
-    });
     let st = Style {
         paint: Paint::Checker(Checker::new(Uvs::PerCorner(&p.corner_uv), 24.0)),
         ..Style::default()
@@ -70,7 +58,8 @@ pub fn param(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
             .into(),
         width: img.image.width,
         height: img.image.height,
-        alternatives: Vec::new(),
+        // The UV layout itself (cones red, seams blue), linked below the picture.
+        alternatives: vec!["param-uv.svg".into()],
     });
     let comments = vec!["ricci param of the demo surface".to_string()];
     env.out.write(
