@@ -33,6 +33,8 @@ enum Command {
     Flow(cmd::flow::Args),
     /// Cut to a disk, lay out isometrically (plane / Poincaré disk / sphere), deck group.
     Layout(cmd::layout::Args),
+    /// Conformal UV map with cones and seams on the input's own faces (or onto the sphere).
+    Param(cmd::param::Args),
     /// Geodesic length spectrum of a closed surface of genus ≥ 1.
     Spectrum(cmd::spectrum::Args),
     /// Holomorphic 1-forms: period matrix, zeros, conformal net (genus ≥ 1).
@@ -79,6 +81,7 @@ fn main() {
 
         Command::Flow(a) => cmd::flow::run(a),
         Command::Layout(a) => cmd::layout::run(a),
+        Command::Param(a) => cmd::param::run(a),
         Command::Spectrum(a) => cmd::spectrum::run(a),
         Command::Forms(a) => cmd::forms::run(a),
         Command::Demo(a) => cmd::demo::run(a),

@@ -146,7 +146,10 @@ fn every_link_of_the_page_is_a_local_non_empty_file() {
         .collect();
     assert_eq!(
         order,
-        ["surface", "flow", "cone", "loops", "layout", "spectrum", "atlas", "spline", "pou"]
+        [
+            "surface", "flow", "cone", "loops", "layout", "spectrum", "atlas", "spline", "pou",
+            "param"
+        ]
     );
     let mut at = 0;
     for id in order {

@@ -76,8 +76,9 @@ fn parse<A: clap::Args + clap::FromArgMatches>(name: &str, argv: &[String]) -> R
 }
 
 /// The subcommands the package runs, by name.
-const COMMANDS: [&str; 10] = [
+const COMMANDS: [&str; 11] = [
     "info", "flow", "layout", "spectrum", "cut", "atlas", "spline", "pou", "render", "generate",
+    "param",
 ];
 
 fn dispatch(command: &str, argv: &[String]) -> Result<(), Failure> {
@@ -92,6 +93,7 @@ fn dispatch(command: &str, argv: &[String]) -> Result<(), Failure> {
         "pou" => cmd::pou::run_cmd(parse(command, argv)?),
         "render" => cmd::render::run(parse(command, argv)?),
         "generate" => cmd::generate::run(parse(command, argv)?),
+        "param" => cmd::param::run(parse(command, argv)?),
         _ => {
             return Err(Failure::Usage(format!(
                 "unknown command {command:?}; the package runs {}",

@@ -22,6 +22,7 @@
 //! * [`layout`] — isometric layouts in the plane, the Poincaré disk and the sphere, deck groups;
 //! * [`analysis`] — distortion, geodesic spectrum (beside `layout`: it uses it);
 //! * [`atlas`] — affine atlas with one extraordinary point;
+//! * [`param`] — conformal UV maps with cones and seams (beside `atlas`);
 //! * [`spline`] — triangular B-splines (DMS) and manifold splines.
 //!
 //! [`error`] and [`progress`] are utilities every module may use. The order is checked by
@@ -43,6 +44,7 @@ pub mod layout;
 pub mod mesh;
 pub mod metric;
 pub mod numeric;
+pub mod param;
 pub mod progress;
 pub mod spline;
 

@@ -34,6 +34,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("layout", 6),
     ("analysis", 6),
     ("atlas", 7),
+    ("param", 7),
     ("spline", 8),
 ];
 

@@ -20,6 +20,8 @@
 //! marked places below); remove its entry from [`PLACEHOLDERS`].
 
 mod pou;
+
+mod param_stage;
 mod report;
 mod stages;
 
@@ -130,6 +132,8 @@ pub const STAGES: &[Stage] = &[
         needs: &["surface"],
         run: pou::pou,
     },
+
+    Stage { id: "param", title: "Conformal UV map with cones", reference: "ricci param: greedy cones (Ben-Chen–Gotsman–Bunin 2008), conformal flow with intrinsic Delaunay flips, cut, UVs on the input's faces", needs: &["surface"], run: param_stage::param },
 ];
 
 /// Stages announced in the page but not built yet (title, sentence).

@@ -9,6 +9,7 @@ pub mod forms;
 pub mod generate;
 pub mod info;
 pub mod layout;
+pub mod param;
 pub mod pou;
 pub mod render;
 pub mod spectrum;

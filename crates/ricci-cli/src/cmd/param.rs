@@ -1,0 +1,231 @@
+//! `ricci param MESH [--out UV.obj] [--svg UV.svg] [--cones auto|none|N|V=K,…|file:PATH]
+//! [--max-area-distortion D] [--boundary free|round|fixed-angles] [--sphere] [--seamless]
+//! [--margin M] [--json]`: a conformal UV map of the mesh in one command
+//! (`ricci::param::parametrize`): conformal flow with intrinsic Delaunay flips, a cut through
+//! the cones and the handles, a flat layout, UVs on the input's own faces (seams as extra
+//! `vt`), charts packed into [0, 1]².
+//!
+//! Cones (closed components): `auto` (default for genus ≠ 1) places greedy cones until the
+//! linearised log area distortion is ≤ `--max-area-distortion` (default 1.0); `N` places N;
+//! `V=K,…` gives vertex ids and curvatures (`K` in radians, `pi/2`, `-pi` accepted; cone angle
+//! 2π − K); `file:PATH` reads per-vertex curvatures (the `--target file:` format of
+//! `ricci flow`; nonzero entries are cones); `none` (a torus).
+//! `--sphere` maps a closed genus-0 surface onto the unit sphere instead (UV.obj then holds
+//! the sphere points as `v`).
+//! The JSON report: `uv_faces` ("input"), `flipped_faces`, `qc_mean`/`qc_p95`/`qc_max`
+//! (σmax/σmin per face), `log_area_sigma` (σ of log(A_uv/A_3d)), `cones`, `seam_length`,
+//! per-chart details and `seconds`.
+
+use crate::util::read_surface;
+use crate::util::{print_json, write_atomic, UsageError};
+use ricci::flow::target::{parse_angle, resolve};
+use ricci::flow::TargetSpec;
+use ricci::layout::export::obj_with_corner_uv;
+use ricci::metric::Geometry;
+use ricci::param::sphere::sphere_map;
+use ricci::param::svg::uv_svg;
+use ricci::param::{parametrize, BoundaryMode, ConeSpec, ParamOptions};
+use serde_json::json;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Mesh file (OBJ, OFF, PLY, STL).
+    pub mesh: PathBuf,
+    /// Output OBJ: the input's vertices and faces with texture coordinates (`f v/vt`).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Output SVG picture of the UV layout (seams blue, cones red, flipped faces red).
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+    /// Cones of closed components: auto | none | N | V=K,... | file:PATH.
+    #[arg(long)]
+    pub cones: Option<String>,
+    /// With --cones auto: bound on the linearised max |log area ratio| (default 1.0).
+    #[arg(long)]
+    pub max_area_distortion: Option<f64>,
+    /// Boundary condition of components with boundary: free | round | fixed-angles.
+    #[arg(long, default_value = "free")]
+    pub boundary: String,
+    /// Closed genus-0 surfaces: map onto the unit sphere (Möbius-centred).
+    #[arg(long)]
+    pub sphere: bool,
+    /// Cone angles multiples of π/2 (transitions across seams: rotations by k·90° on genus 0).
+    #[arg(long)]
+    pub seamless: bool,
+    /// Margin of the packing in [0, 1]² (default 0.01).
+    #[arg(long, default_value_t = 0.01)]
+    pub margin: f64,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn cone_spec(a: &Args, surface: &ricci::mesh::Surface) -> anyhow::Result<ConeSpec> {
+    let bound = a.max_area_distortion.unwrap_or(1.0);
+    if bound.is_nan() || bound <= 0.0 {
+        return Err(UsageError("--max-area-distortion must be positive".into()).into());
+    }
+    let Some(c) = a.cones.as_deref() else {
+        return Ok(if a.max_area_distortion.is_some() {
+            ConeSpec::Auto {
+                max_area_distortion: bound,
+            }
+        } else {
+            ConeSpec::Default
+        });
+    };
+    let c = c.trim();
+    if c == "auto" {
+        return Ok(ConeSpec::Auto {
+            max_area_distortion: bound,
+        });
+    }
+    if c == "none" {
+        return Ok(ConeSpec::None);
+    }
+    if let Ok(n) = c.parse::<usize>() {
+        return Ok(ConeSpec::Count(n));
+    }
+    if let Some(p) = c.strip_prefix("file:") {
+        let t = resolve(
+            &surface.mesh,
+            Geometry::Euclidean,
+            &TargetSpec::File(PathBuf::from(p)),
+        )?;
+        let list: Vec<(u32, f64)> = t
+            .curvature
+            .iter()
+            .enumerate()
+            .filter(|(_, &k)| k != 0.0)
+            .map(|(v, &k)| (v as u32, k))
+            .collect();
+        return Ok(ConeSpec::Given(list));
+    }
+    let mut list = Vec::new();
+    for item in c.split(',').filter(|x| !x.trim().is_empty()) {
+        let (v, k) = item.split_once('=').ok_or_else(|| {
+            UsageError(format!(
+                "--cones: '{item}' is not auto, none, a count, file:PATH or V=K"
+            ))
+        })?;
+        let v: u32 = v
+            .trim()
+            .parse()
+            .map_err(|_| UsageError(format!("--cones: '{v}' is not a vertex id")))?;
+        let k = parse_angle(k)
+            .ok_or_else(|| UsageError(format!("--cones: '{k}' is not a curvature")))?;
+        list.push((v, k));
+    }
+    Ok(ConeSpec::Given(list))
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let t0 = Instant::now();
+    let boundary: BoundaryMode = a.boundary.parse().map_err(UsageError)?;
+    let (surface, _) = read_surface(&a.mesh)?;
+    let mut bar = super::layout::spinner(a.json);
+    let name = a.mesh.display().to_string();
+    if a.sphere {
+        let m = sphere_map(&surface, &mut bar).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+        bar.0.finish_and_clear();
+        if let Some(path) = &a.out {
+            let mut text = format!("# ricci param --sphere of {name}: points on the unit sphere\n");
+            for p in &m.positions {
+                text.push_str(&format!("v {:e} {:e} {:e}\n", p[0], p[1], p[2]));
+            }
+            for t in surface.mesh.faces() {
+                text.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+            }
+            write_atomic(path, text.as_bytes())?;
+        }
+        let out = json!({
+            "file": name, "mode": "sphere", "vertices": surface.mesh.n_vertices(),
+            "faces": surface.mesh.n_faces(), "uv_faces": "input",
+            "flipped_faces": m.stats.flipped_faces, "qc_mean": m.stats.qc_mean,
+            "qc_p95": m.stats.qc_p95, "qc_max": m.stats.qc_max,
+            "log_area_sigma": m.stats.log_area_sigma, "sphere": m,
+            "seconds": t0.elapsed().as_secs_f64(),
+        });
+        return report(&a, &out);
+    }
+    let opts = ParamOptions {
+        cones: cone_spec(&a, &surface)?,
+        boundary,
+        seamless: a.seamless,
+        margin: a.margin,
+        ..ParamOptions::default()
+    };
+    let p = parametrize(&surface, &opts, &mut bar).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+    bar.0.finish_and_clear();
+    let cones: Vec<_> = p
+        .charts
+        .iter()
+        .flat_map(|c| c.cones.iter().copied())
+        .collect();
+    if let Some(path) = &a.out {
+        let comments = vec![
+            format!("ricci param of {name}"),
+            "vt: conformal UVs in [0,1]^2 per corner of the input's faces; several vt per \
+             vertex along the seams"
+                .to_string(),
+        ];
+        let text = obj_with_corner_uv(
+            &surface.positions,
+            surface.mesh.faces(),
+            &p.corner_uv,
+            &comments,
+        );
+        write_atomic(path, text.as_bytes())?;
+    }
+    if let Some(path) = &a.svg {
+        let cv: Vec<u32> = cones.iter().map(|c| c.vertex).collect();
+        let svg = uv_svg(&surface.mesh, &p.corner_uv, &p.seam, &cv, 1024.0, 300_000);
+        write_atomic(path, svg.as_bytes())?;
+    }
+    let seam_length: f64 = p.charts.iter().map(|c| c.seam_length).sum();
+    let out = json!({
+        "file": name, "mode": "plane", "vertices": surface.mesh.n_vertices(),
+        "faces": surface.mesh.n_faces(), "charts": p.charts.len(), "uv_faces": "input",
+        "flipped_faces": p.stats.flipped_faces, "qc_mean": p.stats.qc_mean,
+        "qc_p95": p.stats.qc_p95, "qc_max": p.stats.qc_max,
+        "log_area_sigma": p.stats.log_area_sigma, "distortion": p.stats,
+        "cone_count": cones.len(), "cones": cones, "seam_length": seam_length,
+        "seam_edges": p.seam.iter().filter(|&&s| s).count(),
+        "seamless": a.seamless, "boundary": boundary, "chart_details": p.charts,
+        "seconds": t0.elapsed().as_secs_f64(),
+    });
+    report(&a, &out)
+}
+
+fn report(a: &Args, out: &serde_json::Value) -> anyhow::Result<()> {
+    if a.json {
+        print_json(out);
+    } else {
+        println!(
+            "{}: {} map",
+            a.mesh.display(),
+            out["mode"].as_str().unwrap_or("")
+        );
+        println!("  flipped faces: {}", out["flipped_faces"]);
+        println!(
+            "  qc mean / p95 / max: {:.4} / {:.4} / {:.4}",
+            out["qc_mean"].as_f64().unwrap_or(f64::NAN),
+            out["qc_p95"].as_f64().unwrap_or(f64::NAN),
+            out["qc_max"].as_f64().unwrap_or(f64::NAN)
+        );
+        println!(
+            "  σ(log area ratio): {:.4}",
+            out["log_area_sigma"].as_f64().unwrap_or(f64::NAN)
+        );
+        if let Some(c) = out.get("cone_count") {
+            println!(
+                "  cones: {c}, seam length {:.4}",
+                out["seam_length"].as_f64().unwrap_or(0.0)
+            );
+        }
+        println!("  seconds: {:.3}", out["seconds"].as_f64().unwrap_or(0.0));
+    }
+    Ok(())
+}

@@ -1,0 +1,119 @@
+//! `ricci param`: one command from a mesh to a UV map on its own faces.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn bin() -> PathBuf {
+    PathBuf::from(env!("CARGO_BIN_EXE_ricci"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("ricci-cli-param-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+fn generate(kind: &str, file: &str) -> PathBuf {
+    let p = tmp(file);
+    let st = Command::new(bin())
+        .args(["generate", kind, "--out"])
+        .arg(&p)
+        .status()
+        .unwrap();
+    assert!(st.success());
+    p
+}
+
+/// Faces and `f v/vt` triples of an OBJ.
+fn obj_faces(text: &str) -> (usize, usize, Vec<[(usize, usize); 3]>) {
+    let (mut v, mut vt, mut f) = (0, 0, Vec::new());
+    for l in text.lines() {
+        let w: Vec<&str> = l.split_whitespace().collect();
+        match w.first() {
+            Some(&"v") => v += 1,
+            Some(&"vt") => vt += 1,
+            Some(&"f") => {
+                let c: Vec<(usize, usize)> = w[1..]
+                    .iter()
+                    .map(|x| {
+                        let mut it = x.split('/');
+                        let a = it.next().unwrap().parse().unwrap();
+                        let b = it.next().and_then(|b| b.parse().ok()).unwrap_or(0);
+                        (a, b)
+                    })
+                    .collect();
+                f.push([c[0], c[1], c[2]]);
+            }
+            _ => {}
+        }
+    }
+    (v, vt, f)
+}
+
+/// A torus: the OBJ keeps the input's vertices and faces, seams show as extra `vt`, the JSON
+/// reports 0 flipped faces and no cones.
+#[test]
+fn torus_uv_obj_is_on_the_input_faces() {
+    let mesh = generate("torus", "torus.obj");
+    let out = tmp("torus-uv.obj");
+    let svg = tmp("torus-uv.svg");
+    let o = Command::new(bin())
+        .arg("param")
+        .arg(&mesh)
+        .arg("--out")
+        .arg(&out)
+        .arg("--svg")
+        .arg(&svg)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["flipped_faces"], 0);
+    assert_eq!(v["uv_faces"], "input");
+    assert_eq!(v["cone_count"], 0);
+    assert!(v["qc_p95"].as_f64().unwrap() < 1.5);
+    let (nv_in, _, f_in) = obj_faces(&std::fs::read_to_string(&mesh).unwrap());
+    let (nv, nvt, f) = obj_faces(&std::fs::read_to_string(&out).unwrap());
+    assert_eq!(nv, nv_in);
+    assert_eq!(f.len(), f_in.len());
+    for (a, b) in f.iter().zip(&f_in) {
+        assert_eq!([a[0].0, a[1].0, a[2].0], [b[0].0, b[1].0, b[2].0]);
+    }
+    assert!(nvt > nv, "seams need extra vt ({nvt} vt, {nv} v)");
+    assert!(std::fs::read_to_string(&svg).unwrap().starts_with("<svg"));
+}
+
+/// Cones given by vertex and angle on a sphere; a bad cone list is a usage error; --sphere
+/// maps onto the unit sphere.
+#[test]
+fn given_cones_usage_errors_and_sphere() {
+    let mesh = generate("sphere", "sphere.obj");
+    let o = Command::new(bin())
+        .arg("param")
+        .arg(&mesh)
+        .args(["--cones", "0=pi,1=pi,2=pi,3=pi", "--json"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["cone_count"], 4);
+    assert_eq!(v["flipped_faces"], 0);
+    let bad = Command::new(bin())
+        .arg("param")
+        .arg(&mesh)
+        .args(["--cones", "0=banana", "--json"])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    let s = Command::new(bin())
+        .arg("param")
+        .arg(&mesh)
+        .args(["--sphere", "--json"])
+        .output()
+        .unwrap();
+    assert!(s.status.success(), "{}", String::from_utf8_lossy(&s.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&s.stdout).unwrap();
+    assert_eq!(v["mode"], "sphere");
+    assert_eq!(v["flipped_faces"], 0);
+}

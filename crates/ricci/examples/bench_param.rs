@@ -1,0 +1,91 @@
+//! `ricci param` benchmark: conformal UV maps (`ricci::param::parametrize`) of the shared
+//! meshes of issue 16 with the cone counts of the BFF comparison. Prints per case: faces,
+//! cones, flipped input faces, qc mean / p95 / max, σ(log area ratio), seam length, flow
+//! flips, wall seconds.
+//!
+//! ```sh
+//! RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_param
+//! RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_param -- face
+//! ```
+
+use ricci::mesh::io::read_surface;
+use ricci::param::{parametrize, ConeSpec, ParamOptions};
+use ricci::progress::NoProgress;
+use std::path::PathBuf;
+
+fn main() {
+    let dir = match std::env::var_os("RICCI_MESHES") {
+        Some(d) => PathBuf::from(d),
+        None => {
+            eprintln!("set RICCI_MESHES to the shared mesh folder");
+            return;
+        }
+    };
+    let filter: Vec<String> = std::env::args().skip(1).collect();
+    let cases: Vec<(&str, &str, ConeSpec)> = vec![
+        ("face", "face.off", ConeSpec::Default),
+        ("camelhead", "camelhead.off", ConeSpec::Default),
+        ("bunny", "bunny.off", ConeSpec::Default),
+        ("beetle", "beetle.off", ConeSpec::Default),
+        ("kitten", "kitten.nf20k.off", ConeSpec::Default),
+        ("rocker-arm", "rocker-arm.off", ConeSpec::Default),
+        ("botijo-8", "botijo.off", ConeSpec::Count(8)),
+        ("seahorse-8", "seahorse2_100K.off", ConeSpec::Count(8)),
+        ("horse-8", "horse.ply", ConeSpec::Count(8)),
+        ("maxplanck-8", "maxplanck.nf25k.off", ConeSpec::Count(8)),
+        ("camel-8", "camel.off", ConeSpec::Count(8)),
+        ("eight-auto", "eight.off", ConeSpec::Default),
+    ];
+    println!(
+        "{:<14} {:>7} {:>5} {:>6} {:>7} {:>7} {:>8} {:>7} {:>9} {:>7} {:>8}",
+        "case",
+        "faces",
+        "cones",
+        "flips",
+        "qc_mean",
+        "qc_p95",
+        "qc_max",
+        "σ_logA",
+        "seam_len",
+        "iflips",
+        "seconds"
+    );
+    for (name, file, cones) in cases {
+        if !filter.is_empty() && !filter.iter().any(|f| name.contains(f.as_str())) {
+            continue;
+        }
+        let (s, _) = match read_surface(&dir.join(file)) {
+            Ok(x) => x,
+            Err(e) => {
+                println!("{name:<14} read error: {e}");
+                continue;
+            }
+        };
+        let opts = ParamOptions {
+            cones,
+            ..ParamOptions::default()
+        };
+        match parametrize(&s, &opts, &mut NoProgress) {
+            Ok(p) => {
+                let cones: usize = p.charts.iter().map(|c| c.cones.len()).sum();
+                let flips: usize = p.charts.iter().map(|c| c.flips).sum();
+                let seam: f64 = p.charts.iter().map(|c| c.seam_length).sum();
+                println!(
+                    "{:<14} {:>7} {:>5} {:>6} {:>7.4} {:>7.4} {:>8.3} {:>7.4} {:>9.3} {:>7} {:>8.3}",
+                    name,
+                    s.mesh.n_faces(),
+                    cones,
+                    p.stats.flipped_faces,
+                    p.stats.qc_mean,
+                    p.stats.qc_p95,
+                    p.stats.qc_max,
+                    p.stats.log_area_sigma,
+                    seam,
+                    flips,
+                    p.seconds
+                );
+            }
+            Err(e) => println!("{name:<14} error: {e}"),
+        }
+    }
+}

@@ -1,0 +1,267 @@
+//! `ricci::param`: conformal UV maps with cones and seams on the input's own faces.
+//!
+//! Every map is checked by [`check_map`] against facts that do not come from the code that
+//! made it: every input face's UV triangle is positively oriented; UVs lie in the packing
+//! square; off the seams the two faces at an edge agree on its UVs; across a seam the two
+//! sides have the same length (the transition is a rigid motion); and the UV corner angles
+//! around every interior vertex add up to its cone angle `2π − K̄` (2π off the cones) — the
+//! flat cone metric's angle, measured from the UVs alone.
+
+#[path = "ricci_meshes/mod.rs"]
+mod ricci_meshes;
+
+use ricci::mesh::generate::{disk, genus, icosphere, torus};
+use ricci::mesh::Surface;
+use ricci::param::sphere::sphere_map;
+use ricci::param::{parametrize, ConeSpec, ParamOptions, Parametrization};
+use ricci::progress::NoProgress;
+use std::f64::consts::PI;
+
+fn angle(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    let u = [b[0] - a[0], b[1] - a[1]];
+    let v = [c[0] - a[0], c[1] - a[1]];
+    (u[0] * v[1] - u[1] * v[0]).atan2(u[0] * v[0] + u[1] * v[1])
+}
+
+/// See the module docs; `tol` bounds the angle sums and the seam length mismatch.
+fn check_map(s: &Surface, p: &Parametrization, margin: f64, tol: f64) {
+    let m = &s.mesh;
+    let uv = &p.corner_uv;
+    assert_eq!(uv.len(), 3 * m.n_faces());
+    for (f, _) in m.faces().iter().enumerate() {
+        let q = [uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]];
+        let a =
+            (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
+        assert!(a > 0.0, "face {f} has UV area {a}");
+        for x in q {
+            assert!(
+                x[0] >= margin - 1e-12 && x[0] <= 1.0 - margin + 1e-12,
+                "{x:?}"
+            );
+            assert!(
+                x[1] >= margin - 1e-12 && x[1] <= 1.0 - margin + 1e-12,
+                "{x:?}"
+            );
+        }
+    }
+    assert_eq!(p.stats.flipped_faces, 0);
+    for e in 0..m.n_edges() as u32 {
+        if m.is_boundary_edge(e) {
+            continue;
+        }
+        let h = m.edge_halfedge(e);
+        let g = m.he_twin(h);
+        let (pa, pb) = (uv[h as usize], uv[m.he_next(h) as usize]);
+        let (qb, qa) = (uv[g as usize], uv[m.he_next(g) as usize]);
+        if p.seam[e as usize] {
+            let l1 = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
+            let l2 = (qb[0] - qa[0]).hypot(qb[1] - qa[1]);
+            assert!((l1 - l2).abs() <= tol * l1, "seam edge {e}: {l1} vs {l2}");
+        } else {
+            assert_eq!(
+                (pa, pb),
+                (qa, qb),
+                "edge {e} is not a seam but its UVs differ"
+            );
+        }
+    }
+    let mut k = vec![0.0; m.n_vertices()];
+    for c in p.charts.iter().flat_map(|c| &c.cones) {
+        k[c.vertex as usize] = c.curvature;
+    }
+    let mut sum = vec![0.0; m.n_vertices()];
+    for (f, t) in m.faces().iter().enumerate() {
+        for i in 0..3 {
+            sum[t[i] as usize] += angle(
+                uv[3 * f + i],
+                uv[3 * f + (i + 1) % 3],
+                uv[3 * f + (i + 2) % 3],
+            );
+        }
+    }
+    for v in 0..m.n_vertices() as u32 {
+        if !m.is_isolated(v) && !m.is_boundary_vertex(v) {
+            let want = 2.0 * PI - k[v as usize];
+            assert!(
+                (sum[v as usize] - want).abs() < tol,
+                "vertex {v}: UV angle sum {} against cone angle {want}",
+                sum[v as usize]
+            );
+        }
+    }
+}
+
+fn run(s: &Surface, cones: ConeSpec, seamless: bool) -> Parametrization {
+    let opts = ParamOptions {
+        cones,
+        seamless,
+        ..ParamOptions::default()
+    };
+    parametrize(s, &opts, &mut NoProgress).unwrap()
+}
+
+/// A planar disk is already flat: the free-boundary map (u = 0 on the boundary, flat inside)
+/// is an isometry up to the packing scale — every face conformal and equally scaled.
+#[test]
+fn planar_disk_is_mapped_isometrically() {
+    let s = disk(24).unwrap();
+    let p = run(&s, ConeSpec::Default, false);
+    check_map(&s, &p, 0.01, 1e-9);
+    assert!(p.stats.qc_max < 1.0 + 1e-8, "{:?}", p.stats);
+    assert!(p.stats.log_area_sigma < 1e-8, "{:?}", p.stats);
+    assert_eq!(p.charts[0].seam_edges, 0);
+}
+
+/// A torus needs no cone; its flat metric has trivial holonomy, so every transition is a
+/// translation (rotation 0).
+#[test]
+fn torus_is_flat_and_its_transitions_are_translations() {
+    let s = torus(1.0, 0.4, 24).unwrap();
+    let p = run(&s, ConeSpec::Default, false);
+    check_map(&s, &p, 0.01, 1e-8);
+    let c = &p.charts[0];
+    assert!(c.cones.is_empty());
+    assert!(c.seam_edges > 0);
+    assert!(c.quarter_turn_error < 1e-9 && c.transition_angles.iter().all(|a| a.abs() < 1e-9));
+}
+
+/// Genus 2 with six greedy cones: the cones carry 2πχ = −4π (Gauss–Bonnet), and the UV
+/// angles around every cone add up to its angle.
+#[test]
+fn genus_two_with_greedy_cones() {
+    let s = genus(2, 20).unwrap();
+    let p = run(&s, ConeSpec::Count(6), false);
+    check_map(&s, &p, 0.01, 1e-8);
+    let k: f64 = p.charts[0].cones.iter().map(|c| c.curvature).sum();
+    assert!((k + 4.0 * PI).abs() < 1e-9, "{k}");
+    assert_eq!(p.charts[0].cones.len(), 6);
+}
+
+/// A sphere with eight greedy cones rounded to quarter turns: every cone curvature is a
+/// multiple of π/2 and every transition across the seams is a rotation by k·90° (genus 0:
+/// the holonomy is generated by the cones).
+#[test]
+fn seamless_sphere_has_quarter_turn_transitions() {
+    let s = icosphere(3).unwrap();
+    let p = run(&s, ConeSpec::Count(8), true);
+    check_map(&s, &p, 0.01, 1e-8);
+    let c = &p.charts[0];
+    assert!(!c.cones.is_empty());
+    let mut total = 0.0;
+    for cone in &c.cones {
+        let q = cone.curvature / (PI / 2.0);
+        assert!((q - q.round()).abs() < 1e-12, "{cone:?}");
+        total += cone.curvature;
+    }
+    assert!((total - 4.0 * PI).abs() < 1e-12);
+    assert!(c.quarter_turn_error < 1e-9, "{}", c.quarter_turn_error);
+}
+
+/// Given cones at two antipodal vertices of the icosphere (2π each: a doubled disk... here
+/// π each on four vertices) are honoured, and the map is valid.
+#[test]
+fn given_cones_are_honoured() {
+    let s = icosphere(2).unwrap();
+    // Four cones of curvature π (angle π): a "pillowcase" metric.
+    let p = run(
+        &s,
+        ConeSpec::Given(vec![(0, PI), (1, PI), (2, PI), (3, PI)]),
+        false,
+    );
+    check_map(&s, &p, 0.01, 1e-8);
+    assert_eq!(p.charts[0].cones.len(), 4);
+    assert_eq!(p.charts[0].cone_source, "given");
+}
+
+/// Two components (a disk and a torus side by side) become two charts whose UV boxes do not
+/// overlap.
+#[test]
+fn components_are_separate_charts() {
+    let a = disk(12).unwrap();
+    let b = torus(1.0, 0.4, 16).unwrap();
+    let n = a.positions.len() as u32;
+    let mut pos = a.positions.clone();
+    pos.extend(b.positions.iter().map(|p| [p[0] + 5.0, p[1], p[2]]));
+    let mut faces = a.mesh.faces().to_vec();
+    faces.extend(
+        b.mesh
+            .faces()
+            .iter()
+            .map(|t| [t[0] + n, t[1] + n, t[2] + n]),
+    );
+    let s = Surface::new(pos, faces).unwrap();
+    let p = run(&s, ConeSpec::Default, false);
+    check_map(&s, &p, 0.01, 1e-8);
+    assert_eq!(p.charts.len(), 2);
+    let nfa = a.mesh.n_faces();
+    let bbox = |r: std::ops::Range<usize>| {
+        let mut b = [
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        for q in &p.corner_uv[3 * r.start..3 * r.end] {
+            b = [
+                b[0].min(q[0]),
+                b[1].min(q[1]),
+                b[2].max(q[0]),
+                b[3].max(q[1]),
+            ];
+        }
+        b
+    };
+    let (x, y) = (bbox(0..nfa), bbox(nfa..s.mesh.n_faces()));
+    let overlap = x[0] < y[2] && y[0] < x[2] && x[1] < y[3] && y[1] < x[3];
+    assert!(!overlap, "{x:?} {y:?}");
+}
+
+/// A closed genus-2 surface without cones cannot be flattened: refused with a sentence.
+#[test]
+fn closed_surface_without_cones_is_refused() {
+    let s = genus(2, 12).unwrap();
+    let e = parametrize(
+        &s,
+        &ParamOptions {
+            cones: ConeSpec::None,
+            ..ParamOptions::default()
+        },
+        &mut NoProgress,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("needs cones"), "{e}");
+}
+
+/// Real meshes (RICCI_MESHES): the disk `face` (free boundary; BFF: qc p95 1.097), the genus-1
+/// `kitten`, the genus-2 `eight` with 8 cones, `camelhead` (free boundary with BFF's
+/// qc p95 1.192), and `maxplanck` onto the sphere.
+#[test]
+fn shared_meshes() {
+    let Some(dir) = ricci_meshes::ricci_meshes() else {
+        eprintln!("RICCI_MESHES not set; skipped");
+        return;
+    };
+    let read = |f: &str| ricci::mesh::io::read_surface(&dir.join(f)).unwrap().0;
+    let face = read("face.off");
+    let p = run(&face, ConeSpec::Default, false);
+    check_map(&face, &p, 0.01, 1e-8);
+    assert!(p.stats.qc_p95 <= 1.0975, "{:?}", p.stats);
+    let cam = read("camelhead.off");
+    let p = run(&cam, ConeSpec::Default, false);
+    check_map(&cam, &p, 0.01, 1e-7);
+    assert!(p.stats.qc_p95 <= 1.192, "{:?}", p.stats);
+    let kitten = read("kitten.nf20k.off");
+    let p = run(&kitten, ConeSpec::Default, true);
+    check_map(&kitten, &p, 0.01, 1e-8);
+    assert!(p.charts[0].quarter_turn_error < 1e-9);
+    let eight = read("eight.off");
+    let p = run(&eight, ConeSpec::Count(8), false);
+    check_map(&eight, &p, 0.01, 1e-8);
+    let mp = read("maxplanck.nf25k.off");
+    let m = sphere_map(&mp, &mut NoProgress).unwrap();
+    assert_eq!(m.stats.flipped_faces, 0);
+    assert!(m.centroid_norm < 1e-9);
+    for x in &m.positions {
+        assert!(((x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt() - 1.0).abs() < 1e-12);
+    }
+}
