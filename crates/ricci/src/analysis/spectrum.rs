@@ -405,65 +405,8 @@ pub fn fuchsian_spectrum(
                 crossings.push(sides);
             }
         }
-        let mut pos_of: HashMap<usize, usize> = HashMap::new();
-        for (c, &i) in cand.iter().enumerate() {
-            pos_of.insert(i, c);
-        }
-        let mut parent: Vec<usize> = (0..cand.len()).collect();
-        fn find(p: &mut [usize], x: usize) -> usize {
-            let mut r = x;
-            while p[r] != r {
-                r = p[r];
-            }
-            let mut y = x;
-            while p[y] != r {
-                let nx = p[y];
-                p[y] = r;
-                y = nx;
-            }
-            r
-        }
-        let mut unmatched = 0;
-        // A link to a tile that is not a candidate is expected when an axis only touches ∂F
-        // at a vertex from outside; a link to a tile that was not enumerated is not.
-        let lookup = |m: &Mobius| -> Result<Option<usize>, ()> {
-            match index.find(apply_h(&m.klein_matrix(), o_h)) {
-                Some(i) => Ok(pos_of.get(&i).copied()),
-                None => Err(()),
-            }
-        };
-        for (c, &i) in cand.iter().enumerate() {
-            let g = elems[i];
-            let mut links = vec![g.inverse()];
-            for &s in &crossings[c] {
-                let sm = side_maps[s];
-                links.push(sm.inverse().compose(&g).compose(&sm).normalized());
-            }
-            for h in links {
-                match lookup(&h) {
-                    Ok(Some(d)) => {
-                        let (a, b) = (find(&mut parent, c), find(&mut parent, d));
-                        if a != b {
-                            parent[a.max(b)] = a.min(b);
-                        }
-                    }
-                    Ok(None) => {}
-                    Err(()) => unmatched += 1,
-                }
-            }
-        }
-        let mut classes: HashMap<usize, GeodesicClass> = HashMap::new();
-        for (c, &i) in cand.iter().enumerate() {
-            let r = find(&mut parent, c);
-            let g = elems[i];
-            let e = classes.entry(r).or_insert(GeodesicClass {
-                length: g.translation_length(),
-                representative: g,
-                pieces: 0,
-            });
-            e.pieces += 1;
-        }
-        let mut classes: Vec<GeodesicClass> = classes.into_values().collect();
+        let (mut classes, unmatched) =
+            group_classes(&elems, &cand, &crossings, &side_maps, &index, o_h);
         classes.sort_by(|a, b| a.length.total_cmp(&b.length));
         if classes.len() >= count {
             classes.truncate(count);
