@@ -148,3 +148,30 @@ fn shared_meshes_under_retriangulation() {
     );
     check_retriangulations("eight", &read("eight.off"), Geometry::Hyperbolic, 4, 3e-3);
 }
+
+/// Issue 15's re-triangulations of three more shared meshes: kitten and rocker-arm (genus 1,
+/// the normalized lattice lengths of the deck group, i.e. the modulus τ) and 3holes (genus 3,
+/// hyperbolic geodesic lengths), each against its own 1-to-4 subdivision and off-centre splits.
+#[test]
+fn shared_meshes_kitten_rocker_arm_3holes_under_retriangulation() {
+    let Some(dir) = ricci_meshes::ricci_meshes().filter(|d| d.is_dir()) else {
+        eprintln!("RICCI_MESHES not set; skipped");
+        return;
+    };
+    let read = |n: &str| ricci::mesh::io::read_surface(&dir.join(n)).unwrap().0;
+    check_retriangulations(
+        "kitten",
+        &read("kitten.nf20k.off"),
+        Geometry::Euclidean,
+        3,
+        3e-3,
+    );
+    check_retriangulations(
+        "rocker-arm",
+        &read("rocker-arm.off"),
+        Geometry::Euclidean,
+        3,
+        3e-3,
+    );
+    check_retriangulations("3holes", &read("3holes.off"), Geometry::Hyperbolic, 3, 3e-3);
+}
