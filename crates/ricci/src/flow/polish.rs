@@ -134,6 +134,17 @@ fn lengths_dd(
     Ok(out)
 }
 
+/// A power of two within a factor 2 of `1/x` (`x > 0` finite; 1 otherwise): multiplying by
+/// it is exact.
+#[inline]
+fn power_of_two_near_inverse(x: f64) -> f64 {
+    if !(x > 0.0) || !x.is_finite() {
+        return 1.0;
+    }
+    let e = ((x.to_bits() >> 52) & 0x7ff) as i32 - 1023;
+    2f64.powi((-e).clamp(-1022, 1023))
+}
+
 /// `K̄ − K` in double-double for target 0 (see the module docs), as doubles.
 fn residual_dd(mesh: &Mesh, lengths: &[Dd], residual: &mut [f64]) -> Result<()> {
     let nv = mesh.n_vertices();
@@ -150,17 +161,20 @@ fn residual_dd(mesh: &Mesh, lengths: &[Dd], residual: &mut [f64]) -> Result<()> 
         }
         let s0 = sig.sinh();
         let sd = d.map(|x| x.sinh());
+        // tan²(θ_i/2) = A/B with A = sinh d_j sinh d_k, B = sinh σ sinh d_i, so
+        // e^{iθ_i} = (1 − t² + 2it)/(1 + t²) is a positive multiple of (B − A) + 2i√(AB), and
+        // AB = sinh σ sinh d₀ sinh d₁ sinh d₂ is the same for the three corners: one square
+        // root per face and no division. The products around a vertex are rescaled by powers of
+        // two (exact) to stay near 1; only their argument is used.
+        let p2 = Dd::new(2.0) * (s0 * sd[0] * sd[1] * sd[2]).sqrt();
         let fv = mesh.face(f);
         for i in 0..3 {
             let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-            let t2 = sd[j] * sd[k] / (s0 * sd[i]);
-            let t = t2.sqrt();
-            let den = Dd::ONE + t2;
-            let z = Cdd {
-                re: (Dd::ONE - t2) / den,
-                im: Dd::new(2.0) * t / den,
-            };
-            prod[fv[i] as usize] = prod[fv[i] as usize] * z;
+            let a = sd[j] * sd[k];
+            let b = s0 * sd[i];
+            let z = prod[fv[i] as usize] * Cdd { re: b - a, im: p2 };
+            let scale = Dd::new(power_of_two_near_inverse(z.re.hi.abs() + z.im.hi.abs()));
+            prod[fv[i] as usize] = z.scale(scale);
         }
     }
     for v in 0..nv {
