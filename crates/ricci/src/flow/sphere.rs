@@ -567,6 +567,22 @@ fn link_of(t: &IntrinsicTriangulation, inf: u32) -> (Vec<u32>, bool) {
     (link, simple)
 }
 
+/// For every vertex, whether its link in `t` is simple (as [`link_of`], for all vertices at
+/// once: the pairs (origin, tip) of all half-edges, sorted, have no repeat and no loop).
+fn simple_links(t: &IntrinsicTriangulation, n: usize) -> Vec<bool> {
+    let mut simple = vec![true; n];
+    let mut pairs: Vec<(u32, u32)> = (0..t.n_halfedges() as u32)
+        .map(|h| (t.origin[h as usize], t.tip(h)))
+        .collect();
+    pairs.sort_unstable();
+    for (k, &(v, j)) in pairs.iter().enumerate() {
+        if v == j || (k > 0 && pairs[k - 1] == (v, j)) {
+            simple[v as usize] = false;
+        }
+    }
+    simple
+}
+
 /// Discrete uniformization of a closed genus-0 surface with Euclidean `lengths` (by edge id
 /// of `mesh`) to the unit sphere, in the discrete conformal class of vertex scaling with
 /// intrinsic Delaunay flips (Bobenko–Pinkall–Springborn 2015 §§5–6, Springborn 2020 §7,
@@ -641,8 +657,9 @@ pub fn conformal_sphere(
             valence[vs[m] as usize] += 1;
         }
     }
+    let simple = simple_links(&t, n);
     let inf = (0..n as u32)
-        .filter(|&v| valence[v as usize] >= 3 && link_of(&t, v).1)
+        .filter(|&v| valence[v as usize] >= 3 && simple[v as usize])
         .max_by(|&a, &b| {
             let ka = (valence[a as usize] >= 5, deficit[a as usize]);
             let kb = (valence[b as usize] >= 5, deficit[b as usize]);
