@@ -6,7 +6,12 @@
 //! ```sh
 //! RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_conformal
 //! RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_conformal -- kitten
+//! RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_conformal -- torus1M
 //! ```
+//!
+//! `torus1M` (only when named) is the generated torus of revolution R = 1, r = 0.3 with 1174
+//! columns (1 003 770 faces), flattened in E². The last column is the peak resident memory
+//! of the process so far (`VmHWM`): run one case per process to read it per case.
 
 use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
 use ricci::mesh::io::read_surface;
@@ -80,7 +85,7 @@ fn main() {
         ),
     ];
     println!(
-        "{:<20} {:>7} {:>7} {:>4} {:>5} {:>8} {:>8} {:>6} {:>10} {:>5} {:>8} {:>8}",
+        "{:<20} {:>7} {:>7} {:>4} {:>5} {:>8} {:>8} {:>6} {:>10} {:>5} {:>8} {:>8} {:>7}",
         "case",
         "V",
         "F",
@@ -92,13 +97,21 @@ fn main() {
         "max|K-K̄|",
         "conv",
         "seconds",
-        "cpu"
+        "cpu",
+        "peak MB"
     );
+    let generated = filter.iter().any(|f| f == "torus1M");
+    let cases = cases
+        .into_iter()
+        .filter(|c| filter.is_empty() || filter.iter().any(|f| c.0.contains(f.as_str())))
+        .map(|(n, f, g, t)| (n, Some(f), g, t))
+        .chain(generated.then_some(("torus1M E2", None, Euclidean, TargetSpec::Uniform)));
     for (name, file, geometry, target) in cases {
-        if !filter.is_empty() && !filter.iter().any(|f| name.contains(f.as_str())) {
-            continue;
-        }
-        let (s, _) = match read_surface(&dir.join(file)) {
+        let read = match file {
+            Some(file) => read_surface(&dir.join(file)).map(|x| x.0),
+            None => ricci::mesh::generate::torus(1.0, 0.3, 1174),
+        };
+        let s = match read {
             Ok(x) => x,
             Err(e) => {
                 println!("{name}: {e}");
@@ -120,7 +133,7 @@ fn main() {
             Ok(r) => {
                 let tri = r.triangulation.as_ref().unwrap();
                 println!(
-                    "{:<20} {:>7} {:>7} {:>4} {:>5} {:>8} {:>8} {:>6} {:>10.2e} {:>5} {:>8.3} {:>8.3}",
+                    "{:<20} {:>7} {:>7} {:>4} {:>5} {:>8} {:>8} {:>6} {:>10.2e} {:>5} {:>8.3} {:>8.3} {:>7.0}",
                     name,
                     s.mesh.n_vertices(),
                     s.mesh.n_faces(),
@@ -132,7 +145,8 @@ fn main() {
                     r.max_curvature_error,
                     r.converged,
                     secs,
-                    cpu
+                    cpu,
+                    peak_rss_mb()
                 );
                 if !r.notes.is_empty() {
                     println!("    notes: {:?}", r.notes);
@@ -154,5 +168,19 @@ fn cpu_seconds() -> f64 {
                 .and_then(|x| x.parse::<f64>().ok())
         })
         .map(|ns| ns * 1e-9)
+        .unwrap_or(f64::NAN)
+}
+
+/// Peak resident memory of this process so far in MB (`VmHWM` of `/proc/self/status`).
+fn peak_rss_mb() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|x| x.parse::<f64>().ok())
+        })
+        .map(|kb| kb / 1024.0)
         .unwrap_or(f64::NAN)
 }

@@ -622,7 +622,10 @@ pub fn layout_dd<S: Space>(
         None => central_face(mesh),
     };
     let canonical = canonical_triangles::<S>(mesh, lengths, lengths_lo);
-    let first = layout_from::<S>(mesh, lengths, &canonical, seed);
+    // The relative placement of each face on the parent it was placed from, kept for the
+    // second pass: a face placed from the same parent edge again reuses it (same bits).
+    let mut relatives: Vec<(u32, Option<S::Frame>)> = vec![(NONE, None); nf];
+    let first = layout_from::<S>(mesh, lengths, &canonical, seed, &mut relatives);
     if seed_face.is_some() || !mesh.has_boundary() {
         return Ok(first);
     }
@@ -640,7 +643,13 @@ pub fn layout_dd<S: Space>(
     if best == seed {
         return Ok(first);
     }
-    Ok(layout_from::<S>(mesh, lengths, &canonical, best))
+    Ok(layout_from::<S>(
+        mesh,
+        lengths,
+        &canonical,
+        best,
+        &mut relatives,
+    ))
 }
 
 fn boundary_points<P: Copy>(mesh: &Mesh, pos: &[P]) -> Vec<P> {
@@ -693,6 +702,7 @@ fn layout_from<S: Space>(
     lengths: &[f64],
     canonical: &[[ExtPoint<S>; 3]],
     seed: u32,
+    relatives: &mut [(u32, Option<S::Frame>)],
 ) -> Layout<S::Point> {
     use std::cmp::Reverse;
     use std::collections::BinaryHeap;
@@ -764,7 +774,14 @@ fn layout_from<S: Space>(
         // triangle with its corners i, j onto (p_i, p_j) in f's frame.
         let cg = canon(g);
         let ti = (t % 3) as usize; // corner of i in g
-        let rel = S::relative(&cg, ti, pi, pj, [len(t), len(tn), len(tp)]);
+        let rel = match relatives[g as usize] {
+            (parent, Some(rel)) if parent == t => rel,
+            _ => {
+                let rel = S::relative(&cg, ti, pi, pj, [len(t), len(tn), len(tp)]);
+                relatives[g as usize] = (t, Some(rel));
+                rel
+            }
+        };
         let fg = ff.compose(&rel).normalized();
         frame[g as usize] = Some(fg);
         let k = mesh.he_tip(tn);
