@@ -10,7 +10,7 @@
 //! ```
 //!
 //! `torus1M` (only when named) is the generated torus of revolution R = 1, r = 0.3 with 1174
-//! columns (1 003 770 faces), flattened in E². The last column is the peak resident memory
+//! columns (1 000 248 faces), flattened in E². The last column is the peak resident memory
 //! of the process so far (`VmHWM`): run one case per process to read it per case.
 
 use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
