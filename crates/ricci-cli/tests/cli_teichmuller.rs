@@ -58,10 +58,10 @@ fn matrix(v: &serde_json::Value) -> Vec<Vec<f64>> {
 }
 
 fn check_matrix(d: &[Vec<f64>]) {
-    for i in 0..d.len() {
-        assert_eq!(d[i][i], 0.0);
-        for j in 0..d.len() {
-            assert!((d[i][j] - d[j][i]).abs() <= 1e-12 * d[i][j].max(1.0));
+    for (i, row) in d.iter().enumerate() {
+        assert_eq!(row[i], 0.0);
+        for (j, x) in row.iter().enumerate() {
+            assert!((x - d[j][i]).abs() <= 1e-12 * x.max(1.0));
         }
     }
 }

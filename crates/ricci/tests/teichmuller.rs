@@ -367,10 +367,10 @@ fn distance_matrix_separates_eight_from_cup() {
         })
         .collect();
     eprintln!("distances eight, cup, eight subdivided: {d:.4?}");
-    for i in 0..3 {
-        assert_eq!(d[i][i], 0.0);
-        for j in 0..3 {
-            assert!((d[i][j] - d[j][i]).abs() <= 1e-12 * d[i][j].max(1.0));
+    for (i, row) in d.iter().enumerate() {
+        assert_eq!(row[i], 0.0);
+        for (j, x) in row.iter().enumerate() {
+            assert!((x - d[j][i]).abs() <= 1e-12 * x.max(1.0));
         }
     }
     // The same surface at two resolutions is much closer than two different surfaces.
@@ -385,4 +385,20 @@ fn distance_matrix_separates_eight_from_cup() {
     // A genus-3 surface has no distance to them.
     let g3 = coords(&genus(3, 14).unwrap(), None);
     assert!(coordinate_distance(&c[0], &g3).is_none());
+}
+
+#[test]
+fn pants_curves_are_3g_minus_3_with_zero_intersections() {
+    for g in 2..=6 {
+        let c = pants_curves(g);
+        assert_eq!(c.len(), 3 * g - 3);
+        let h: Vec<Vec<i64>> = c.iter().map(|c| homology(&c.word(), g)).collect();
+        for x in &h {
+            for y in &h {
+                assert_eq!(intersection_number(x, y), 0);
+            }
+        }
+    }
+    // a1 · b1 = 1: the form is not trivially zero.
+    assert_eq!(intersection_number(&[1, 0, 0, 0], &[0, 1, 0, 0]), 1);
 }
