@@ -39,6 +39,8 @@ enum Command {
     Spectrum(cmd::spectrum::Args),
     /// Holomorphic 1-forms: period matrix, zeros, conformal net (genus ≥ 1).
     Forms(cmd::forms::Args),
+    /// Teichmüller coordinates (Fenchel–Nielsen, length) of genus ≥ 2 surfaces and distances.
+    Teichmuller(cmd::teichmuller::Args),
     /// The whole pipeline on the built-in genus-2 surface: pictures, tables, DIR/index.html.
     Demo(cmd::demo::Args),
     /// Affine atlas with a single extraordinary point (flat cone metric, charts, transitions).
@@ -84,6 +86,7 @@ fn main() {
         Command::Param(a) => cmd::param::run(a),
         Command::Spectrum(a) => cmd::spectrum::run(a),
         Command::Forms(a) => cmd::forms::run(a),
+        Command::Teichmuller(a) => cmd::teichmuller::run(a),
         Command::Demo(a) => cmd::demo::run(a),
         Command::Atlas(a) => cmd::atlas::run(a),
         Command::Spline(a) => cmd::spline::run(a),

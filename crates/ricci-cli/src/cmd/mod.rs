@@ -14,4 +14,5 @@ pub mod pou;
 pub mod render;
 pub mod spectrum;
 pub mod spline;
+pub mod teichmuller;
 pub mod tspline;
