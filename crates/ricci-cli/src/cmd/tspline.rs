@@ -142,7 +142,7 @@ pub fn pictures(
         view,
         ..RenderOptions::default()
     };
-    let curves = tmesh_on_surface(ts, 6, 0.18);
+    let curves = tmesh_on_surface(ts, 6, 0.3);
     let mut polylines: Vec<Polyline> = curves
         .edges
         .into_iter()

@@ -7,7 +7,8 @@ use super::surface::TSpline;
 
 /// Images of the T-mesh's face sides (`per_edge` segments per side; a side shared by two
 /// faces is drawn twice, which draws the same curve) and small loops around the images of the
-/// T-junctions (parameter circles of `marker` times the mean face size, 12 segments).
+/// T-junctions (parameter circles of `marker` times the smallest side of the faces at the
+/// junction, 12 segments).
 #[derive(Debug, Clone, Default)]
 pub struct TMeshCurves {
     pub edges: Vec<Vec<[f64; 3]>>,
@@ -34,11 +35,24 @@ pub fn tmesh_on_surface(ts: &TSpline, per_edge: usize, marker: f64) -> TMeshCurv
         }
     }
     let lat = mesh.lattice;
-    let r = marker * (lat.width * lat.height / mesh.faces().len().max(1) as f64).sqrt();
+    let mean = (lat.width * lat.height / mesh.faces().len().max(1) as f64).sqrt();
+    let tol = 1e-9 * lat.width.max(lat.height);
     let t_junctions = mesh
         .t_junctions()
         .iter()
         .map(|t| {
+            // the smallest side of the faces touching the junction (the conformal factor
+            // makes face sizes vary by orders of magnitude); the mean face size if none is
+            // found (a junction on the glued sides)
+            let side = mesh
+                .faces()
+                .iter()
+                .filter(|f| {
+                    t.u >= f.u0 - tol && t.u <= f.u1 + tol && t.v >= f.v0 - tol && t.v <= f.v1 + tol
+                })
+                .map(|f| (f.u1 - f.u0).min(f.v1 - f.v0))
+                .fold(f64::INFINITY, f64::min);
+            let r = marker * if side.is_finite() { side } else { mean };
             (0..12)
                 .map(|i| {
                     let a = std::f64::consts::TAU * i as f64 / 12.0;
