@@ -148,7 +148,7 @@ fn every_link_of_the_page_is_a_local_non_empty_file() {
         order,
         [
             "surface", "flow", "cone", "loops", "layout", "spectrum", "atlas", "spline", "pou",
-            "param"
+            "param", "tspline"
         ]
     );
     let mut at = 0;

@@ -308,6 +308,8 @@ fn adaptive_fit_reaches_the_tolerance_with_t_junctions() {
     let opts = FitOptions {
         tolerance: 0.002,
         initial_faces: 24,
+        // uniform start: this test is about the error-driven refinement
+        max_points_per_face: 0,
         ..Default::default()
     };
     let r = fit(&pts, &uv, lat, &opts, &mut ricci::progress::NoProgress).unwrap();
@@ -338,6 +340,38 @@ fn adaptive_fit_reaches_the_tolerance_with_t_junctions() {
         let s: f64 = buf.iter().map(|(_, j)| j[0]).sum();
         assert!((s - 1.0).abs() < 1e-12);
     }
+}
+
+#[test]
+fn density_adaptive_start_bounds_the_points_per_face() {
+    // The start splits faces 1-to-4 until none holds more than `max_points_per_face` samples;
+    // counted here from the faces' rectangles, independently of the fit's bookkeeping.
+    use ricci::spline::tspline::fit::{fit, FitOptions};
+    let lat = Lattice {
+        width: 4.0,
+        height: 1.5,
+        shift: 0.9,
+    };
+    let (pts, uv) = torus_samples(90, 40, lat);
+    let opts = FitOptions {
+        tolerance: 0.002,
+        initial_faces: 24,
+        max_points_per_face: 40,
+        max_iterations: 1,
+        ..Default::default()
+    };
+    let r = fit(&pts, &uv, lat, &opts, &mut ricci::progress::NoProgress).unwrap();
+    let faces = r.spline.basis.mesh.faces();
+    assert!(faces.len() > 24, "no split: {} faces", faces.len());
+    let mut count = vec![0usize; faces.len()];
+    for q in &uv {
+        let (u, v) = lat.canonical(q[0], q[1]);
+        let f = faces.iter().position(|f| f.contains(u, v)).unwrap();
+        count[f] += 1;
+    }
+    assert!(count.iter().all(|&c| c <= 40), "{count:?}");
+    assert_eq!(count.iter().sum::<usize>(), uv.len());
+    assert!(r.spline.basis.mesh.is_analysis_suitable());
 }
 
 #[test]

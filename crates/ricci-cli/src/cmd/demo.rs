@@ -24,6 +24,7 @@ mod pou;
 mod param_stage;
 mod report;
 mod stages;
+mod tspline_stage;
 
 use crate::util::{print_json, write_atomic, UsageError};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -134,6 +135,7 @@ pub const STAGES: &[Stage] = &[
     },
 
     Stage { id: "param", title: "Conformal UV map with cones", reference: "ricci param: greedy cones (Ben-Chen–Gotsman–Bunin 2008), conformal flow with intrinsic Delaunay flips, cut, UVs on the input's faces", needs: &["surface"], run: param_stage::param },
+    Stage { id: "tspline", title: "Manifold T-spline of a torus", reference: "cubic T-spline over the flat torus, adaptive least-squares fit, analysis-suitable T-mesh (paper 003 §3)", needs: &[], run: tspline_stage::tspline },
 ];
 
 /// Stages announced in the page but not built yet (title, sentence).

@@ -8,14 +8,18 @@
 //! `--out DIR` writes `tspline.step` (AP214, one `B_SPLINE_SURFACE_WITH_KNOTS` face per Bézier
 //! patch), `tspline.igs` (entity 128 per patch), `surface.obj` (closed welded tessellation on a lattice grid), `tmesh.svg`
 //! (the T-mesh in the parameter domain, T-junctions in red), `samples.json` (parameters and
-//! points of our evaluation, to check readers against) and `tspline.json` (the report).
+//! points of our evaluation, to check readers against), `tmesh-surface.png` (the T-mesh's
+//! edges mapped onto the surface through the fit, T-junctions in red: paper 003 Fig. 5/7),
+//! `zebra.png` (reflection lines of the fitted surface) and `tspline.json` (the report).
 
 use crate::cmd::layout::spinner;
 use crate::util::{print_json, write_atomic, UsageError};
 use ricci::mesh::io::read_surface;
+use ricci::spline::tspline::curves::{tmesh_on_surface, torus_tessellation};
 use ricci::spline::tspline::export::{iges, step, torus_obj};
 use ricci::spline::tspline::fit::{fit, flat_torus_domain, FitOptions};
 use ricci::spline::tspline::{continuity, extract, BezierPatch, TSpline};
+use ricci_render::{render, Image, Paint, Polyline, RenderOptions, Style, View};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -34,8 +38,16 @@ pub struct Args {
     /// Faces of the initial tensor-product T-mesh (about).
     #[arg(long, default_value_t = 64)]
     pub initial_faces: usize,
+    /// Refine only faces whose error exceeds this fraction of the largest error (0 = every
+    /// face above the tolerance, paper 003's rule).
+    #[arg(long, default_value_t = 0.5)]
+    pub mark_fraction: f64,
+    /// Before the first fit, split faces holding more than this many mesh vertices (0 = uniform
+    /// start).
+    #[arg(long, default_value_t = 80)]
+    pub max_points_per_face: usize,
     /// Budget: refinement iterations.
-    #[arg(long, default_value_t = 12)]
+    #[arg(long, default_value_t = 30)]
     pub max_iterations: usize,
     /// Budget: control points.
     #[arg(long, default_value_t = 20_000)]
@@ -108,6 +120,58 @@ fn tmesh_svg(ts: &TSpline) -> String {
     s
 }
 
+/// Pictures of the fitted surface, rendered from the lattice-grid tessellation with about
+/// `per_side` segments per Bézier patch side: the T-mesh on the surface (edges in dark grey,
+/// T-junctions as red loops; paper 003 Fig. 5/7) and zebra stripes (reflection lines).
+pub fn pictures(
+    ts: &TSpline,
+    patches: usize,
+    per_side: usize,
+    size: (u32, u32),
+    view: View,
+) -> anyhow::Result<(Image, Image)> {
+    let lattice = ts.basis.mesh.lattice;
+    let per = (patches.max(1) as f64).sqrt() * per_side as f64;
+    let ratio = (lattice.width / lattice.height).sqrt();
+    let (n, m) = ((per * ratio).ceil() as usize, (per / ratio).ceil() as usize);
+    let (positions, triangles) = torus_tessellation(ts, n.min(2000), m.min(2000));
+    let opts = RenderOptions {
+        width: size.0,
+        height: size.1,
+        supersample: 2,
+        view,
+        ..RenderOptions::default()
+    };
+    let curves = tmesh_on_surface(ts, 6, 0.3);
+    let mut polylines: Vec<Polyline> = curves
+        .edges
+        .into_iter()
+        .map(|points| Polyline {
+            points,
+            color: [0.12, 0.12, 0.16],
+            width: 1.0,
+            closed: false,
+        })
+        .collect();
+    polylines.extend(curves.t_junctions.into_iter().map(|points| Polyline {
+        points,
+        color: [0.9, 0.05, 0.05],
+        width: 2.5,
+        closed: true,
+    }));
+    let net = Style {
+        polylines,
+        ..Style::default()
+    };
+    let tmesh = render(&positions, &triangles, &net, &opts)?.image;
+    let zebra = Style {
+        paint: Paint::Zebra(ricci_render::Zebra::default()),
+        ..Style::default()
+    };
+    let zebra = render(&positions, &triangles, &zebra, &opts)?.image;
+    Ok((tmesh, zebra))
+}
+
 fn samples_json(ts: &TSpline, patches: &[BezierPatch]) -> serde_json::Value {
     let mut out = Vec::with_capacity(2 * patches.len());
     for p in patches {
@@ -126,6 +190,13 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
     let tolerance = parse_tolerance(&a.tolerance)?;
     if !(a.smoothing >= 0.0 && a.smoothing.is_finite()) {
         return Err(UsageError(format!("--smoothing {} must be ≥ 0", a.smoothing)).into());
+    }
+    if !(0.0..1.0).contains(&a.mark_fraction) {
+        return Err(UsageError(format!(
+            "--mark-fraction {} is not in [0, 1)",
+            a.mark_fraction
+        ))
+        .into());
     }
     if !(1..=64).contains(&a.tessellation) {
         return Err(UsageError(format!(
@@ -162,6 +233,8 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         initial_faces: a.initial_faces,
         max_iterations: a.max_iterations.max(1),
         max_control_points: a.max_control_points,
+        mark_fraction: a.mark_fraction,
+        max_points_per_face: a.max_points_per_face,
         ..FitOptions::default()
     };
     bar.0.set_message("fitting");
@@ -232,6 +305,15 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
             torus_obj(&r.spline, n, m).as_bytes(),
         )?;
         write_atomic(&dir.join("tmesh.svg"), tmesh_svg(&r.spline).as_bytes())?;
+        let (net, zebra) = pictures(
+            &r.spline,
+            patches.len(),
+            a.tessellation,
+            (1200, 900),
+            View::default(),
+        )?;
+        write_atomic(&dir.join("tmesh-surface.png"), &net.to_png()?)?;
+        write_atomic(&dir.join("zebra.png"), &zebra.to_png()?)?;
         write_atomic(
             &dir.join("samples.json"),
             serde_json::to_string(&samples_json(&r.spline, &patches))?.as_bytes(),

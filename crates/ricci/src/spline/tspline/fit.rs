@@ -10,8 +10,15 @@
 //! free of the scale of the domain. The system is solved by conjugate gradients (faer),
 //! symmetrically Jacobi-scaled, warm-started from the previous surface.
 //!
+//! **Start**: a uniform tensor grid whose faces holding more than
+//! [`FitOptions::max_points_per_face`] data points are split 1-to-4 (repeatedly): for an evenly
+//! sampled mesh the knot spacing then follows the inverse of the conformal factor `e^u`, which
+//! the conformal map makes vary by orders of magnitude (ears, tails).
+//!
 //! **Refinement** (§3.3): a T-mesh face `I` whose points have `L∞ᴵ > 2ε` is split 1-to-4,
-//! one with `ε < L∞ᴵ ≤ 2ε` 1-to-2 across its longer side; then T-junctions are extended until
+//! one with `ε < L∞ᴵ ≤ 2ε` 1-to-2 across its longer side — of the faces with
+//! `L∞ᴵ > max(ε, θ L∞)` only ([`FitOptions::mark_fraction`] `θ`; paper 003 refines every face
+//! above `ε`, `θ = 0`, which spends control points where one more refit would do); then T-junctions are extended until
 //! the T-mesh is analysis-suitable, and the fit is repeated, until `L∞ ≤ ε` or the budget of
 //! iterations / control points is spent (reported, not hidden).
 
@@ -40,6 +47,13 @@ pub struct FitOptions {
     pub initial_faces: usize,
     pub max_iterations: usize,
     pub max_control_points: usize,
+    /// Marking: a face is refined when its `L∞ᴵ > max(ε, mark_fraction · L∞)`. `0` is paper
+    /// 003's rule (every face above `ε`); larger values refine only the worst faces per step.
+    pub mark_fraction: f64,
+    /// Before the first fit, faces holding more than this many data points are split 1-to-4
+    /// (repeatedly): the initial knot spacing follows the point density, i.e. the inverse of
+    /// the conformal factor `e^u` for a mesh of even sampling. `0` = uniform start.
+    pub max_points_per_face: usize,
     /// Relative residual of the conjugate gradients and their iteration budget.
     pub cg_tolerance: f64,
     pub cg_max_iterations: usize,
@@ -51,8 +65,10 @@ impl Default for FitOptions {
             tolerance: 0.005,
             smoothing: 1e-5,
             initial_faces: 64,
-            max_iterations: 12,
+            max_iterations: 30,
             max_control_points: 20_000,
+            mark_fraction: 0.5,
+            max_points_per_face: 80,
             cg_tolerance: 1e-10,
             cg_max_iterations: 5000,
         }
@@ -278,6 +294,12 @@ pub fn fit(
             "data point {k} or its parameter is not finite"
         )));
     }
+    if !(0.0..1.0).contains(&opts.mark_fraction) {
+        return Err(Error::input(format!(
+            "the marking fraction {} of the T-spline fit must be in [0, 1)",
+            opts.mark_fraction
+        )));
+    }
     let scale = bbox_scale(points);
     if !(scale > 0.0) {
         return Err(Error::input("the data points have an empty bounding box"));
@@ -295,6 +317,27 @@ pub fn fit(
             [u, v]
         })
         .collect();
+    if opts.max_points_per_face > 0 {
+        for _ in 0..16 {
+            let mut count = vec![0usize; mesh.faces().len()];
+            for uv in &params {
+                if let Some(f) = mesh.locate(uv[0], uv[1]) {
+                    count[f] += 1;
+                }
+            }
+            let marks: Vec<(usize, bool)> = count
+                .iter()
+                .enumerate()
+                .filter(|(_, &c)| c > opts.max_points_per_face)
+                .map(|(f, _)| (f, true))
+                .collect();
+            if marks.is_empty() {
+                break;
+            }
+            mesh.refine_faces(&marks);
+            mesh.make_analysis_suitable(50_000)?;
+        }
+    }
     let mut steps = Vec::new();
     let mut prev: Option<TSpline> = None;
     let mut iteration = 0;
@@ -350,10 +393,11 @@ pub fn fit(
                 }
             }
         }
+        let threshold = eps.max(opts.mark_fraction * max);
         let marks: Vec<(usize, bool)> = face_err
             .iter()
             .enumerate()
-            .filter(|(_, &e)| e > eps)
+            .filter(|(_, &e)| e > threshold)
             .map(|(f, &e)| (f, e > 2.0 * eps))
             .collect();
         if marks.is_empty() {

@@ -8,6 +8,7 @@
 //! * [`surface`] — blending functions `B_i = N[u⃗_i](u) N[v⃗_i](v)` summed over lattice
 //!   translates, T-spline surfaces with derivatives up to order two;
 //! * [`bezier`] — Bézier extraction to bicubic patches, continuity across patch sides;
+//! * [`curves`] — the T-mesh drawn on the surface (paper 003 Fig. 5/7), the torus tessellation;
 //! * [`export`] — STEP (AP214 `B_SPLINE_SURFACE_WITH_KNOTS` faces), IGES (entity 128), OBJ;
 //! * [`fit`] — paper 003 §3.3: least squares to the data points plus thin-plate fairness
 //!   (conjugate gradients), adaptive refinement (1-to-4 where `L∞ > 2ε`, else 1-to-2), and the
@@ -20,6 +21,7 @@
 
 pub mod basis;
 pub mod bezier;
+pub mod curves;
 pub mod export;
 pub mod fit;
 pub mod surface;
