@@ -15,6 +15,21 @@ use std::path::{Path, PathBuf};
 
 use ricci::mesh::{BuildReport, Surface};
 
+/// CPU time of this process so far (user + system, all threads) in seconds, from
+/// `/proc/self/stat` (Linux; clock ticks of 1/100 s, the kernel's `USER_HZ`); `None` elsewhere.
+/// The demo reports it per stage, so that stage costs can be compared on a busy machine, where
+/// wall times mostly measure the other processes.
+pub fn process_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which is in parentheses and may contain spaces): state
+    // is field 3, utime and stime are fields 14 and 15.
+    let rest = &stat[stat.rfind(')')? + 1..];
+    let mut fields = rest.split_whitespace().skip(11);
+    let utime: f64 = fields.next()?.parse().ok()?;
+    let stime: f64 = fields.next()?.parse().ok()?;
+    Some((utime + stime) / 100.0)
+}
+
 /// Output paths starting with this are kept in memory by an active [`Capture`].
 pub const MEMORY_PREFIX: &str = "<memory>/";
 

@@ -30,11 +30,12 @@
 
 use std::collections::HashMap;
 
+use faer::linalg::matmul::triangular::BlockStructure;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
 
 use crate::error::{Error, Result};
-use crate::numeric::{dense::gram, sparse::Cholesky};
+use crate::numeric::sparse::Cholesky;
 
 use super::dms::{multi_indices, Precision, Workspace};
 use super::simplex::{n_partials, Point};
@@ -601,14 +602,28 @@ fn energy_gram<S: SplineSpace + ?Sized>(space: &S, blocks: &mut Blocks) -> Resul
                     v[(3 * r + c, col)] += dc;
                 }
             }
-            // (`gram` leaves this thread's vector registers clean for the next triangle's
-            // basis evaluations, `crate::numeric::simd`.)
-            let g = gram(&v);
+            // The lower triangle of VᵀV only (G is symmetric; the scatter below reads it),
+            // on this thread: the faces are the parallelism, and half the product's work.
+            let cols = v.ncols();
+            let mut g = Mat::<f64>::zeros(cols, cols);
+            faer::linalg::matmul::triangular::matmul(
+                g.as_mut(),
+                BlockStructure::TriangularLower,
+                faer::Accum::Replace,
+                v.transpose(),
+                BlockStructure::Rectangular,
+                v.as_ref(),
+                BlockStructure::Rectangular,
+                1.0,
+                faer::Par::Seq,
+            );
+            // Leave this thread's vector registers clean for the next triangle's basis
+            // evaluations (`crate::numeric::simd`).
+            crate::numeric::simd::clear_upper_state_here();
             Ok((groups, g))
         })
         .collect::<Result<_>>()?;
-    // faer may have spread a product over other threads of the pool, which `gram` cannot
-    // clean from the calling thread: clean them all once after the phase.
+    // Clean every thread of the pool once after the phase (as the other faer phases do).
     crate::numeric::simd::clear_upper_state();
     for (groups, g) in grams {
         for (la, &ta) in groups.iter().enumerate() {
@@ -619,7 +634,8 @@ fn energy_gram<S: SplineSpace + ?Sized>(space: &S, blocks: &mut Blocks) -> Resul
                 let blk = blocks.block_mut(ta, tb);
                 for p in 0..nb {
                     for q in 0..nb {
-                        blk[p * nb + q] += g[(la * nb + p, lb * nb + q)];
+                        let (i, j) = (la * nb + p, lb * nb + q);
+                        blk[p * nb + q] += if i >= j { g[(i, j)] } else { g[(j, i)] };
                     }
                 }
             }
