@@ -122,6 +122,63 @@ pub fn sentence(e: &anyhow::Error) -> String {
     s
 }
 
+/// Make a refusal say which file it is about and end with one `try: …` that works (issue 22
+/// item 3): `sentence` is the error of subcommand `sub` run on the mesh `mesh` (its first
+/// positional argument). Library errors do not know file names, and only the CLI knows which
+/// command to suggest; sentences that already name the file or carry a `try:` keep theirs.
+pub fn refusal(sub: &str, mesh: Option<&str>, sentence: String) -> String {
+    let Some(mesh) = mesh else {
+        return sentence;
+    };
+    let mut s = if sentence.contains(mesh) {
+        sentence
+    } else {
+        format!("{mesh}: {sentence}")
+    };
+    // A suggestion without the command: complete it.
+    if let Some(rest) =
+        s.strip_suffix("try: --scheme conformal (the default), which has no such condition")
+    {
+        s = format!(
+            "{rest}try: ricci {sub} {mesh} (the default conformal scheme has no such condition)"
+        );
+    }
+    if s.contains("try: ") {
+        return s;
+    }
+    let lower = s.to_lowercase();
+    let line_no = s
+        .split("line ")
+        .nth(1)
+        .and_then(|t| t.split(|c: char| !c.is_ascii_digit()).next())
+        .filter(|t| !t.is_empty());
+    let suggestion = if lower.contains("no such file") {
+        let dir = Path::new(mesh)
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .map_or(".".into(), |p| p.display().to_string());
+        format!("ls {dir} (the files there)")
+    } else if lower.contains("unknown mesh format") {
+        format!("file {mesh} (what the file holds)")
+    } else if let Some(n) = line_no {
+        format!("sed -n '{n}p' {mesh} (the line)")
+    } else if lower.contains("genus-0")
+        || lower.contains("genus 0")
+        || lower.contains("euler characteristic 2")
+    {
+        format!("ricci layout {mesh} (a closed genus-0 surface: its conformal map to the sphere)")
+    } else if sub == "pou" && lower.contains("euler characteristic") {
+        format!("ricci spline {mesh} --out spline (genus 1 and open surfaces)")
+    } else if sub == "layout" && lower.contains("gauss–bonnet") {
+        format!("ricci layout {mesh} (the geometry its topology asks for)")
+    } else if sub == "render" && lower.contains("faces, but the mesh has") {
+        format!("ricci layout {mesh} --out uv.obj (a layout on this mesh's faces)")
+    } else {
+        return s;
+    };
+    format!("{s}; try: {suggestion}")
+}
+
 /// Write a file atomically: to a temporary file next to it, then rename. Nothing
 /// half-written is left behind if writing fails.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
