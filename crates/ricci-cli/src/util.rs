@@ -161,7 +161,7 @@ pub fn refusal(sub: &str, mesh: Option<&str>, sentence: String) -> String {
     } else if lower.contains("unknown mesh format") {
         format!("file {mesh} (what the file holds)")
     } else if let Some(n) = line_no {
-        format!("sed -n '{n}p' {mesh} (the line)")
+        format!("sed -n {n}p {mesh} (the line)")
     } else if lower.contains("genus-0")
         || lower.contains("genus 0")
         || lower.contains("euler characteristic 2")

@@ -20,8 +20,8 @@ fn ricci(dir: &Path, args: &[&str], parse_only: bool) -> Output {
     c.output().expect("ricci runs")
 }
 
-fn scratch() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ricci-refusals-{}", std::process::id()));
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("ricci-refusals-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     let files: [(&str, &str); 7] = [
@@ -51,7 +51,7 @@ fn scratch() -> PathBuf {
 
 #[test]
 fn every_refusal_names_the_file_and_ends_with_a_working_try() {
-    let d = scratch();
+    let d = scratch("all");
     let g = ricci(
         &d,
         &["generate", "genus2", "-n", "12", "--out", "g2.off"],
@@ -141,7 +141,7 @@ fn every_refusal_names_the_file_and_ends_with_a_working_try() {
 /// `try:`; with `--out` it does not.
 #[test]
 fn pou_without_out_warns() {
-    let d = scratch();
+    let d = scratch("pou");
     let g = ricci(
         &d,
         &["generate", "genus2", "-n", "12", "--out", "g2.off"],
