@@ -95,7 +95,17 @@ fn main() {
         Command::Tspline(a) => cmd::tspline::run_cmd(a),
     };
     if let Err(e) = result {
-        let sentence = util::sentence(&e);
+        // The mesh: the first argument after the subcommand, when it is not an option.
+        let args: Vec<String> = std::env::args().collect();
+        let sub = args.get(1).map_or("", String::as_str);
+        let mesh = args
+            .get(2)
+            .filter(|a| !a.starts_with('-') && !matches!(sub, "batch" | "demo" | "generate"));
+        let sentence = if util::exit_code(&e) == 1 {
+            util::refusal(sub, mesh.map(String::as_str), util::sentence(&e))
+        } else {
+            util::sentence(&e)
+        };
         if json {
             util::print_error_json(&sentence);
         }

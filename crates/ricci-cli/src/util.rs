@@ -15,6 +15,21 @@ use std::path::{Path, PathBuf};
 
 use ricci::mesh::{BuildReport, Surface};
 
+/// CPU time of this process so far (user + system, all threads) in seconds, from
+/// `/proc/self/stat` (Linux; clock ticks of 1/100 s, the kernel's `USER_HZ`); `None` elsewhere.
+/// The demo reports it per stage, so that stage costs can be compared on a busy machine, where
+/// wall times mostly measure the other processes.
+pub fn process_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which is in parentheses and may contain spaces): state
+    // is field 3, utime and stime are fields 14 and 15.
+    let rest = &stat[stat.rfind(')')? + 1..];
+    let mut fields = rest.split_whitespace().skip(11);
+    let utime: f64 = fields.next()?.parse().ok()?;
+    let stime: f64 = fields.next()?.parse().ok()?;
+    Some((utime + stime) / 100.0)
+}
+
 /// Output paths starting with this are kept in memory by an active [`Capture`].
 pub const MEMORY_PREFIX: &str = "<memory>/";
 
@@ -105,6 +120,63 @@ pub fn sentence(e: &anyhow::Error) -> String {
         }
     }
     s
+}
+
+/// Make a refusal say which file it is about and end with one `try: …` that works (issue 22
+/// item 3): `sentence` is the error of subcommand `sub` run on the mesh `mesh` (its first
+/// positional argument). Library errors do not know file names, and only the CLI knows which
+/// command to suggest; sentences that already name the file or carry a `try:` keep theirs.
+pub fn refusal(sub: &str, mesh: Option<&str>, sentence: String) -> String {
+    let Some(mesh) = mesh else {
+        return sentence;
+    };
+    let mut s = if sentence.contains(mesh) {
+        sentence
+    } else {
+        format!("{mesh}: {sentence}")
+    };
+    // A suggestion without the command: complete it.
+    if let Some(rest) =
+        s.strip_suffix("try: --scheme conformal (the default), which has no such condition")
+    {
+        s = format!(
+            "{rest}try: ricci {sub} {mesh} (the default conformal scheme has no such condition)"
+        );
+    }
+    if s.contains("try: ") {
+        return s;
+    }
+    let lower = s.to_lowercase();
+    let line_no = s
+        .split("line ")
+        .nth(1)
+        .and_then(|t| t.split(|c: char| !c.is_ascii_digit()).next())
+        .filter(|t| !t.is_empty());
+    let suggestion = if lower.contains("no such file") {
+        let dir = Path::new(mesh)
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .map_or(".".into(), |p| p.display().to_string());
+        format!("ls {dir} (the files there)")
+    } else if lower.contains("unknown mesh format") {
+        format!("file {mesh} (what the file holds)")
+    } else if let Some(n) = line_no {
+        format!("sed -n {n}p {mesh} (the line)")
+    } else if lower.contains("genus-0")
+        || lower.contains("genus 0")
+        || lower.contains("euler characteristic 2")
+    {
+        format!("ricci layout {mesh} (a closed genus-0 surface: its conformal map to the sphere)")
+    } else if sub == "pou" && lower.contains("euler characteristic") {
+        format!("ricci spline {mesh} --out spline (genus 1 and open surfaces)")
+    } else if sub == "layout" && lower.contains("gauss–bonnet") {
+        format!("ricci layout {mesh} (the geometry its topology asks for)")
+    } else if sub == "render" && lower.contains("faces, but the mesh has") {
+        format!("ricci layout {mesh} --out uv.obj (a layout on this mesh's faces)")
+    } else {
+        return s;
+    };
+    format!("{s}; try: {suggestion}")
 }
 
 /// Write a file atomically: to a temporary file next to it, then rename. Nothing

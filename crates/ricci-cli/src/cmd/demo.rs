@@ -278,6 +278,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             })
             .collect();
         let ts = Instant::now();
+        let cpu0 = crate::util::process_cpu_seconds();
         let mut section = if missing.is_empty() {
             let keep = out.files.len();
             let mut env = Env {
@@ -313,6 +314,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         section.title = st.title.to_string();
         section.reference = st.reference.to_string();
         section.seconds = ts.elapsed().as_secs_f64();
+        section.cpu_seconds = cpu0
+            .zip(crate::util::process_cpu_seconds())
+            .map(|(a, b)| b - a);
         bar.bar.println(format!(
             "{} [{}/{n}] {} ({:.2} s){}",
             match section.status {
@@ -420,6 +424,7 @@ fn summary_json(a: &Args, sections: &[Section], files: &[String], total: f64) ->
         v["status"] = json!(s.status.name());
         v["message"] = json!(s.status.message());
         v["seconds"] = json!(s.seconds);
+        v["cpu_seconds"] = json!(s.cpu_seconds);
         v["files"] = json!(s.files.iter().map(|f| &f.0).collect::<Vec<_>>());
         stages.insert(s.id.to_string(), v);
     }

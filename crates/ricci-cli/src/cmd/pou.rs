@@ -120,6 +120,18 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         )?;
     }
     out["seconds_total"] = json!(t0.elapsed().as_secs_f64());
+    // After the work (a failure stays one sentence on stderr), as `ricci spline` does.
+    if a.out.is_none() {
+        let stem = a
+            .mesh
+            .file_stem()
+            .map_or("pou".into(), |s| s.to_string_lossy().into_owned());
+        eprintln!(
+            "warning: no --out: the surface was computed and only its numbers are reported; to \
+             keep it, try: ricci pou {} --out {stem}-pou",
+            a.mesh.display()
+        );
+    }
     if a.json {
         print_json(&out);
     } else {

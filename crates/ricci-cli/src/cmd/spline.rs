@@ -61,10 +61,47 @@ pub struct Args {
     /// Output directory.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Budget in CPU-seconds: the command estimates its cost up front (scaled from measured
+    /// runs, BENCHMARKS.md) and refuses to start when the estimate exceeds it; 0 = no limit.
+    #[arg(long, default_value_t = 120.0, allow_hyphen_values = true)]
+    pub budget: f64,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
 }
+
+/// Estimated CPU-seconds and peak memory (GB) of `ricci spline` on `faces` faces: measured on
+/// the demo's surface (2 432 faces, BENCHMARKS.md, *Spline budget*) per degree and fit,
+/// linear in the faces; degrees other than 3 and 4 scale with the cube of the basis functions
+/// per triangle (the simplex-spline recurrence and the dense per-face blocks).
+pub fn estimate(faces: usize, degree: usize, fairness: usize, fit: bool) -> (f64, f64) {
+    let scale = faces as f64 / 2432.0;
+    // (CPU-seconds, GB) at degree 3 (r = 1) and 4 (r = 2), without and with the fit.
+    let (cpu, gb) = match (degree, fit) {
+        (3, false) => (EST_D3.0, EST_D3.1),
+        (3, true) => (EST_D3_FIT.0, EST_D3_FIT.1),
+        (4, false) => (EST_D4.0, EST_D4.1),
+        (4, true) => (
+            EST_D4.0 * EST_D3_FIT.0 / EST_D3.0,
+            EST_D4.1 * EST_D3_FIT.1 / EST_D3.1,
+        ),
+        (n, f) => {
+            let base = if f { EST_D3_FIT } else { EST_D3 };
+            let nb = ((n + 1) * (n + 2) / 2) as f64;
+            let k = (nb / 10.0).powi(3);
+            (base.0 * k, base.1 * k)
+        }
+    };
+    // Fairness adds constraint rows (about linear in r + 1).
+    let r = (fairness as f64 + 1.0) / if degree == 4 { 3.0 } else { 2.0 };
+    (cpu * scale * r.max(0.5), gb * scale * r.max(0.5))
+}
+
+/// Measured on the demo surface (2 432 faces): degree 3 r = 1 without / with `--fit 1e-3`,
+/// degree 4 r = 2 without fit (CPU-seconds, peak GB).
+const EST_D3: (f64, f64) = (2.8, 0.26);
+const EST_D3_FIT: (f64, f64) = (8.2, 0.57);
+const EST_D4: (f64, f64) = (108.0, 0.74);
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
@@ -88,21 +125,60 @@ pub fn run(a: Args) -> anyhow::Result<()> {
          the surface, try: ricci spline {} --out {stem}-spline",
         a.mesh.display()
     );
-    // An estimate up front: the cost grows with the faces and the square of the basis
-    // functions per face (the fit's and the fairing's dense blocks); measured: 2 432 faces
-    // at degree 3 with --fit take ~13 CPU-seconds, ~0.6 GB (BENCHMARKS.md).
-    let per_face = ((a.degree + 1) * (a.degree + 2) / 2) as f64;
-    let scale = surface.mesh.n_faces() as f64 / 2432.0 * (per_face / 10.0).powi(2);
-    let est_seconds = 13.0 * scale;
-    let est_gb = 0.6 * scale;
+    // An estimate up front (`estimate`), refused when over the budget; printed when long.
+    let (est_seconds, est_gb) = estimate(
+        surface.mesh.n_faces(),
+        a.degree,
+        a.fairness,
+        a.fit.is_some(),
+    );
+    if a.budget > 0.0 && est_seconds > a.budget {
+        // The same command with a budget above the estimate.
+        let mut cmd = format!(
+            "ricci spline {} --degree {} --fairness {}",
+            a.mesh.display(),
+            a.degree,
+            a.fairness
+        );
+        if let Some(l) = a.fit {
+            let _ = write!(cmd, " --fit {l}");
+        }
+        if a.singularity != "auto" {
+            let _ = write!(cmd, " --singularity {}", a.singularity);
+        }
+        if a.charts != "local" {
+            let _ = write!(cmd, " --charts {}", a.charts);
+        }
+        if a.tessellation != 8 {
+            let _ = write!(cmd, " --tessellation {}", a.tessellation);
+        }
+        if let Some(o) = &a.out {
+            let _ = write!(cmd, " --out {}", o.display());
+        }
+        let raise = (est_seconds * 2.0 / 100.0).ceil() * 100.0;
+        anyhow::bail!(
+            "{}: a degree-{} spline (r = {}{}) on {} faces would take roughly {:.0} CPU-seconds \
+             and {:.1} GB of memory, over the budget of {:.0} s (--budget), so nothing was \
+             computed; try: {cmd} --budget {raise:.0}",
+            a.mesh.display(),
+            a.degree,
+            a.fairness,
+            if a.fit.is_some() { ", fitted" } else { "" },
+            surface.mesh.n_faces(),
+            est_seconds,
+            est_gb,
+            a.budget,
+        );
+    }
     if est_seconds > 30.0 {
         bar.line(&format!(
             "estimate: {} faces at degree {}: roughly {:.0} CPU-seconds and {:.1} GB of memory \
-             (scaled from 13 s / 0.6 GB for 2 432 faces at degree 3); progress follows{}",
+             (budget {:.0} s); progress follows{}",
             surface.mesh.n_faces(),
             a.degree,
             est_seconds,
             est_gb,
+            a.budget,
             if a.out.is_none() {
                 " (no --out: nothing will be written)"
             } else {
@@ -234,6 +310,13 @@ fn check_args(a: &Args) -> anyhow::Result<Singularity> {
         return Err(UsageError(format!(
             "--tessellation {} is not in 1..=64",
             a.tessellation
+        ))
+        .into());
+    }
+    if !(a.budget >= 0.0 && a.budget.is_finite()) {
+        return Err(UsageError(format!(
+            "--budget {} must be a number of CPU-seconds ≥ 0 (0: no limit)",
+            a.budget
         ))
         .into());
     }

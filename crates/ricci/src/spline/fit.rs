@@ -30,11 +30,13 @@
 
 use std::collections::HashMap;
 
+use faer::linalg::matmul::triangular::BlockStructure;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
 
 use crate::error::{Error, Result};
-use crate::numeric::{dense::gram, sparse::Cholesky};
+use crate::numeric::sparse::Cholesky;
+use crate::progress::{NoProgress, Progress};
 
 use super::dms::{multi_indices, Precision, Workspace};
 use super::simplex::{n_partials, Point};
@@ -551,7 +553,15 @@ pub fn thin_plate_energy_with<S: SplineSpace + ?Sized>(
 /// basis functions met at its points get local columns, the scaled second partials form a
 /// dense matrix `V` (three rows per point) and `VᵀV` is one dense product (faer), scattered
 /// into the blocks once per triangle instead of once per point.
-fn energy_gram<S: SplineSpace + ?Sized>(space: &S, blocks: &mut Blocks) -> Result<()> {
+///
+/// The faces are processed in [`GRAM_CHUNKS`] consecutive chunks (each in parallel), with a
+/// progress report on the calling thread after each: the fraction of the quadrature done. The
+/// per-face Gram matrices are scattered in face order as before, so the chunks change nothing.
+fn energy_gram<S: SplineSpace + ?Sized>(
+    space: &S,
+    blocks: &mut Blocks,
+    progress: &mut dyn Progress,
+) -> Result<()> {
     use rayon::prelude::*;
     let nb = blocks.nb;
     let np2 = n_partials(2);
@@ -566,49 +576,95 @@ fn energy_gram<S: SplineSpace + ?Sized>(space: &S, blocks: &mut Blocks) -> Resul
         }
     }
     type FaceGram = (Vec<u32>, Mat<f64>);
-    let grams: Vec<FaceGram> = runs
-        .par_iter()
-        .map(|&(a, b)| -> Result<FaceGram> {
-            // Quadrature and data rows: double precision suffices (module docs, *Precision*).
-            let mut ws = Workspace::with_precision(Precision::Double);
-            let mut groups: Vec<u32> = Vec::new();
-            let mut local: HashMap<u32, usize> = HashMap::new();
-            // One entry per (point, basis function): its local column and its scaled second
-            // partials √w·(∂xx, √2 ∂xy, ∂yy), so that VᵀV sums w(∂xx² + 2∂xy² + ∂yy²).
-            let mut entries: Vec<(usize, usize, [f64; 3])> = Vec::new();
-            for (r, &(f, u, w)) in quad[a..b].iter().enumerate() {
-                let m = space.basis_at(f, u, 2, &mut ws)?;
-                let sw = [w.sqrt(), (2.0 * w).sqrt(), w.sqrt()];
-                for (gi, g) in ws.indices[..m].chunks(nb).enumerate() {
-                    let t = g[0] / nb as u32;
-                    let lg = *local.entry(t).or_insert_with(|| {
-                        groups.push(t);
-                        groups.len() - 1
-                    });
-                    for (p, &gp) in g.iter().enumerate() {
-                        let vals = &ws.values[(gi * nb + p) * np2..];
-                        entries.push((
-                            r,
-                            lg * nb + gp as usize % nb,
-                            [sw[0] * vals[3], sw[1] * vals[4], sw[2] * vals[5]],
-                        ));
+    // Per worker thread: the basis workspace, the point/function entries and the matrix `V`
+    // (its storage reused from face to face instead of a fresh megabyte of zeroed pages).
+    type Scratch = (Workspace, Vec<(usize, usize, [f64; 3])>, Mat<f64>);
+    let chunk = runs.len().div_ceil(GRAM_CHUNKS).max(1);
+    let mut grams: Vec<FaceGram> = Vec::with_capacity(runs.len());
+    for (ci, part) in runs.chunks(chunk).enumerate() {
+        let done: Vec<FaceGram> = part
+            .par_iter()
+            .map_init(
+                || -> Scratch {
+                    // Quadrature and data rows: double precision suffices (module docs,
+                    // *Precision*).
+                    (
+                        Workspace::with_precision(Precision::Double),
+                        Vec::new(),
+                        Mat::zeros(0, 0),
+                    )
+                },
+                |(ws, entries, vbuf), &(a, b)| -> Result<FaceGram> {
+                    let mut groups: Vec<u32> = Vec::new();
+                    let mut local: HashMap<u32, usize> = HashMap::new();
+                    // One entry per (point, basis function): its local column and its scaled second
+                    // partials √w·(∂xx, √2 ∂xy, ∂yy), so that VᵀV sums w(∂xx² + 2∂xy² + ∂yy²).
+                    entries.clear();
+                    for (r, &(f, u, w)) in quad[a..b].iter().enumerate() {
+                        let m = space.basis_at(f, u, 2, ws)?;
+                        let sw = [w.sqrt(), (2.0 * w).sqrt(), w.sqrt()];
+                        for (gi, g) in ws.indices[..m].chunks(nb).enumerate() {
+                            let t = g[0] / nb as u32;
+                            let lg = *local.entry(t).or_insert_with(|| {
+                                groups.push(t);
+                                groups.len() - 1
+                            });
+                            for (p, &gp) in g.iter().enumerate() {
+                                let vals = &ws.values[(gi * nb + p) * np2..];
+                                entries.push((
+                                    r,
+                                    lg * nb + gp as usize % nb,
+                                    [sw[0] * vals[3], sw[1] * vals[4], sw[2] * vals[5]],
+                                ));
+                            }
+                        }
                     }
-                }
-            }
-            let mut v = Mat::<f64>::zeros(3 * (b - a), groups.len() * nb);
-            for &(r, col, d) in &entries {
-                for (c, dc) in d.iter().enumerate() {
-                    v[(3 * r + c, col)] += dc;
-                }
-            }
-            // (`gram` leaves this thread's vector registers clean for the next triangle's
-            // basis evaluations, `crate::numeric::simd`.)
-            let g = gram(&v);
-            Ok((groups, g))
-        })
-        .collect::<Result<_>>()?;
-    // faer may have spread a product over other threads of the pool, which `gram` cannot
-    // clean from the calling thread: clean them all once after the phase.
+                    let (rows, cols) = (3 * (b - a), groups.len() * nb);
+                    if vbuf.nrows() < rows || vbuf.ncols() < cols {
+                        *vbuf = Mat::zeros(rows.max(vbuf.nrows()), cols.max(vbuf.ncols()));
+                    }
+                    let mut v = vbuf.as_mut().submatrix_mut(0, 0, rows, cols);
+                    v.fill(0.0);
+                    for &(r, col, d) in entries.iter() {
+                        for (c, dc) in d.iter().enumerate() {
+                            v[(3 * r + c, col)] += dc;
+                        }
+                    }
+                    // The lower triangle of VᵀV only (G is symmetric; the scatter below reads it),
+                    // on this thread: the faces are the parallelism, and half the product's work.
+                    let v = v.as_ref();
+                    let mut g = Mat::<f64>::zeros(cols, cols);
+                    faer::linalg::matmul::triangular::matmul(
+                        g.as_mut(),
+                        BlockStructure::TriangularLower,
+                        faer::Accum::Replace,
+                        v.transpose(),
+                        BlockStructure::Rectangular,
+                        v,
+                        BlockStructure::Rectangular,
+                        1.0,
+                        faer::Par::Seq,
+                    );
+                    // Leave this thread's vector registers clean for the next triangle's basis
+                    // evaluations (`crate::numeric::simd`).
+                    crate::numeric::simd::clear_upper_state_here();
+                    Ok((groups, g))
+                },
+            )
+            .collect::<Result<_>>()?;
+        grams.extend(done);
+        let finished = ((ci + 1) * chunk).min(runs.len());
+        progress.report(
+            "fit",
+            Some(finished as f64 / runs.len().max(1) as f64),
+            &format!(
+                "thin-plate quadrature: {finished} of {} faces ({} points each)",
+                runs.len(),
+                quadrature_barycentric().len()
+            ),
+        );
+    }
+    // Clean every thread of the pool once after the phase (as the other faer phases do).
     crate::numeric::simd::clear_upper_state();
     for (groups, g) in grams {
         for (la, &ta) in groups.iter().enumerate() {
@@ -619,7 +675,8 @@ fn energy_gram<S: SplineSpace + ?Sized>(space: &S, blocks: &mut Blocks) -> Resul
                 let blk = blocks.block_mut(ta, tb);
                 for p in 0..nb {
                     for q in 0..nb {
-                        blk[p * nb + q] += g[(la * nb + p, lb * nb + q)];
+                        let (i, j) = (la * nb + p, lb * nb + q);
+                        blk[p * nb + q] += if i >= j { g[(i, j)] } else { g[(j, i)] };
                     }
                 }
             }
@@ -627,6 +684,9 @@ fn energy_gram<S: SplineSpace + ?Sized>(space: &S, blocks: &mut Blocks) -> Resul
     }
     Ok(())
 }
+
+/// Chunks of faces between two progress reports of the fit's quadrature ([`fit_with_progress`]).
+pub const GRAM_CHUNKS: usize = 20;
 
 /// Least-squares fit of the control points to data with a thin-plate fairness term (module
 /// docs). `initial` (`dim` per control point) is the ridge's anchor.
@@ -636,6 +696,19 @@ pub fn fit<S: SplineSpace + ?Sized>(
     initial: &[f64],
     dim: usize,
     opts: &FitOptions,
+) -> Result<(Vec<f64>, FitReport)> {
+    fit_with_progress(space, data, initial, dim, opts, &mut NoProgress)
+}
+
+/// [`fit`], reporting the fraction of its thin-plate quadrature done (stage `"fit"`, after each
+/// of [`GRAM_CHUNKS`] chunks of faces) and the solve.
+pub fn fit_with_progress<S: SplineSpace + ?Sized>(
+    space: &S,
+    data: &[DataPoint],
+    initial: &[f64],
+    dim: usize,
+    opts: &FitOptions,
+    progress: &mut dyn Progress,
 ) -> Result<(Vec<f64>, FitReport)> {
     let nc = space.n_control_points();
     let nb = space.per_triangle();
@@ -685,7 +758,7 @@ pub fn fit<S: SplineSpace + ?Sized>(
             }
         }
     }
-    energy_gram(space, &mut energy_blocks)?;
+    energy_gram(space, &mut energy_blocks, progress)?;
     // Ridge relative to the data term's diagonal.
     let mut diag_mean = 0.0;
     for (&(a, b), &off) in &data_blocks.index {
@@ -750,6 +823,11 @@ pub fn fit<S: SplineSpace + ?Sized>(
         Error::numerical(format!("fit: could not assemble the normal matrix ({e:?})"))
     })?;
     drop(trip);
+    progress.report(
+        "fit",
+        Some(1.0),
+        &format!("sparse Cholesky of the {nc} × {nc} normal matrix"),
+    );
     let llt = Cholesky::factor(h.as_ref()).map_err(|e| {
         Error::numerical(format!("fit: Cholesky of the normal matrix failed ({e:?})"))
     })?;

@@ -45,7 +45,7 @@ use crate::error::{Error, Result};
 use crate::progress::Progress;
 
 use super::dms::KnotOptions;
-use super::fit::{fair, fit, DataPoint, FairingReport, FitOptions, FitReport};
+use super::fit::{fair, fit_with_progress, DataPoint, FairingReport, FitOptions, FitReport};
 use super::hole::Hole;
 use super::manifold::{ManifoldReport, ManifoldSpace};
 
@@ -120,7 +120,7 @@ pub fn build<A: FlatCharts + Sync + ?Sized>(
         let mut result = None;
         let mut last = None;
         for ridge in [1e-9, 1e-7, 1e-5] {
-            match fit(
+            match fit_with_progress(
                 space,
                 &data,
                 &c1,
@@ -129,6 +129,7 @@ pub fn build<A: FlatCharts + Sync + ?Sized>(
                     smoothing: lam,
                     ridge,
                 },
+                progress,
             ) {
                 Ok(x) => {
                     result = Some((x, ridge));

@@ -104,6 +104,9 @@ pub struct Section {
     /// Per-stage summary for `--json` and `demo.json`.
     pub summary: Value,
     pub seconds: f64,
+    /// CPU time of the process (all threads, user + system) during the stage, where the
+    /// system reports it ([`crate::util::process_cpu_seconds`]).
+    pub cpu_seconds: Option<f64>,
 }
 
 impl Section {
@@ -121,6 +124,7 @@ impl Section {
             commands: Vec::new(),
             summary: Value::Object(Default::default()),
             seconds: 0.0,
+            cpu_seconds: None,
         }
     }
 }

@@ -354,6 +354,20 @@ impl MeshDistance {
             if best <= (r as f64 - 1.0).max(0.0) * self.cell {
                 break;
             }
+            // Sharper, for points inside the grid: a triangle not yet seen has its bounding
+            // box outside the block of cells within r of `c`, so it is farther from `p` than
+            // the block's nearest face (less a margin for the rounding of cell indices). Most
+            // points stop after one cell instead of 5³.
+            let gap = (0..3)
+                .map(|k| {
+                    let below = self.lo[k] + (c[k] - r) as f64 * self.cell;
+                    let above = self.lo[k] + (c[k] + r + 1) as f64 * self.cell;
+                    (p[k] - below).min(above - p[k])
+                })
+                .fold(f64::INFINITY, f64::min);
+            if best <= gap - 1e-9 * (self.cell + self.diagonal) {
+                break;
+            }
         }
         best
     }
