@@ -17,6 +17,7 @@
 use crate::util::read_surface;
 use crate::util::{print_json, write_atomic, UsageError};
 use indicatif::{ProgressBar, ProgressStyle};
+use ricci::flow::FlowResult;
 use ricci::layout::cover::{tiles_by_radius, word_string};
 use ricci::layout::export::obj_with_corner_uv;
 use ricci::layout::input_uv::input_face_uvs;
@@ -31,7 +32,6 @@ use ricci::layout::{deck_group, DeckGroup, Isometry, Layout, Polygon};
 use ricci::mesh::{topology, Mesh, Surface};
 use ricci::metric::file::MetricFile;
 use ricci::metric::{Euclidean, Geometry, Hyperbolic, Scheme, Spherical};
-use ricci::flow::FlowResult;
 use serde_json::{json, Value};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -513,6 +513,7 @@ where
             uv["triangles"] = json!(s.triangles.len());
             uv["crossings"] = json!(s.crossings);
             uv["seam_faces"] = json!(s.seam_faces);
+            uv["t_flipped_faces"] = json!(s.t_flipped_faces);
             format!(
                 "the common subdivision of the input and the intrinsic triangulation ({} \
                  vertices on the input surface, {} faces, {} flipped; the input's own faces \
@@ -657,7 +658,10 @@ fn sphere_layout(
             text.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
         }
         write_atomic(path, text.as_bytes())?;
-        eprintln!("wrote {}: points on the unit sphere, {what}", path.display());
+        eprintln!(
+            "wrote {}: points on the unit sphere, {what}",
+            path.display()
+        );
     }
     if let Some(path) = &a.svg {
         write_atomic(path, sphere_svg(&surface.mesh, points).as_bytes())?;

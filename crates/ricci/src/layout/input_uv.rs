@@ -70,7 +70,10 @@ where
         )));
     }
     let nv = used.len();
-    if let Some(f) = faces.iter().position(|t| t.iter().any(|&v| v as usize >= nv)) {
+    if let Some(f) = faces
+        .iter()
+        .position(|t| t.iter().any(|&v| v as usize >= nv))
+    {
         return Err(Error::input(format!(
             "face {f} names a vertex beyond the surface's {nv}"
         )));

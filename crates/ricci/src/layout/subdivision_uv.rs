@@ -58,6 +58,10 @@ pub struct SubdivisionUv {
     pub flipped_faces: usize,
     /// Faces of `T` whose corners needed a deck transformation (they straddle a seam).
     pub seam_faces: usize,
+    /// Faces of `T` whose layout triangle is not positively oriented (then the pieces inside
+    /// are not either: the layout, not the subdivision, is at fault — e.g. points too far out
+    /// in the Poincaré disk for double precision).
+    pub t_flipped_faces: usize,
     /// Crossings of input edges with edges of `T`, and faces of `T`.
     pub crossings: usize,
     pub t_faces: usize,
@@ -127,14 +131,7 @@ where
             "common_subdivision_uvs lays out E² and H²; use sphere_common_subdivision on S²",
         ));
     }
-    let (sub, loc, positions) = base(
-        input,
-        input_positions,
-        input_lengths,
-        S::KIND,
-        intrinsic,
-        u,
-    )?;
+    let (sub, loc, positions) = base(input, input_positions, input_lengths, S::KIND, intrinsic, u)?;
     let tri = &sub.triangulation;
     let faces: Vec<[u32; 3]> = (0..tri.n_faces() as u32).map(|f| tri.face(f)).collect();
     let mut used = vec![false; tri.n_vertices];
@@ -156,6 +153,7 @@ where
         sphere_points: Vec::new(),
         flipped_faces,
         seam_faces: corners.seam_faces,
+        t_flipped_faces: corners.flipped_faces.len(),
         crossings: sub.crossings.len(),
         t_faces: tri.n_faces(),
     })
@@ -266,6 +264,13 @@ pub fn sphere_common_subdivision(
         sphere_points: sphere,
         flipped_faces,
         seam_faces: 0,
+        t_flipped_faces: sphere_flipped_faces(
+            points,
+            &(0..tri.n_faces() as u32)
+                .map(|f| tri.face(f))
+                .collect::<Vec<_>>(),
+        )
+        .len(),
         crossings: sub.crossings.len(),
         t_faces: tri.n_faces(),
     })
