@@ -583,7 +583,8 @@ fn sphere_layout(
         .iter()
         .filter(|&&f| {
             let v = t_faces[f as usize].map(|v| points[v as usize]);
-            !(sphere_orientation(v[0], v[1], v[2]) < 0.0)
+            let d = sphere_orientation(v[0], v[1], v[2]);
+            d.is_nan() || d >= 0.0
         })
         .count();
     let mut max_err = 0.0f64;

@@ -77,8 +77,8 @@ impl SubdivisionUv {
 fn locations(sub: &CommonSubdivision) -> Result<Vec<(u32, [f64; 3])>> {
     let mut loc = vec![(u32::MAX, [f64::NAN; 3]); sub.n_vertices()];
     for (t, tr) in sub.triangles.iter().enumerate() {
-        for i in 0..3 {
-            let v = tr[i] as usize;
+        for (i, &v) in tr.iter().enumerate() {
+            let v = v as usize;
             if loc[v].0 == u32::MAX {
                 loc[v] = (sub.input_face[t], sub.input_barycentric[3 * t + i]);
             }
@@ -92,6 +92,9 @@ fn locations(sub: &CommonSubdivision) -> Result<Vec<(u32, [f64; 3])>> {
     Ok(loc)
 }
 
+/// The subdivision, the locations of its vertices and their points on the input surface.
+type Base = (CommonSubdivision, Vec<(u32, [f64; 3])>, Vec<[f64; 3]>);
+
 fn base(
     input: &Mesh,
     input_positions: &[[f64; 3]],
@@ -99,7 +102,7 @@ fn base(
     geometry: Geometry,
     intrinsic: &IntrinsicTriangulation,
     u: &[f64],
-) -> Result<(CommonSubdivision, Vec<(u32, [f64; 3])>, Vec<[f64; 3]>)> {
+) -> Result<Base> {
     let sub = CommonSubdivision::from_triangulation(input, geometry, input_lengths, intrinsic, u)?;
     let loc = locations(&sub)?;
     let positions = sub.positions(input, input_positions)?;
@@ -221,8 +224,8 @@ pub fn sphere_common_subdivision(
     let mut sphere = vec![[f64::NAN; 3]; sub.n_vertices()];
     for (t, (tr, &f)) in sub.triangles.iter().zip(&sub.t_face).enumerate() {
         let verts = tri.face(f);
-        for c in 0..3 {
-            let v = tr[c] as usize;
+        for (c, &v) in tr.iter().enumerate() {
+            let v = v as usize;
             if !sphere[v][0].is_nan() {
                 continue;
             }
@@ -245,7 +248,7 @@ pub fn sphere_common_subdivision(
                 }
             }
             let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-            if !(r > 0.0) {
+            if r.is_nan() || r <= 0.0 {
                 return Err(Error::numerical(format!(
                     "vertex {v} of the common subdivision is at the centre of the sphere \
                      (the origin is not inside the hull of the points)"
