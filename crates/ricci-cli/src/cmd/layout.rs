@@ -17,12 +17,16 @@
 use crate::util::read_surface;
 use crate::util::{print_json, write_atomic, UsageError};
 use indicatif::{ProgressBar, ProgressStyle};
+use ricci::flow::FlowResult;
 use ricci::layout::cover::{tiles_by_radius, word_string};
 use ricci::layout::export::obj_with_corner_uv;
 use ricci::layout::input_uv::input_face_uvs;
 use ricci::layout::isometry::{Complex, Mobius, RigidMotion};
 use ricci::layout::pipeline::{cut_disk, cut_disk_polished, uniformization_geometry, CutDisk};
 use ricci::layout::place::{layout, layout_dd, minimax_centre, Space};
+use ricci::layout::subdivision_uv::{
+    common_subdivision_uvs, sphere_common_subdivision, sphere_flipped_faces, sphere_orientation,
+};
 use ricci::layout::svg::{fundamental_domain_svg, sphere_svg, tiling_svg};
 use ricci::layout::{deck_group, DeckGroup, Isometry, Layout, Polygon};
 use ricci::mesh::{topology, Mesh, Surface};
@@ -172,6 +176,8 @@ pub struct PolishedLengths {
     pub report: Value,
     /// The `metric_polish` report.
     pub polish: Value,
+    /// The flow that computed the metric (`None` with `--metric`).
+    pub flow: Option<ricci::flow::FlowResult>,
 }
 
 /// [`metric`], then for hyperbolic metrics (when `polish`) the double-double polish
@@ -197,12 +203,15 @@ pub fn polished_metric(
         lengths_lo: None,
         report,
         polish: json!({"applied": false, "reason": "not a hyperbolic metric"}),
+        flow: None,
     };
     if g != Geometry::Hyperbolic {
+        out.flow = flow;
         return Ok(out);
     }
     if !polish {
         out.polish = json!({"applied": false, "reason": "--no-polish"});
+        out.flow = flow;
         return Ok(out);
     }
     progress.report("polish", None, "polishing the metric to double-double");
@@ -226,6 +235,7 @@ pub fn polished_metric(
         }
         Err(e) => out.polish = json!({"applied": false, "reason": e.to_string()}),
     }
+    out.flow = flow;
     Ok(out)
 }
 
@@ -334,6 +344,7 @@ fn planar<S: Space<Point = Complex>>(
     disk: Option<&CutDisk>,
     lengths: &[f64],
     lengths_lo: Option<&[f64]>,
+    flow: Option<&FlowResult>,
     out: &mut Value,
 ) -> anyhow::Result<()>
 where
@@ -388,29 +399,11 @@ where
             out["relation_error"] = Value::Null;
         }
     }
-    // UVs on the input's own faces: each corner takes the layout position of its vertex,
-    // mapped across the seams by the deck group (`ricci::layout::input_uv`).
     let origin: Vec<u32> = match disk {
         Some(d) => d.vertex_origin.clone(),
         None => (0..mesh.n_vertices() as u32).collect(),
     };
-    let uvs = input_face_uvs::<S>(&surface.mesh, &l.positions, &origin, group.as_ref())?;
-    out["uv"] = json!({
-        "faces": "input",
-        "flipped_faces": uvs.flipped_faces.len(),
-        "seam_faces": uvs.seam_faces,
-    });
-    if let Some(path) = &a.out {
-        let corner: Vec<[f64; 2]> = uvs.corner.iter().map(|z| [z.re, z.im]).collect();
-        let comments = vec![
-            format!("ricci layout of {} ({})", a.mesh.display(), S::KIND.name()),
-            "vt: layout coordinates per corner of the input's faces (Poincaré disk for \
-             hyperbolic); several vt per vertex along the seams"
-                .to_string(),
-        ];
-        let text = obj_with_corner_uv(&surface.positions, surface.mesh.faces(), &corner, &comments);
-        write_atomic(path, text.as_bytes())?;
-    }
+    planar_uv::<S>(a, surface, flow, &l.positions, &origin, group.as_ref(), out)?;
     if let Some(path) = &a.svg {
         let svg = match (a.tiling, &group, poly) {
             (Some(n), Some(g), Some(p)) => {
@@ -453,6 +446,282 @@ where
     Ok(())
 }
 
+/// `uv` of the report and `--out` (E², H²): the input's own faces, each corner at the layout
+/// position of its vertex mapped across the seams by the deck group
+/// (`ricci::layout::input_uv`); when some of their UV triangles are flipped or degenerate and
+/// the metric comes from a conformal flow, the common subdivision of the input and the
+/// flow's intrinsic triangulation instead (`ricci::layout::subdivision_uv`: points on the
+/// input surface, projective interpolation of the layout).
+#[allow(clippy::too_many_arguments)]
+fn planar_uv<S: Space<Point = Complex>>(
+    a: &Args,
+    surface: &Surface,
+    flow: Option<&FlowResult>,
+    positions: &[Complex],
+    origin: &[u32],
+    group: Option<&DeckGroup<S::Iso>>,
+    out: &mut Value,
+) -> anyhow::Result<()>
+where
+    S::Iso: JsonIso,
+{
+    let uvs = input_face_uvs::<S>(&surface.mesh, positions, origin, group)?;
+    let n_flipped = uvs.flipped_faces.len();
+    let mut uv = json!({
+        "on": "input", "faces": "input", "flipped_faces": n_flipped,
+        "input_flipped_faces": n_flipped, "seam_faces": uvs.seam_faces,
+    });
+    let intrinsic = flow.and_then(|f| f.triangulation.as_ref().map(|t| (&t.triangulation, &f.u)));
+    let mut sub = None;
+    if n_flipped > 0 {
+        match intrinsic {
+            Some((t, u)) => match common_subdivision_uvs::<S>(
+                &surface.mesh,
+                &surface.positions,
+                &surface.edge_lengths(),
+                t,
+                u,
+                positions,
+                origin,
+                group,
+            ) {
+                Ok(s) => sub = Some(s),
+                Err(e) => {
+                    uv["common_subdivision_error"] = json!(e.to_string());
+                    eprintln!(
+                        "warning: {}: {n_flipped} input face(s) have flipped UV triangles and the \
+                         common subdivision failed ({e}); writing the input's faces",
+                        a.mesh.display()
+                    );
+                }
+            },
+            None => eprintln!(
+                "warning: {}: {n_flipped} input face(s) have flipped or degenerate UV triangles \
+                 (a common subdivision needs the intrinsic triangulation of a conformal flow: \
+                 run without --metric, with the default scheme)",
+                a.mesh.display()
+            ),
+        }
+    }
+    let kind = S::KIND.name();
+    let what = match &sub {
+        Some(s) => {
+            uv["on"] = json!("common_subdivision");
+            uv["faces"] = json!("common_subdivision");
+            uv["flipped_faces"] = json!(s.flipped_faces);
+            uv["vertices"] = json!(s.n_vertices());
+            uv["triangles"] = json!(s.triangles.len());
+            uv["crossings"] = json!(s.crossings);
+            uv["seam_faces"] = json!(s.seam_faces);
+            uv["t_flipped_faces"] = json!(s.t_flipped_faces);
+            format!(
+                "the common subdivision of the input and the intrinsic triangulation ({} \
+                 vertices on the input surface, {} faces, {} flipped; the input's own faces \
+                 would have {n_flipped} flipped UV triangle(s))",
+                s.n_vertices(),
+                s.triangles.len(),
+                s.flipped_faces
+            )
+        }
+        None => format!(
+            "the input's {} vertices and {} faces ({n_flipped} flipped UV triangle(s))",
+            surface.mesh.n_vertices(),
+            surface.mesh.n_faces()
+        ),
+    };
+    out["uv"] = uv;
+    if let Some(path) = &a.out {
+        let comments = vec![
+            format!("ricci layout of {} ({kind})", a.mesh.display()),
+            format!("v, f: {what}"),
+            "vt: layout coordinates per corner (Poincaré disk for hyperbolic); several vt per \
+             vertex along the seams"
+                .to_string(),
+        ];
+        let text = match &sub {
+            Some(s) => obj_with_corner_uv(&s.positions, &s.triangles, &s.corner_uv, &comments),
+            None => {
+                let corner: Vec<[f64; 2]> = uvs.corner.iter().map(|z| [z.re, z.im]).collect();
+                obj_with_corner_uv(&surface.positions, surface.mesh.faces(), &corner, &comments)
+            }
+        };
+        write_atomic(path, text.as_bytes())?;
+        eprintln!("wrote {}: {kind} UVs on {what}", path.display());
+    }
+    Ok(())
+}
+
+/// The layout on the sphere (closed genus 0). With the conformal flow's points
+/// (`ricci::flow::sphere::conformal_sphere`) the report measures them against the metric and
+/// `--out` writes the input's faces on the sphere, or — when some of them are not positively
+/// oriented there — the common subdivision (`ricci::layout::subdivision_uv`); without (a
+/// metric file, another scheme), the metric is laid out face by face.
+fn sphere_layout(
+    a: &Args,
+    surface: &Surface,
+    work: &Mesh,
+    lengths: &[f64],
+    flow: Option<&FlowResult>,
+    out: &mut Value,
+) -> anyhow::Result<()> {
+    out["deck_generators"] = json!([]);
+    out["relation_error"] = Value::Null;
+    let conformal = flow.and_then(|f| {
+        f.triangulation
+            .as_ref()
+            .filter(|t| !t.points.is_empty())
+            .map(|t| (t, &f.u))
+    });
+    let Some((t, u)) = conformal else {
+        return sphere_from_lengths(a, work, lengths, out);
+    };
+    let tri = &t.triangulation;
+    let points = &t.points;
+    let t_faces: Vec<[u32; 3]> = (0..tri.n_faces() as u32).map(|f| tri.face(f)).collect();
+    let bad = sphere_flipped_faces(points, &t_faces);
+    let degenerate = bad
+        .iter()
+        .filter(|&&f| {
+            let v = t_faces[f as usize].map(|v| points[v as usize]);
+            let d = sphere_orientation(v[0], v[1], v[2]);
+            d.is_nan() || d >= 0.0
+        })
+        .count();
+    let mut max_err = 0.0f64;
+    for e in 0..tri.n_edges() as u32 {
+        let [i, j] = tri.edge_vertices(e);
+        let (p, q) = (points[i as usize], points[j as usize]);
+        let chord = ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();
+        let metric = 2.0 * (0.5 * tri.lambda[e as usize]).exp().min(1.0).asin();
+        max_err = max_err.max((2.0 * (0.5 * chord).min(1.0).asin() - metric).abs());
+    }
+    out["flipped_faces"] = json!(bad.len() - degenerate);
+    out["degenerate_faces"] = json!(degenerate);
+    out["seed_face"] = Value::Null;
+    out["max_length_error"] = json!(max_err);
+    let input_bad = sphere_flipped_faces(points, surface.mesh.faces()).len();
+    let mut uv = json!({
+        "on": "input", "faces": "input", "flipped_faces": input_bad,
+        "input_flipped_faces": input_bad, "points": "conformal_sphere",
+    });
+    let sub = if input_bad > 0 {
+        let s = sphere_common_subdivision(
+            &surface.mesh,
+            &surface.positions,
+            &surface.edge_lengths(),
+            tri,
+            u,
+            points,
+        )?;
+        uv["on"] = json!("common_subdivision");
+        uv["faces"] = json!("common_subdivision");
+        uv["flipped_faces"] = json!(s.flipped_faces);
+        uv["vertices"] = json!(s.n_vertices());
+        uv["triangles"] = json!(s.triangles.len());
+        uv["crossings"] = json!(s.crossings);
+        Some(s)
+    } else {
+        None
+    };
+    out["uv"] = uv;
+    if let Some(path) = &a.out {
+        let (pts, faces, what) = match &sub {
+            Some(s) => (
+                &s.sphere_points[..],
+                &s.triangles[..],
+                format!(
+                    "the common subdivision of the input and the intrinsic triangulation ({} \
+                     vertices, {} faces, {} not positively oriented; the input's own faces \
+                     would have {input_bad})",
+                    s.n_vertices(),
+                    s.triangles.len(),
+                    s.flipped_faces
+                ),
+            ),
+            None => (
+                &points[..],
+                surface.mesh.faces(),
+                format!(
+                    "the input's {} vertices and {} faces (0 not positively oriented)",
+                    surface.mesh.n_vertices(),
+                    surface.mesh.n_faces()
+                ),
+            ),
+        };
+        let mut text = format!(
+            "# ricci layout of {} on the unit sphere\n# v: points on the unit sphere; f: {what}\n",
+            a.mesh.display()
+        );
+        for p in pts {
+            text.push_str(&format!("v {:e} {:e} {:e}\n", p[0], p[1], p[2]));
+        }
+        for t in faces {
+            text.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+        }
+        write_atomic(path, text.as_bytes())?;
+        eprintln!(
+            "wrote {}: points on the unit sphere, {what}",
+            path.display()
+        );
+    }
+    if let Some(path) = &a.svg {
+        write_atomic(path, sphere_svg(&surface.mesh, points).as_bytes())?;
+    }
+    Ok(())
+}
+
+/// The sphere laid out face by face from the lengths (a metric file, or a scheme without the
+/// conformal sphere's points); `--out` writes the metric's triangulation.
+fn sphere_from_lengths(
+    a: &Args,
+    work: &Mesh,
+    lengths: &[f64],
+    out: &mut Value,
+) -> anyhow::Result<()> {
+    let l = layout::<Spherical>(work, lengths, a.seed_face)?;
+    out["flipped_faces"] = json!(l.flipped_faces.len());
+    out["degenerate_faces"] = json!(l.degenerate_faces.len());
+    out["seed_face"] = json!(l.seed_face);
+    out["max_length_error"] = json!(l.max_length_error);
+    if !l.flipped_faces.is_empty() || !l.degenerate_faces.is_empty() {
+        // Never silently: a layout placed triangle by triangle cannot resolve triangles a
+        // map shrinks to ~1e-5.
+        eprintln!(
+            "warning: {}: the sphere layout has {} flipped and {} degenerate face(s) (laid out \
+             face by face from the lengths; the points cannot resolve its smallest triangles); \
+             the counts are in the JSON",
+            a.mesh.display(),
+            l.flipped_faces.len(),
+            l.degenerate_faces.len()
+        );
+    }
+    if let Some(path) = &a.out {
+        let mut text = format!(
+            "# ricci layout of {} on the unit sphere\n# v: points on the unit sphere; f: the \
+             metric's triangulation\n",
+            a.mesh.display()
+        );
+        for p in &l.positions {
+            text.push_str(&format!("v {:e} {:e} {:e}\n", p[0], p[1], p[2]));
+        }
+        for t in work.faces() {
+            text.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+        }
+        write_atomic(path, text.as_bytes())?;
+        eprintln!(
+            "wrote {}: points on the unit sphere, the metric's triangulation ({} vertices, {} \
+             faces)",
+            path.display(),
+            work.n_vertices(),
+            work.n_faces()
+        );
+    }
+    if let Some(path) = &a.svg {
+        write_atomic(path, sphere_svg(work, &l.positions).as_bytes())?;
+    }
+    Ok(())
+}
+
 pub fn run(a: Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let geometry: Option<Geometry> = match &a.geometry {
@@ -474,6 +743,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         lengths_lo,
         report: metric_report,
         polish: mut polish_report,
+        flow,
     } = polished_metric(
         &surface,
         geometry,
@@ -505,40 +775,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             anyhow::bail!("spherical layouts need a closed genus-0 surface");
         }
         bar.0.set_message("layout on the sphere");
-        let l = layout::<Spherical>(work, &lengths, a.seed_face)?;
-        out["flipped_faces"] = json!(l.flipped_faces.len());
-        out["degenerate_faces"] = json!(l.degenerate_faces.len());
-        out["seed_face"] = json!(l.seed_face);
-        out["max_length_error"] = json!(l.max_length_error);
-        if !l.flipped_faces.is_empty() || !l.degenerate_faces.is_empty() {
-            // Never silently: the metric converged, but points on the sphere cannot resolve
-            // the triangles the map shrinks to ~1e-5 (horse: 438 flipped faces).
-            eprintln!(
-                "warning: {}: the sphere layout has {} flipped and {} degenerate face(s) (the \
-                 metric converged; the points cannot resolve its smallest triangles); the counts are in the JSON",
-                a.mesh.display(),
-                l.flipped_faces.len(),
-                l.degenerate_faces.len()
-            );
-        }
-        out["deck_generators"] = json!([]);
-        out["relation_error"] = Value::Null;
-        if let Some(path) = &a.out {
-            let mut text = format!(
-                "# ricci layout of {} on the unit sphere\n",
-                a.mesh.display()
-            );
-            for p in &l.positions {
-                text.push_str(&format!("v {:e} {:e} {:e}\n", p[0], p[1], p[2]));
-            }
-            for t in work.faces() {
-                text.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
-            }
-            write_atomic(path, text.as_bytes())?;
-        }
-        if let Some(path) = &a.svg {
-            write_atomic(path, sphere_svg(work, &l.positions).as_bytes())?;
-        }
+        sphere_layout(&a, &surface, work, &lengths, flow.as_ref(), &mut out)?;
     } else {
         let disk = if simply_connected && comp.boundary_loops == 1 {
             None
@@ -573,9 +810,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 disk.as_ref(),
                 &lengths,
                 lengths_lo.as_deref(),
+                flow.as_ref(),
                 &mut out,
             )?,
-            _ => planar::<Euclidean>(&a, &surface, work, disk.as_ref(), &lengths, None, &mut out)?,
+            _ => planar::<Euclidean>(
+                &a,
+                &surface,
+                work,
+                disk.as_ref(),
+                &lengths,
+                None,
+                flow.as_ref(),
+                &mut out,
+            )?,
         }
     }
     bar.0.finish_and_clear();

@@ -94,6 +94,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         lengths_lo,
         report: metric_report,
         polish: polish_report,
+        ..
     } = polished_metric(
         &surface,
         Some(want),

@@ -222,6 +222,11 @@ pub struct IntrinsicResult {
     pub splits: usize,
     /// Vertices of the simplicial mesh (input vertices + splits).
     pub simplicial_vertices: usize,
+    /// S² only: the input vertices' points on the unit sphere
+    /// ([`sphere::ConformalSphere::positions`]; `triangulation` is their convex hull, faces
+    /// counter-clockwise seen from outside); empty in E² and H².
+    #[serde(skip)]
+    pub points: Vec<[f64; 3]>,
 }
 
 impl FlowResult {
@@ -659,6 +664,7 @@ fn conformal_flow(
     }
     let result_lengths = simplicial.lengths.clone();
     let triangulation = IntrinsicResult {
+        points: Vec::new(),
         initial_flips: init.flips,
         flips: out.flips,
         splits: simplicial.splits,
@@ -778,6 +784,7 @@ fn conformal_sphere_flow(
     let converged = max_err <= options.tolerance && degenerate == 0;
     let simplicial = tri.to_simplicial(geometry, &[])?;
     let triangulation = IntrinsicResult {
+        points: s.positions.clone(),
         initial_flips: s.initial_flips,
         flips: s.flips + state.flips,
         splits: simplicial.splits,

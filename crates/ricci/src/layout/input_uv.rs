@@ -43,6 +43,25 @@ pub fn input_face_uvs<S: Space>(
 where
     S::Iso: Isometry<Point = S::Point>,
 {
+    let used: Vec<bool> = (0..input.n_vertices() as u32)
+        .map(|v| !input.is_isolated(v))
+        .collect();
+    face_uvs::<S>(&used, input.faces(), positions, origin, group)
+}
+
+/// [`input_face_uvs`] for any list of triangles on the surface's vertices (`used[v]`: vertex
+/// `v` is a corner of some triangle) — e.g. the faces of an intrinsic triangulation, which
+/// may be a Δ-complex (self-loops, multi-edges) and so not a [`Mesh`].
+pub fn face_uvs<S: Space>(
+    used: &[bool],
+    faces: &[[u32; 3]],
+    positions: &[S::Point],
+    origin: &[u32],
+    group: Option<&DeckGroup<S::Iso>>,
+) -> Result<InputUvs<S::Point>>
+where
+    S::Iso: Isometry<Point = S::Point>,
+{
     if positions.len() != origin.len() {
         return Err(Error::input(format!(
             "{} layout positions for {} vertex origins",
@@ -50,14 +69,22 @@ where
             origin.len()
         )));
     }
-    let nv = input.n_vertices();
+    let nv = used.len();
+    if let Some(f) = faces
+        .iter()
+        .position(|t| t.iter().any(|&v| v as usize >= nv))
+    {
+        return Err(Error::input(format!(
+            "face {f} names a vertex beyond the surface's {nv}"
+        )));
+    }
     let mut copies: Vec<Vec<u32>> = vec![Vec::new(); nv];
     for (c, &v) in origin.iter().enumerate() {
         if (v as usize) < nv {
             copies[v as usize].push(c as u32);
         }
     }
-    if let Some(v) = (0..nv).find(|&v| copies[v].is_empty() && !input.is_isolated(v as u32)) {
+    if let Some(v) = (0..nv).find(|&v| copies[v].is_empty() && used[v]) {
         return Err(Error::input(format!(
             "input vertex {v} has no position in the layout"
         )));
@@ -94,7 +121,6 @@ where
         cands.extend(prods);
         level_end[2] = cands.len();
     }
-    let faces = input.faces();
     // Nearest image of vertex `w` to point `p`: (distance, point).
     let nearest = |w: u32, p: S::Point, n: usize| -> (f64, S::Point) {
         let mut best = (f64::INFINITY, p);

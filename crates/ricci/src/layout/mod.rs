@@ -27,6 +27,7 @@ pub mod input_uv;
 pub mod isometry;
 pub mod pipeline;
 pub mod place;
+pub mod subdivision_uv;
 pub mod svg;
 pub mod synthetic;
 

@@ -1,0 +1,280 @@
+//! Texture coordinates on the **common subdivision** of the input mesh and the final intrinsic
+//! triangulation `T` of a conformal flow (Gillespie–Springborn–Crane 2021, "Discrete
+//! conformal equivalence of polyhedral surfaces" (CEPS) §5): every vertex is a point of the
+//! input surface (an input vertex, or the crossing of an input edge with an edge of `T`,
+//! given by its input face and barycentric coordinates there), every triangle lies in one
+//! input face and one face of `T`, and its UVs are the projective interpolation of the layout
+//! of `T` ([`crate::metric::common_subdivision`]). The map is exact at the vertices of `T` and
+//! the pieces are convex in both charts, so — unlike the input's own faces, whose UV triangles
+//! join layout points of vertices that are not adjacent in `T` — no triangle is flipped.
+//!
+//! * E² and H² ([`common_subdivision_uvs`]): `T` is laid out through the cut of the surface
+//!   (the laid-out mesh is `T`'s simplicial refinement, cut to a disk); the three corners of
+//!   every face of `T` take the layout positions of their vertices, mapped across the seams by
+//!   the deck group exactly as [`super::input_uv::input_face_uvs`] does for input faces.
+//! * S² ([`sphere_common_subdivision`]): `T` is the convex hull of the points of
+//!   [`crate::flow::sphere::conformal_sphere`] (inscribed in the unit sphere). A point with
+//!   projective weights `β` on a hull face is `Σ β_i p_i / Σ β_i` on the face's plane — the
+//!   Klein model of the face's ideal triangle — and it is sent to the sphere by central
+//!   projection. The origin lies inside the hull, so a piece positively oriented on its face
+//!   plane stays positively oriented on the sphere (`det[p0, p1, p2] > 0`).
+//!
+//! **Known limitation.** The flow's flip log starts with isometric flips (to the Delaunay
+//! triangulation of the input metric) and [`CommonSubdivision::from_triangulation`] maps the
+//! input faces to the ideal triangles spanned by their straightened edges (a continuous,
+//! piecewise projective homeomorphism, exact on every input edge the isometric flips kept),
+//! not through the Euclidean triangles of that Delaunay triangulation (CEPS's three-way
+//! overlay); see that function.
+
+use super::deck::DeckGroup;
+use super::input_uv::face_uvs;
+use super::isometry::Complex;
+use super::place::Space;
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use crate::metric::common_subdivision::CommonSubdivision;
+use crate::metric::intrinsic::IntrinsicTriangulation;
+use crate::metric::Geometry;
+
+/// The common subdivision with its UVs (see the module docs).
+#[derive(Debug, Clone)]
+pub struct SubdivisionUv {
+    /// Per vertex: an input face that contains it and its barycentric coordinates on that
+    /// face (in the order of `mesh.face(f)`). Vertices `0..V` are the input vertices.
+    pub locations: Vec<(u32, [f64; 3])>,
+    /// Per vertex: its point on the input surface (from `locations` and the input positions).
+    pub positions: Vec<[f64; 3]>,
+    /// Triangles (counter-clockwise on the input surface).
+    pub triangles: Vec<[u32; 3]>,
+    /// Input face of every triangle.
+    pub input_face: Vec<u32>,
+    /// Per triangle corner (`3t + i`): E² plane, H² Poincaré disk; on S² the point on the
+    /// unit sphere is in `sphere_points` and this is empty.
+    pub corner_uv: Vec<[f64; 2]>,
+    /// S²: per vertex, its point on the unit sphere; empty in E² and H².
+    pub sphere_points: Vec<[f64; 3]>,
+    /// Triangles whose image is not positively oriented (E²: signed area; H²: signed area in
+    /// the Klein model; S²: `det[p0, p1, p2]`), degenerate ones included.
+    pub flipped_faces: usize,
+    /// Faces of `T` whose corners needed a deck transformation (they straddle a seam).
+    pub seam_faces: usize,
+    /// Faces of `T` whose layout triangle is not positively oriented (then the pieces inside
+    /// are not either: the layout, not the subdivision, is at fault — e.g. points too far out
+    /// in the Poincaré disk for double precision).
+    pub t_flipped_faces: usize,
+    /// Crossings of input edges with edges of `T`, and faces of `T`.
+    pub crossings: usize,
+    pub t_faces: usize,
+}
+
+impl SubdivisionUv {
+    /// Number of vertices.
+    pub fn n_vertices(&self) -> usize {
+        self.locations.len()
+    }
+}
+
+fn locations(sub: &CommonSubdivision) -> Result<Vec<(u32, [f64; 3])>> {
+    let mut loc = vec![(u32::MAX, [f64::NAN; 3]); sub.n_vertices()];
+    for (t, tr) in sub.triangles.iter().enumerate() {
+        for (i, &v) in tr.iter().enumerate() {
+            let v = v as usize;
+            if loc[v].0 == u32::MAX {
+                loc[v] = (sub.input_face[t], sub.input_barycentric[3 * t + i]);
+            }
+        }
+    }
+    if let Some(v) = loc.iter().position(|l| l.0 == u32::MAX) {
+        return Err(Error::numerical(format!(
+            "vertex {v} of the common subdivision is in no triangle"
+        )));
+    }
+    Ok(loc)
+}
+
+/// The subdivision, the locations of its vertices and their points on the input surface.
+type Base = (CommonSubdivision, Vec<(u32, [f64; 3])>, Vec<[f64; 3]>);
+
+fn base(
+    input: &Mesh,
+    input_positions: &[[f64; 3]],
+    input_lengths: &[f64],
+    geometry: Geometry,
+    intrinsic: &IntrinsicTriangulation,
+    u: &[f64],
+) -> Result<Base> {
+    let sub = CommonSubdivision::from_triangulation(input, geometry, input_lengths, intrinsic, u)?;
+    let loc = locations(&sub)?;
+    let positions = sub.positions(input, input_positions)?;
+    Ok((sub, loc, positions))
+}
+
+/// The common subdivision of `input` (positions and Euclidean edge lengths — the lengths the
+/// flow started from, only used to replay the flips) and the final intrinsic triangulation
+/// `intrinsic` of a conformal flow in E² or H² (`FlowResult::triangulation.triangulation`,
+/// with `u = FlowResult::u`), with UVs from a layout of `T`: `layout_positions` are the
+/// positions of the laid-out mesh's vertices, `origin[v]` the surface vertex each is a copy
+/// of (input ids first), `group` the deck group (`None` for a disk).
+#[allow(clippy::too_many_arguments)]
+pub fn common_subdivision_uvs<S: Space<Point = Complex>>(
+    input: &Mesh,
+    input_positions: &[[f64; 3]],
+    input_lengths: &[f64],
+    intrinsic: &IntrinsicTriangulation,
+    u: &[f64],
+    layout_positions: &[Complex],
+    origin: &[u32],
+    group: Option<&DeckGroup<S::Iso>>,
+) -> Result<SubdivisionUv>
+where
+    S::Iso: super::isometry::Isometry<Point = Complex>,
+{
+    if S::KIND == Geometry::Spherical {
+        return Err(Error::input(
+            "common_subdivision_uvs lays out E² and H²; use sphere_common_subdivision on S²",
+        ));
+    }
+    let (sub, loc, positions) = base(input, input_positions, input_lengths, S::KIND, intrinsic, u)?;
+    let tri = &sub.triangulation;
+    let faces: Vec<[u32; 3]> = (0..tri.n_faces() as u32).map(|f| tri.face(f)).collect();
+    let mut used = vec![false; tri.n_vertices];
+    for t in &faces {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let corners = face_uvs::<S>(&used, &faces, layout_positions, origin, group)?;
+    let corner: Vec<[f64; 2]> = corners.corner.iter().map(|z| [z.re, z.im]).collect();
+    let uv = sub.uv(S::KIND, u, &corner)?;
+    let flipped_faces = sub.flipped_triangles(S::KIND, &uv);
+    Ok(SubdivisionUv {
+        locations: loc,
+        positions,
+        triangles: sub.triangles.clone(),
+        input_face: sub.input_face.clone(),
+        corner_uv: uv,
+        sphere_points: Vec::new(),
+        flipped_faces,
+        seam_faces: corners.seam_faces,
+        t_flipped_faces: corners.flipped_faces.len(),
+        crossings: sub.crossings.len(),
+        t_faces: tri.n_faces(),
+    })
+}
+
+/// `det[a, b, c]`, computed as `((b − a) × (c − a)) · a` (small triangles on the unit sphere
+/// keep their relative accuracy).
+pub fn sphere_orientation(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+    let d1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let d2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let n = [
+        d1[1] * d2[2] - d1[2] * d2[1],
+        d1[2] * d2[0] - d1[0] * d2[2],
+        d1[0] * d2[1] - d1[1] * d2[0],
+    ];
+    n[0] * a[0] + n[1] * a[1] + n[2] * a[2]
+}
+
+/// Faces of `faces` whose points (on the unit sphere) are not positively oriented
+/// (`det ≤ 0`, or not finite).
+pub fn sphere_flipped_faces(points: &[[f64; 3]], faces: &[[u32; 3]]) -> Vec<u32> {
+    faces
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| {
+            let d = sphere_orientation(
+                points[t[0] as usize],
+                points[t[1] as usize],
+                points[t[2] as usize],
+            );
+            d.is_nan() || d <= 0.0
+        })
+        .map(|(f, _)| f as u32)
+        .collect()
+}
+
+/// The common subdivision of `input` and the final triangulation of the conformal map to the
+/// sphere (`FlowResult::triangulation`: `intrinsic` its Δ-complex, `points` its vertices on
+/// the unit sphere, `u = FlowResult::u`), each vertex sent to the sphere by projective
+/// interpolation on its hull face and central projection (see the module docs).
+pub fn sphere_common_subdivision(
+    input: &Mesh,
+    input_positions: &[[f64; 3]],
+    input_lengths: &[f64],
+    intrinsic: &IntrinsicTriangulation,
+    u: &[f64],
+    points: &[[f64; 3]],
+) -> Result<SubdivisionUv> {
+    if points.len() != intrinsic.n_vertices {
+        return Err(Error::input(format!(
+            "{} points on the sphere for a triangulation with {} vertices",
+            points.len(),
+            intrinsic.n_vertices
+        )));
+    }
+    let (sub, loc, positions) = base(
+        input,
+        input_positions,
+        input_lengths,
+        Geometry::Euclidean,
+        intrinsic,
+        u,
+    )?;
+    let tri = &sub.triangulation;
+    let mut sphere = vec![[f64::NAN; 3]; sub.n_vertices()];
+    for (t, (tr, &f)) in sub.triangles.iter().zip(&sub.t_face).enumerate() {
+        let verts = tri.face(f);
+        for (c, &v) in tr.iter().enumerate() {
+            let v = v as usize;
+            if !sphere[v][0].is_nan() {
+                continue;
+            }
+            // β_i = w_i e^{−u_i}, normalised in log space (as CommonSubdivision::uv).
+            let w = sub.t_weights[3 * t + c];
+            let logs: [f64; 3] = [0, 1, 2].map(|i| {
+                if w[i] > 0.0 {
+                    w[i].ln() - u.get(verts[i] as usize).copied().unwrap_or(0.0)
+                } else {
+                    f64::NEG_INFINITY
+                }
+            });
+            let m = logs.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            let beta = logs.map(|l| if l.is_finite() { (l - m).exp() } else { 0.0 });
+            let mut x = [0.0f64; 3];
+            for i in 0..3 {
+                let p = points[verts[i] as usize];
+                for k in 0..3 {
+                    x[k] += beta[i] * p[k];
+                }
+            }
+            let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+            if r.is_nan() || r <= 0.0 {
+                return Err(Error::numerical(format!(
+                    "vertex {v} of the common subdivision is at the centre of the sphere \
+                     (the origin is not inside the hull of the points)"
+                )));
+            }
+            sphere[v] = x.map(|c| c / r);
+        }
+    }
+    let flipped_faces = sphere_flipped_faces(&sphere, &sub.triangles).len();
+    Ok(SubdivisionUv {
+        locations: loc,
+        positions,
+        triangles: sub.triangles.clone(),
+        input_face: sub.input_face.clone(),
+        corner_uv: Vec::new(),
+        sphere_points: sphere,
+        flipped_faces,
+        seam_faces: 0,
+        t_flipped_faces: sphere_flipped_faces(
+            points,
+            &(0..tri.n_faces() as u32)
+                .map(|f| tri.face(f))
+                .collect::<Vec<_>>(),
+        )
+        .len(),
+        crossings: sub.crossings.len(),
+        t_faces: tri.n_faces(),
+    })
+}

@@ -1,0 +1,378 @@
+//! The common subdivision of an input mesh and the final intrinsic triangulation of a conformal
+//! flow, with its UVs (`ricci::layout::subdivision_uv`), on surfaces whose flip log starts
+//! with isometric flips: it must be a valid mesh of the input surface — the same area, face by
+//! face (signed, so a reversed piece fails), every input vertex at its place, every other
+//! vertex on an input edge, a manifold with the input's Euler characteristic and boundary —
+//! and its UVs (plane, Klein model, or points on the sphere) must have no flipped triangle.
+//! Every quantity is recomputed here from positions, not taken from the library's counts.
+
+mod ricci_meshes;
+use ricci::flow::{ricci_flow, FlowOptions, FlowResult, TargetSpec};
+use ricci::layout::place::layout;
+use ricci::layout::subdivision_uv::{
+    common_subdivision_uvs, sphere_common_subdivision, SubdivisionUv,
+};
+use ricci::mesh::{generate, topology, Mesh, Surface};
+use ricci::metric::{Euclidean, Geometry, Scheme};
+use ricci::progress::NoProgress;
+
+/// Deterministic pseudo-random numbers in [0, 1).
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Split `count` random faces at points close to one of their corners (weights 0.9, 0.05,
+/// 0.05 up to noise): thin triangles, so that the input metric is far from Delaunay.
+fn split_off_centre(s: &Surface, count: usize, rng: &mut Lcg) -> Surface {
+    split_off_centre_at(s, count, rng, 0.9)
+}
+
+fn split_off_centre_at(s: &Surface, count: usize, rng: &mut Lcg, near: f64) -> Surface {
+    let mut pos = s.positions.clone();
+    let mut faces = s.mesh.faces().to_vec();
+    for _ in 0..count {
+        let f = ((rng.next() * faces.len() as f64) as usize).min(faces.len() - 1);
+        let [a, b, c] = faces[f];
+        if [a, b, c]
+            .iter()
+            .any(|&v| (v as usize) < s.mesh.n_vertices() && s.mesh.is_boundary_vertex(v))
+        {
+            continue;
+        }
+        let w = [
+            near - 0.1 * rng.next(),
+            0.5 * (1.0 - near) * (1.0 + rng.next()),
+            0.0,
+        ];
+        let w = [w[0], w[1], 1.0 - w[0] - w[1]];
+        let (pa, pb, pc) = (pos[a as usize], pos[b as usize], pos[c as usize]);
+        let p = [0, 1, 2].map(|k| w[0] * pa[k] + w[1] * pb[k] + w[2] * pc[k]);
+        let v = pos.len() as u32;
+        pos.push(p);
+        faces[f] = [a, b, v];
+        faces.push([b, c, v]);
+        faces.push([c, a, v]);
+    }
+    Surface::new(pos, faces).unwrap()
+}
+
+fn face_normal(p: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {
+    cross(
+        sub3(p[t[1] as usize], p[t[0] as usize]),
+        sub3(p[t[2] as usize], p[t[0] as usize]),
+    )
+}
+
+/// The checks of the module docs. `uv_orientation(t)` is the signed area of triangle `t`'s
+/// image (recomputed by the caller from the UVs).
+fn check_subdivision(
+    name: &str,
+    surface: &Surface,
+    s: &SubdivisionUv,
+    uv_orientation: &dyn Fn(usize) -> f64,
+) {
+    let mesh = &surface.mesh;
+    let nv = mesh.n_vertices();
+    let n = s.n_vertices();
+    assert_eq!(s.positions.len(), n, "{name}");
+    // Every vertex is used; the input vertices are at their places.
+    let mut used = vec![false; n];
+    for t in &s.triangles {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    assert!(
+        used.iter().all(|&u| u),
+        "{name}: a vertex is in no triangle"
+    );
+    for v in 0..nv {
+        assert_eq!(
+            s.positions[v], surface.positions[v],
+            "{name}: input vertex {v}"
+        );
+    }
+    // Every other vertex lies on an input edge: one barycentric coordinate is 0, and its point
+    // is on the segment between the other two corners.
+    let scale = surface
+        .positions
+        .iter()
+        .map(|p| norm(*p))
+        .fold(0.0f64, f64::max);
+    for v in nv..n {
+        let (f, b) = s.locations[v];
+        let zero = (0..3).filter(|&i| b[i].abs() <= 1e-12).count();
+        assert_eq!(
+            zero, 1,
+            "{name}: vertex {v} has barycentrics {b:?} on face {f}"
+        );
+        assert!(b.iter().all(|&x| x >= -1e-12), "{name}: vertex {v}: {b:?}");
+        let fv = mesh.face(f);
+        let k = (0..3).find(|&i| b[i].abs() <= 1e-12).unwrap();
+        let (p, q) = (
+            surface.positions[fv[(k + 1) % 3] as usize],
+            surface.positions[fv[(k + 2) % 3] as usize],
+        );
+        let x = s.positions[v];
+        let d = sub3(q, p);
+        let t = (dot(sub3(x, p), d) / dot(d, d)).clamp(0.0, 1.0);
+        let foot = [0, 1, 2].map(|i| p[i] + t * d[i]);
+        assert!(
+            norm(sub3(x, foot)) <= 1e-12 * scale,
+            "{name}: vertex {v} is {:.2e} off its input edge",
+            norm(sub3(x, foot))
+        );
+        assert!(
+            t > 0.0 && t < 1.0,
+            "{name}: vertex {v} at an end of its edge"
+        );
+    }
+    // Area, face by face, signed along the input face's normal.
+    let mut per_face = vec![0.0f64; mesh.n_faces()];
+    for (t, tr) in s.triangles.iter().enumerate() {
+        let f = s.input_face[t];
+        let nf = face_normal(&surface.positions, mesh.face(f));
+        let nt = face_normal(&s.positions, *tr);
+        per_face[f as usize] += 0.5 * dot(nt, nf) / norm(nf);
+    }
+    let mut total_in = 0.0;
+    let mut total_sub = 0.0;
+    for f in 0..mesh.n_faces() as u32 {
+        let a = 0.5 * norm(face_normal(&surface.positions, mesh.face(f)));
+        total_in += a;
+        total_sub += per_face[f as usize];
+        assert!(
+            (per_face[f as usize] - a).abs() <= 1e-9 * a,
+            "{name}: input face {f} has area {a}, its pieces {}",
+            per_face[f as usize]
+        );
+    }
+    assert!(
+        (total_sub - total_in).abs() <= 1e-9 * total_in,
+        "{name}: area {total_sub} vs {total_in}"
+    );
+    // A manifold with the input's topology.
+    let sm = Mesh::from_triangles(n, s.triangles.clone())
+        .unwrap_or_else(|e| panic!("{name}: not a manifold mesh: {e}"));
+    let (ti, ts) = (topology(mesh), topology(&sm));
+    assert_eq!(
+        ts.euler_characteristic(),
+        ti.euler_characteristic(),
+        "{name}"
+    );
+    assert_eq!(ts.boundary_loops(), ti.boundary_loops(), "{name}");
+    assert_eq!(ts.components.len(), ti.components.len(), "{name}");
+    // No flipped UV triangle (recomputed).
+    let flipped = (0..s.triangles.len())
+        .filter(|&t| {
+            let o = uv_orientation(t);
+            o.is_nan() || o <= 0.0
+        })
+        .count();
+    assert_eq!(flipped, 0, "{name}: {flipped} flipped UV triangles");
+    assert_eq!(s.flipped_faces, 0, "{name}");
+}
+
+fn planar_orientation(uv: &[[f64; 2]], t: usize, klein: bool) -> f64 {
+    let q = [0, 1, 2].map(|i| {
+        let z = uv[3 * t + i];
+        if klein {
+            let s = 2.0 / (1.0 + z[0] * z[0] + z[1] * z[1]);
+            [s * z[0], s * z[1]]
+        } else {
+            z
+        }
+    });
+    (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0])
+}
+
+fn conformal(s: &Surface, geometry: Geometry, target: TargetSpec) -> FlowResult {
+    let o = FlowOptions {
+        geometry,
+        scheme: Scheme::Conformal,
+        target,
+        tolerance: 1e-10,
+        ..FlowOptions::default()
+    };
+    let r = ricci_flow(&s.mesh, &s.edge_lengths(), &o, &mut NoProgress).unwrap();
+    assert!(r.converged, "{:?}", r.notes);
+    r
+}
+
+/// A bumpy disk with thin triangles: free-boundary flattening, laid out in the plane.
+#[test]
+fn flattened_disk_with_thin_triangles_has_a_valid_common_subdivision() {
+    let d = generate::disk(16).unwrap();
+    let pos: Vec<[f64; 3]> = d
+        .positions
+        .iter()
+        .map(|p| {
+            let (x, y) = (p[0], p[1]);
+            [x, y, 0.5 * (3.0 * x).sin() * (2.0 * y).cos() + 0.7 * x * x]
+        })
+        .collect();
+    let s = Surface::new(pos, d.mesh.faces().to_vec()).unwrap();
+    let s = split_off_centre_at(&s, 120, &mut Lcg(7), 0.75);
+    let r = conformal(&s, Geometry::Euclidean, TargetSpec::FreeBoundary);
+    let it = r.triangulation.as_ref().unwrap();
+    assert!(
+        it.initial_flips > 20,
+        "only {} isometric flips",
+        it.initial_flips
+    );
+    let l = layout::<Euclidean>(&it.simplicial.mesh, &r.lengths, None).unwrap();
+    let origin: Vec<u32> = (0..it.simplicial.mesh.n_vertices() as u32).collect();
+    let sub = common_subdivision_uvs::<Euclidean>(
+        &s.mesh,
+        &s.positions,
+        &s.edge_lengths(),
+        &it.triangulation,
+        &r.u,
+        &l.positions,
+        &origin,
+        None,
+    )
+    .unwrap();
+    assert!(sub.crossings > 50, "{} crossings", sub.crossings);
+    let uv = sub.corner_uv.clone();
+    check_subdivision("disk", &s, &sub, &|t| planar_orientation(&uv, t, false));
+}
+
+fn sphere_det(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+    dot(a, cross(b, c))
+}
+
+/// A bumpy sphere with thin triangles, mapped to the sphere: the pieces must be positively
+/// oriented on the sphere (det of their corners' points).
+#[test]
+fn bumpy_sphere_with_thin_triangles_has_a_valid_common_subdivision() {
+    let ico = generate::icosphere(3).unwrap();
+    let x: Vec<[f64; 3]> = ico
+        .positions
+        .iter()
+        .map(|p| {
+            let r = norm(*p);
+            let q = [p[0] / r, p[1] / r, p[2] / r];
+            let bump = 1.0 + 0.3 * (3.0 * q[0]).sin() * (2.0 * q[1]).cos() + 0.4 * q[2] * q[2];
+            [2.0 * q[0] * bump, q[1] * bump, 0.7 * q[2] * bump]
+        })
+        .collect();
+    let s = Surface::new(x, ico.mesh.faces().to_vec()).unwrap();
+    let s = split_off_centre(&s, 300, &mut Lcg(11));
+    let r = conformal(&s, Geometry::Spherical, TargetSpec::Uniform);
+    let it = r.triangulation.as_ref().unwrap();
+    assert!(
+        it.initial_flips > 20,
+        "{} isometric flips",
+        it.initial_flips
+    );
+    assert_eq!(it.points.len(), s.mesh.n_vertices());
+    let sub = sphere_common_subdivision(
+        &s.mesh,
+        &s.positions,
+        &s.edge_lengths(),
+        &it.triangulation,
+        &r.u,
+        &it.points,
+    )
+    .unwrap();
+    assert!(sub.crossings > 50, "{} crossings", sub.crossings);
+    for p in &sub.sphere_points {
+        assert!((norm(*p) - 1.0).abs() < 1e-12);
+    }
+    // The input vertices keep the flow's points.
+    for v in 0..s.mesh.n_vertices() {
+        assert!(norm(sub3(sub.sphere_points[v], it.points[v])) < 1e-12);
+    }
+    let pts = sub.sphere_points.clone();
+    let tris = sub.triangles.clone();
+    check_subdivision("sphere", &s, &sub, &|t| {
+        let [a, b, c] = tris[t].map(|v| pts[v as usize]);
+        sphere_det(a, b, c)
+    });
+}
+
+/// beetle (geodesic boundary, H²) through the whole pipeline: cut, layout, deck group. Its
+/// own faces have flipped UV triangles; the common subdivision has none.
+#[test]
+fn beetle_common_subdivision_has_no_flipped_triangle() {
+    use ricci::layout::deck_group;
+    use ricci::layout::input_uv::input_face_uvs;
+    use ricci::layout::pipeline::{cut_disk_polished, polish_uniformization};
+    use ricci::layout::place::layout_dd;
+    use ricci::metric::Hyperbolic;
+    let Some(dir) = ricci_meshes::ricci_meshes().filter(|d| d.is_dir()) else {
+        eprintln!("RICCI_MESHES unset: skipping beetle");
+        return;
+    };
+    let (s, _) = ricci::mesh::io::read_surface(&dir.join("beetle.off")).unwrap();
+    let o = FlowOptions {
+        geometry: Geometry::Hyperbolic,
+        scheme: Scheme::Conformal,
+        target: TargetSpec::GeodesicBoundary,
+        tolerance: 1e-12,
+        ..FlowOptions::default()
+    };
+    let r = ricci_flow(&s.mesh, &s.edge_lengths(), &o, &mut NoProgress).unwrap();
+    assert!(r.converged, "{:?}", r.notes);
+    let it = r.triangulation.as_ref().unwrap();
+    assert!(it.initial_flips > 0);
+    // As `ricci layout` does: the metric polished to double-double, cut, laid out.
+    let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &r).unwrap();
+    let d = cut_disk_polished(
+        &it.simplicial.mesh,
+        &p.lengths,
+        &p.lengths_lo,
+        None,
+        None,
+        &mut NoProgress,
+    )
+    .unwrap();
+    let l = layout_dd::<Hyperbolic>(&d.mesh, &d.lengths, Some(&d.lengths_lo), None).unwrap();
+    let g = deck_group::<Hyperbolic>(&l, &d.polygon).unwrap();
+    let own =
+        input_face_uvs::<Hyperbolic>(&s.mesh, &l.positions, &d.vertex_origin, Some(&g)).unwrap();
+    let sub = common_subdivision_uvs::<Hyperbolic>(
+        &s.mesh,
+        &s.positions,
+        &s.edge_lengths(),
+        &it.triangulation,
+        &r.u,
+        &l.positions,
+        &d.vertex_origin,
+        Some(&g),
+    )
+    .unwrap();
+    eprintln!(
+        "beetle: {} input faces flipped, subdivision {} vertices / {} triangles",
+        own.flipped_faces.len(),
+        sub.n_vertices(),
+        sub.triangles.len()
+    );
+    let uv = sub.corner_uv.clone();
+    check_subdivision("beetle", &s, &sub, &|t| planar_orientation(&uv, t, true));
+}
