@@ -644,11 +644,6 @@ const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
         "demo stage inline; demo branch",
     ),
     (
-        "crates/ricci-cli/src/cmd/flow.rs",
-        "run",
-        "CLI flow: options, run and report inline; to split",
-    ),
-    (
         "crates/ricci-cli/src/cmd/forms.rs",
         "run",
         "forms: report assembly inline; split next",
@@ -659,11 +654,6 @@ const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
         "CLI render: options, fields and pictures inline; to split",
     ),
     (
-        "crates/ricci-render/src/gltf.rs",
-        "glb_build",
-        "glTF: buffers, accessors and JSON inline; to split",
-    ),
-    (
         "crates/ricci-render/src/plot.rs",
         "",
         "plots of every kind in one file; to split by plot kind",
@@ -672,21 +662,6 @@ const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
         "crates/ricci-render/src/plot.rs",
         "layout_figure",
         "the layout figure's panels inline; to split",
-    ),
-    (
-        "crates/ricci-render/src/render.rs",
-        "",
-        "rasterizer, shading and labels in one file; to split",
-    ),
-    (
-        "crates/ricci-render/src/render.rs",
-        "render",
-        "scene setup, rasterization and overlays inline; to split",
-    ),
-    (
-        "crates/ricci-render/src/render.rs",
-        "shade",
-        "shading models inline; to split",
     ),
 ];
 
