@@ -210,6 +210,14 @@ fn flow_options(a: &Args, surface: &ricci::mesh::Surface) -> anyhow::Result<Flow
     })
 }
 
+/// What [`refine_and_flow`] returns: the surface the metric lives on, the refinement report
+/// and the flow's result.
+type Flowed = (
+    ricci::mesh::Surface,
+    serde_json::Value,
+    ricci::Result<FlowResult>,
+);
+
 /// The flow, after `--widen-boundary` and with `--refine-degenerate` when asked: the surface
 /// the metric lives on, the refinement report (`null` without refinement) and the flow's
 /// result. An error of the widening is returned at once, one of the flow in the result.
@@ -218,11 +226,7 @@ fn refine_and_flow(
     surface: ricci::mesh::Surface,
     options: &FlowOptions,
     progress: &mut dyn ricci::progress::Progress,
-) -> anyhow::Result<(
-    ricci::mesh::Surface,
-    serde_json::Value,
-    ricci::Result<FlowResult>,
-)> {
+) -> anyhow::Result<Flowed> {
     let mut lengths = surface.edge_lengths();
     let mut surface = surface;
     let mut refinement = serde_json::Value::Null;

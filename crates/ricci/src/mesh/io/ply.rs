@@ -100,9 +100,15 @@ impl PlyMesh {
     }
 }
 
+/// The property indices of `x`, `y`, `z` and of a UV pair, if any.
+struct VertexLayout {
+    xyz: [usize; 3],
+    uv: Option<(usize, usize)>,
+}
+
 /// The property indices of `x`, `y`, `z` and of a UV pair (`u v`, `s t`, `texture_u
 /// texture_v` or `texture_s texture_t`) in the vertex element.
-fn vertex_layout(el: &Element) -> ReadResult<([usize; 3], Option<(usize, usize)>)> {
+fn vertex_layout(el: &Element) -> ReadResult<VertexLayout> {
     let find = |name: &[u8]| {
         el.props
             .iter()
@@ -126,7 +132,7 @@ fn vertex_layout(el: &Element) -> ReadResult<([usize; 3], Option<(usize, usize)>
     ]
     .iter()
     .find_map(|(a, b)| Some((find(a)?, find(b)?)));
-    Ok((xyz, uv_pair))
+    Ok(VertexLayout { xyz, uv: uv_pair })
 }
 
 /// The records of the vertex element: positions, UVs, and (ascii) their lines.
@@ -137,7 +143,7 @@ fn read_vertices(
     binary: bool,
     mesh: &mut PlyMesh,
 ) -> ReadResult<()> {
-    let (xyz, uv_pair) = vertex_layout(el)?;
+    let VertexLayout { xyz, uv: uv_pair } = vertex_layout(el)?;
     mesh.soup.positions.reserve(cap);
     if uv_pair.is_some() {
         mesh.uvs = Some(Vec::with_capacity(cap));
