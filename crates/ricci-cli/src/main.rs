@@ -1,5 +1,5 @@
 //! `ricci` — the command-line tool. Argument parsing, progress, JSON reports and error
-//! messages for people; no math lives here (DESIGN.md §2, §4).
+//! messages for people; no math lives here (docs/DESIGN.md §2, §4).
 //!
 //! Exit codes: 0 success, 1 bad input (the library refused the data), 2 bad arguments.
 
@@ -56,7 +56,7 @@ enum Command {
 }
 
 fn main() {
-    // With `--json`, a failure also prints `{"error": "..."}` on stdout (DESIGN.md §4), so a
+    // With `--json`, a failure also prints `{"error": "..."}` on stdout (docs/DESIGN.md §4), so a
     // script always gets one JSON object.
     let json = std::env::args_os().any(|a| a == "--json");
     let cli = match Cli::try_parse() {

@@ -1,5 +1,5 @@
 //! Quantities worth looking at, computed from plain slices (positions, triangles, UVs) for
-//! pictures: corner angles, angle defect (discrete Gaussian curvature, DESIGN.md §3), pointwise
+//! pictures: corner angles, angle defect (discrete Gaussian curvature, docs/DESIGN.md §3), pointwise
 //! Gaussian and mean curvature (cotangent Laplacian with mixed Voronoi areas, Meyer et al.
 //! 2003), the log area distortion of a parameterization (paper 000 Sec. 4, Fig. 10) and corner
 //! angle ratios (paper 001 Fig. 7d).

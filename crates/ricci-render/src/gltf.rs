@@ -132,21 +132,41 @@ fn glb_build(
             return input_err(format!("texture coordinate of vertex {i} is not finite"));
         }
     }
-    let mut bin: Vec<u8> = Vec::new();
-    let mut root = json::Root::default();
-    let buffer_index = json::Index::<json::Buffer>::new(0);
-    let view = |root: &mut json::Root,
-                bin: &mut Vec<u8>,
-                bytes: &[u8],
-                target: Option<json::buffer::Target>,
-                stride: Option<usize>| {
-        while !bin.len().is_multiple_of(4) {
-            bin.push(0);
+    let mut w = GlbWriter::default();
+    let attributes = w.vertex_attributes(positions, normals, uvs, opts.colors);
+    let indices = w.indices(triangles);
+    let material = w.material(uvs.is_some(), opts)?;
+    w.scene(attributes, indices, material, opts.name.clone());
+    w.into_glb()
+}
+
+/// A glTF document being written: the JSON root and the binary buffer its views point into.
+#[derive(Default)]
+struct GlbWriter {
+    root: json::Root,
+    bin: Vec<u8>,
+}
+
+type Attributes = std::collections::BTreeMap<
+    json::validation::Checked<json::mesh::Semantic>,
+    json::Index<json::Accessor>,
+>;
+
+impl GlbWriter {
+    /// A buffer view over `bytes`, appended to the buffer at a 4-byte boundary.
+    fn view(
+        &mut self,
+        bytes: &[u8],
+        target: Option<json::buffer::Target>,
+        stride: Option<usize>,
+    ) -> json::Index<json::buffer::View> {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
         }
-        let offset = bin.len();
-        bin.extend_from_slice(bytes);
-        root.push(json::buffer::View {
-            buffer: buffer_index,
+        let offset = self.bin.len();
+        self.bin.extend_from_slice(bytes);
+        self.root.push(json::buffer::View {
+            buffer: json::Index::<json::Buffer>::new(0),
             byte_length: USize64::from(bytes.len()),
             byte_offset: Some(USize64::from(offset)),
             byte_stride: stride.map(json::buffer::Stride),
@@ -155,15 +175,19 @@ fn glb_build(
             extensions: None,
             extras: Default::default(),
         })
-    };
-    let accessor = |root: &mut json::Root,
-                    view: json::Index<json::buffer::View>,
-                    count: usize,
-                    ct: json::accessor::ComponentType,
-                    ty: json::accessor::Type,
-                    min: Option<json::Value>,
-                    max: Option<json::Value>| {
-        root.push(json::Accessor {
+    }
+
+    /// An accessor of `count` elements of type `ty` over a view.
+    fn accessor(
+        &mut self,
+        view: json::Index<json::buffer::View>,
+        count: usize,
+        ct: json::accessor::ComponentType,
+        ty: json::accessor::Type,
+        bounds: Option<(json::Value, json::Value)>,
+    ) -> json::Index<json::Accessor> {
+        let (min, max) = bounds.unzip();
+        self.root.push(json::Accessor {
             buffer_view: Some(view),
             byte_offset: None,
             count: USize64::from(count),
@@ -177,230 +201,235 @@ fn glb_build(
             normalized: false,
             sparse: None,
         })
-    };
-    use json::accessor::{ComponentType as C, Type as T};
-    use json::buffer::Target;
-
-    // Positions (f32) with bounds.
-    let mut lo = [f32::MAX; 3];
-    let mut hi = [f32::MIN; 3];
-    let mut bytes = Vec::with_capacity(12 * n);
-    for p in positions {
-        for k in 0..3 {
-            let v = p[k] as f32;
-            lo[k] = lo[k].min(v);
-            hi[k] = hi[k].max(v);
-            bytes.extend_from_slice(&v.to_le_bytes());
-        }
     }
-    let v = view(
-        &mut root,
-        &mut bin,
-        &bytes,
-        Some(Target::ArrayBuffer),
-        Some(12),
-    );
-    let pos = accessor(
-        &mut root,
-        v,
-        n,
-        C::F32,
-        T::Vec3,
-        Some(json::Value::from(lo.to_vec())),
-        Some(json::Value::from(hi.to_vec())),
-    );
-    let mut attributes = std::collections::BTreeMap::new();
-    attributes.insert(Valid(json::mesh::Semantic::Positions), pos);
 
-    // Normals (unit length; isolated vertices get +z).
-    let mut bytes = Vec::with_capacity(12 * n);
-    for nrm in normals {
-        let nrm = if nrm == &[0.0; 3] {
-            [0.0, 0.0, 1.0]
-        } else {
-            *nrm
-        };
-        for c in nrm {
-            bytes.extend_from_slice(&(c as f32).to_le_bytes());
-        }
+    /// A vertex attribute of `n` vectors of type `ty` (`stride` bytes each) from
+    /// little-endian f32 `bytes`.
+    fn f32_attribute(
+        &mut self,
+        bytes: &[u8],
+        n: usize,
+        (ty, stride): (json::accessor::Type, usize),
+        bounds: Option<(json::Value, json::Value)>,
+    ) -> json::Index<json::Accessor> {
+        let v = self.view(bytes, Some(json::buffer::Target::ArrayBuffer), Some(stride));
+        self.accessor(v, n, json::accessor::ComponentType::F32, ty, bounds)
     }
-    let v = view(
-        &mut root,
-        &mut bin,
-        &bytes,
-        Some(Target::ArrayBuffer),
-        Some(12),
-    );
-    let nacc = accessor(&mut root, v, n, C::F32, T::Vec3, None, None);
-    attributes.insert(Valid(json::mesh::Semantic::Normals), nacc);
 
-    // UVs.
-    if let Some(uv) = uvs {
-        let mut bytes = Vec::with_capacity(8 * n);
-        for p in uv {
-            bytes.extend_from_slice(&(p[0] as f32).to_le_bytes());
-            bytes.extend_from_slice(&((1.0 - p[1]) as f32).to_le_bytes());
-        }
-        let v = view(
-            &mut root,
-            &mut bin,
-            &bytes,
-            Some(Target::ArrayBuffer),
-            Some(8),
-        );
-        let a = accessor(&mut root, v, n, C::F32, T::Vec2, None, None);
-        attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), a);
-    }
-    // Colours.
-    if let Some(cs) = opts.colors {
+    /// Positions (f32, with bounds), normals (unit; isolated vertices get +z), UVs (v flipped
+    /// to glTF's top-left origin) and linear colours.
+    fn vertex_attributes(
+        &mut self,
+        positions: &[[f64; 3]],
+        normals: &[[f64; 3]],
+        uvs: Option<&[[f64; 2]]>,
+        colors: Option<&[Rgb]>,
+    ) -> Attributes {
+        use json::accessor::Type as T;
+        use json::mesh::Semantic;
+        let n = positions.len();
+        let mut lo = [f32::MAX; 3];
+        let mut hi = [f32::MIN; 3];
         let mut bytes = Vec::with_capacity(12 * n);
-        for c in cs {
-            for x in color::to_linear(*c) {
-                bytes.extend_from_slice(&x.clamp(0.0, 1.0).to_le_bytes());
+        for p in positions {
+            for k in 0..3 {
+                let v = p[k] as f32;
+                lo[k] = lo[k].min(v);
+                hi[k] = hi[k].max(v);
+                bytes.extend_from_slice(&v.to_le_bytes());
             }
         }
-        let v = view(
-            &mut root,
-            &mut bin,
-            &bytes,
-            Some(Target::ArrayBuffer),
-            Some(12),
+        let bounds = (
+            json::Value::from(lo.to_vec()),
+            json::Value::from(hi.to_vec()),
         );
-        let a = accessor(&mut root, v, n, C::F32, T::Vec3, None, None);
-        attributes.insert(Valid(json::mesh::Semantic::Colors(0)), a);
-    }
-    // Indices.
-    let mut bytes = Vec::with_capacity(12 * triangles.len());
-    for t in triangles {
-        for &i in t {
-            bytes.extend_from_slice(&i.to_le_bytes());
-        }
-    }
-    let v = view(
-        &mut root,
-        &mut bin,
-        &bytes,
-        Some(Target::ElementArrayBuffer),
-        None,
-    );
-    let indices = accessor(
-        &mut root,
-        v,
-        3 * triangles.len(),
-        C::U32,
-        T::Scalar,
-        None,
-        None,
-    );
+        let mut attributes = Attributes::new();
+        let pos = self.f32_attribute(&bytes, n, (T::Vec3, 12), Some(bounds));
+        attributes.insert(Valid(Semantic::Positions), pos);
 
-    // Material, with the checker texture when there are UVs.
-    let mut pbr = json::material::PbrMetallicRoughness {
-        metallic_factor: json::material::StrengthFactor(0.0),
-        roughness_factor: json::material::StrengthFactor(0.75),
-        ..Default::default()
-    };
-    if uvs.is_some() {
-        let f = opts.checker_frequency.unwrap_or(8.0);
-        if !(f.is_finite() && f > 0.0) {
-            return input_err(format!("the checker frequency {f} must be positive"));
+        let mut bytes = Vec::with_capacity(12 * n);
+        for nrm in normals {
+            let nrm = if nrm == &[0.0; 3] {
+                [0.0, 0.0, 1.0]
+            } else {
+                *nrm
+            };
+            for c in nrm {
+                bytes.extend_from_slice(&(c as f32).to_le_bytes());
+            }
         }
-        let checks = (f.round() as u32).clamp(1, 64);
-        let px = (2048 / checks).clamp(8, 64);
-        let png = checker_texture(checks, px).to_png()?;
-        let v = view(&mut root, &mut bin, &png, None, None);
-        let image = root.push(json::Image {
-            buffer_view: Some(v),
-            mime_type: Some(json::image::MimeType("image/png".into())),
-            name: Some("checkerboard".into()),
-            uri: None,
+        let nacc = self.f32_attribute(&bytes, n, (T::Vec3, 12), None);
+        attributes.insert(Valid(Semantic::Normals), nacc);
+
+        if let Some(uv) = uvs {
+            let mut bytes = Vec::with_capacity(8 * n);
+            for p in uv {
+                bytes.extend_from_slice(&(p[0] as f32).to_le_bytes());
+                bytes.extend_from_slice(&((1.0 - p[1]) as f32).to_le_bytes());
+            }
+            let a = self.f32_attribute(&bytes, n, (T::Vec2, 8), None);
+            attributes.insert(Valid(Semantic::TexCoords(0)), a);
+        }
+        if let Some(cs) = colors {
+            let mut bytes = Vec::with_capacity(12 * n);
+            for c in cs {
+                for x in color::to_linear(*c) {
+                    bytes.extend_from_slice(&x.clamp(0.0, 1.0).to_le_bytes());
+                }
+            }
+            let a = self.f32_attribute(&bytes, n, (T::Vec3, 12), None);
+            attributes.insert(Valid(Semantic::Colors(0)), a);
+        }
+        attributes
+    }
+
+    /// The triangle indices (u32).
+    fn indices(&mut self, triangles: &[[u32; 3]]) -> json::Index<json::Accessor> {
+        let mut bytes = Vec::with_capacity(12 * triangles.len());
+        for t in triangles {
+            for &i in t {
+                bytes.extend_from_slice(&i.to_le_bytes());
+            }
+        }
+        let v = self.view(&bytes, Some(json::buffer::Target::ElementArrayBuffer), None);
+        self.accessor(
+            v,
+            3 * triangles.len(),
+            json::accessor::ComponentType::U32,
+            json::accessor::Type::Scalar,
+            None,
+        )
+    }
+
+    /// The surface's material, with the checker texture when there are UVs.
+    fn material(
+        &mut self,
+        textured: bool,
+        opts: &GlbOptions,
+    ) -> Result<json::Index<json::Material>> {
+        let mut pbr = json::material::PbrMetallicRoughness {
+            metallic_factor: json::material::StrengthFactor(0.0),
+            roughness_factor: json::material::StrengthFactor(0.75),
+            ..Default::default()
+        };
+        if textured {
+            let f = opts.checker_frequency.unwrap_or(8.0);
+            if !(f.is_finite() && f > 0.0) {
+                return input_err(format!("the checker frequency {f} must be positive"));
+            }
+            let checks = (f.round() as u32).clamp(1, 64);
+            let px = (2048 / checks).clamp(8, 64);
+            let png = checker_texture(checks, px).to_png()?;
+            let v = self.view(&png, None, None);
+            let image = self.root.push(json::Image {
+                buffer_view: Some(v),
+                mime_type: Some(json::image::MimeType("image/png".into())),
+                name: Some("checkerboard".into()),
+                uri: None,
+                extensions: None,
+                extras: Default::default(),
+            });
+            let sampler = self.root.push(json::texture::Sampler {
+                mag_filter: Some(Valid(json::texture::MagFilter::Nearest)),
+                min_filter: Some(Valid(json::texture::MinFilter::LinearMipmapLinear)),
+                wrap_s: Valid(json::texture::WrappingMode::Repeat),
+                wrap_t: Valid(json::texture::WrappingMode::Repeat),
+                ..Default::default()
+            });
+            let texture = self.root.push(json::Texture {
+                name: None,
+                sampler: Some(sampler),
+                source: image,
+                extensions: None,
+                extras: Default::default(),
+            });
+            pbr.base_color_texture = Some(json::texture::Info {
+                index: texture,
+                tex_coord: 0,
+                extensions: None,
+                extras: Default::default(),
+            });
+        }
+        Ok(self.root.push(json::Material {
+            pbr_metallic_roughness: pbr,
+            double_sided: true,
+            name: Some("surface".into()),
+            ..Default::default()
+        }))
+    }
+
+    /// One mesh of one triangle primitive, in one node of the default scene.
+    fn scene(
+        &mut self,
+        attributes: Attributes,
+        indices: json::Index<json::Accessor>,
+        material: json::Index<json::Material>,
+        name: Option<String>,
+    ) {
+        let mesh = self.root.push(json::Mesh {
             extensions: None,
             extras: Default::default(),
+            name: name.clone(),
+            primitives: vec![json::mesh::Primitive {
+                attributes,
+                extensions: None,
+                extras: Default::default(),
+                indices: Some(indices),
+                material: Some(material),
+                mode: Valid(json::mesh::Mode::Triangles),
+                targets: None,
+            }],
+            weights: None,
         });
-        let sampler = root.push(json::texture::Sampler {
-            mag_filter: Some(Valid(json::texture::MagFilter::Nearest)),
-            min_filter: Some(Valid(json::texture::MinFilter::LinearMipmapLinear)),
-            wrap_s: Valid(json::texture::WrappingMode::Repeat),
-            wrap_t: Valid(json::texture::WrappingMode::Repeat),
+        let node = self.root.push(json::Node {
+            mesh: Some(mesh),
+            name,
             ..Default::default()
         });
-        let texture = root.push(json::Texture {
+        let scene = self.root.push(json::Scene {
+            extensions: None,
+            extras: Default::default(),
             name: None,
-            sampler: Some(sampler),
-            source: image,
-            extensions: None,
-            extras: Default::default(),
+            nodes: vec![node],
         });
-        pbr.base_color_texture = Some(json::texture::Info {
-            index: texture,
-            tex_coord: 0,
-            extensions: None,
-            extras: Default::default(),
-        });
+        self.root.scene = Some(scene);
     }
-    let material = root.push(json::Material {
-        pbr_metallic_roughness: pbr,
-        double_sided: true,
-        name: Some("surface".into()),
-        ..Default::default()
-    });
-    let mesh = root.push(json::Mesh {
-        extensions: None,
-        extras: Default::default(),
-        name: opts.name.clone(),
-        primitives: vec![json::mesh::Primitive {
-            attributes,
-            extensions: None,
-            extras: Default::default(),
-            indices: Some(indices),
-            material: Some(material),
-            mode: Valid(json::mesh::Mode::Triangles),
-            targets: None,
-        }],
-        weights: None,
-    });
-    let node = root.push(json::Node {
-        mesh: Some(mesh),
-        name: opts.name.clone(),
-        ..Default::default()
-    });
-    let scene = root.push(json::Scene {
-        extensions: None,
-        extras: Default::default(),
-        name: None,
-        nodes: vec![node],
-    });
-    root.scene = Some(scene);
-    while !bin.len().is_multiple_of(4) {
-        bin.push(0);
-    }
-    root.push(json::Buffer {
-        byte_length: USize64::from(bin.len()),
-        extensions: None,
-        extras: Default::default(),
-        name: None,
-        uri: None,
-    });
-    root.asset.generator = Some(format!("ricci-render {}", env!("CARGO_PKG_VERSION")));
 
-    let mut js =
-        json::serialize::to_vec(&root).map_err(|e| Error::Encode(format!("glTF JSON: {e}")))?;
-    while !js.len().is_multiple_of(4) {
-        js.push(b' ');
+    /// The binary glTF: header, JSON chunk (space-padded), BIN chunk (zero-padded).
+    fn into_glb(mut self) -> Result<Vec<u8>> {
+        let bin = &mut self.bin;
+        while !bin.len().is_multiple_of(4) {
+            bin.push(0);
+        }
+        self.root.push(json::Buffer {
+            byte_length: USize64::from(bin.len()),
+            extensions: None,
+            extras: Default::default(),
+            name: None,
+            uri: None,
+        });
+        self.root.asset.generator = Some(format!("ricci-render {}", env!("CARGO_PKG_VERSION")));
+        let mut js = json::serialize::to_vec(&self.root)
+            .map_err(|e| Error::Encode(format!("glTF JSON: {e}")))?;
+        while !js.len().is_multiple_of(4) {
+            js.push(b' ');
+        }
+        let bin = &self.bin;
+        let total = 12 + 8 + js.len() + 8 + bin.len();
+        let total32 = u32::try_from(total)
+            .map_err(|_| Error::Encode("the glTF file would exceed 4 GiB".into()))?;
+        let mut out = Vec::with_capacity(total);
+        out.extend_from_slice(b"glTF");
+        out.extend_from_slice(&2u32.to_le_bytes());
+        out.extend_from_slice(&total32.to_le_bytes());
+        out.extend_from_slice(&(js.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"JSON");
+        out.extend_from_slice(&js);
+        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(bin);
+        Ok(out)
     }
-    let total = 12 + 8 + js.len() + 8 + bin.len();
-    let total32 = u32::try_from(total)
-        .map_err(|_| Error::Encode("the glTF file would exceed 4 GiB".into()))?;
-    let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&total32.to_le_bytes());
-    out.extend_from_slice(&(js.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&js);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin);
-    Ok(out)
 }
 
 #[cfg(test)]

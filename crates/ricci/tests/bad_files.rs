@@ -508,3 +508,53 @@ fn fuzz_regression_binary_stl_refuses_coordinates_beyond_f32() {
         .flatten()
         .any(|&x| x == 3.333333333333333e110));
 }
+
+#[test]
+fn read_errors_carry_the_record_and_its_place_as_data() {
+    use ricci::mesh::io::{parse_soup, Record};
+    // The records and lines below are those of the corrupted sample, counted by hand.
+    let off = TETRA_OFF.replace("3 2 0 3", "3 2 0 -1");
+    let e = parse_soup(off.as_bytes(), Format::Off).unwrap_err();
+    assert_eq!(
+        (&e.record, e.face(), e.line()),
+        (&Record::Face(3), Some(3), Some(10))
+    );
+    let obj = TETRA_OBJ.replace("v 0 1 0", "v 0 x 0");
+    let e = parse_soup(obj.as_bytes(), Format::Obj).unwrap_err();
+    assert_eq!((e.vertex(), e.line()), (Some(2), Some(3)), "{e}");
+    let obj = TETRA_OBJ.replace("f 3 1 4", "f 3 1 5");
+    let e = parse_soup(obj.as_bytes(), Format::Obj).unwrap_err();
+    assert_eq!((e.face(), e.line()), (Some(3), Some(8)), "{e}");
+    let obj = TETRA_OBJ.replace("f 1 2 4", "vt 0 0\nf 1/2 2 4");
+    let e = parse_soup(obj.as_bytes(), Format::Obj).unwrap_err();
+    assert_eq!((e.face(), e.line()), (Some(1), Some(7)), "{e}");
+    // Binary PLY cut inside face 2: the face and the byte where the data end.
+    let d = tetra_ply_binary("uchar", "int");
+    let header_len = d.len() - 4 * 12 - 4 * 13;
+    let face2 = header_len + 48 + 2 * 13;
+    let e = parse_soup(&d[..face2 + 6], Format::Ply).unwrap_err();
+    assert_eq!(e.face(), Some(2), "{e}");
+    assert_eq!(e.location.byte, Some(face2 as u64 + 5), "{e}");
+    // A bad property type is about the header, at its line (5).
+    let bad = String::from_utf8_lossy(&d[..header_len]).replace("float y", "real y");
+    let e = parse_soup(bad.as_bytes(), Format::Ply).unwrap_err();
+    assert_eq!((&e.record, e.line()), (&Record::Header, Some(5)), "{e}");
+    // Another element's record: named, with its index.
+    let ascii = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                 property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+                 element edge 2\nproperty int a\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n5\nq\n";
+    let e = parse_soup(ascii.as_bytes(), Format::Ply).unwrap_err();
+    assert_eq!(
+        (&e.record, e.line()),
+        (
+            &Record::Element {
+                name: "edge".into(),
+                index: 1
+            },
+            Some(17)
+        ),
+        "{e}"
+    );
+    // The conversion into ricci::Error keeps the sentence.
+    assert_eq!(ricci::Error::from(e.clone()).to_string(), e.to_string());
+}

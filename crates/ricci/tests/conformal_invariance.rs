@@ -1,5 +1,5 @@
 //! The conformal scheme computes invariants of the *surface*, not of its triangulation
-//! (issue 15, DESIGN.md §5): a surface, its 1-to-4 midpoint subdivision and a copy with random
+//! (issue 15, docs/DESIGN.md §5): a surface, its 1-to-4 midpoint subdivision and a copy with random
 //! off-centre face splits give length spectra within 0.3 % of each other, and an irregular
 //! torus of revolution (random points, Delaunay in the parameter square, slivers below 1°)
 //! matches the closed form `√(R² − r²)/r` to 0.3 %. Plain vertex scaling degenerates on the

@@ -1,5 +1,5 @@
 //! Closed form: a torus of revolution (R, r) is conformal to the flat torus of the rectangle with
-//! side ratio r / √(R² − r²) (DESIGN.md §5). The flat metric from Ricci flow is developed into
+//! side ratio r / √(R² − r²) (docs/DESIGN.md §5). The flat metric from Ricci flow is developed into
 //! the plane along a spanning tree of faces (a small layout inside the test); the deck
 //! translations read off the cut edges generate the period lattice, whose reduced basis gives
 //! the ratio and the angle.

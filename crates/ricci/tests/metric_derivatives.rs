@@ -241,7 +241,7 @@ fn hessian_matches_finite_differences_of_curvature_and_is_symmetric() {
                         assert!(rel_close(h[j * n + i], fd, 1e-4 * hmax, 1e-6));
                     }
                 }
-                // Signs: ∂K_i/∂u_i > 0 away from S² (DESIGN.md §3).
+                // Signs: ∂K_i/∂u_i > 0 away from S² (docs/DESIGN.md §3).
                 if g != Geometry::Spherical {
                     for i in 0..n {
                         assert!(h[i * n + i] > 0.0, "{name}, {g}, {sc}: H[{i}][{i}] ≤ 0");

@@ -442,7 +442,7 @@ fn torus_of_revolution_domain_has_the_closed_form_modulus_and_fits_c2() {
     let (big, small) = (1.0, 0.5);
     let s = ricci::mesh::generate::torus(big, small, 48).unwrap();
     let (uv, lat) = flat_torus_domain(&s, &mut ricci::progress::NoProgress).unwrap();
-    // conformal to a rectangle with side ratio r / √(R² − r²) (DESIGN.md §5)
+    // conformal to a rectangle with side ratio r / √(R² − r²) (docs/DESIGN.md §5)
     let want = small / (big * big - small * small).sqrt();
     let ratio = lat.width.min(lat.height) / lat.width.max(lat.height);
     assert!(

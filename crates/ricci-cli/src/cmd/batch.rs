@@ -1,5 +1,5 @@
 //! `ricci batch MANIFEST --out DIR [--jobs N] [--timeout S] [--retry-failed] [--json] --
-//! COMMAND [ARGS]`: one subcommand over many meshes, in parallel, resumable (DESIGN.md §4).
+//! COMMAND [ARGS]`: one subcommand over many meshes, in parallel, resumable (docs/DESIGN.md §4).
 //!
 //! MANIFEST is a text file with one mesh path a line (blank lines and `#` comments skipped;
 //! relative paths are relative to the manifest's folder), or a folder: every mesh file in it

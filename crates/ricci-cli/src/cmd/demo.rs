@@ -1,5 +1,5 @@
 //! `ricci demo --out DIR [--json] [--resolution N]`: the whole pipeline on the built-in
-//! genus-2 surface, with pictures, tables and a static `DIR/index.html` (DESIGN.md §1, §4).
+//! genus-2 surface, with pictures, tables and a static `DIR/index.html` (docs/DESIGN.md §1, §4).
 //!
 //! The demo is a list of [`STAGES`]; each stage reads what earlier stages left in the
 //! [`Ctx`], writes its files through the [`Env`] and returns a [`Section`] (text, pictures, tables, files and a JSON

@@ -128,6 +128,44 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .into());
     }
     let (surface, _report) = read_surface(&a.mesh)?;
+    let options = flow_options(&a, &surface)?;
+    let bar = ProgressBar::new(1000);
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed:>4} [{bar:30}] {prefix}: {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    let mut progress = |stage: &str, fraction: Option<f64>, message: &str| {
+        bar.set_prefix(stage.to_string());
+        if let Some(f) = fraction {
+            bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
+        }
+        bar.set_message(message.to_string());
+    };
+    let (surface, refinement, result) = refine_and_flow(&a, surface, &options, &mut progress)?;
+    bar.finish_and_clear();
+    let r = result.map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?;
+    let source = a.mesh.display().to_string();
+    if let Some(path) = &a.refined_out {
+        ricci::mesh::io::write_surface(path, &surface)?;
+    }
+    if let Some(out) = &a.out {
+        write_json_atomic(out, metric_json(&r, &surface.mesh, &source))?;
+    }
+    if !r.converged {
+        eprintln!("warning: {source}: {}", not_converged_reason(&r));
+    }
+    if a.json {
+        print_json(&report_json(&a, &r, &surface, &source, refinement));
+    } else {
+        print_report(&a, &r, &source);
+    }
+    Ok(())
+}
+
+/// The flow's options from the arguments: the geometry, target and scheme the surface's
+/// topology calls for unless given.
+fn flow_options(a: &Args, surface: &ricci::mesh::Surface) -> anyhow::Result<FlowOptions> {
     let bordered = surface.mesh.has_boundary();
     // Targets that name a flat metric (cones, free or round boundary) or a hyperbolic one.
     let flat = matches!(
@@ -150,7 +188,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         None if geometry == Geometry::Hyperbolic => TargetSpec::GeodesicBoundary,
         None => TargetSpec::FreeBoundary,
     };
-    let options = FlowOptions {
+    Ok(FlowOptions {
         geometry,
         // The gradient flow is the papers' method (the conformal scheme is solved by Newton
         // only): with `--solver gradient` and no scheme, the papers' Thurston packing.
@@ -169,20 +207,26 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             Route::Newton => SphereRoute::Newton,
             Route::Puncture => SphereRoute::Puncture,
         },
-    };
-    let bar = ProgressBar::new(1000);
-    bar.set_style(
-        ProgressStyle::with_template("{elapsed:>4} [{bar:30}] {prefix}: {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    let mut progress = |stage: &str, fraction: Option<f64>, message: &str| {
-        bar.set_prefix(stage.to_string());
-        if let Some(f) = fraction {
-            bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
-        }
-        bar.set_message(message.to_string());
-    };
+    })
+}
+
+/// What [`refine_and_flow`] returns: the surface the metric lives on, the refinement report
+/// and the flow's result.
+type Flowed = (
+    ricci::mesh::Surface,
+    serde_json::Value,
+    ricci::Result<FlowResult>,
+);
+
+/// The flow, after `--widen-boundary` and with `--refine-degenerate` when asked: the surface
+/// the metric lives on, the refinement report (`null` without refinement) and the flow's
+/// result. An error of the widening is returned at once, one of the flow in the result.
+fn refine_and_flow(
+    a: &Args,
+    surface: ricci::mesh::Surface,
+    options: &FlowOptions,
+    progress: &mut dyn ricci::progress::Progress,
+) -> anyhow::Result<Flowed> {
     let mut lengths = surface.edge_lengths();
     let mut surface = surface;
     let mut refinement = serde_json::Value::Null;
@@ -217,7 +261,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             &lengths,
             Some(&surface.positions),
         );
-        ricci::flow::ricci_flow_refined(start, &options, rounds, &mut progress).map(|(rf, r)| {
+        ricci::flow::ricci_flow_refined(start, options, rounds, progress).map(|(rf, r)| {
             refinement = json!({
                 "min_faces": a.widen_boundary,
                 "refine_degenerate": rounds,
@@ -234,99 +278,98 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             r
         })
     } else {
-        ricci_flow(&surface.mesh, &lengths, &options, &mut progress)
+        ricci_flow(&surface.mesh, &lengths, options, progress)
     };
-    bar.finish_and_clear();
-    let r = result.map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?;
-    let source = a.mesh.display().to_string();
-    if let Some(path) = &a.refined_out {
-        ricci::mesh::io::write_surface(path, &surface)?;
+    Ok((surface, refinement, result))
+}
+
+/// The `--json` report.
+fn report_json(
+    a: &Args,
+    r: &FlowResult,
+    surface: &ricci::mesh::Surface,
+    source: &str,
+    refinement: serde_json::Value,
+) -> serde_json::Value {
+    json!({
+        "mesh": source,
+        "vertices": surface.mesh.n_vertices(),
+        "faces": surface.mesh.n_faces(),
+        "geometry": r.geometry,
+        "scheme": r.scheme,
+        "solver": r.solver,
+        "route": r.route,
+        "method": format!("{} ({})", r.solver, r.route),
+        "target": r.target_description,
+        "iterations": r.iterations,
+        "max_curvature_error": r.max_curvature_error,
+        "gauss_bonnet_error": r.gauss_bonnet_error,
+        "converged": r.converged,
+        "tolerance": r.tolerance,
+        "seconds": r.seconds,
+        "area": r.area,
+        "input_scale": r.input_scale,
+        "clamped_edges": r.clamped_edges,
+        "initial_length_error": r.initial_length_error,
+        "degenerate_faces": r.degenerate_faces,
+        "flips": r.triangulation.as_ref().map(|t| t.initial_flips + t.flips),
+        "triangulation": r.triangulation.as_ref().map(|t| json!({
+            "kind": "intrinsic",
+            "initial_flips": t.initial_flips,
+            "flips": t.flips,
+            "splits": t.splits,
+            "vertices": t.simplicial.mesh.n_vertices(),
+            "faces": t.simplicial.mesh.n_faces(),
+        })),
+        "pinned": r.pinned,
+        "notes": r.notes,
+        "refinement": refinement,
+        "history": r.history,
+        "out": a.out.as_ref().map(|p| p.display().to_string()),
+    })
+}
+
+/// The report for people.
+fn print_report(a: &Args, r: &FlowResult, source: &str) {
+    println!(
+        "{source}: {} {} metric ({}), target {}",
+        r.geometry, r.scheme, r.route, r.target_description
+    );
+    println!(
+        "  {} after {} {} iteration(s): max |K − K̄| = {:.3e}, Gauss–Bonnet residual {:.3e}, \
+         {:.3} s",
+        if r.converged {
+            "converged"
+        } else {
+            "NOT converged"
+        },
+        r.iterations,
+        r.solver,
+        r.max_curvature_error,
+        r.gauss_bonnet_error,
+        r.seconds
+    );
+    for h in &r.history {
+        println!(
+            "    {:5}  max |K − K̄| {:.3e}  step {:.2e}  {:.3} s",
+            h.iteration, h.max_curvature_error, h.step, h.seconds
+        );
+    }
+    if let Some(t) = &r.triangulation {
+        println!(
+            "  intrinsic Delaunay triangulation: {} + {} flips, {} splits ({} vertices, {} \
+             faces)",
+            t.initial_flips,
+            t.flips,
+            t.splits,
+            t.simplicial.mesh.n_vertices(),
+            t.simplicial.mesh.n_faces()
+        );
+    }
+    for n in &r.notes {
+        println!("  note: {n}");
     }
     if let Some(out) = &a.out {
-        write_json_atomic(out, metric_json(&r, &surface.mesh, &source))?;
+        println!("  metric written to {}", out.display());
     }
-    if !r.converged {
-        eprintln!("warning: {source}: {}", not_converged_reason(&r));
-    }
-    if a.json {
-        print_json(&json!({
-            "mesh": source,
-            "vertices": surface.mesh.n_vertices(),
-            "faces": surface.mesh.n_faces(),
-            "geometry": r.geometry,
-            "scheme": r.scheme,
-            "solver": r.solver,
-            "route": r.route,
-            "method": format!("{} ({})", r.solver, r.route),
-            "target": r.target_description,
-            "iterations": r.iterations,
-            "max_curvature_error": r.max_curvature_error,
-            "gauss_bonnet_error": r.gauss_bonnet_error,
-            "converged": r.converged,
-            "tolerance": r.tolerance,
-            "seconds": r.seconds,
-            "area": r.area,
-            "input_scale": r.input_scale,
-            "clamped_edges": r.clamped_edges,
-            "initial_length_error": r.initial_length_error,
-            "degenerate_faces": r.degenerate_faces,
-            "flips": r.triangulation.as_ref().map(|t| t.initial_flips + t.flips),
-            "triangulation": r.triangulation.as_ref().map(|t| json!({
-                "kind": "intrinsic",
-                "initial_flips": t.initial_flips,
-                "flips": t.flips,
-                "splits": t.splits,
-                "vertices": t.simplicial.mesh.n_vertices(),
-                "faces": t.simplicial.mesh.n_faces(),
-            })),
-            "pinned": r.pinned,
-            "notes": r.notes,
-            "refinement": refinement,
-            "history": r.history,
-            "out": a.out.as_ref().map(|p| p.display().to_string()),
-        }));
-    } else {
-        println!(
-            "{source}: {} {} metric ({}), target {}",
-            r.geometry, r.scheme, r.route, r.target_description
-        );
-        println!(
-            "  {} after {} {} iteration(s): max |K − K̄| = {:.3e}, Gauss–Bonnet residual {:.3e}, \
-             {:.3} s",
-            if r.converged {
-                "converged"
-            } else {
-                "NOT converged"
-            },
-            r.iterations,
-            r.solver,
-            r.max_curvature_error,
-            r.gauss_bonnet_error,
-            r.seconds
-        );
-        for h in &r.history {
-            println!(
-                "    {:5}  max |K − K̄| {:.3e}  step {:.2e}  {:.3} s",
-                h.iteration, h.max_curvature_error, h.step, h.seconds
-            );
-        }
-        if let Some(t) = &r.triangulation {
-            println!(
-                "  intrinsic Delaunay triangulation: {} + {} flips, {} splits ({} vertices, {} \
-                 faces)",
-                t.initial_flips,
-                t.flips,
-                t.splits,
-                t.simplicial.mesh.n_vertices(),
-                t.simplicial.mesh.n_faces()
-            );
-        }
-        for n in &r.notes {
-            println!("  note: {n}");
-        }
-        if let Some(out) = &a.out {
-            println!("  metric written to {}", out.display());
-        }
-    }
-    Ok(())
 }

@@ -1,5 +1,5 @@
 //! `ricci info MESH [--json]`: validate a mesh file, report its topology per component and
-//! its triangle quality (DESIGN.md §4).
+//! its triangle quality (docs/DESIGN.md §4).
 //!
 //! A file that is not a valid oriented 2-manifold (non-manifold edge or vertex,
 //! non-orientable, out-of-range index, …) is refused with one sentence naming the culprit

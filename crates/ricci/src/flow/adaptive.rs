@@ -1,5 +1,5 @@
 //! Ricci flow with adaptive, metric-preserving refinement of the faces where the discrete
-//! conformal metric does not exist on the given triangulation (DESIGN.md §3; the splits of
+//! conformal metric does not exist on the given triangulation (docs/DESIGN.md §3; the splits of
 //! [`crate::metric::refine`]).
 //!
 //! A discrete conformal class on a fixed triangulation can miss a target: with vertex scaling

@@ -1,7 +1,7 @@
 //! Discrete conformal equivalence: Newton's method for vertex scaling on the intrinsic Delaunay
 //! triangulation of the current metric (Gu–Luo–Sun–Wu 2018 for E², Gu–Guo–Luo–Sun–Wu 2018
 //! for H²; Springborn 2020; Bobenko–Pinkall–Springborn 2015 for the convex energy;
-//! Gillespie–Springborn–Crane 2021 (CEPS) §4 for the algorithm; DESIGN.md §3 "Our default").
+//! Gillespie–Springborn–Crane 2021 (CEPS) §4 for the algorithm; docs/DESIGN.md §3 "Our default").
 //!
 //! The input metric is first made intrinsically Delaunay with *isometric* flips
 //! ([`IntrinsicTriangulation::make_delaunay_isometric`]) — its log Penner coordinates on that

@@ -1,5 +1,5 @@
 //! Target curvatures and Ricci flow solvers (paper 001 §V, paper 000 §4 Step 3, paper 002
-//! §4.3, §6.2.1, §7.1; DESIGN.md §3).
+//! §4.3, §6.2.1, §7.1; docs/DESIGN.md §3).
 //!
 //! [`ricci_flow`] takes connectivity and Euclidean edge lengths (never positions), builds the
 //! initial conformal structure of the chosen scheme ([`crate::metric::conformal`]), resolves and

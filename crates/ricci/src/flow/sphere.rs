@@ -10,7 +10,7 @@
 //!    the north pole `N` scales chords by `|σ(x) − σ(y)| = 2|x − y| / (|x − N||y − N|)`, so the
 //!    planar image of a vertex-scaled unit sphere with `v` at `N` is a vertex-scaled flat disk
 //!    whose link values are `−2 log l_vj` up to a constant (the inversion of the star about
-//!    `v`). (DESIGN.md suggests a round boundary here; the Dirichlet condition is the one that
+//!    `v`). (docs/DESIGN.md suggests a round boundary here; the Dirichlet condition is the one that
 //!    reproduces the discrete conformal class exactly, and it is a convex problem.);
 //! 3. lay the disk out in the plane (breadth-first placement by circle intersection) and move
 //!    the least-squares circle through its boundary to the unit circle;

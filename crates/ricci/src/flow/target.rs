@@ -1,4 +1,4 @@
-//! Target curvature designs (paper 001 §V Step 1, §VI-B; paper 000 §4 Step 1; DESIGN.md §4)
+//! Target curvature designs (paper 001 §V Step 1, §VI-B; paper 000 §4 Step 1; docs/DESIGN.md §4)
 //! and their admissibility: Gauss–Bonnet (paper 001 eq. 8) and the combinatorial condition of
 //! Chow and Luo (paper 000 eq. 7, paper 001 Theorem 4).
 //!

@@ -15,7 +15,7 @@
 //! `(p_i, t, p_i × t)` solves `p·p_i = cos l_ik`, `p·p_j = cos l_jk`, `|p| = 1`,
 //! `det[p_i, p_j, p] > 0` without cancellation. The angle at `i` comes from the half-angle
 //! form of the cosine law ([`Background::angle`]), accurate for needle triangles; the papers'
-//! sphere seed formula (which takes chord lengths) is not used: lengths are geodesic (DESIGN.md §3).
+//! sphere seed formula (which takes chord lengths) is not used: lengths are geodesic (docs/DESIGN.md §3).
 //!
 //! **Precision.** Face frames are composed in the working precision of the space ([`Frame`]):
 //! double precision in E² and S², double-double in H² ([`super::dd`]), where a frame at

@@ -1,5 +1,5 @@
 //! The metric file (`METRIC.json`) that `ricci flow --out` writes and `ricci cut`, `layout`
-//! and `spectrum --metric` read: one reader and one writer for every command (DESIGN.md §4).
+//! and `spectrum --metric` read: one reader and one writer for every command (docs/DESIGN.md §4).
 //!
 //! Format (a JSON object):
 //! * `geometry`: `euclidean` | `hyperbolic` | `spherical` (default `euclidean` when absent);

@@ -5,7 +5,7 @@
 //! written once against the [`Background`] trait; the runtime [`Geometry`] enum picks the
 //! implementation once at the top (`match g { Geometry::Euclidean => f::<Euclidean>(), … }`).
 //!
-//! Notation (DESIGN.md §3): `s(x), c(x)` are `x, 1` (E²), `sinh x, cosh x` (H²),
+//! Notation (docs/DESIGN.md §3): `s(x), c(x)` are `x, 1` (E²), `sinh x, cosh x` (H²),
 //! `sin x, cos x` (S²).
 
 use serde::{Deserialize, Serialize};
@@ -125,7 +125,7 @@ pub trait Background: Copy + Send + Sync + 'static {
     /// Area of the triangle with sides `a, b, c` (Heron; angle defect / excess).
     fn area(a: f64, b: f64, c: f64) -> f64;
 
-    // ----- conformal structure helpers (paper 001 eq. 9, 12; DESIGN.md §3) -----
+    // ----- conformal structure helpers (paper 001 eq. 9, 12; docs/DESIGN.md §3) -----
 
     /// Circle radius γ of the circle-packing variable `u` (paper 001 eq. 9): E² `u = log γ`,
     /// H² `u = log tanh(γ/2)` (defined for `u < 0` only; NaN otherwise), S² `u = log tan(γ/2)`.

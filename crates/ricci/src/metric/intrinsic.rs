@@ -2,7 +2,7 @@
 //! criterion and metric-preserving splits down to a simplicial mesh (Springborn 2020,
 //! "Ideal hyperbolic polyhedra and discrete uniformization" §§3–5; Gillespie–Springborn–Crane
 //! 2021 "Discrete conformal equivalence of polyhedral surfaces" (CEPS) §§3–4; Gu–Luo–Sun–Wu 2018
-//! (E²), Gu–Guo–Luo–Sun–Wu 2018 (H²); DESIGN.md §3 "Our default").
+//! (E²), Gu–Guo–Luo–Sun–Wu 2018 (H²); docs/DESIGN.md §3 "Our default").
 //!
 //! **Connectivity.** A Δ-complex: half-edge `h` lies in face `h / 3`, `next(h) = 3(h/3) +
 //! (h%3 + 1)%3`; `origin[h]`, `twin[h]` (`NONE` on the boundary — there are no boundary

@@ -1,6 +1,6 @@
 //! The hot loop of Ricci flow: from variables `u` to edge lengths, corner angles, curvature and
 //! the sparse Hessian `H = ∂K/∂u`, generic over the background geometry and the length law
-//! (paper 001 §V Step 3, Appendix D; DESIGN.md §3).
+//! (paper 001 §V Step 3, Appendix D; docs/DESIGN.md §3).
 //!
 //! Angles use the half-angle form of the cosine law, `tan²(θ_i/2) = s(σ−l_j)s(σ−l_k) /
 //! (s(σ)s(σ−l_i))`, from which `sin θ = 2t/(1+t²)` and `cos θ = (1−t²)/(1+t²)` follow without

@@ -1,5 +1,5 @@
 //! Background geometries, discrete conformal schemes, curvature, Ricci energy and its Hessian
-//! (paper 001 §IV–V and Appendix D, paper 002 ch. 3; DESIGN.md §3).
+//! (paper 001 §IV–V and Appendix D, paper 002 ch. 3; docs/DESIGN.md §3).
 //!
 //! * [`geometry`] — the backgrounds E², H², S² and their stable cosine laws;
 //! * [`scheme`] — Thurston / tangential / inversive distance circle packings and vertex scaling;

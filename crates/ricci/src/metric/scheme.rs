@@ -1,6 +1,6 @@
 //! Discrete conformal schemes: how per-vertex variables `u` and per-edge coefficients give edge
 //! lengths (paper 001 §IV "Discrete Conformal Deformation", eq. 9 and 12; the unified framework
-//! of Zhang–Guo–Zeng–Luo–Yau–Gu 2014; DESIGN.md §3).
+//! of Zhang–Guo–Zeng–Luo–Yau–Gu 2014; docs/DESIGN.md §3).
 //!
 //! Two length laws cover the four schemes:
 //!

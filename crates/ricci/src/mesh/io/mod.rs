@@ -4,6 +4,9 @@
 //! (binary) at fault; they never panic, whatever the bytes. Each produces a
 //! [`PolygonSoup`] with 1-based source lines for vertices and polygons; [`read_surface`]
 //! then validates it with [`build_surface`] into a [`Surface`] and a [`BuildReport`].
+//! The readers' errors are [`ReadError`]s: the sentence the user sees, the place (file, line,
+//! byte) and the record at fault (vertex, face, …) as data; they convert into
+//! [`Error::Parse`] with the same sentence.
 //! The byte-slice entry points ([`parse_obj`], [`parse_off`], [`parse_ply`], [`parse_stl`])
 //! serve tests and fuzzing.
 //!
@@ -11,12 +14,14 @@
 //! formatting, so a written file reads back to the same `f64` bit patterns.
 //! [`write_surface`] picks the format by extension and writes atomically.
 
+mod error;
 mod obj;
 mod off;
 mod ply;
 mod stl;
 pub(crate) mod text;
 
+pub use error::{ReadError, ReadResult, Record};
 pub use obj::{parse_obj, write_obj};
 pub use off::{parse_off, write_off};
 pub use ply::{parse_ply, write_ply};
@@ -88,6 +93,11 @@ impl Format {
 
 /// Parse a file held in memory into a polygon soup (no validation beyond the syntax).
 pub fn parse(data: &[u8], format: Format) -> Result<PolygonSoup> {
+    Ok(parse_soup(data, format)?)
+}
+
+/// Like [`parse`], with the reader's own error ([`ReadError`]: place and record as data).
+pub fn parse_soup(data: &[u8], format: Format) -> ReadResult<PolygonSoup> {
     match format {
         Format::Obj => parse_obj(data),
         Format::Off => parse_off(data),

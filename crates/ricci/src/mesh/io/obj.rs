@@ -9,6 +9,7 @@
 //! with a note (a texture seam needs per-corner UVs, which a [`Surface`] does not have); the
 //! per-corner coordinates stay available in [`PolygonSoup::corner_uvs`].
 
+use super::error::{ReadResult, Record};
 use super::text::{self, at_line, parse_f64, parse_i64, show, strip_comment, tokens};
 use crate::error::{Error, Result};
 use crate::mesh::{PolygonSoup, Surface, NONE};
@@ -53,222 +54,277 @@ const IGNORED: &[&[u8]] = &[
 ];
 
 /// Parse an OBJ file held in memory.
-pub fn parse_obj(data: &[u8]) -> Result<PolygonSoup> {
-    let mut positions: Vec<[f64; 3]> = Vec::new();
-    let mut vertex_lines = Vec::new();
-    let mut texcoords: Vec<[f64; 2]> = Vec::new();
-    let mut polygons: Vec<Vec<u32>> = Vec::new();
-    let mut polygon_lines = Vec::new();
-    // vt index of every corner (NONE where the corner has none), flat in polygon order.
-    let mut corner_vt: Vec<u32> = Vec::new();
-    let mut any_vt_corner = false;
-    let mut unknown: Option<(usize, String)> = None;
-    let mut unknown_count = 0usize;
-    let mut anything = false;
-
+pub fn parse_obj(data: &[u8]) -> ReadResult<PolygonSoup> {
+    let mut records = ObjRecords::default();
     let mut lines = text::Lines::new(data);
     let mut joined: Vec<u8> = Vec::new();
     while let Some((n, raw)) = lines.next() {
         let mut line = strip_comment(raw);
-        // `\` at the end of a line continues it on the next one.
         if line.trim_ascii_end().ends_with(b"\\") {
-            joined.clear();
-            let mut cur = line;
-            loop {
-                let t = cur.trim_ascii_end();
-                if let Some(body) = t.strip_suffix(b"\\") {
-                    joined.extend_from_slice(body);
-                    joined.push(b' ');
-                    match lines.next() {
-                        Some((_, l)) => cur = strip_comment(l),
-                        None => break,
-                    }
-                } else {
-                    joined.extend_from_slice(cur);
-                    break;
-                }
-            }
+            join_continued(line, &mut lines, &mut joined);
             line = &joined;
         }
         let mut t = tokens(line);
         let Some(key) = t.next() else { continue };
-        anything = true;
+        records.anything = true;
         match key {
-            b"v" => {
-                let mut p = [0.0f64; 3];
-                for (k, x) in p.iter_mut().enumerate() {
-                    let tok = t.next().ok_or_else(|| {
-                        at_line(
-                            n,
-                            format!(
-                                "vertex {} has {k} coordinates; three are needed (v x y z)",
-                                positions.len() + 1
-                            ),
-                        )
-                    })?;
+            b"v" => records.vertex(n, t)?,
+            b"vt" => records.texture_coordinate(n, t)?,
+            b"f" | b"fo" => records.face(n, t)?,
+            k if IGNORED.contains(&k) => {}
+            k => records.unknown(n, k),
+        }
+    }
+    records.finish()
+}
+
+/// A line ending in `\` continues on the next one: `first` and its continuations, joined by
+/// spaces, into `joined` (the continuation lines are consumed from `lines`).
+fn join_continued(first: &[u8], lines: &mut text::Lines<'_>, joined: &mut Vec<u8>) {
+    joined.clear();
+    let mut cur = first;
+    loop {
+        let t = cur.trim_ascii_end();
+        if let Some(body) = t.strip_suffix(b"\\") {
+            joined.extend_from_slice(body);
+            joined.push(b' ');
+            match lines.next() {
+                Some((_, l)) => cur = strip_comment(l),
+                None => break,
+            }
+        } else {
+            joined.extend_from_slice(cur);
+            break;
+        }
+    }
+}
+
+/// The records of an OBJ file read so far, one method per statement kind.
+#[derive(Default)]
+struct ObjRecords {
+    positions: Vec<[f64; 3]>,
+    vertex_lines: Vec<usize>,
+    texcoords: Vec<[f64; 2]>,
+    polygons: Vec<Vec<u32>>,
+    polygon_lines: Vec<usize>,
+    /// vt index of every corner (NONE where the corner has none), flat in polygon order.
+    corner_vt: Vec<u32>,
+    any_vt_corner: bool,
+    /// The first statement this reader does not know (line, keyword), and how many there are.
+    unknown: Option<(usize, String)>,
+    unknown_count: usize,
+    /// Whether any line holds a statement.
+    anything: bool,
+}
+
+impl ObjRecords {
+    /// `v x y z` at line `n` (anything after z is ignored).
+    fn vertex<'a>(&mut self, n: usize, mut t: impl Iterator<Item = &'a [u8]>) -> ReadResult<()> {
+        let i = self.positions.len();
+        let mut p = [0.0f64; 3];
+        for (k, x) in p.iter_mut().enumerate() {
+            let tok = t.next().ok_or_else(|| {
+                at_line(
+                    n,
+                    format!(
+                        "vertex {} has {k} coordinates; three are needed (v x y z)",
+                        i + 1
+                    ),
+                )
+                .about(Record::Vertex(i))
+            })?;
+            *x = parse_f64(tok).ok_or_else(|| {
+                at_line(
+                    n,
+                    format!("vertex {}: '{}' is not a number", i + 1, show(tok)),
+                )
+                .about(Record::Vertex(i))
+            })?;
+        }
+        self.positions.push(p);
+        self.vertex_lines.push(n);
+        Ok(())
+    }
+
+    /// `vt u [v]` at line `n` (v = 0 when absent, the OBJ default).
+    fn texture_coordinate<'a>(
+        &mut self,
+        n: usize,
+        mut t: impl Iterator<Item = &'a [u8]>,
+    ) -> ReadResult<()> {
+        let i = self.texcoords.len();
+        let mut uv = [0.0f64; 2];
+        for (k, x) in uv.iter_mut().enumerate() {
+            match t.next() {
+                Some(tok) => {
                     *x = parse_f64(tok).ok_or_else(|| {
                         at_line(
                             n,
                             format!(
-                                "vertex {}: '{}' is not a number",
-                                positions.len() + 1,
+                                "texture coordinate {}: '{}' is not a number",
+                                i + 1,
                                 show(tok)
                             ),
                         )
-                    })?;
+                        .about(Record::TextureCoordinate(i))
+                    })?
                 }
-                positions.push(p);
-                vertex_lines.push(n);
-            }
-            b"vt" => {
-                let mut uv = [0.0f64; 2];
-                for (k, x) in uv.iter_mut().enumerate() {
-                    match t.next() {
-                        Some(tok) => {
-                            *x = parse_f64(tok).ok_or_else(|| {
-                                at_line(
-                                    n,
-                                    format!(
-                                        "texture coordinate {}: '{}' is not a number",
-                                        texcoords.len() + 1,
-                                        show(tok)
-                                    ),
-                                )
-                            })?
-                        }
-                        None if k == 1 => {} // `vt u` alone: v = 0 (OBJ default)
-                        None => {
-                            return Err(at_line(
-                                n,
-                                format!("texture coordinate {} is empty", texcoords.len() + 1),
-                            ))
-                        }
-                    }
-                }
-                texcoords.push(uv);
-            }
-            b"f" | b"fo" => {
-                let mut poly = Vec::with_capacity(4);
-                for corner in t {
-                    let mut parts = corner.split(|&b| b == b'/');
-                    let vi = parts.next().unwrap_or_default();
-                    let ti = parts.next().unwrap_or_default();
-                    let v = resolve(vi, positions.len(), n, "vertex", polygons.len())?;
-                    poly.push(v);
-                    if ti.is_empty() {
-                        corner_vt.push(NONE);
-                    } else {
-                        let vt =
-                            resolve(ti, texcoords.len(), n, "texture coordinate", polygons.len())?;
-                        corner_vt.push(vt);
-                        any_vt_corner = true;
-                    }
-                }
-                polygons.push(poly);
-                polygon_lines.push(n);
-            }
-            k if IGNORED.contains(&k) => {}
-            k => {
-                unknown_count += 1;
-                if unknown.is_none() {
-                    unknown = Some((n, show(k)));
+                None if k == 1 => {} // `vt u` alone: v = 0 (OBJ default)
+                None => {
+                    return Err(at_line(n, format!("texture coordinate {} is empty", i + 1))
+                        .about(Record::TextureCoordinate(i)))
                 }
             }
         }
+        self.texcoords.push(uv);
+        Ok(())
     }
-    if !anything {
-        return Err(text::empty_file());
+
+    /// `f` (or `fo`) at line `n` with corners `i`, `i/j`, `i//k`, `i/j/k`.
+    fn face<'a>(&mut self, n: usize, t: impl Iterator<Item = &'a [u8]>) -> ReadResult<()> {
+        let face = self.polygons.len();
+        let mut poly = Vec::with_capacity(4);
+        for corner in t {
+            let mut parts = corner.split(|&b| b == b'/');
+            let vi = parts.next().unwrap_or_default();
+            let ti = parts.next().unwrap_or_default();
+            poly.push(resolve(vi, self.positions.len(), n, "vertex", face)?);
+            if ti.is_empty() {
+                self.corner_vt.push(NONE);
+            } else {
+                let vt = resolve(ti, self.texcoords.len(), n, "texture coordinate", face)?;
+                self.corner_vt.push(vt);
+                self.any_vt_corner = true;
+            }
+        }
+        self.polygons.push(poly);
+        self.polygon_lines.push(n);
+        Ok(())
     }
-    if positions.is_empty() && polygons.is_empty() {
-        return Err(match unknown {
-            Some((n, k)) => at_line(
-                n,
-                format!("'{k}' is not an OBJ statement, and the file has no 'v' or 'f' lines: is it an OBJ file?"),
-            ),
-            None => text::whole("the file has no vertices ('v' lines) and no faces ('f' lines)"),
-        });
+
+    /// A statement this reader does not know, at line `n`: counted, reported in a note.
+    fn unknown(&mut self, n: usize, keyword: &[u8]) {
+        self.unknown_count += 1;
+        if self.unknown.is_none() {
+            self.unknown = Some((n, show(keyword)));
+        }
     }
-    // Positive indices may refer forward; check them now that every vertex is known.
-    let nv = positions.len();
-    for (i, poly) in polygons.iter().enumerate() {
-        if let Some(&v) = poly.iter().find(|&&v| v as usize >= nv) {
-            return Err(at_line(
-                polygon_lines[i],
-                format!(
-                    "face {i} refers to vertex {} (1-based OBJ index), but the file has only {nv} vertices",
-                    v as u64 + 1
+
+    /// The polygon soup, after the checks that need the whole file (forward indices).
+    fn finish(self) -> ReadResult<PolygonSoup> {
+        if !self.anything {
+            return Err(text::empty_file());
+        }
+        if self.positions.is_empty() && self.polygons.is_empty() {
+            return Err(match self.unknown {
+                Some((n, k)) => at_line(
+                    n,
+                    format!("'{k}' is not an OBJ statement, and the file has no 'v' or 'f' lines: is it an OBJ file?"),
                 ),
+                None => text::whole("the file has no vertices ('v' lines) and no faces ('f' lines)"),
+            });
+        }
+        self.check_indices()?;
+        let nv = self.positions.len();
+        let mut notes = Vec::new();
+        if self.unknown_count > 0 {
+            let (n, k) = self.unknown.clone().unwrap_or_default();
+            notes.push(format!(
+                "{} lines with statements this reader does not know were ignored (first: '{k}' at line {n})",
+                self.unknown_count
             ));
         }
+        let corner_vt = &self.corner_vt;
+        let uvs = if self.any_vt_corner {
+            match per_vertex_uvs(
+                &self.polygons,
+                &self.polygon_lines,
+                corner_vt,
+                &self.texcoords,
+                nv,
+            ) {
+                Ok(uvs) => Some(uvs),
+                Err(why) => {
+                    notes.push(format!("texture coordinates were ignored: {why}"));
+                    None
+                }
+            }
+        } else {
+            None
+        };
+        let corner_uvs =
+            (self.any_vt_corner && corner_vt.iter().all(|&vt| vt != NONE)).then(|| {
+                corner_vt
+                    .iter()
+                    .map(|&vt| self.texcoords[vt as usize])
+                    .collect()
+            });
+        Ok(PolygonSoup {
+            positions: self.positions,
+            polygons: self.polygons,
+            vertex_lines: Some(self.vertex_lines),
+            polygon_lines: Some(self.polygon_lines),
+            uvs,
+            corner_uvs,
+            notes,
+        })
     }
-    if let Some((j, &vt)) = corner_vt
-        .iter()
-        .enumerate()
-        .find(|(_, &vt)| vt != NONE && vt as usize >= texcoords.len())
-    {
-        let face = polygon_of_corner(&polygons, j);
-        return Err(at_line(
-            polygon_lines[face],
-            format!(
-                "face {face} refers to texture coordinate {} (1-based), but the file has only {} of them",
-                vt as u64 + 1,
-                texcoords.len()
-            ),
-        ));
-    }
-    let mut notes = Vec::new();
-    if unknown_count > 0 {
-        let (n, k) = unknown.unwrap_or_default();
-        notes.push(format!(
-            "{unknown_count} lines with statements this reader does not know were ignored (first: '{k}' at line {n})"
-        ));
-    }
-    let uvs = if any_vt_corner {
-        match per_vertex_uvs(&polygons, &polygon_lines, &corner_vt, &texcoords, nv) {
-            Ok(uvs) => Some(uvs),
-            Err(why) => {
-                notes.push(format!("texture coordinates were ignored: {why}"));
-                None
+
+    /// Positive indices may refer forward; check them once every vertex and `vt` is known.
+    fn check_indices(&self) -> ReadResult<()> {
+        let nv = self.positions.len();
+        for (i, poly) in self.polygons.iter().enumerate() {
+            if let Some(&v) = poly.iter().find(|&&v| v as usize >= nv) {
+                return Err(at_line(
+                    self.polygon_lines[i],
+                    format!(
+                        "face {i} refers to vertex {} (1-based OBJ index), but the file has only {nv} vertices",
+                        v as u64 + 1
+                    ),
+                )
+                .about(Record::Face(i)));
             }
         }
-    } else {
-        None
-    };
-    let corner_uvs = (any_vt_corner && corner_vt.iter().all(|&vt| vt != NONE))
-        .then(|| corner_vt.iter().map(|&vt| texcoords[vt as usize]).collect());
-    Ok(PolygonSoup {
-        positions,
-        polygons,
-        vertex_lines: Some(vertex_lines),
-        polygon_lines: Some(polygon_lines),
-        uvs,
-        corner_uvs,
-        notes,
-    })
+        if let Some((j, &vt)) = self
+            .corner_vt
+            .iter()
+            .enumerate()
+            .find(|(_, &vt)| vt != NONE && vt as usize >= self.texcoords.len())
+        {
+            let face = polygon_of_corner(&self.polygons, j);
+            return Err(at_line(
+                self.polygon_lines[face],
+                format!(
+                    "face {face} refers to texture coordinate {} (1-based), but the file has only {} of them",
+                    vt as u64 + 1,
+                    self.texcoords.len()
+                ),
+            )
+            .about(Record::Face(face)));
+        }
+        Ok(())
+    }
 }
 
 /// An OBJ index (1-based, or negative = relative to the `count` elements defined so far) as a
 /// 0-based index. Positive indices are checked against the final count later.
-fn resolve(tok: &[u8], count: usize, line: usize, what: &str, face: usize) -> Result<u32> {
+fn resolve(tok: &[u8], count: usize, line: usize, what: &str, face: usize) -> ReadResult<u32> {
+    let at = |message: String| at_line(line, message).about(Record::Face(face));
     match parse_i64(tok) {
-        Some(0) => Err(at_line(
-            line,
+        Some(0) => Err(at(
             format!("face {face} uses {what} index 0; OBJ indices start at 1 (or are negative)"),
         )),
         Some(i) if i > 0 && i < u32::MAX as i64 => Ok((i - 1) as u32),
         Some(i) if i < 0 && -i <= count as i64 => Ok((count as i64 + i) as u32),
-        Some(i) if i < 0 => Err(at_line(
-            line,
+        Some(i) if i < 0 => Err(at(
             format!(
                 "face {face} uses relative {what} index {i}, but only {count} were defined before this line"
             ),
         )),
-        Some(i) => Err(at_line(
-            line,
+        Some(i) => Err(at(
             format!("face {face} refers to {what} {i}, beyond what 32-bit indices allow"),
         )),
-        None => Err(at_line(
-            line,
+        None => Err(at(
             format!("face {face}: '{}' is not a {what} index", show(tok)),
         )),
     }

@@ -7,13 +7,14 @@
 //! with a message naming the line: binary OFF, 4D/nD OFF, a malformed counts line, missing
 //! coordinates or indices, negative indices, a file that ends before the declared counts.
 
+use super::error::{ReadResult, Record};
 use super::text::{self, at_line, is_blank, parse_f64, parse_i64, show, strip_comment, tokens};
 use crate::error::{Error, Result};
 use crate::mesh::{PolygonSoup, Surface};
 use std::io::Write;
 
 /// Parse an OFF file held in memory.
-pub fn parse_off(data: &[u8]) -> Result<PolygonSoup> {
+pub fn parse_off(data: &[u8]) -> ReadResult<PolygonSoup> {
     let mut lines = text::Lines::new(data)
         .map(|(n, l)| (n, strip_comment(l)))
         .filter(|(_, l)| !is_blank(l));
@@ -31,7 +32,8 @@ pub fn parse_off(data: &[u8]) -> Result<PolygonSoup> {
         return Err(at_line(
             hline,
             "binary OFF is not supported; convert the file to ascii OFF, PLY or OBJ",
-        ));
+        )
+        .about(Record::Header));
     }
     // The counts line: on the header line, or the next meaningful line.
     let (cline, counts): (usize, Vec<&[u8]>) = if rest.is_empty() {
@@ -40,7 +42,8 @@ pub fn parse_off(data: &[u8]) -> Result<PolygonSoup> {
             None => return Err(at_line(
                 hline,
                 "the file ends after the OFF header, before the counts line 'vertices faces edges'",
-            )),
+            )
+            .about(Record::Header)),
         }
     } else {
         (hline, rest)
@@ -54,7 +57,8 @@ pub fn parse_off(data: &[u8]) -> Result<PolygonSoup> {
                 "wrong counts line: expected 'vertices faces edges' (two or three non-negative integers), found '{}'",
                 found.join(" ")
             ),
-        ));
+        )
+        .about(Record::Header));
     }
     let nv = parsed[0].unwrap_or(0) as usize;
     let nf = parsed[1].unwrap_or(0) as usize;
@@ -62,7 +66,7 @@ pub fn parse_off(data: &[u8]) -> Result<PolygonSoup> {
         return Err(at_line(
             cline,
             format!("the counts line declares {nv} vertices and {nf} faces, more than 32-bit indices allow"),
-        ));
+        ).about(Record::Header));
     }
 
     let mut soup = PolygonSoup {
@@ -80,7 +84,8 @@ pub fn parse_off(data: &[u8]) -> Result<PolygonSoup> {
                 format!(
                     "the counts line declares {nv} vertices but the file ends after {i} of them"
                 ),
-            ));
+            )
+            .about(Record::Vertex(i)));
         };
         let mut p = [0.0f64; 3];
         let mut t = tokens(l);
@@ -89,10 +94,12 @@ pub fn parse_off(data: &[u8]) -> Result<PolygonSoup> {
                 return Err(at_line(
                     n,
                     format!("vertex {i} has {k} coordinates; three are needed (x y z)"),
-                ));
+                )
+                .about(Record::Vertex(i)));
             };
             *x = parse_f64(tok).ok_or_else(|| {
                 at_line(n, format!("vertex {i}: '{}' is not a number", show(tok)))
+                    .about(Record::Vertex(i))
             })?;
         }
         soup.positions.push(p);
@@ -104,54 +111,10 @@ pub fn parse_off(data: &[u8]) -> Result<PolygonSoup> {
             return Err(at_line(
                 cline,
                 format!("the counts line declares {nf} faces but the file ends after {i} of them"),
-            ));
+            )
+            .about(Record::Face(i)));
         };
-        let mut t = tokens(l);
-        let first = t.next().unwrap_or_default();
-        let k = match parse_i64(first) {
-            Some(k) if k >= 0 => k as usize,
-            _ => {
-                return Err(at_line(
-                    n,
-                    format!(
-                        "face {i} must start with its number of corners, found '{}'",
-                        show(first)
-                    ),
-                ))
-            }
-        };
-        let mut poly = Vec::with_capacity(k.min(16));
-        for j in 0..k {
-            let Some(tok) = t.next() else {
-                return Err(at_line(
-                    n,
-                    format!("face {i} declares {k} corners but lists only {j} vertex indices"),
-                ));
-            };
-            match parse_i64(tok) {
-                Some(v) if (0..=u32::MAX as i64 - 1).contains(&v) => poly.push(v as u32),
-                Some(v) if v < 0 => {
-                    return Err(at_line(
-                        n,
-                        format!("face {i} refers to vertex {v}; vertex indices cannot be negative"),
-                    ))
-                }
-                Some(v) => {
-                    return Err(at_line(
-                        n,
-                        format!(
-                            "face {i} refers to vertex {v}, but the file has only {nv} vertices"
-                        ),
-                    ))
-                }
-                None => {
-                    return Err(at_line(
-                        n,
-                        format!("face {i}: '{}' is not a vertex index", show(tok)),
-                    ))
-                }
-            }
-        }
+        let poly = off_face(n, l, i, nv)?;
         // Anything after the indices is a per-face colour: ignored.
         soup.polygons.push(poly);
         plines.push(n);
@@ -159,8 +122,53 @@ pub fn parse_off(data: &[u8]) -> Result<PolygonSoup> {
     Ok(soup)
 }
 
+/// Face `i` at line `n` of a file with `nv` vertices: `k v₀ … v_{k−1}`, anything after the
+/// indices (a per-face colour) ignored.
+fn off_face(n: usize, l: &[u8], i: usize, nv: usize) -> ReadResult<Vec<u32>> {
+    let mut t = tokens(l);
+    let first = t.next().unwrap_or_default();
+    let at = |message: String| at_line(n, message).about(Record::Face(i));
+    let k = match parse_i64(first) {
+        Some(k) if k >= 0 => k as usize,
+        _ => {
+            return Err(at(format!(
+                "face {i} must start with its number of corners, found '{}'",
+                show(first)
+            )))
+        }
+    };
+    let mut poly = Vec::with_capacity(k.min(16));
+    for j in 0..k {
+        let Some(tok) = t.next() else {
+            return Err(at(format!(
+                "face {i} declares {k} corners but lists only {j} vertex indices"
+            )));
+        };
+        match parse_i64(tok) {
+            Some(v) if (0..=u32::MAX as i64 - 1).contains(&v) => poly.push(v as u32),
+            Some(v) if v < 0 => {
+                return Err(at(format!(
+                    "face {i} refers to vertex {v}; vertex indices cannot be negative"
+                )))
+            }
+            Some(v) => {
+                return Err(at(format!(
+                    "face {i} refers to vertex {v}, but the file has only {nv} vertices"
+                )))
+            }
+            None => {
+                return Err(at(format!(
+                    "face {i}: '{}' is not a vertex index",
+                    show(tok)
+                )))
+            }
+        }
+    }
+    Ok(poly)
+}
+
 /// The header keyword: `[ST][C][N]OFF` in any order of the prefixes.
-fn check_keyword(line: usize, keyword: &[u8]) -> Result<()> {
+fn check_keyword(line: usize, keyword: &[u8]) -> ReadResult<()> {
     let upper = keyword.to_ascii_uppercase();
     if let Some(prefix) = upper.strip_suffix(b"OFF") {
         // Geomview's `4OFF` / `nOFF` (lower-case n) describe points in other dimensions.
@@ -171,7 +179,8 @@ fn check_keyword(line: usize, keyword: &[u8]) -> Result<()> {
                     "'{}' (4D or n-dimensional OFF) is not supported; only surfaces in 3D are",
                     show(keyword)
                 ),
-            ));
+            )
+            .about(Record::Header));
         }
         let mut p = prefix;
         if let Some(r) = p.strip_prefix(b"ST") {
@@ -187,7 +196,8 @@ fn check_keyword(line: usize, keyword: &[u8]) -> Result<()> {
             "expected the OFF header ('OFF', 'COFF', 'NOFF', …), found '{}'",
             show(keyword)
         ),
-    ))
+    )
+    .about(Record::Header))
 }
 
 /// Write a surface as ascii OFF. Coordinates use the shortest representation that reads back

@@ -7,6 +7,7 @@
 //! Binary STL stores `f32`, so a binary round trip is exact only for `f32` coordinates; the
 //! ascii writer uses the shortest round-trip `f64` formatting.
 
+use super::error::{ReadResult, Record};
 use super::text::{self, at_byte, at_line, parse_f64, show, strip_comment, tokens};
 use crate::error::{Error, Result};
 use crate::mesh::{PolygonSoup, Surface};
@@ -77,7 +78,7 @@ impl Welder {
 }
 
 /// Parse an STL file (ascii or binary) held in memory.
-pub fn parse_stl(data: &[u8]) -> Result<PolygonSoup> {
+pub fn parse_stl(data: &[u8]) -> ReadResult<PolygonSoup> {
     if data.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(text::empty_file());
     }
@@ -108,7 +109,8 @@ pub fn parse_stl(data: &[u8]) -> Result<PolygonSoup> {
                     format!(
                         "truncated binary STL: the header declares {n} triangles (84 + 50·{n} = {expected} bytes) but the file has {have} bytes; triangle {k} is the first incomplete one"
                     ),
-                ))
+                )
+                .about(Record::Face(k as usize)))
             } else {
                 Err(at_byte(
                     expected as usize,
@@ -125,7 +127,7 @@ pub fn parse_stl(data: &[u8]) -> Result<PolygonSoup> {
     }
 }
 
-fn parse_binary(data: &[u8], n: usize) -> Result<PolygonSoup> {
+fn parse_binary(data: &[u8], n: usize) -> ReadResult<PolygonSoup> {
     let mut w = Welder::new(n / 2 + 3);
     let mut polygons = Vec::with_capacity(n);
     let f = |b: &[u8], o: usize| f32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]) as f64;
@@ -141,7 +143,8 @@ fn parse_binary(data: &[u8], n: usize) -> Result<PolygonSoup> {
                         "triangle {k} has a non-finite corner coordinate ({}, {}, {})",
                         p[0], p[1], p[2]
                     ),
-                ));
+                )
+                .about(Record::Face(k)));
             }
             tri.push(w.vertex(p, None));
         }
@@ -154,7 +157,7 @@ fn parse_binary(data: &[u8], n: usize) -> Result<PolygonSoup> {
     })
 }
 
-fn parse_ascii(data: &[u8]) -> Result<PolygonSoup> {
+fn parse_ascii(data: &[u8]) -> ReadResult<PolygonSoup> {
     let mut w = Welder::new(1024);
     let mut polygons: Vec<Vec<u32>> = Vec::new();
     let mut polygon_lines = Vec::new();

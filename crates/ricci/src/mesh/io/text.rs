@@ -1,7 +1,9 @@
 //! Small helpers shared by the text readers: lines with their 1-based numbers, whitespace
-//! tokens, numbers parsed from bytes, and error constructors that carry the line.
+//! tokens, numbers parsed from bytes, and constructors of [`ReadError`] that carry the line or
+//! byte offset.
 
-use crate::error::{Error, Location};
+use super::error::ReadError;
+use crate::error::Location;
 
 /// Lines of a byte buffer with their 1-based numbers; `\n`, `\r\n` and lone `\r` all end a
 /// line (old Mac files), the terminator is not part of the line.
@@ -115,37 +117,30 @@ pub(crate) fn show(tok: &[u8]) -> String {
     }
 }
 
-/// A parse error at a 1-based line.
-pub(crate) fn at_line(line: usize, message: impl Into<String>) -> Error {
-    Error::parse(
-        Location {
-            file: None,
-            line: Some(line),
-            byte: None,
-        },
-        message,
-    )
+/// A read error at a 1-based line, about the file as a whole until [`ReadError::about`]
+/// names the record.
+pub(crate) fn at_line(line: usize, message: impl Into<String>) -> ReadError {
+    ReadError {
+        location: Location::default().with_line(line),
+        ..ReadError::whole(message)
+    }
 }
 
-/// A parse error at a byte offset (binary formats).
-pub(crate) fn at_byte(byte: usize, message: impl Into<String>) -> Error {
-    Error::parse(
-        Location {
-            file: None,
-            line: None,
-            byte: Some(byte as u64),
-        },
-        message,
-    )
+/// A read error at a byte offset (binary formats).
+pub(crate) fn at_byte(byte: usize, message: impl Into<String>) -> ReadError {
+    ReadError {
+        location: Location::default().with_byte(byte as u64),
+        ..ReadError::whole(message)
+    }
 }
 
-/// A parse error about the file as a whole.
-pub(crate) fn whole(message: impl Into<String>) -> Error {
-    Error::parse(Location::default(), message)
+/// A read error about the file as a whole.
+pub(crate) fn whole(message: impl Into<String>) -> ReadError {
+    ReadError::whole(message)
 }
 
 /// The error for a file with no content.
-pub(crate) fn empty_file() -> Error {
+pub(crate) fn empty_file() -> ReadError {
     whole("the file is empty")
 }
 
