@@ -338,6 +338,9 @@ pub fn input_face_map(
     Ok(out)
 }
 
+/// A flow result kept while the cone correction tries another: flow, cut, cones, `σ(2u)`.
+type Candidate = (crate::flow::FlowResult, Vec<bool>, Vec<(u32, f64)>, f64);
+
 struct ChartUv {
     corner_uv: Vec<[f64; 2]>,
     cut: Vec<bool>,
@@ -458,7 +461,7 @@ fn chart_uv(
     } else {
         0
     };
-    let mut best: Option<(crate::flow::FlowResult, Vec<bool>, Vec<(u32, f64)>, f64)> = None;
+    let mut best: Option<Candidate> = None;
     let mut corrections = 0usize;
     let (r, cut) = loop {
         round += 1;
