@@ -1,7 +1,9 @@
 //! `ricci param` benchmark: conformal UV maps (`ricci::param::parametrize`) of the shared
 //! meshes of issue 16 with the cone counts of the BFF comparison. Prints per case: faces,
 //! cones, flipped input faces, qc mean / p95 / max, σ(log area ratio), seam length, flow
-//! flips, wall seconds.
+//! flips, wall seconds. Cases ending in `+c` run one round of
+//! `ParamOptions::cone_corrections`; `BENCH_PARAM_CHARTS=1` also prints per chart the flow
+//! runs, corrections and the flow's σ(2u).
 //!
 //! ```sh
 //! RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_param
@@ -30,11 +32,15 @@ fn main() {
         ("kitten", "kitten.nf20k.off", ConeSpec::Default),
         ("rocker-arm", "rocker-arm.off", ConeSpec::Default),
         ("botijo-8", "botijo.off", ConeSpec::Count(8)),
+        ("botijo-8+c", "botijo.off", ConeSpec::Count(8)),
         ("seahorse-8", "seahorse2_100K.off", ConeSpec::Count(8)),
         ("horse-8", "horse.ply", ConeSpec::Count(8)),
+        ("horse-8+c", "horse.ply", ConeSpec::Count(8)),
         ("maxplanck-8", "maxplanck.nf25k.off", ConeSpec::Count(8)),
+        ("maxplanck-8+c", "maxplanck.nf25k.off", ConeSpec::Count(8)),
         ("camel-8", "camel.off", ConeSpec::Count(8)),
         ("eight-auto", "eight.off", ConeSpec::Default),
+        ("eight-auto+c", "eight.off", ConeSpec::Default),
     ];
     println!(
         "{:<14} {:>7} {:>5} {:>6} {:>7} {:>7} {:>8} {:>7} {:>9} {:>7} {:>8}",
@@ -63,6 +69,8 @@ fn main() {
         };
         let opts = ParamOptions {
             cones,
+            // `+c`: one round of cone-curvature correction on the nonlinear flow.
+            cone_corrections: usize::from(name.ends_with("+c")),
             ..ParamOptions::default()
         };
         match parametrize(&s, &opts, &mut NoProgress) {
@@ -86,6 +94,16 @@ fn main() {
                 );
             }
             Err(e) => println!("{name:<14} error: {e}"),
+        }
+        if std::env::var_os("BENCH_PARAM_CHARTS").is_some() {
+            if let Ok(p) = parametrize(&s, &opts, &mut NoProgress) {
+                for c in &p.charts {
+                    println!(
+                        "  chart {}: flow runs {}, cone corrections {}, σ(2u) {:.4}, moved cones {}, flow {:.2} s",
+                        c.component, c.flow_runs, c.cone_corrections, c.log_scale_sigma, c.moved_cones, c.flow_seconds
+                    );
+                }
+            }
         }
     }
 }

@@ -1,6 +1,6 @@
 //! `ricci param MESH [--out UV.obj] [--svg UV.svg] [--cones auto|none|N|V=K,…|file:PATH]
 //! [--max-area-distortion D] [--boundary free|round|fixed-angles] [--sphere] [--seamless]
-//! [--margin M] [--json]`: a conformal UV map of the mesh in one command
+//! [--cone-corrections R] [--margin M] [--json]`: a conformal UV map of the mesh in one command
 //! (`ricci::param::parametrize`): conformal flow with intrinsic Delaunay flips, a cut through
 //! the cones and the handles, a flat layout, UVs on the input's own faces (seams as extra
 //! `vt`), charts packed into [0, 1]².
@@ -54,6 +54,10 @@ pub struct Args {
     /// Cone angles multiples of π/2 (transitions across seams: rotations by k·90° on genus 0).
     #[arg(long)]
     pub seamless: bool,
+    /// Rounds of correcting greedy cone curvatures on the nonlinear flow (least L² norm of
+    /// the log scale factor; each round runs the flow once more; kept when σ(2u) drops).
+    #[arg(long, default_value_t = 0)]
+    pub cone_corrections: usize,
     /// Margin of the packing in [0, 1]² (default 0.01).
     #[arg(long, default_value_t = 0.01)]
     pub margin: f64,
@@ -155,6 +159,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         boundary,
         seamless: a.seamless,
         margin: a.margin,
+        cone_corrections: a.cone_corrections,
         ..ParamOptions::default()
     };
     let p = parametrize(&surface, &opts, &mut bar).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;

@@ -277,6 +277,140 @@ pub fn greedy_cones(mesh: &Mesh, lengths: &[f64], budget: ConeBudget) -> Result<
     })
 }
 
+/// One Newton-type correction of cone curvatures on the *nonlinear* flow towards the least
+/// `L²` norm of the log scale factor (the energy of Soliman–Slepčev–Crane, "Optimal cone
+/// singularities for conformal flattening", 2018, §4, here with the cone positions fixed).
+/// `u` is the conformal factor the flow reached with curvatures `cones` (per vertex of the
+/// closed, connected `mesh`); the change `δk` (with `Σ δk = 0`: Gauss–Bonnet kept)
+/// minimises `‖u − ū + G δk‖²_M`, `G` the Green's functions of the input's cotangent
+/// Laplacian (`L g_c = δ_c − a/A`, zero area mean), i.e. the linear response of the flow's
+/// `u` to moving curvature between the cones (normal equations: the `(|C| + 1)²` system
+/// `[GᵀMG 1; 1ᵀ 0] [δk; λ] = [−GᵀM(u − ū); 0]`). `damping ∈ (0, 1]` scales the step.
+/// Returns the new `(vertex, K̄)` list, cone angles kept positive (`K̄ ≤ 2π − 0.05`).
+pub fn correct_cone_curvatures(
+    mesh: &Mesh,
+    lengths: &[f64],
+    cones: &[(u32, f64)],
+    u: &[f64],
+    damping: f64,
+) -> Result<Vec<(u32, f64)>> {
+    let lap = laplacian(mesh, lengths)?;
+    let n = lap.n;
+    let pattern = LowerCsc {
+        n,
+        col_ptr: &lap.col_ptr,
+        row_idx: &lap.row_idx,
+    };
+    let mut solver = SymmetricSolver::new(pattern)?;
+    let total_area: f64 = lap.area.iter().sum();
+    let used: Vec<bool> = (0..n as u32).map(|v| !mesh.is_isolated(v)).collect();
+    let scale = lap.diag.iter().map(|&i| lap.values[i]).fold(0.0, f64::max);
+    let penalty = 1e10 * scale.max(1e-300);
+    let pin = (0..n).find(|&v| used[v]).unwrap_or(0);
+    let mut vals = lap.values.clone();
+    for v in 0..n {
+        if v == pin || !used[v] {
+            vals[lap.diag[v]] += penalty;
+        }
+    }
+    if !solver.factor_llt(&vals) && !solver.factor_ldlt(&vals) {
+        return Err(Error::numerical(
+            "the cotangent Laplacian could not be factorized for the cone correction",
+        ));
+    }
+    let area = &lap.area;
+    let mean_u: f64 = (0..n).map(|v| u[v] * area[v]).sum::<f64>() / total_area;
+    let r: Vec<f64> = (0..n)
+        .map(|v| if used[v] { u[v] - mean_u } else { 0.0 })
+        .collect();
+    let m = cones.len();
+    let mut g: Vec<Vec<f64>> = Vec::with_capacity(m);
+    for &(c, _) in cones {
+        let mut x: Vec<f64> = (0..n)
+            .map(|v| {
+                if v == pin || !used[v] {
+                    0.0
+                } else {
+                    (if v == c as usize { 1.0 } else { 0.0 }) - area[v] / total_area
+                }
+            })
+            .collect();
+        solver.solve(&mut x);
+        let mx: f64 = (0..n).map(|v| x[v] * area[v]).sum::<f64>() / total_area;
+        for v in 0..n {
+            x[v] = if used[v] { x[v] - mx } else { 0.0 };
+        }
+        g.push(x);
+    }
+    let dot = |x: &[f64], y: &[f64]| -> f64 { (0..n).map(|v| x[v] * area[v] * y[v]).sum() };
+    let mut a = vec![vec![0.0; m + 1]; m + 1];
+    let mut rhs = vec![0.0; m + 1];
+    for i in 0..m {
+        for j in i..m {
+            let d = dot(&g[i], &g[j]);
+            a[i][j] = d;
+            a[j][i] = d;
+        }
+        a[i][m] = 1.0;
+        a[m][i] = 1.0;
+        rhs[i] = -dot(&g[i], &r);
+    }
+    let x = crate::analysis::forms::small::solve(&a, &rhs);
+    if x.iter().any(|v| !v.is_finite()) {
+        return Err(Error::numerical(
+            "the cone curvature correction is singular (two cones too close?)",
+        ));
+    }
+    let total: f64 = cones.iter().map(|c| c.1).sum();
+    let mut out: Vec<(u32, f64)> = cones
+        .iter()
+        .zip(&x)
+        .map(|(&(c, k), &d)| (c, k + damping * d))
+        .collect();
+    // Curvatures kept in [K_lo, 2π − 0.05], K_lo the most negative given curvature (no cone
+    // angle grows beyond the largest given one: a stronger cone makes the flow flip its whole
+    // neighbourhood away, where the cut on kept input edges cannot reach it); what is cut off
+    // goes to the cones inside the range, equally.
+    let upper = 2.0 * PI - 0.05;
+    let lower = cones
+        .iter()
+        .map(|c| c.1)
+        .fold(f64::INFINITY, f64::min)
+        .min(upper);
+    for _ in 0..16 {
+        let excess: f64 = out
+            .iter()
+            .map(|&(_, k)| (k - upper).max(0.0) - (lower - k).max(0.0))
+            .sum();
+        for x in out.iter_mut() {
+            x.1 = x.1.clamp(lower, upper);
+        }
+        if excess.abs() <= 1e-15 {
+            break;
+        }
+        let share: Vec<usize> = (0..out.len())
+            .filter(|&i| {
+                if excess > 0.0 {
+                    out[i].1 < upper
+                } else {
+                    out[i].1 > lower
+                }
+            })
+            .collect();
+        if share.is_empty() {
+            break;
+        }
+        for &i in &share {
+            out[i].1 += excess / share.len() as f64;
+        }
+    }
+    let sum: f64 = out.iter().map(|x| x.1).sum();
+    if let Some(last) = out.last_mut() {
+        last.1 += total - sum;
+    }
+    Ok(out)
+}
+
 /// Round cone curvatures to multiples of `π/2` keeping their sum (a multiple of `π/2` when it
 /// is `2πχ`): nearest multiples first, then the cones with the largest rounding error moved
 /// by `±π/2` until the sum is right. Cones that round to 0 are dropped; cone angles stay

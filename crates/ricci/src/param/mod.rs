@@ -15,6 +15,10 @@
 //!
 //!    Closed surfaces: cones `K̄_c` at given vertices, or placed by the greedy of
 //!    [`cones`] (Ben-Chen–Gotsman–Bunin 2008), flat elsewhere; a torus may have none.
+//!    Greedy cones can be corrected on the nonlinear flow
+//!    ([`ParamOptions::cone_corrections`], [`cones::correct_cone_curvatures`]): the cone
+//!    curvatures are re-solved for the least `L²` norm of the flow's log scale factor
+//!    (Soliman–Slepčev–Crane 2018 §4 with the positions fixed) and the flow runs again.
 //!    `--seamless` rounds cone curvatures to multiples of π/2 ([`cones::round_to_quarter_turns`];
 //!    Campen–Shen–Zhou–Zorin 2019 §3): on genus 0 every transition across a seam is then a
 //!    rotation by a multiple of 90° (the holonomy around a cone is its curvature). On genus
@@ -50,7 +54,7 @@ use crate::layout::place::layout;
 use crate::mesh::{topology, Mesh, Surface, NONE};
 use crate::metric::{Euclidean, Geometry, Scheme};
 use crate::progress::Progress;
-use cones::{greedy_cones, round_to_quarter_turns, ConeBudget};
+use cones::{correct_cone_curvatures, greedy_cones, round_to_quarter_turns, ConeBudget};
 use serde::Serialize;
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -107,6 +111,11 @@ pub struct ParamOptions {
     pub margin: f64,
     /// Most cones the automatic placement may use (default 64).
     pub max_cones: usize,
+    /// Rounds of [`cones::correct_cone_curvatures`] on the nonlinear flow for greedy cones
+    /// (not with `--seamless`): each re-solves the cone curvatures for the least-squares log
+    /// scale factor and runs the flow again, kept only when `σ(2u)` drops (default 0: each
+    /// round costs one more flow).
+    pub cone_corrections: usize,
 }
 
 impl Default for ParamOptions {
@@ -118,6 +127,7 @@ impl Default for ParamOptions {
             tolerance: 1e-9,
             margin: 0.01,
             max_cones: 64,
+            cone_corrections: 0,
         }
     }
 }
@@ -170,6 +180,10 @@ pub struct Chart {
     /// cut runs on kept input edges), and flows run.
     pub moved_cones: usize,
     pub flow_runs: usize,
+    /// Rounds of the cone-curvature correction on the nonlinear flow that ran, and the
+    /// area-weighted `σ(2u)` of the flow's conformal factor that was kept.
+    pub cone_corrections: usize,
+    pub log_scale_sigma: f64,
     pub seconds: f64,
 }
 
@@ -265,6 +279,26 @@ fn fixed_angle_targets(mesh: &Mesh, lengths: &[f64], seamless: bool) -> Vec<f64>
     t
 }
 
+/// Area-weighted standard deviation of the log area ratio `2u` of a conformal factor `u` per
+/// vertex (face value: the mean of its corners), the quantity the cone correction lowers.
+fn log_scale_sigma(surface: &Surface, u: &[f64]) -> f64 {
+    use crate::numeric::vec3::{cross, norm, sub};
+    let (mut w, mut s1, mut s2) = (0.0, 0.0, 0.0);
+    for t in surface.mesh.faces() {
+        let p = |i: usize| surface.positions[t[i] as usize];
+        let a = 0.5 * norm(cross(sub(p(1), p(0)), sub(p(2), p(0))));
+        let x = 2.0 * (u[t[0] as usize] + u[t[1] as usize] + u[t[2] as usize]) / 3.0;
+        w += a;
+        s1 += a * x;
+        s2 += a * x * x;
+    }
+    if w <= 0.0 {
+        return 0.0;
+    }
+    let m = s1 / w;
+    (s2 / w - m * m).max(0.0).sqrt()
+}
+
 /// The map of the input's faces into the layout of the opened intrinsic triangulation: one
 /// UV per input corner (see the module docs, step 5). `t_mesh` is the simplicial mesh of the
 /// flow (input vertices first, same ids), `t_cut` its cut flags, `t_uv[3f + i]` the layout
@@ -303,6 +337,9 @@ pub fn input_face_map(
     }
     Ok(out)
 }
+
+/// A flow result kept while the cone correction tries another: flow, cut, cones, `σ(2u)`.
+type Candidate = (crate::flow::FlowResult, Vec<bool>, Vec<(u32, f64)>, f64);
 
 struct ChartUv {
     corner_uv: Vec<[f64; 2]>,
@@ -419,6 +456,13 @@ fn chart_uv(
     const CONE_MOVES: usize = 3;
     let mut moved_cones = 0usize;
     let mut round = 0usize;
+    let mut corrections_left = if cone_source == "greedy" && !opts.seamless {
+        opts.cone_corrections
+    } else {
+        0
+    };
+    let mut best: Option<Candidate> = None;
+    let mut corrections = 0usize;
     let (r, cut) = loop {
         round += 1;
         let target = if cone_list.is_empty() {
@@ -434,7 +478,19 @@ fn chart_uv(
             tolerance: opts.tolerance,
             ..FlowOptions::default()
         };
-        let r = ricci_flow(mesh, &lengths, &fo, progress)?;
+        let r = match ricci_flow(mesh, &lengths, &fo, progress) {
+            Ok(r) if !r.converged && best.is_some() => {
+                let (r, cut, c, _) = best.take().expect("checked");
+                cone_list = c;
+                break (r, cut);
+            }
+            Err(_) if best.is_some() => {
+                let (r, cut, c, _) = best.take().expect("checked");
+                cone_list = c;
+                break (r, cut);
+            }
+            x => x?,
+        };
         if !r.converged {
             return Err(Error::numerical(format!(
                 "component {component}: the conformal flow did not converge (max |K − K̄| = \
@@ -545,11 +601,40 @@ fn chart_uv(
         let needs_cut = comp.boundary_loops != 1 || comp.genus > 0 || !cone_vertices.is_empty();
         let cut = if needs_cut {
             progress.report("cut", None, "cut graph through the cones and the handles");
-            seams::cut_graph(mesh, &lengths, &allowed, &cone_vertices)
-                .map_err(|e| Error::numerical(format!("component {component}: {e}")))?
+            match seams::cut_graph(mesh, &lengths, &allowed, &cone_vertices) {
+                Ok(c) => c,
+                Err(_) if best.is_some() => {
+                    let (r, cut, c, _) = best.take().expect("checked");
+                    cone_list = c;
+                    break (r, cut);
+                }
+                Err(e) => {
+                    return Err(Error::numerical(format!("component {component}: {e}")));
+                }
+            }
         } else {
             vec![false; mesh.n_edges()]
         };
+        let sigma = log_scale_sigma(&piece.surface, &r.u);
+        let better = best.as_ref().is_none_or(|b| sigma < b.3);
+        if corrections_left > 0 {
+            // Re-solve the cone curvatures on the nonlinear result and flow again.
+            corrections_left -= 1;
+            progress.report("cones", None, "cone curvatures corrected on the flow");
+            if let Ok(next) = correct_cone_curvatures(mesh, &lengths, &cone_list, &r.u, 1.0) {
+                if better {
+                    best = Some((r, cut, cone_list.clone(), sigma));
+                }
+                cone_list = next;
+                corrections += 1;
+                continue;
+            }
+        }
+        if !better {
+            let (r, cut, c, _) = best.take().expect("checked");
+            cone_list = c;
+            break (r, cut);
+        }
         break (r, cut);
     };
     let flow_seconds = r.seconds;
@@ -667,6 +752,8 @@ fn chart_uv(
         flow_seconds,
         moved_cones,
         flow_runs: round,
+        cone_corrections: corrections,
+        log_scale_sigma: log_scale_sigma(&piece.surface, &r.u),
         seconds: t0.elapsed().as_secs_f64(),
     };
     Ok(ChartUv {
