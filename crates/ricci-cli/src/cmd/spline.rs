@@ -125,67 +125,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
          the surface, try: ricci spline {} --out {stem}-spline",
         a.mesh.display()
     );
-    // An estimate up front (`estimate`), refused when over the budget; printed when long.
-    let (est_seconds, est_gb) = estimate(
-        surface.mesh.n_faces(),
-        a.degree,
-        a.fairness,
-        a.fit.is_some(),
-    );
-    if a.budget > 0.0 && est_seconds > a.budget {
-        // The same command with a budget above the estimate.
-        let mut cmd = format!(
-            "ricci spline {} --degree {} --fairness {}",
-            a.mesh.display(),
-            a.degree,
-            a.fairness
-        );
-        if let Some(l) = a.fit {
-            let _ = write!(cmd, " --fit {l}");
-        }
-        if a.singularity != "auto" {
-            let _ = write!(cmd, " --singularity {}", a.singularity);
-        }
-        if a.charts != "local" {
-            let _ = write!(cmd, " --charts {}", a.charts);
-        }
-        if a.tessellation != 8 {
-            let _ = write!(cmd, " --tessellation {}", a.tessellation);
-        }
-        if let Some(o) = &a.out {
-            let _ = write!(cmd, " --out {}", o.display());
-        }
-        let raise = (est_seconds * 2.0 / 100.0).ceil() * 100.0;
-        anyhow::bail!(
-            "{}: a degree-{} spline (r = {}{}) on {} faces would take roughly {:.0} CPU-seconds \
-             and {:.1} GB of memory, over the budget of {:.0} s (--budget), so nothing was \
-             computed; try: {cmd} --budget {raise:.0}",
-            a.mesh.display(),
-            a.degree,
-            a.fairness,
-            if a.fit.is_some() { ", fitted" } else { "" },
-            surface.mesh.n_faces(),
-            est_seconds,
-            est_gb,
-            a.budget,
-        );
-    }
-    if est_seconds > 30.0 {
-        bar.line(&format!(
-            "estimate: {} faces at degree {}: roughly {:.0} CPU-seconds and {:.1} GB of memory \
-             (budget {:.0} s); progress follows{}",
-            surface.mesh.n_faces(),
-            a.degree,
-            est_seconds,
-            est_gb,
-            a.budget,
-            if a.out.is_none() {
-                " (no --out: nothing will be written)"
-            } else {
-                ""
-            }
-        ));
-    }
+    check_budget(&a, surface.mesh.n_faces(), &mut bar)?;
     let t_ricci = Instant::now();
     let dist = MeshDistance::new(&surface.positions, surface.mesh.faces());
     let opts = SplineOptions {
@@ -240,24 +180,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "tessellation": {"vertices": tess.positions.len(), "triangles": tess.triangles.len(), "spline_triangles": tess.spline_triangles},
     });
     if let Some(dir) = &a.out {
-        let surface_obj = surface_obj(&rep, &tess);
-        let side = json!({"face": tess.vertex_face, "chart": tess.vertex_chart});
-        let c = control_net_obj(charts, &control, rep.degree, rep.control_points);
-        let bo = boundaries_obj(&tess);
-        out["out"] = json!(dir.display().to_string());
-        out["seconds_total"] = json!(t0.elapsed().as_secs_f64());
-        out["seconds"] = out["seconds_total"].clone();
-        write_atomic(&dir.join("surface.obj"), surface_obj.as_bytes())?;
-        write_atomic(
-            &dir.join("surface_vertices.json"),
-            serde_json::to_string(&side)?.as_bytes(),
-        )?;
-        write_atomic(&dir.join("control_net.obj"), c.as_bytes())?;
-        write_atomic(&dir.join("boundaries.obj"), bo.as_bytes())?;
-        write_atomic(
-            &dir.join("spline.json"),
-            serde_json::to_string_pretty(&out)?.as_bytes(),
-        )?;
+        write_outputs(dir, charts, &rep, &tess, &control, &mut out, t0)?;
     }
     // `seconds`: the whole command (reading, flat domain, spline, measuring, writing).
     let total = t0.elapsed().as_secs_f64();
@@ -290,6 +213,99 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             );
         }
     }
+    Ok(())
+}
+
+/// An estimate up front ([`estimate`]): refused when over `--budget`, printed when long.
+fn check_budget(a: &Args, n_faces: usize, bar: &mut Reporter) -> anyhow::Result<()> {
+    // An estimate up front (`estimate`), refused when over the budget; printed when long.
+    let (est_seconds, est_gb) = estimate(n_faces, a.degree, a.fairness, a.fit.is_some());
+    if a.budget > 0.0 && est_seconds > a.budget {
+        // The same command with a budget above the estimate.
+        let mut cmd = format!(
+            "ricci spline {} --degree {} --fairness {}",
+            a.mesh.display(),
+            a.degree,
+            a.fairness
+        );
+        if let Some(l) = a.fit {
+            let _ = write!(cmd, " --fit {l}");
+        }
+        if a.singularity != "auto" {
+            let _ = write!(cmd, " --singularity {}", a.singularity);
+        }
+        if a.charts != "local" {
+            let _ = write!(cmd, " --charts {}", a.charts);
+        }
+        if a.tessellation != 8 {
+            let _ = write!(cmd, " --tessellation {}", a.tessellation);
+        }
+        if let Some(o) = &a.out {
+            let _ = write!(cmd, " --out {}", o.display());
+        }
+        let raise = (est_seconds * 2.0 / 100.0).ceil() * 100.0;
+        anyhow::bail!(
+            "{}: a degree-{} spline (r = {}{}) on {} faces would take roughly {:.0} CPU-seconds \
+             and {:.1} GB of memory, over the budget of {:.0} s (--budget), so nothing was \
+             computed; try: {cmd} --budget {raise:.0}",
+            a.mesh.display(),
+            a.degree,
+            a.fairness,
+            if a.fit.is_some() { ", fitted" } else { "" },
+            n_faces,
+            est_seconds,
+            est_gb,
+            a.budget,
+        );
+    }
+    if est_seconds > 30.0 {
+        bar.line(&format!(
+            "estimate: {} faces at degree {}: roughly {:.0} CPU-seconds and {:.1} GB of memory \
+             (budget {:.0} s); progress follows{}",
+            n_faces,
+            a.degree,
+            est_seconds,
+            est_gb,
+            a.budget,
+            if a.out.is_none() {
+                " (no --out: nothing will be written)"
+            } else {
+                ""
+            }
+        ));
+    }
+    Ok(())
+}
+
+/// Writes `surface.obj`, `surface_vertices.json`, `control_net.obj`, `boundaries.obj` and
+/// `spline.json` into `dir` (each atomically).
+fn write_outputs(
+    dir: &std::path::Path,
+    charts: &(dyn FlatCharts + Sync),
+    rep: &SplineReport,
+    tess: &Tessellation,
+    control: &[f64],
+    out: &mut serde_json::Value,
+    t0: Instant,
+) -> anyhow::Result<()> {
+    let surface_obj = surface_obj(rep, tess);
+    let side = json!({"face": tess.vertex_face, "chart": tess.vertex_chart});
+    let c = control_net_obj(charts, control, rep.degree, rep.control_points);
+    let bo = boundaries_obj(tess);
+    out["out"] = json!(dir.display().to_string());
+    out["seconds_total"] = json!(t0.elapsed().as_secs_f64());
+    out["seconds"] = out["seconds_total"].clone();
+    write_atomic(&dir.join("surface.obj"), surface_obj.as_bytes())?;
+    write_atomic(
+        &dir.join("surface_vertices.json"),
+        serde_json::to_string(&side)?.as_bytes(),
+    )?;
+    write_atomic(&dir.join("control_net.obj"), c.as_bytes())?;
+    write_atomic(&dir.join("boundaries.obj"), bo.as_bytes())?;
+    write_atomic(
+        &dir.join("spline.json"),
+        serde_json::to_string_pretty(&*out)?.as_bytes(),
+    )?;
     Ok(())
 }
 

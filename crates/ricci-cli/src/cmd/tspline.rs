@@ -185,9 +185,8 @@ fn samples_json(ts: &TSpline, patches: &[BezierPatch]) -> serde_json::Value {
     json!({"samples": out, "patches": bounds, "samples_per_patch": 2})
 }
 
-pub fn run_cmd(a: Args) -> anyhow::Result<()> {
-    let t0 = Instant::now();
-    let tolerance = parse_tolerance(&a.tolerance)?;
+/// The ranges of the numeric arguments (usage errors, exit 2).
+fn check_ranges(a: &Args) -> anyhow::Result<()> {
     if !(a.smoothing >= 0.0 && a.smoothing.is_finite()) {
         return Err(UsageError(format!("--smoothing {} must be ≥ 0", a.smoothing)).into());
     }
@@ -212,6 +211,13 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         ))
         .into());
     }
+    Ok(())
+}
+
+pub fn run_cmd(a: Args) -> anyhow::Result<()> {
+    let t0 = Instant::now();
+    let tolerance = parse_tolerance(&a.tolerance)?;
+    check_ranges(&a)?;
     let (surface, _) = read_surface(&a.mesh)?;
     let topo = ricci::mesh::topology(&surface.mesh);
     let (comps, genus, loops) = match topo.components.first() {

@@ -38,7 +38,7 @@ use crate::error::{Error, Result};
 use crate::numeric::sparse::Cholesky;
 use crate::progress::{NoProgress, Progress};
 
-use super::dms::{multi_indices, Precision, Workspace};
+use super::dms::{Precision, Workspace};
 use super::simplex::{n_partials, Point};
 
 /// Compatibility re-exports: the spline-space interface and the quadrature rules moved to
@@ -50,347 +50,8 @@ pub use super::quadrature::{
 };
 pub use super::space::{evaluate, SplineSpace};
 
-/// One fairing constraint `c̃[single] − Σ_b weights[b] c̃[target * nb + b] = 0`.
-#[derive(Debug, Clone)]
-pub struct Constraint {
-    /// Global index of the constrained control point (of triangle `I`).
-    pub single: u32,
-    /// The neighbouring triangle `J` whose B-patch blossom it must equal.
-    pub target: u32,
-    /// Blossom weights of `J`'s control points (one per β of `J`).
-    pub weights: Vec<f64>,
-}
-
-/// The constraints of paper 000 eq. 14 for fairness parameter `r` (`0 ≤ r ≤ n − 1`), for
-/// both orientations of every interior edge (the shared-control-point rows, `β_o = 0`, once).
-pub fn fairness_constraints<S: SplineSpace + ?Sized>(
-    space: &S,
-    r: usize,
-) -> Result<Vec<Constraint>> {
-    let n = space.degree();
-    if r >= n {
-        return Err(Error::input(format!(
-            "fairness parameter r = {r} must be between 0 and n − 1 = {}",
-            n - 1
-        )));
-    }
-    let nb = space.per_triangle();
-    let mut out = Vec::new();
-    for (fi, fj, o) in space.neighbour_pairs() {
-        for (k, beta) in multi_indices(n).into_iter().enumerate() {
-            if beta[o] > r {
-                continue;
-            }
-            // With β_o = 0 the constraint only involves the edge's knots and says that the
-            // two triangles share this control point: the same equation as the opposite
-            // orientation's, so it is imposed once (from the lower face index).
-            if beta[o] == 0 && fi > fj {
-                continue;
-            }
-            let mut w = vec![0.0; nb];
-            space.blossom_weights_between(fi, beta, fj, &mut w);
-            out.push(Constraint {
-                single: (fi as usize * nb + k) as u32,
-                target: fj,
-                weights: w,
-            });
-        }
-    }
-    Ok(out)
-}
-
-/// Residuals `A c` of the constraints (`dim` numbers per constraint).
-pub fn constraint_residuals<S: SplineSpace + ?Sized>(
-    space: &S,
-    cons: &[Constraint],
-    control: &[f64],
-    dim: usize,
-) -> Vec<f64> {
-    let nb = space.per_triangle();
-    let mut r = vec![0.0; cons.len() * dim];
-    for (i, c) in cons.iter().enumerate() {
-        for d in 0..dim {
-            let mut s = control[c.single as usize * dim + d];
-            for (b, w) in c.weights.iter().enumerate() {
-                s -= w * control[(c.target as usize * nb + b) * dim + d];
-            }
-            r[i * dim + d] = s;
-        }
-    }
-    r
-}
-
-/// What [`fair`] did.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct FairingReport {
-    pub fairness: usize,
-    pub constraints: usize,
-    /// `max_i |A_i c̃| / (‖A_i‖₁ max |c|)`: constraint residual relative to the size of its terms.
-    pub max_constraint_residual: f64,
-    /// Requested tolerance for the above.
-    pub tolerance: f64,
-    /// `sqrt(mean ‖c̃ − c‖²)` over control points.
-    pub rms_change: f64,
-    /// Objective of eq. 14, `Σ ‖c̃ − c‖²`.
-    pub objective: f64,
-    /// Largest number of preconditioned CG steps (over coordinates).
-    pub refinement_steps: usize,
-    pub converged: bool,
-}
-
-/// Paper 000's fairing (module docs) of control points with `dim` coordinates each.
-pub fn fair<S: SplineSpace + ?Sized>(
-    space: &S,
-    control: &[f64],
-    dim: usize,
-    r: usize,
-) -> Result<(Vec<f64>, FairingReport)> {
-    let nc = space.n_control_points();
-    if control.len() != nc * dim {
-        return Err(Error::input(format!(
-            "fairing: {} numbers given for {nc} control points of dimension {dim}",
-            control.len()
-        )));
-    }
-    let cons = fairness_constraints(space, r)?;
-    let nb = space.per_triangle();
-    let m = cons.len();
-    let scale = control
-        .iter()
-        .fold(0.0f64, |a, b| a.max(b.abs()))
-        .max(1e-300);
-    let tolerance = 1e-10;
-    if m == 0 {
-        return Ok((
-            control.to_vec(),
-            FairingReport {
-                fairness: r,
-                constraints: 0,
-                max_constraint_residual: 0.0,
-                tolerance,
-                rms_change: 0.0,
-                objective: 0.0,
-                refinement_steps: 0,
-                converged: true,
-            },
-        ));
-    }
-    // Rows touching each triangle's control points (as target) and rows whose single lies in
-    // each triangle.
-    let nf = space.n_triangles();
-    let mut by_target: Vec<Vec<u32>> = vec![Vec::new(); nf];
-    let mut by_single_face: Vec<Vec<u32>> = vec![Vec::new(); nf];
-    let mut by_single: HashMap<u32, Vec<u32>> = HashMap::new();
-    for (i, c) in cons.iter().enumerate() {
-        by_target[c.target as usize].push(i as u32);
-        by_single_face[c.single as usize / nb].push(i as u32);
-        by_single.entry(c.single).or_default().push(i as u32);
-    }
-    // A Aᵀ, lower triangle, as triplets (duplicates are summed by faer).
-    let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::new();
-    let push = |a: u32, b: u32, v: f64, trip: &mut Vec<Triplet<usize, usize, f64>>| {
-        let (i, j) = if a >= b { (a, b) } else { (b, a) };
-        trip.push(Triplet::new(i as usize, j as usize, v));
-    };
-    let mut diag_max: f64 = 0.0;
-    for c in &cons {
-        let d = 1.0 + c.weights.iter().map(|w| w * w).sum::<f64>();
-        diag_max = diag_max.max(d);
-    }
-    for (i, c) in cons.iter().enumerate() {
-        let d = 1.0 + c.weights.iter().map(|w| w * w).sum::<f64>();
-        push(i as u32, i as u32, d, &mut trip);
-    }
-    for f in 0..nf {
-        let rows = &by_target[f];
-        // Both rows target f: w_a · w_b.
-        for (x, &a) in rows.iter().enumerate() {
-            for &b in &rows[..x] {
-                let s: f64 = cons[a as usize]
-                    .weights
-                    .iter()
-                    .zip(&cons[b as usize].weights)
-                    .map(|(p, q)| p * q)
-                    .sum();
-                push(a, b, s, &mut trip);
-            }
-        }
-        // Row a's single lies in f, row b targets f: −w_b(local index of a's single).
-        for &a in &by_single_face[f] {
-            let local = cons[a as usize].single as usize % nb;
-            for &b in rows {
-                if a != b {
-                    push(a, b, -cons[b as usize].weights[local], &mut trip);
-                }
-            }
-        }
-    }
-    for rows in by_single.values() {
-        for (x, &a) in rows.iter().enumerate() {
-            for &b in &rows[..x] {
-                push(a, b, 1.0, &mut trip);
-            }
-        }
-    }
-    // A and Aᵀ on one coordinate.
-    let apply_a = |x: &[f64], out: &mut [f64]| {
-        for (i, c) in cons.iter().enumerate() {
-            let mut s = x[c.single as usize];
-            let base = c.target as usize * nb;
-            for (b, w) in c.weights.iter().enumerate() {
-                s -= w * x[base + b];
-            }
-            out[i] = s;
-        }
-    };
-    let apply_at = |y: &[f64], out: &mut [f64]| {
-        out.fill(0.0);
-        for (i, c) in cons.iter().enumerate() {
-            let v = y[i];
-            out[c.single as usize] += v;
-            let base = c.target as usize * nb;
-            for (b, w) in c.weights.iter().enumerate() {
-                out[base + b] -= w * v;
-            }
-        }
-    };
-    // Factor A Aᵀ + shift·I; a shift that is too small for the rounding errors of the
-    // factorisation spoils the preconditioner, so it grows until the iteration converges.
-    let mut best: Option<(Vec<f64>, f64, usize)> = None;
-    for shift_rel in [1e-10, 1e-8, 1e-6, 1e-4] {
-        let shift = shift_rel * diag_max;
-        let mut t2 = trip.clone();
-        for i in 0..m {
-            t2.push(Triplet::new(i, i, shift));
-        }
-        let aat = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &t2)
-            .map_err(|e| Error::numerical(format!("fairing: could not assemble A Aᵀ ({e:?})")))?;
-        drop(t2);
-        let Ok(llt) = Cholesky::factor(aat.as_ref()) else {
-            continue;
-        };
-        let precond = |r: &[f64]| -> Vec<f64> {
-            let mut z = Mat::<f64>::zeros(m, 1);
-            for i in 0..m {
-                z[(i, 0)] = r[i];
-            }
-            llt.solve_in_place(z.as_mut());
-            (0..m).map(|i| z[(i, 0)]).collect()
-        };
-        // Preconditioned conjugate gradients on the consistent system A Aᵀ y = A c, one coordinate
-        // at a time; the shifted factorisation is the preconditioner.
-        let mut x = control.to_vec();
-        let mut steps = 0;
-        let mut worst: f64 = 0.0;
-        // Residuals are measured relative to the size of their terms: |A_i x| / (‖A_i‖₁ max|c|).
-        let row_norm: Vec<f64> = cons
-            .iter()
-            .map(|c| 1.0 + c.weights.iter().map(|w| w.abs()).sum::<f64>())
-            .collect();
-        let rel_max = |r: &[f64]| {
-            r.iter()
-                .zip(&row_norm)
-                .fold(0.0f64, |a, (v, n)| a.max(v.abs() / n))
-                / scale
-        };
-        let dotp = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();
-        let mut xc = vec![0.0; nc];
-        let mut tmp = vec![0.0; nc];
-        for d in 0..dim {
-            for k in 0..nc {
-                xc[k] = control[k * dim + d];
-            }
-            let mut y = vec![0.0; m];
-            let mut it = 0;
-            // Restarted PCG: each restart recomputes the true residual A(c − Aᵀ y).
-            for _restart in 0..4 {
-                let mut r = vec![0.0; m];
-                apply_at(&y, &mut tmp);
-                for k in 0..nc {
-                    tmp[k] = xc[k] - tmp[k];
-                }
-                apply_a(&tmp, &mut r);
-                let mut rmax = rel_max(&r);
-                if rmax <= tolerance {
-                    break;
-                }
-                let mut z = precond(&r);
-                let mut p = z.clone();
-                let mut rz = dotp(&r, &z);
-                let mut q = vec![0.0; m];
-                let mut inner = 0;
-                while rmax > tolerance && inner < 40 {
-                    inner += 1;
-                    it += 1;
-                    apply_at(&p, &mut tmp);
-                    apply_a(&tmp, &mut q);
-                    let pq = dotp(&p, &q);
-                    if !(pq > 0.0) {
-                        break;
-                    }
-                    let alpha = rz / pq;
-                    for i in 0..m {
-                        y[i] += alpha * p[i];
-                        r[i] -= alpha * q[i];
-                    }
-                    rmax = rel_max(&r);
-                    z = precond(&r);
-                    let rz_new = dotp(&r, &z);
-                    let beta = rz_new / rz;
-                    rz = rz_new;
-                    for i in 0..m {
-                        p[i] = z[i] + beta * p[i];
-                    }
-                }
-            }
-            steps = steps.max(it);
-            apply_at(&y, &mut tmp);
-            for k in 0..nc {
-                x[k * dim + d] = control[k * dim + d] - tmp[k];
-            }
-        }
-        // Report the true residual of the result.
-        for d in 0..dim {
-            for k in 0..nc {
-                xc[k] = x[k * dim + d];
-            }
-            let mut r = vec![0.0; m];
-            apply_a(&xc, &mut r);
-            worst = worst.max(rel_max(&r));
-        }
-        let better = best.as_ref().is_none_or(|b| worst < b.1);
-        if better && worst.is_finite() {
-            best = Some((x, worst, steps));
-        }
-        if best.as_ref().is_some_and(|b| b.1 <= tolerance) {
-            break;
-        }
-    }
-    let Some((x, worst, steps)) = best else {
-        return Err(Error::numerical(
-            "fairing: the Cholesky factorisation of A Aᵀ failed for every diagonal shift",
-        ));
-    };
-    if !worst.is_finite() {
-        return Err(Error::numerical(
-            "fairing: the constrained least-squares solve produced non-finite values",
-        ));
-    }
-    let objective: f64 = x.iter().zip(control).map(|(a, b)| (a - b) * (a - b)).sum();
-    Ok((
-        x,
-        FairingReport {
-            fairness: r,
-            constraints: m,
-            max_constraint_residual: worst,
-            tolerance,
-            rms_change: (objective / nc as f64).sqrt(),
-            objective,
-            refinement_steps: steps,
-            converged: worst <= tolerance,
-        },
-    ))
-}
+mod fairing;
+pub use fairing::{constraint_residuals, fair, fairness_constraints, Constraint, FairingReport};
 
 /// One data point for [`fit`]: a parameter point in a domain face and its target.
 #[derive(Debug, Clone)]
@@ -688,30 +349,16 @@ fn energy_gram<S: SplineSpace + ?Sized>(
 /// Chunks of faces between two progress reports of the fit's quadrature ([`fit_with_progress`]).
 pub const GRAM_CHUNKS: usize = 20;
 
-/// Least-squares fit of the control points to data with a thin-plate fairness term (module
-/// docs). `initial` (`dim` per control point) is the ridge's anchor.
-pub fn fit<S: SplineSpace + ?Sized>(
+/// The input checks of [`fit`]: sizes of `initial` and of every target, faces in range, finite
+/// parameters, admissible weights.
+fn check_fit_inputs<S: SplineSpace + ?Sized>(
     space: &S,
     data: &[DataPoint],
     initial: &[f64],
     dim: usize,
     opts: &FitOptions,
-) -> Result<(Vec<f64>, FitReport)> {
-    fit_with_progress(space, data, initial, dim, opts, &mut NoProgress)
-}
-
-/// [`fit`], reporting the fraction of its thin-plate quadrature done (stage `"fit"`, after each
-/// of [`GRAM_CHUNKS`] chunks of faces) and the solve.
-pub fn fit_with_progress<S: SplineSpace + ?Sized>(
-    space: &S,
-    data: &[DataPoint],
-    initial: &[f64],
-    dim: usize,
-    opts: &FitOptions,
-    progress: &mut dyn Progress,
-) -> Result<(Vec<f64>, FitReport)> {
+) -> Result<()> {
     let nc = space.n_control_points();
-    let nb = space.per_triangle();
     if initial.len() != nc * dim {
         return Err(Error::input(format!(
             "fit: {} initial numbers for {nc} control points of dimension {dim}",
@@ -738,41 +385,19 @@ pub fn fit_with_progress<S: SplineSpace + ?Sized>(
     if !(opts.smoothing >= 0.0 && opts.ridge > 0.0) {
         return Err(Error::input("fit: smoothing must be ≥ 0 and ridge > 0"));
     }
-    // Scale of the energy term.
-    let (hbar, area) = space.domain_scale();
-    let kdata = data.len() as f64;
-    let lam = opts.smoothing * hbar * hbar / area;
+    Ok(())
+}
 
-    let mut data_blocks = Blocks::new(nb);
-    let mut energy_blocks = Blocks::new(nb);
-    let mut rhs = vec![0.0; nc * dim];
-    // Quadrature and data rows: double precision suffices (module docs, *Precision*).
-    let mut ws = Workspace::with_precision(Precision::Double);
-    for p in data {
-        let m = space.basis_at(p.face, p.param, 0, &mut ws)?;
-        data_blocks.add_point(&ws.indices[..m], &ws.values, 1, &[(0, 1.0 / kdata)]);
-        for i in 0..m {
-            let g = ws.indices[i] as usize;
-            for d in 0..dim {
-                rhs[g * dim + d] += ws.values[i] * p.target[d] / kdata;
-            }
-        }
-    }
-    energy_gram(space, &mut energy_blocks, progress)?;
-    // Ridge relative to the data term's diagonal.
-    let mut diag_mean = 0.0;
-    for (&(a, b), &off) in &data_blocks.index {
-        if a == b {
-            for p in 0..nb {
-                diag_mean += data_blocks.data[off + p * nb + p];
-            }
-        }
-    }
-    diag_mean = (diag_mean / nc as f64).max(1e-300);
-    let gamma = opts.ridge * diag_mean;
-    for k in 0..nc * dim {
-        rhs[k] += gamma * initial[k];
-    }
+/// The lower triangle of the normal matrix `H = D + λ T + γ I` of [`fit`] (data Gram `D`,
+/// thin-plate Gram `T`), with the ridge diagonal also on control points no block touches.
+fn normal_matrix(
+    data_blocks: &Blocks,
+    energy_blocks: &Blocks,
+    nc: usize,
+    nb: usize,
+    lam: f64,
+    gamma: f64,
+) -> Result<SparseColMat<usize, f64>> {
     // Assemble H = D + λ T + γ I (lower triangle).
     let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::new();
     let mut merged: HashMap<(u32, u32), usize> = data_blocks.index.clone();
@@ -819,10 +444,71 @@ pub fn fit_with_progress<S: SplineSpace + ?Sized>(
             }
         }
     }
-    let h = SparseColMat::<usize, f64>::try_new_from_triplets(nc, nc, &trip).map_err(|e| {
-        Error::numerical(format!("fit: could not assemble the normal matrix ({e:?})"))
-    })?;
-    drop(trip);
+    SparseColMat::<usize, f64>::try_new_from_triplets(nc, nc, &trip)
+        .map_err(|e| Error::numerical(format!("fit: could not assemble the normal matrix ({e:?})")))
+}
+
+/// Least-squares fit of the control points to data with a thin-plate fairness term (module
+/// docs). `initial` (`dim` per control point) is the ridge's anchor.
+pub fn fit<S: SplineSpace + ?Sized>(
+    space: &S,
+    data: &[DataPoint],
+    initial: &[f64],
+    dim: usize,
+    opts: &FitOptions,
+) -> Result<(Vec<f64>, FitReport)> {
+    fit_with_progress(space, data, initial, dim, opts, &mut NoProgress)
+}
+
+/// [`fit`], reporting the fraction of its thin-plate quadrature done (stage `"fit"`, after each
+/// of [`GRAM_CHUNKS`] chunks of faces) and the solve.
+pub fn fit_with_progress<S: SplineSpace + ?Sized>(
+    space: &S,
+    data: &[DataPoint],
+    initial: &[f64],
+    dim: usize,
+    opts: &FitOptions,
+    progress: &mut dyn Progress,
+) -> Result<(Vec<f64>, FitReport)> {
+    check_fit_inputs(space, data, initial, dim, opts)?;
+    let nc = space.n_control_points();
+    let nb = space.per_triangle();
+    // Scale of the energy term.
+    let (hbar, area) = space.domain_scale();
+    let kdata = data.len() as f64;
+    let lam = opts.smoothing * hbar * hbar / area;
+
+    let mut data_blocks = Blocks::new(nb);
+    let mut energy_blocks = Blocks::new(nb);
+    let mut rhs = vec![0.0; nc * dim];
+    // Quadrature and data rows: double precision suffices (module docs, *Precision*).
+    let mut ws = Workspace::with_precision(Precision::Double);
+    for p in data {
+        let m = space.basis_at(p.face, p.param, 0, &mut ws)?;
+        data_blocks.add_point(&ws.indices[..m], &ws.values, 1, &[(0, 1.0 / kdata)]);
+        for i in 0..m {
+            let g = ws.indices[i] as usize;
+            for d in 0..dim {
+                rhs[g * dim + d] += ws.values[i] * p.target[d] / kdata;
+            }
+        }
+    }
+    energy_gram(space, &mut energy_blocks, progress)?;
+    // Ridge relative to the data term's diagonal.
+    let mut diag_mean = 0.0;
+    for (&(a, b), &off) in &data_blocks.index {
+        if a == b {
+            for p in 0..nb {
+                diag_mean += data_blocks.data[off + p * nb + p];
+            }
+        }
+    }
+    diag_mean = (diag_mean / nc as f64).max(1e-300);
+    let gamma = opts.ridge * diag_mean;
+    for k in 0..nc * dim {
+        rhs[k] += gamma * initial[k];
+    }
+    let h = normal_matrix(&data_blocks, &energy_blocks, nc, nb, lam, gamma)?;
     progress.report(
         "fit",
         Some(1.0),
