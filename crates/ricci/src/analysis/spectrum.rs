@@ -561,7 +561,8 @@ impl BallCover {
 /// vertex; `centre`: the vertex the domain grows from, default a central one), through a **compact fundamental domain** instead of the canonical polygon.
 ///
 /// The domain `F` is the development of the surface along a spanning tree of the dual graph
-/// grown in the order of the (edge-path) distance from a central vertex (Prim on faces): the
+/// grown in the order of the hyperbolic distance of each face's developed copy from a central
+/// vertex (Prim on faces, developed in double precision for the order): the
 /// surface is sliced along the edges the tree does not cross (a disk) and laid out in
 /// double-double with the central face at the centre. Its side pairings (one per sliced
 /// edge, deduplicated) generate the deck group. Because the faces were added nearest first,
@@ -575,7 +576,10 @@ impl BallCover {
 /// tiles `gF` at distance ≤ L from `F` are connected under side adjacency, and all of them
 /// satisfy `d(o, go) ≤ L + 2·radius`, so a breadth-first search through the side pairings
 /// that keeps the tiles with `d(o, go) ≤ L + 2·radius` (widened by 1e-9 relative) finds every
-/// such `γ`. Classes are formed as in [`fuchsian_spectrum`] (the pieces of one closed geodesic
+/// such `γ`. Tiles are also dropped when a cover of `F` by balls `B(c_j, r_j)` of radius
+/// about 1 proves `d(F, gF) > L` (`d(c_j, g c_k) > L + r_j + r_k` for all pairs), and words
+/// are composed in double-double (the side pairings move `o` by up to `2·radius`; double
+/// products lost the 1e-7 that tells two tiles apart). Classes are formed as in [`fuchsian_spectrum`] (the pieces of one closed geodesic
 /// are linked through the sides its axis crosses). `L` starts at the shortest side pairing's
 /// translation length and grows by 1.25 until `count` classes are complete.
 ///
