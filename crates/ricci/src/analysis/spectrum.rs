@@ -670,7 +670,7 @@ pub fn surface_spectrum(
                     lengths[mesh.he_edge(tn) as usize],
                     lengths[mesh.he_edge(mesh.he_next(tn)) as usize],
                 );
-                if !(pc.norm_sqr() < 1.0) {
+                if pc.norm_sqr().is_nan() || pc.norm_sqr() >= 1.0 {
                     continue; // numerically outside the disk: never the nearest copy
                 }
                 let key = pa.norm_sqr().max(pb.norm_sqr()).max(pc.norm_sqr());
