@@ -29,6 +29,7 @@
 //! the requested number of classes have length ≤ L; every class shorter than L is then found.
 
 use crate::error::{Error, Result};
+use crate::layout::dd::MobiusDd;
 use crate::layout::deck::{DeckGroup, Polygon};
 use crate::layout::isometry::{disk_distance, poincare_to_hyperboloid, Complex, Isometry, Mobius};
 use crate::layout::place::Layout;
@@ -405,8 +406,10 @@ pub fn fuchsian_spectrum(
                 crossings.push(sides);
             }
         }
+        let elems_dd: Vec<MobiusDd> = elems.iter().map(|&g| g.into()).collect();
+        let maps_dd: Vec<MobiusDd> = side_maps.iter().map(|&g| g.into()).collect();
         let (mut classes, unmatched) =
-            group_classes(&elems, &cand, &crossings, &side_maps, &index, o_h);
+            group_classes(&elems_dd, &cand, &crossings, &maps_dd, &index, o_h);
         classes.sort_by(|a, b| a.length.total_cmp(&b.length));
         if classes.len() >= count {
             classes.truncate(count);
@@ -434,6 +437,123 @@ pub struct CompactDomain {
     pub boundary_edges: usize,
     /// Distinct side pairings of the domain (a generating set of the deck group).
     pub generators: usize,
+    /// Balls covering the domain (the tile test of the search).
+    pub balls: usize,
+}
+
+/// A cover of a fundamental domain `F` by hyperbolic balls `B(c_j, r_j)` (hyperboloid
+/// centres), for the conservative test `d(F, gF) ≤ L ⇒ ∃ j, k: d(c_j, g c_k) ≤ L + r_j + r_k`.
+struct BallCover {
+    /// (centre on the hyperboloid, centre in the disk, radius).
+    balls: Vec<([f64; 3], Complex, f64)>,
+    /// Largest distance from the domain's centre to one of its points.
+    radius: f64,
+    centre: [f64; 3],
+}
+
+/// Thresholds of [`BallCover::may_be_within`] for one length bound, in cosh form.
+struct CoverLimits {
+    /// cosh(L + r_j + r_k), widened, row-major.
+    pair: Vec<f64>,
+    /// cosh(L + r_j + radius), widened: a ball farther than this from g o cannot be near gF.
+    reach: Vec<f64>,
+}
+
+impl BallCover {
+    /// Greedy farthest-point cover of the vertices `points` of a triangulated domain with
+    /// balls of radius about `r`, padded by `pad` (the longest edge: a point of a triangle is
+    /// within its longest side of each of its corners), at most `max_balls` balls (the
+    /// radius grows when the budget is reached).
+    fn of_points(points: &[Complex], centre: Complex, r: f64, pad: f64, max_balls: usize) -> Self {
+        let h: Vec<[f64; 3]> = points.iter().map(|&p| poincare_to_hyperboloid(p)).collect();
+        let c0 = poincare_to_hyperboloid(centre);
+        let cosh_d =
+            |x: &[f64; 3], y: &[f64; 3]| (x[2] * y[2] - x[0] * y[0] - x[1] * y[1]).max(1.0);
+        // Nearest chosen centre per point (cosh of the distance) and its index.
+        let mut near: Vec<(f64, usize)> = h.iter().map(|x| (cosh_d(x, &c0), 0)).collect();
+        let radius = near.iter().map(|n| n.0).fold(1.0, f64::max).acosh() + pad;
+        let mut centres = vec![c0];
+        let mut disk = vec![centre];
+        let target = r.cosh();
+        while centres.len() < max_balls {
+            let (far, &(worst, _)) = near
+                .iter()
+                .enumerate()
+                .max_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
+                .unwrap_or((0, &(1.0, 0)));
+            if worst <= target {
+                break;
+            }
+            let c = h[far];
+            let k = centres.len();
+            centres.push(c);
+            disk.push(points[far]);
+            for (x, n) in h.iter().zip(near.iter_mut()) {
+                let d = cosh_d(x, &c);
+                if d < n.0 {
+                    *n = (d, k);
+                }
+            }
+        }
+        let mut rad = vec![0.0f64; centres.len()];
+        for n in &near {
+            rad[n.1] = rad[n.1].max(n.0);
+        }
+        let balls = centres
+            .into_iter()
+            .zip(disk)
+            .zip(rad)
+            .map(|((c, z), rc)| (c, z, rc.acosh() + pad))
+            .collect();
+        BallCover {
+            balls,
+            radius,
+            centre: c0,
+        }
+    }
+
+    fn limits(&self, l: f64, radius: f64) -> CoverLimits {
+        // Widened by a relative 1e-9 so that rounding can only keep a tile more.
+        let widen = |x: f64| x.cosh() * (1.0 + 1e-9) + 1e-9;
+        let n = self.balls.len();
+        CoverLimits {
+            pair: (0..n * n)
+                .map(|i| widen(l + self.balls[i / n].2 + self.balls[i % n].2))
+                .collect(),
+            reach: self.balls.iter().map(|b| widen(l + b.2 + radius)).collect(),
+        }
+    }
+
+    /// False only if `d(F, gF) > L` is certain.
+    fn may_be_within(&self, g: &Mobius, lim: &CoverLimits) -> bool {
+        let cosh_d = |x: &[f64; 3], y: &[f64; 3]| x[2] * y[2] - x[0] * y[0] - x[1] * y[1];
+        let k = g.klein_matrix();
+        let go = apply_h(&k, self.centre);
+        let n = self.balls.len();
+        let mut moved: Vec<Option<[f64; 3]>> = vec![None; n];
+        for (j, bj) in self.balls.iter().enumerate() {
+            if cosh_d(&bj.0, &go) > lim.reach[j] {
+                continue;
+            }
+            let row = &lim.pair[j * n..(j + 1) * n];
+            for (kk, bk) in self.balls.iter().enumerate() {
+                let gk = *moved[kk].get_or_insert_with(|| apply_h(&k, bk.0));
+                if cosh_d(&bj.0, &gk) <= row[kk] {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    /// False only if the axis (the real diameter in the frame `fr`) certainly misses `F`.
+    fn meets_axis(&self, fr: &Mobius) -> bool {
+        self.balls.iter().any(|b| {
+            let w = fr.apply(b.1);
+            let sinh_d = 2.0 * w.im.abs() / (1.0 - w.norm_sqr()).max(1e-300);
+            sinh_d.asinh() <= b.2 * (1.0 + 1e-9) + 1e-9
+        })
+    }
 }
 
 /// Length spectrum of a closed hyperbolic surface given by a triangulation with a hyperbolic
@@ -441,7 +561,8 @@ pub struct CompactDomain {
 /// vertex; `centre`: the vertex the domain grows from, default a central one), through a **compact fundamental domain** instead of the canonical polygon.
 ///
 /// The domain `F` is the development of the surface along a spanning tree of the dual graph
-/// grown in the order of the (edge-path) distance from a central vertex (Prim on faces): the
+/// grown in the order of the hyperbolic distance of each face's developed copy from a central
+/// vertex (Prim on faces, developed in double precision for the order): the
 /// surface is sliced along the edges the tree does not cross (a disk) and laid out in
 /// double-double with the central face at the centre. Its side pairings (one per sliced
 /// edge, deduplicated) generate the deck group. Because the faces were added nearest first,
@@ -455,7 +576,10 @@ pub struct CompactDomain {
 /// tiles `gF` at distance ≤ L from `F` are connected under side adjacency, and all of them
 /// satisfy `d(o, go) ≤ L + 2·radius`, so a breadth-first search through the side pairings
 /// that keeps the tiles with `d(o, go) ≤ L + 2·radius` (widened by 1e-9 relative) finds every
-/// such `γ`. Classes are formed as in [`fuchsian_spectrum`] (the pieces of one closed geodesic
+/// such `γ`. Tiles are also dropped when a cover of `F` by balls `B(c_j, r_j)` of radius
+/// about 1 proves `d(F, gF) > L` (`d(c_j, g c_k) > L + r_j + r_k` for all pairs), and words
+/// are composed in double-double (the side pairings move `o` by up to `2·radius`; double
+/// products lost the 1e-7 that tells two tiles apart). Classes are formed as in [`fuchsian_spectrum`] (the pieces of one closed geodesic
 /// are linked through the sides its axis crosses). `L` starts at the shortest side pairing's
 /// translation length and grows by 1.25 until `count` classes are complete.
 ///
@@ -469,7 +593,7 @@ pub fn surface_spectrum(
     count: usize,
     max_tiles: usize,
 ) -> Result<(HyperbolicSpectrum, CompactDomain)> {
-    use crate::layout::dd::{Cdd, MobiusDd};
+    use crate::layout::dd::Cdd;
     use crate::layout::place::layout_dd;
     use crate::metric::Hyperbolic;
     use std::cmp::Reverse;
@@ -497,14 +621,10 @@ pub fn surface_spectrum(
         }
         None => crate::cut::central_vertex(mesh, lengths)?,
     };
-    let dist = crate::cut::distances(mesh, lengths, &[o]);
-    let key = |f: u32| -> f64 {
-        mesh.face(f)
-            .iter()
-            .map(|&v| dist[v as usize])
-            .fold(0.0, f64::max)
-    };
-    // Prim on the dual graph, nearest faces first.
+    // Dirichlet-like growth: develop the faces in the hyperbolic plane (double precision,
+    // for the order only) from a face at `o`, attaching next the face whose developed copy
+    // lies nearest to `o` (largest |z| of its corners: the hyperbolic distance 2 atanh|z| is
+    // monotone in |z|).
     let nf = mesh.n_faces();
     let seed = mesh
         .outgoing(o)
@@ -513,38 +633,75 @@ pub fn surface_spectrum(
         .ok_or_else(|| Error::topology(format!("vertex {o} has no face")))?;
     let mut developed = vec![false; nf];
     let mut crossed = vec![false; ne];
-    // Entries: (face key, key of the shared edge, face, edge): a face is attached across
-    // its edge nearest to the centre.
-    type Entry = (Reverse<u64>, Reverse<u64>, u32, u32);
+    let mut corner = vec![Complex::new(0.0, 0.0); 3 * nf];
+    {
+        use crate::layout::place::Space;
+        let len = |h: u32| lengths[mesh.he_edge(h) as usize];
+        let [h0, h1, h2] = mesh.face_halfedges(seed);
+        // Rotate the seed so that `o` is its first corner (at the centre of the disk).
+        let i0 = mesh.face(seed).iter().position(|&v| v == o).unwrap_or(0);
+        let hs = [h0, h1, h2];
+        let p = Hyperbolic::seed(len(hs[i0]), len(hs[(i0 + 1) % 3]), len(hs[(i0 + 2) % 3]));
+        for r in 0..3 {
+            corner[3 * seed as usize + (i0 + r) % 3] = p[r];
+        }
+    }
+    // Entries: (key = max |z|² of the copy's corners, face, half-edge of the face on the
+    // shared edge, position of the corner opposite).
+    type Entry = (Reverse<u64>, u32, u32, (u64, u64));
     let mut heap: BinaryHeap<Entry> = BinaryHeap::new();
-    heap.push((Reverse(0), Reverse(0), seed, u32::MAX));
-    while let Some((_, _, f, via)) = heap.pop() {
-        if developed[f as usize] {
-            continue;
-        }
-        developed[f as usize] = true;
-        if via != u32::MAX {
-            crossed[via as usize] = true;
-        }
-        for h in mesh.face_halfedges(f) {
-            let g = mesh.he_face(mesh.he_twin(h));
-            if g != crate::mesh::NONE && !developed[g as usize] {
-                let [a, b] = mesh.edge_vertices(mesh.he_edge(h));
-                let ek = dist[a as usize].max(dist[b as usize]);
+    let push_neighbours =
+        |f: u32, corner: &[Complex], developed: &[bool], heap: &mut BinaryHeap<Entry>| {
+            use crate::layout::place::Space;
+            for h in mesh.face_halfedges(f) {
+                let t = mesh.he_twin(h);
+                let g = mesh.he_face(t);
+                if g == crate::mesh::NONE || developed[g as usize] {
+                    continue;
+                }
+                // t runs b → a in g = (b, a, c).
+                let pa = corner[h as usize];
+                let pb = corner[mesh.he_next(h) as usize];
+                let tn = mesh.he_next(t);
+                let pc = Hyperbolic::third(
+                    pb,
+                    pa,
+                    lengths[mesh.he_edge(t) as usize],
+                    lengths[mesh.he_edge(tn) as usize],
+                    lengths[mesh.he_edge(mesh.he_next(tn)) as usize],
+                );
+                if pc.norm_sqr().is_nan() || pc.norm_sqr() >= 1.0 {
+                    continue; // numerically outside the disk: never the nearest copy
+                }
+                let key = pa.norm_sqr().max(pb.norm_sqr()).max(pc.norm_sqr());
                 heap.push((
-                    Reverse(key(g).to_bits()),
-                    Reverse(ek.to_bits()),
+                    Reverse(key.to_bits()),
                     g,
-                    mesh.he_edge(h),
+                    t,
+                    (pc.re.to_bits(), pc.im.to_bits()),
                 ));
             }
+        };
+    developed[seed as usize] = true;
+    push_neighbours(seed, &corner, &developed, &mut heap);
+    while let Some((_, g, t, (cre, cim))) = heap.pop() {
+        if developed[g as usize] {
+            continue;
         }
+        developed[g as usize] = true;
+        crossed[mesh.he_edge(t) as usize] = true;
+        let h = mesh.he_twin(t);
+        let tn = mesh.he_next(t);
+        corner[t as usize] = corner[mesh.he_next(h) as usize];
+        corner[tn as usize] = corner[h as usize];
+        corner[mesh.he_next(tn) as usize] = Complex::new(f64::from_bits(cre), f64::from_bits(cim));
+        push_neighbours(g, &corner, &developed, &mut heap);
     }
     if developed.iter().any(|&d| !d) {
         return Err(Error::topology("the surface is not connected"));
     }
     let cut: Vec<bool> = crossed.iter().map(|&c| !c).collect();
-    let (cm, _origin) = crate::cut::slice(mesh, &cut)?;
+    let (cm, origin) = crate::cut::slice(mesh, &cut)?;
     let mut cl = vec![0.0; cm.n_edges()];
     let mut cl_lo = vec![0.0; cm.n_edges()];
     for h in 0..cm.n_corners() as u32 {
@@ -572,14 +729,16 @@ pub fn surface_spectrum(
         )));
     }
     let bloop = &loops[0];
-    let mut gens: Vec<Mobius> = Vec::new();
+    let mut gens: Vec<MobiusDd> = Vec::new();
     let mut gen_index = TileIndex::new();
+    // The centre: the copy of `o` in the seed face (the domain was grown around it).
     let o_pt = {
-        let pts: Vec<Complex> = bloop
+        let i0 = cm
+            .face(seed)
             .iter()
-            .map(|&h| lay.positions[cm.he_origin(h) as usize])
-            .collect();
-        crate::layout::place::minimax_centre::<Hyperbolic>(&pts)
+            .position(|&v| origin[v as usize] == o)
+            .unwrap_or(0);
+        lay.positions[cm.face(seed)[i0] as usize]
     };
     let o_h = poincare_to_hyperboloid(o_pt);
     let mut bnd: Vec<(Complex, usize)> = Vec::with_capacity(bloop.len());
@@ -591,8 +750,8 @@ pub fn surface_spectrum(
             pos(cm.he_tip(h)),
             pos(cm.he_origin(h)),
         )
-        .round();
-        let go = apply_h(&m.klein_matrix(), o_h);
+        .normalized();
+        let go = apply_h(&m.round().klein_matrix(), o_h);
         let k = match gen_index.find(go) {
             Some(k) => k,
             None => {
@@ -602,20 +761,20 @@ pub fn surface_spectrum(
         };
         bnd.push((lay.positions[cm.he_origin(h) as usize], k));
     }
-    let radius = bnd
-        .iter()
-        .map(|b| disk_distance(o_pt, b.0))
-        .fold(0.0, f64::max);
+    let max_edge = lengths.iter().copied().fold(0.0, f64::max);
+    let cover = BallCover::of_points(&lay.positions, o_pt, 1.0, max_edge, 400);
+    let radius = cover.radius;
     let domain = CompactDomain {
         radius,
         faces: nf,
         boundary_edges: bnd.len(),
         generators: gens.len(),
+        balls: cover.balls.len(),
     };
     let nb = bnd.len();
     let mut l = gens
         .iter()
-        .map(|g| g.translation_length())
+        .map(|g| g.round().translation_length())
         .filter(|x| *x > 0.0)
         .fold(f64::INFINITY, f64::min);
     if !l.is_finite() {
@@ -628,19 +787,29 @@ pub fn surface_spectrum(
     };
     for _round in 0..16 {
         let bound = (l + 2.0 * radius) * (1.0 + 1e-9) + 1e-9;
+        let limits = cover.limits(l, radius);
         let mut index = TileIndex::new();
+        // Words are composed in double-double: the side pairings of a compact domain move
+        // its centre by up to twice its radius, and double-precision products of a few of
+        // them lose the 1e-7 that tells tiles apart.
+        let mut elems_dd: Vec<MobiusDd> = vec![MobiusDd::IDENTITY];
         let mut elems: Vec<Mobius> = vec![Mobius::identity()];
         index.insert(o_h);
         let mut queue = VecDeque::from([0usize]);
         while let Some(t) = queue.pop_front() {
             for sm in &gens {
-                let g = elems[t].compose(sm).normalized();
+                let gd = elems_dd[t].compose(sm).normalized();
+                let g = gd.round();
                 let go = apply_h(&g.klein_matrix(), o_h);
-                if hdist(o_h, go) > bound || index.find(go).is_some() {
+                if hdist(o_h, go) > bound || !cover.may_be_within(&g, &limits) {
+                    continue;
+                }
+                if index.find(go).is_some() {
                     continue;
                 }
                 index.insert(go);
                 elems.push(g);
+                elems_dd.push(gd);
                 queue.push_back(elems.len() - 1);
                 if elems.len() > max_tiles {
                     return Err(Error::numerical(format!(
@@ -663,9 +832,7 @@ pub fn surface_spectrum(
             let Some(fr) = axis_frame(g) else { continue };
             // The axis is the real diameter in the frame: skip it when it passes farther
             // than the domain's radius from o (sinh d = 2|Im w|/(1 − |w|²)).
-            let w = fr.apply(o_pt);
-            let sinh_d = 2.0 * w.im.abs() / (1.0 - w.norm_sqr()).max(1e-300);
-            if sinh_d.asinh() > radius * (1.0 + 1e-9) + 1e-9 {
+            if !cover.meets_axis(&fr) {
                 continue;
             }
             let ims: Vec<f64> = bnd.iter().map(|b| fr.apply(b.0).im).collect();
@@ -684,7 +851,7 @@ pub fn surface_spectrum(
                 crossings.push(sides);
             }
         }
-        let classes = group_classes(&elems, &cand, &crossings, &gens, &index, o_h);
+        let classes = group_classes(&elems_dd, &cand, &crossings, &gens, &index, o_h);
         let (mut classes, unmatched) = classes;
         classes.sort_by(|a, b| a.length.total_cmp(&b.length));
         if classes.len() >= count {
@@ -711,10 +878,10 @@ pub fn surface_spectrum(
 /// with its inverse and with its conjugates by the side pairings of the sides its axis
 /// crosses. Returns the classes and the number of links to tiles that were not enumerated.
 fn group_classes(
-    elems: &[Mobius],
+    elems: &[MobiusDd],
     cand: &[usize],
     crossings: &[Vec<usize>],
-    side_maps: &[Mobius],
+    side_maps: &[MobiusDd],
     index: &TileIndex,
     o_h: [f64; 3],
 ) -> (Vec<GeodesicClass>, usize) {
@@ -745,7 +912,7 @@ fn group_classes(
             links.push(sm.inverse().compose(&g).compose(&sm).normalized());
         }
         for h in links {
-            match index.find(apply_h(&h.klein_matrix(), o_h)) {
+            match index.find(apply_h(&h.round().klein_matrix(), o_h)) {
                 Some(i) => {
                     if let Some(&d) = pos_of.get(&i) {
                         let (a, b) = (find(&mut parent, c), find(&mut parent, d));
@@ -761,7 +928,7 @@ fn group_classes(
     let mut classes: HashMap<usize, GeodesicClass> = HashMap::new();
     for (c, &i) in cand.iter().enumerate() {
         let r = find(&mut parent, c);
-        let g = elems[i];
+        let g = elems[i].round();
         let e = classes.entry(r).or_insert(GeodesicClass {
             length: g.translation_length(),
             representative: g,
