@@ -514,7 +514,7 @@ const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
         "group search, classes and report in one loop; analysis is rewritten on another branch",
     ),
     (
-        "crates/ricci/src/analysis/spectrum.rs",
+        "crates/ricci/src/analysis/spectrum/surface.rs",
         "surface_spectrum",
         "cut, layout and search of one surface in one function; analysis branch",
     ),
