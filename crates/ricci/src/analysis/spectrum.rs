@@ -207,6 +207,25 @@ fn apply_h(m: &[[f64; 3]; 3], x: [f64; 3]) -> [f64; 3] {
     ]
 }
 
+/// The sides of a domain, given as its boundary points each tagged with the side that starts
+/// there, that the real diameter of the frame `fr` (an axis, see [`axis_frame`]) crosses or
+/// touches (within `tol`), each once.
+fn sides_crossed(fr: &Mobius, bnd: &[(Complex, usize)], tol: f64) -> Vec<usize> {
+    let nb = bnd.len();
+    let ims: Vec<f64> = bnd.iter().map(|b| fr.apply(b.0).im).collect();
+    let mut sides = Vec::new();
+    for e in 0..nb {
+        let (a, b) = (ims[e], ims[(e + 1) % nb]);
+        if a * b <= 0.0 || a.abs() < tol || b.abs() < tol {
+            let s = bnd[e].1;
+            if !sides.contains(&s) {
+                sides.push(s);
+            }
+        }
+    }
+    sides
+}
+
 /// The Möbius map taking the axis of a hyperbolic element to the real diameter, its
 /// attracting fixed point to +1.
 fn axis_frame(g: &Mobius) -> Option<Mobius> {
@@ -390,17 +409,7 @@ pub fn fuchsian_spectrum(
                 continue;
             }
             let Some(fr) = axis_frame(g) else { continue };
-            let ims: Vec<f64> = bnd.iter().map(|b| fr.apply(b.0).im).collect();
-            let mut sides = Vec::new();
-            for e in 0..nb {
-                let (a, b) = (ims[e], ims[(e + 1) % nb]);
-                if a * b <= 0.0 || a.abs() < tol || b.abs() < tol {
-                    let s = bnd[e].1;
-                    if !sides.contains(&s) {
-                        sides.push(s);
-                    }
-                }
-            }
+            let sides = sides_crossed(&fr, &bnd, tol);
             if !sides.is_empty() {
                 cand.push(i);
                 crossings.push(sides);

@@ -350,7 +350,6 @@ pub fn surface_spectrum(
         generators: gens.len(),
         balls: cover.balls.len(),
     };
-    let nb = bnd.len();
     let mut l = gens
         .iter()
         .map(|g| g.round().translation_length())
@@ -414,17 +413,7 @@ pub fn surface_spectrum(
             if !cover.meets_axis(&fr) {
                 continue;
             }
-            let ims: Vec<f64> = bnd.iter().map(|b| fr.apply(b.0).im).collect();
-            let mut sides = Vec::new();
-            for e in 0..nb {
-                let (a, b) = (ims[e], ims[(e + 1) % nb]);
-                if a * b <= 0.0 || a.abs() < tol || b.abs() < tol {
-                    let s = bnd[e].1;
-                    if !sides.contains(&s) {
-                        sides.push(s);
-                    }
-                }
-            }
+            let sides = sides_crossed(&fr, &bnd, tol);
             if !sides.is_empty() {
                 cand.push(i);
                 crossings.push(sides);
