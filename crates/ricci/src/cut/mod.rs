@@ -43,6 +43,7 @@
 //! Genus 0: a closed surface is slit along a path of two edges (word `c₁ c₁⁻¹`); a disk is
 //! already cut (word `d₁`); with `b ≥ 2` boundary loops, `b` paths join them to `x`.
 
+mod assemble;
 pub mod homology;
 pub mod paths;
 pub mod schema;
@@ -54,8 +55,9 @@ use crate::mesh::{topology, Mesh, NONE};
 use crate::metric::refine::{Refined, Refiner};
 use crate::metric::Geometry;
 use crate::progress::Progress;
+use assemble::assemble;
 use serde::Serialize;
-use system::{RawKind, RawPath};
+use system::RawPath;
 
 pub use homology::Cohomology;
 pub use paths::{
@@ -232,83 +234,164 @@ pub fn canonical_cut(
     progress: &mut dyn Progress,
 ) -> Result<CanonicalCut> {
     let t0 = std::time::Instant::now();
-    if lengths.len() != mesh.n_edges() {
-        return Err(Error::input(format!(
-            "the metric has {} edge lengths but the mesh has {} edges",
-            lengths.len(),
-            mesh.n_edges()
-        )));
+    let surface = Surface {
+        mesh,
+        lengths,
+        geometry,
+        positions,
+    };
+    let setup = Setup::new(mesh, lengths, options)?;
+    if setup.closed() && options.construction == Construction::CutAndPaste {
+        return cut_and_paste(surface, &setup, setup.min_valence, progress, t0);
     }
-    let topo = topology(mesh);
-    if topo.components.len() != 1 {
-        return Err(Error::topology(format!(
-            "cutting needs a connected surface; this mesh has {} components",
-            topo.components.len()
-        )));
-    }
-    let comp = &topo.components[0];
-    if comp.vertices != mesh.n_vertices() {
-        return Err(Error::topology(format!(
-            "the mesh has {} isolated vertices",
-            mesh.n_vertices() - comp.vertices
-        )));
-    }
-    let genus = comp.genus.max(0) as usize;
-    let nb = comp.boundary_loops;
-    let (base, automatic) = match options.base {
-        Some(v) => {
-            if v as usize >= mesh.n_vertices() {
+    greedy(surface, &setup, options, progress, t0)
+}
+
+/// The surface being cut: connectivity, metric and (optional) positions.
+#[derive(Clone, Copy)]
+struct Surface<'a> {
+    mesh: &'a Mesh,
+    lengths: &'a [f64],
+    geometry: Geometry,
+    positions: Option<&'a [[f64; 3]]>,
+}
+
+/// What is settled before the construction: topology, base vertex, the valence wanted there.
+struct Setup {
+    genus: usize,
+    /// Boundary loops of the input.
+    nb: usize,
+    base: u32,
+    /// Whether the base vertex was chosen automatically.
+    automatic: bool,
+    /// Paths through the base vertex: `4g` loop ends and the connectors.
+    paths_needed: usize,
+    /// The minimum valence requested at the base vertex (first round).
+    min_valence: usize,
+    valence_before: usize,
+    /// Dimension of the first Z₂ homology.
+    expected_dim: usize,
+    /// Mean length of the edges at the base vertex.
+    mean_spoke: f64,
+}
+
+impl Setup {
+    /// Check the input (one component, no isolated vertex, an interior base vertex) and
+    /// settle the base vertex and the valence wanted there.
+    fn new(mesh: &Mesh, lengths: &[f64], options: &CutOptions) -> Result<Setup> {
+        if lengths.len() != mesh.n_edges() {
+            return Err(Error::input(format!(
+                "the metric has {} edge lengths but the mesh has {} edges",
+                lengths.len(),
+                mesh.n_edges()
+            )));
+        }
+        let topo = topology(mesh);
+        if topo.components.len() != 1 {
+            return Err(Error::topology(format!(
+                "cutting needs a connected surface; this mesh has {} components",
+                topo.components.len()
+            )));
+        }
+        let comp = &topo.components[0];
+        if comp.vertices != mesh.n_vertices() {
+            return Err(Error::topology(format!(
+                "the mesh has {} isolated vertices",
+                mesh.n_vertices() - comp.vertices
+            )));
+        }
+        let genus = comp.genus.max(0) as usize;
+        let nb = comp.boundary_loops;
+        let (base, automatic) = match options.base {
+            Some(v) if v as usize >= mesh.n_vertices() => {
                 return Err(Error::input(format!(
                     "base vertex {v} does not exist (the mesh has {} vertices)",
                     mesh.n_vertices()
                 )));
             }
-            (v, false)
+            Some(v) => (v, false),
+            None => (central_vertex(mesh, lengths)?, true),
+        };
+        let needs_base = genus > 0 || nb != 1;
+        if needs_base && mesh.is_boundary_vertex(base) {
+            return Err(Error::input(format!(
+                "base vertex {base} lies on the boundary; choose an interior vertex"
+            )));
         }
-        None => (central_vertex(mesh, lengths)?, true),
-    };
-    let needs_base = genus > 0 || nb != 1;
-    if needs_base && mesh.is_boundary_vertex(base) {
-        return Err(Error::input(format!(
-            "base vertex {base} lies on the boundary; choose an interior vertex"
-        )));
-    }
-    let n_connectors = if genus > 0 || nb >= 2 { nb } else { 0 };
-    let paths_needed = 4 * genus + n_connectors;
-    let default_valence = if genus > 0 {
-        (4 * genus + 4).max(8 * genus - 4) + nb
-    } else {
-        paths_needed + 4
-    };
-    let mut min_valence = options
-        .min_valence
-        .unwrap_or(default_valence)
-        .max(paths_needed);
-    let valence_before = mesh.valence(base);
-    let max_attempts = options.max_attempts.unwrap_or(4).max(1);
-    let expected_dim = if nb == 0 {
-        2 * genus
-    } else {
-        2 * genus + nb - 1
-    };
-    let mean_spoke = {
-        let s: f64 = mesh
+        let n_connectors = if genus > 0 || nb >= 2 { nb } else { 0 };
+        let paths_needed = 4 * genus + n_connectors;
+        let default_valence = if genus > 0 {
+            (4 * genus + 4).max(8 * genus - 4) + nb
+        } else {
+            paths_needed + 4
+        };
+        let valence_before = mesh.valence(base);
+        let spokes: f64 = mesh
             .outgoing(base)
             .map(|h| lengths[mesh.he_edge(h) as usize])
             .sum();
-        s / valence_before.max(1) as f64
-    };
-
-    let closed = nb == 0 && genus >= 1;
-    let cut_and_paste_from = |valence: usize, progress: &mut dyn Progress| {
-        cut_and_paste(
-            mesh, lengths, geometry, positions, base, automatic, genus, valence, mean_spoke,
-            progress, t0,
-        )
-    };
-    if closed && options.construction == Construction::CutAndPaste {
-        return cut_and_paste_from(min_valence, progress);
+        Ok(Setup {
+            genus,
+            nb,
+            base,
+            automatic,
+            paths_needed,
+            min_valence: options
+                .min_valence
+                .unwrap_or(default_valence)
+                .max(paths_needed),
+            valence_before,
+            expected_dim: if nb == 0 {
+                2 * genus
+            } else {
+                2 * genus + nb - 1
+            },
+            mean_spoke: spokes / valence_before.max(1) as f64,
+        })
     }
+
+    fn closed(&self) -> bool {
+        self.nb == 0 && self.genus >= 1
+    }
+
+    /// The report of a cut made in `attempts` attempts with `min_valence` requested last.
+    #[allow(clippy::too_many_arguments)]
+    fn report(
+        &self,
+        out: &CanonicalCut,
+        min_valence: usize,
+        attempts: usize,
+        failed_attempts: Vec<String>,
+        search: SearchStats,
+        t0: std::time::Instant,
+    ) -> CutReport {
+        CutReport {
+            base_vertex: self.base,
+            base_automatic: self.automatic,
+            valence_before: self.valence_before,
+            valence_after: out.refined.mesh.valence(self.base),
+            min_valence,
+            refinement_splits: out.refined.splits(),
+            attempts,
+            failed_attempts,
+            search,
+            seconds: t0.elapsed().as_secs_f64(),
+        }
+    }
+}
+
+/// The greedy construction of [`system`] with its attempts and restart rounds; on a closed
+/// surface with [`Construction::GreedyThenCutAndPaste`], cut-and-paste when they all fail.
+fn greedy(
+    surface: Surface,
+    setup: &Setup,
+    options: &CutOptions,
+    progress: &mut dyn Progress,
+    t0: std::time::Instant,
+) -> Result<CanonicalCut> {
+    let (base, genus) = (setup.base, setup.genus);
+    let max_attempts = options.max_attempts.unwrap_or(4).max(1);
+    let mut min_valence = setup.min_valence;
     let mut failed = Vec::new();
     let mut attempt = 0;
     progress.report(
@@ -322,162 +405,125 @@ pub fn canonical_cut(
         .iter()
         .map(|f| ((min_valence as f64) * f).ceil() as usize)
         .collect();
+    let total_attempts = max_attempts * round_valence.len();
     let mut round = 0usize;
-    let mut refined = grade_base(
-        mesh,
-        lengths,
-        geometry,
-        positions,
-        base,
-        min_valence,
-        paths_needed,
-        mean_spoke,
-    )?;
+    let mut refined = grade_base(surface, setup, min_valence)?;
     let mut prior: Vec<RawPath> = Vec::new();
     let mut total = SearchStats::default();
     let mut round_attempt = 0usize;
-    let (raw, stats) = loop {
+    let raw = loop {
         attempt += 1;
         round_attempt += 1;
-        let coh = Cohomology::new(&refined.mesh)?;
-        if coh.dim != expected_dim {
-            return Err(Error::topology(format!(
-                "the first Z2 homology has dimension {} but genus {genus} with {nb} boundary loops needs {expected_dim}",
-                coh.dim
-            )));
-        }
-        let input = system::Input {
-            mesh: &refined.mesh,
-            lengths: &refined.lengths,
-            coh: &coh,
-            x: base,
-            genus,
-            boundary_loops: refined.mesh.boundary_loops(),
-        };
-        let total_attempts = max_attempts * round_valence.len();
         progress.report(
             "cut",
             Some(0.1 + 0.8 * (attempt - 1) as f64 / total_attempts as f64),
             &format!("attempt {attempt}: searching {genus} handle(s)"),
         );
-        match system::build(&input, &prior) {
+        let fail = match greedy_attempt(&refined, setup, &prior)? {
             Ok((raw, st)) => {
                 total.add(&st);
-                break (raw, total);
+                break raw;
             }
-            Err(fail) => {
-                let system::Failure {
-                    reason: system::NoRoom(msg),
-                    paths: partial,
-                    stats: st,
-                } = *fail;
-                total.add(&st);
-                failed.push(format!(
-                    "attempt {attempt} (valence {}): {msg}",
-                    refined.mesh.valence(base)
-                ));
-                drop(input);
-                if round_attempt >= max_attempts
-                    && round + 1 >= round_valence.len()
-                    && closed
-                    && options.construction == Construction::GreedyThenCutAndPaste
-                {
-                    drop(refined);
-                    let mut out = cut_and_paste_from(round_valence[0], progress)?;
-                    out.report.attempts += attempt;
-                    out.report.search.attempts += attempt;
-                    failed.append(&mut out.report.failed_attempts);
-                    out.report.failed_attempts = failed;
-                    return Ok(out);
-                }
-                if round_attempt >= max_attempts {
-                    round += 1;
-                    if round >= round_valence.len() {
-                        return Err(Error::numerical(format!(
-                            "no canonical system through vertex {base} was found after {attempt} attempts ({msg}); \
-                             try another base vertex or a larger --min-valence"
-                        )));
-                    }
-                    // Start again with a larger graded neighbourhood of the base vertex.
-                    min_valence = round_valence[round];
-                    progress.report(
-                        "cut",
-                        None,
-                        &format!("restarting with valence {min_valence} at vertex {base}"),
-                    );
-                    refined = grade_base(
-                        mesh,
-                        lengths,
-                        geometry,
-                        positions,
-                        base,
-                        min_valence,
-                        paths_needed,
-                        mean_spoke,
-                    )?;
-                    prior = Vec::new();
-                    round_attempt = 0;
-                    continue;
-                }
-                // Keep what was found, add a free row of vertices along it and more edges at
-                // the base vertex, and resume.
-                min_valence = refined.mesh.valence(base) + 4;
-                refined = widen(refined, &partial, base, geometry, min_valence)?;
-                prior = partial;
-            }
+            Err(fail) => fail,
+        };
+        let system::Failure {
+            reason: system::NoRoom(msg),
+            paths: partial,
+            stats: st,
+        } = *fail;
+        total.add(&st);
+        failed.push(format!(
+            "attempt {attempt} (valence {}): {msg}",
+            refined.mesh.valence(base)
+        ));
+        if round_attempt >= max_attempts
+            && round + 1 >= round_valence.len()
+            && setup.closed()
+            && options.construction == Construction::GreedyThenCutAndPaste
+        {
+            drop(refined);
+            let mut out = cut_and_paste(surface, setup, round_valence[0], progress, t0)?;
+            out.report.attempts += attempt;
+            out.report.search.attempts += attempt;
+            failed.append(&mut out.report.failed_attempts);
+            out.report.failed_attempts = failed;
+            return Ok(out);
         }
+        if round_attempt >= max_attempts {
+            round += 1;
+            if round >= round_valence.len() {
+                return Err(Error::numerical(format!(
+                    "no canonical system through vertex {base} was found after {attempt} attempts ({msg}); \
+                     try another base vertex or a larger --min-valence"
+                )));
+            }
+            // Start again with a larger graded neighbourhood of the base vertex.
+            min_valence = round_valence[round];
+            progress.report(
+                "cut",
+                None,
+                &format!("restarting with valence {min_valence} at vertex {base}"),
+            );
+            refined = grade_base(surface, setup, min_valence)?;
+            prior = Vec::new();
+            round_attempt = 0;
+            continue;
+        }
+        // Keep what was found, add a free row of vertices along it and more edges at the base
+        // vertex, and resume.
+        min_valence = refined.mesh.valence(base) + 4;
+        refined = widen(refined, &partial, base, surface.geometry, min_valence)?;
+        prior = partial;
     };
     progress.report("cut", Some(0.9), "slicing");
-    let mut out = assemble(refined, raw, base, genus, nb, geometry)?;
-    let attempt = attempt;
-    out.report = CutReport {
-        base_vertex: base,
-        base_automatic: automatic,
-        valence_before,
-        valence_after: out.refined.mesh.valence(base),
-        min_valence,
-        refinement_splits: out.refined.splits(),
-        attempts: attempt,
-        failed_attempts: failed,
-        search: stats,
-        seconds: t0.elapsed().as_secs_f64(),
-    };
+    let mut out = assemble(refined, raw, base, genus, surface.geometry)?;
+    out.report = setup.report(&out, min_valence, attempt, failed, total, t0);
     progress.report("cut", Some(1.0), "done");
     Ok(out)
 }
 
+/// One attempt of the greedy on the refined mesh, keeping the paths of `prior`: the raw
+/// system, or why it failed with the paths found so far.
+#[allow(clippy::type_complexity)]
+fn greedy_attempt(
+    refined: &Refined,
+    setup: &Setup,
+    prior: &[RawPath],
+) -> Result<std::result::Result<(Vec<RawPath>, SearchStats), Box<system::Failure>>> {
+    let coh = Cohomology::new(&refined.mesh)?;
+    if coh.dim != setup.expected_dim {
+        return Err(Error::topology(format!(
+            "the first Z2 homology has dimension {} but genus {} with {} boundary loops needs {}",
+            coh.dim, setup.genus, setup.nb, setup.expected_dim
+        )));
+    }
+    let input = system::Input {
+        mesh: &refined.mesh,
+        lengths: &refined.lengths,
+        coh: &coh,
+        x: setup.base,
+        genus: setup.genus,
+        boundary_loops: refined.mesh.boundary_loops(),
+    };
+    Ok(system::build(&input, prior))
+}
+
 /// Closed surfaces of genus `g ≥ 1`: the construction of [`schema`] (disjoint loops with
 /// independent classes, then cut-and-paste moves on the polygon), which does not fail.
-#[allow(clippy::too_many_arguments)]
 fn cut_and_paste(
-    mesh: &Mesh,
-    lengths: &[f64],
-    geometry: Geometry,
-    positions: Option<&[[f64; 3]]>,
-    base: u32,
-    automatic: bool,
-    genus: usize,
+    surface: Surface,
+    setup: &Setup,
     min_valence: usize,
-    mean_spoke: f64,
     progress: &mut dyn Progress,
     t0: std::time::Instant,
 ) -> Result<CanonicalCut> {
-    let valence_before = mesh.valence(base);
+    let (base, genus) = (setup.base, setup.genus);
     progress.report(
         "cut",
         Some(0.0),
         &format!("refining around vertex {base} to valence {min_valence}"),
     );
-    let refined = grade_base(
-        mesh,
-        lengths,
-        geometry,
-        positions,
-        base,
-        min_valence,
-        4 * genus,
-        mean_spoke,
-    )?;
+    let refined = grade_base(surface, setup, min_valence)?;
     let coh = Cohomology::new(&refined.mesh)?;
     if coh.dim != 2 * genus {
         return Err(Error::topology(format!(
@@ -489,7 +535,7 @@ fn cut_and_paste(
     let omega = schema::Schema::halfedge_cocycles(&refined.mesh, &coh);
     let words = coh.words;
     drop(coh);
-    let r = Refiner::resume(refined, geometry)?;
+    let r = Refiner::resume(refined, surface.geometry)?;
     progress.report(
         "cut",
         Some(0.2),
@@ -502,26 +548,13 @@ fn cut_and_paste(
     let raw = sch.build(genus)?;
     let stats = SearchStats {
         moves: sch.moves,
+        attempts: 1,
         ..sch.stats.clone()
     };
     let refined = sch.into_refiner().finish()?;
     progress.report("cut", Some(0.9), "slicing");
-    let mut out = assemble(refined, raw, base, genus, 0, geometry)?;
-    out.report = CutReport {
-        base_vertex: base,
-        base_automatic: automatic,
-        valence_before,
-        valence_after: out.refined.mesh.valence(base),
-        min_valence,
-        refinement_splits: out.refined.splits(),
-        attempts: 1,
-        failed_attempts: Vec::new(),
-        search: SearchStats {
-            attempts: 1,
-            ..stats
-        },
-        seconds: t0.elapsed().as_secs_f64(),
-    };
+    let mut out = assemble(refined, raw, base, genus, surface.geometry)?;
+    out.report = setup.report(&out, min_valence, 1, Vec::new(), stats, t0);
     progress.report("cut", Some(1.0), "done");
     Ok(out)
 }
@@ -532,26 +565,22 @@ const RESTART_FACTORS: [f64; 3] = [1.0, 3.5, 5.0];
 
 /// The input refined around the base vertex: valence raised to `min_valence`, neighbourhood
 /// graded so that about `max(min_valence, 2·paths)` vertices lie on every circle around it.
-#[allow(clippy::too_many_arguments)]
-fn grade_base(
-    mesh: &Mesh,
-    lengths: &[f64],
-    geometry: Geometry,
-    positions: Option<&[[f64; 3]]>,
-    base: u32,
-    min_valence: usize,
-    paths_needed: usize,
-    mean_spoke: f64,
-) -> Result<Refined> {
-    if paths_needed == 0 {
+fn grade_base(surface: Surface, setup: &Setup, min_valence: usize) -> Result<Refined> {
+    let Surface {
+        mesh,
+        lengths,
+        geometry,
+        positions,
+    } = surface;
+    if setup.paths_needed == 0 {
         return Ok(Refined::identity(mesh, lengths, positions));
     }
     let mut r = Refiner::new(mesh, lengths, geometry, positions)?;
-    r.raise_valence(base, min_valence)?;
-    let grade = min_valence.max(2 * paths_needed);
-    let theta = r.cone_angle(base);
-    let radius = 1.5 * grade as f64 * mean_spoke / theta.max(1e-3);
-    r.grade_around(base, grade, radius, 40 * grade * grade + 1000)?;
+    r.raise_valence(setup.base, min_valence)?;
+    let grade = min_valence.max(2 * setup.paths_needed);
+    let theta = r.cone_angle(setup.base);
+    let radius = 1.5 * grade as f64 * setup.mean_spoke / theta.max(1e-3);
+    r.grade_around(setup.base, grade, radius, 40 * grade * grade + 1000)?;
     r.finish()
 }
 
@@ -593,289 +622,6 @@ fn widen(
     }
     r.raise_valence(base, min_valence)?;
     r.finish()
-}
-
-/// Slice along the raw paths, read the polygon from the cut mesh, label and check it.
-fn assemble(
-    refined: Refined,
-    raw: Vec<RawPath>,
-    base: u32,
-    genus: usize,
-    nb: usize,
-    geometry: Geometry,
-) -> Result<CanonicalCut> {
-    let mesh = &refined.mesh;
-    let np = raw.len() as u32;
-    let mut edge_source = vec![NONE; mesh.n_edges()];
-    let mut cut = vec![false; mesh.n_edges()];
-    let mut corner = vec![false; mesh.n_vertices()];
-    let mut raw_he = Vec::with_capacity(raw.len());
-    for (p, r) in raw.iter().enumerate() {
-        let hs = halfedge_path(mesh, &r.vertices)?;
-        for &h in &hs {
-            let e = mesh.he_edge(h) as usize;
-            if cut[e] {
-                return Err(Error::numerical(format!(
-                    "internal error: cut edge {e} is used twice"
-                )));
-            }
-            cut[e] = true;
-            edge_source[e] = p as u32;
-        }
-        corner[r.vertices[0] as usize] = true;
-        corner[*r.vertices.last().unwrap_or(&base) as usize] = true;
-        raw_he.push(hs);
-    }
-    corner[base as usize] = true;
-    let bloops = mesh.boundary_loop_halfedges();
-    for (k, l) in bloops.iter().enumerate() {
-        for &h in l {
-            edge_source[mesh.he_edge(h) as usize] = np + k as u32;
-        }
-    }
-    let (cut_mesh, origin) = slice(mesh, &cut)?;
-    let ct = topology(&cut_mesh);
-    if !(ct.components.len() == 1 && ct.euler_characteristic() == 1 && ct.boundary_loops() == 1) {
-        return Err(Error::numerical(format!(
-            "internal error: the cut mesh is not a disk (χ = {}, {} boundary loops, {} components)",
-            ct.euler_characteristic(),
-            ct.boundary_loops(),
-            ct.components.len()
-        )));
-    }
-    let raw_sides = slice::read_sides(mesh, &cut_mesh, &origin, &corner, &edge_source)?;
-    // Orientation of each side relative to its path.
-    let mut src_dir: Vec<(u32, bool)> = Vec::with_capacity(raw_sides.len());
-    for s in &raw_sides {
-        if s.source >= np {
-            src_dir.push((s.source, true));
-            continue;
-        }
-        let pv = &raw[s.source as usize].vertices;
-        let fwd = s.vertices == *pv;
-        let bwd = s.vertices.iter().rev().eq(pv.iter());
-        if !(fwd || bwd) {
-            return Err(Error::numerical(format!(
-                "internal error: a side of the cut polygon covers only part of path {}",
-                s.source
-            )));
-        }
-        src_dir.push((s.source, fwd));
-    }
-    let parsed = parse_word(&src_dir, &raw, np).ok_or_else(|| {
-        let w: Vec<String> = src_dir
-            .iter()
-            .map(|&(s, f)| format!("{s}{}", if f { "" } else { "'" }))
-            .collect();
-        Error::numerical(format!(
-            "internal error: the cut polygon is not canonical (sides by path: {})",
-            w.join(" ")
-        ))
-    })?;
-    // Loops, in the order a1 b1 … ag bg c1 … cb.
-    let mut loops: Vec<Loop> = Vec::new();
-    let mut loop_of_path = vec![usize::MAX; raw.len()];
-    for &(path, gen, fwd) in &parsed.loops {
-        let mut vertices = raw[path as usize].vertices.clone();
-        if !fwd {
-            vertices.reverse();
-        }
-        let halfedges = halfedge_path(mesh, &vertices)?;
-        let length = halfedges
-            .iter()
-            .map(|&h| refined.lengths[mesh.he_edge(h) as usize])
-            .sum();
-        loop_of_path[path as usize] = loops.len();
-        loops.push(Loop {
-            label: gen.name(),
-            generator: gen,
-            vertices,
-            halfedges,
-            length,
-        });
-    }
-    let n = raw_sides.len();
-    let mut polygon: Vec<Side> = Vec::with_capacity(n);
-    for k in 0..n {
-        let i = (parsed.rotation + k) % n;
-        let s = &raw_sides[i];
-        let (gen, inverse) = parsed.side_labels[i];
-        let label = if inverse {
-            format!("{}^-1", gen.name())
-        } else {
-            gen.name()
-        };
-        let vertices = s
-            .halfedges
-            .iter()
-            .map(|&h| cut_mesh.he_origin(h))
-            .chain(s.halfedges.last().map(|&h| cut_mesh.he_tip(h)))
-            .collect();
-        polygon.push(Side {
-            label,
-            generator: gen,
-            inverse,
-            edges: s.halfedges.iter().map(|&h| mesh.he_edge(h)).collect(),
-            halfedges: s.halfedges.clone(),
-            vertices,
-            partner: None,
-            loop_index: if s.source < np {
-                Some(loop_of_path[s.source as usize])
-            } else {
-                None
-            },
-        });
-    }
-    for i in 0..n {
-        if let Some(l) = polygon[i].loop_index {
-            polygon[i].partner = (0..n).find(|&j| j != i && polygon[j].loop_index == Some(l));
-        }
-    }
-    let boundary_word = polygon
-        .iter()
-        .map(|s| s.label.as_str())
-        .collect::<Vec<_>>()
-        .join(" ");
-    let mut side_of_halfedge = vec![NONE; cut_mesh.n_corners()];
-    for (i, s) in polygon.iter().enumerate() {
-        for &h in &s.halfedges {
-            side_of_halfedge[h as usize] = i as u32;
-        }
-    }
-    let gens: Vec<Vec<u32>> = loops[..2 * genus]
-        .iter()
-        .map(|l| l.halfedges.clone())
-        .collect();
-    let intersection_matrix = paths::intersection_matrix(mesh, &gens)?;
-    if intersection_matrix != standard_symplectic(genus) {
-        return Err(Error::numerical(format!(
-            "internal error: the intersection matrix of the loops is not the standard symplectic one: {intersection_matrix:?}"
-        )));
-    }
-    let _ = nb;
-    Ok(CanonicalCut {
-        geometry,
-        genus,
-        boundary_loops: bloops.len(),
-        base,
-        refined,
-        loops,
-        cut_mesh,
-        cut_vertex_origin: origin,
-        polygon,
-        boundary_word,
-        intersection_matrix,
-        report: CutReport {
-            base_vertex: base,
-            base_automatic: false,
-            valence_before: 0,
-            valence_after: 0,
-            min_valence: 0,
-            refinement_splits: 0,
-            attempts: 0,
-            failed_attempts: Vec::new(),
-            search: SearchStats::default(),
-            seconds: 0.0,
-        },
-        side_of_halfedge,
-    })
-}
-
-struct Parsed {
-    /// Index of the side that becomes `polygon[0]`.
-    rotation: usize,
-    /// Label of every raw side.
-    side_labels: Vec<(Generator, bool)>,
-    /// (path, generator, path read forward) in output order.
-    loops: Vec<(u32, Generator, bool)>,
-}
-
-/// Find the rotation of the side sequence that reads canonically and label it.
-fn parse_word(sides: &[(u32, bool)], raw: &[RawPath], np: u32) -> Option<Parsed> {
-    let n = sides.len();
-    'rot: for r in 0..n {
-        let at = |k: usize| sides[(r + k) % n];
-        let mut labels = vec![(Generator::Slit, false); n];
-        let mut loops = Vec::new();
-        let mut k = 0;
-        let (mut handles, mut conns) = (0usize, 0usize);
-        while k < n {
-            let (s0, f0) = at(k);
-            if s0 >= np {
-                // A bare boundary side: only a disk without cuts reads like that.
-                if n == 1 {
-                    labels[(r + k) % n] = (Generator::D { boundary: 1 }, false);
-                    k += 1;
-                    continue;
-                }
-                continue 'rot;
-            }
-            match raw[s0 as usize].kind {
-                RawKind::Handle { .. } => {
-                    if conns > 0 || k + 4 > n {
-                        continue 'rot;
-                    }
-                    let (s1, f1) = at(k + 1);
-                    let (s2, f2) = at(k + 2);
-                    let (s3, f3) = at(k + 3);
-                    if s1 >= np || !matches!(raw[s1 as usize].kind, RawKind::Handle { .. }) {
-                        continue 'rot;
-                    }
-                    if !(s1 != s0 && s2 == s0 && s3 == s1 && f2 != f0 && f3 != f1) {
-                        continue 'rot;
-                    }
-                    handles += 1;
-                    let (ga, gb) = (
-                        Generator::A { handle: handles },
-                        Generator::B { handle: handles },
-                    );
-                    labels[(r + k) % n] = (ga, false);
-                    labels[(r + k + 1) % n] = (gb, false);
-                    labels[(r + k + 2) % n] = (ga, true);
-                    labels[(r + k + 3) % n] = (gb, true);
-                    loops.push((s0, ga, f0));
-                    loops.push((s1, gb, f1));
-                    k += 4;
-                }
-                RawKind::Connector { .. } => {
-                    if k + 3 > n {
-                        continue 'rot;
-                    }
-                    let (s1, _) = at(k + 1);
-                    let (s2, f2) = at(k + 2);
-                    if !(s1 >= np && s2 == s0 && f2 != f0) {
-                        continue 'rot;
-                    }
-                    conns += 1;
-                    let gc = Generator::C { boundary: conns };
-                    labels[(r + k) % n] = (gc, false);
-                    labels[(r + k + 1) % n] = (Generator::D { boundary: conns }, false);
-                    labels[(r + k + 2) % n] = (gc, true);
-                    loops.push((s0, gc, f0));
-                    k += 3;
-                }
-                RawKind::Slit => {
-                    if n != 2 {
-                        continue 'rot;
-                    }
-                    let (s1, f1) = at(1);
-                    if !(s1 == s0 && f1 != f0) {
-                        continue 'rot;
-                    }
-                    labels[r % n] = (Generator::Slit, false);
-                    labels[(r + 1) % n] = (Generator::Slit, true);
-                    loops.push((s0, Generator::Slit, f0));
-                    k += 2;
-                }
-            }
-        }
-        return Some(Parsed {
-            rotation: r,
-            side_labels: labels,
-            loops,
-        });
-    }
-    None
 }
 
 impl CanonicalCut {
