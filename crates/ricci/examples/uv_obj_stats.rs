@@ -11,7 +11,10 @@
 
 use ricci::analysis::distortion::{face_distortions, stats};
 
-fn parse(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<[f64; 2]>), String> {
+/// Positions, triangles (by position index) and the UV of every corner.
+type UvMesh = (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<[f64; 2]>);
+
+fn parse(text: &str) -> Result<UvMesh, String> {
     let (mut v, mut vt, mut faces, mut corner) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (ln, line) in text.lines().enumerate() {
         let mut it = line.split_whitespace();
