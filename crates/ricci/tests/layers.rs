@@ -564,11 +564,6 @@ const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
         "the overlay built inline; rewritten on another branch",
     ),
     (
-        "crates/ricci/src/param/mod.rs",
-        "chart_uv",
-        "param: flow, cut, layout and transfer of one chart in one function; split next",
-    ),
-    (
         "crates/ricci/src/spline/fit/fairing.rs",
         "fair",
         "to split: constraints, solve (needs a fit-energy comparison)",

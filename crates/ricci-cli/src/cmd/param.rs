@@ -12,7 +12,12 @@
 //! `ricci flow`; nonzero entries are cones); `none` (a torus).
 //! `--sphere` maps a closed genus-0 surface onto the unit sphere instead (UV.obj then holds
 //! the sphere points as `v`).
-//! The JSON report: `uv_faces` ("input"), `flipped_faces`, `qc_mean`/`qc_p95`/`qc_max`
+//! When the input's own faces would fold (or the cut needs edges the flow flipped), UV.obj
+//! holds the common subdivision of the input and the flat triangulation instead (points on
+//! the input surface, every triangle inside one input face), and the JSON says so:
+//! `uv.on` / `uv_faces` = "common_subdivision" (else "input"), with `uv.vertices`,
+//! `uv.triangles`, `uv.input_flipped_faces`.
+//! The JSON report: `uv_faces`, `flipped_faces` (of what is written), `qc_mean`/`qc_p95`/`qc_max`
 //! (σmax/σmin per face), `log_area_sigma` (σ of log(A_uv/A_3d)), `cones`, `seam_length`,
 //! per-chart details and `seconds`.
 
@@ -170,29 +175,69 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .flat_map(|c| c.cones.iter().copied())
         .collect();
     if let Some(path) = &a.out {
-        let comments = vec![
-            format!("ricci param of {name}"),
-            "vt: conformal UVs in [0,1]^2 per corner of the input's faces; several vt per \
-             vertex along the seams"
-                .to_string(),
-        ];
-        let text = obj_with_corner_uv(
-            &surface.positions,
-            surface.mesh.faces(),
-            &p.corner_uv,
-            &comments,
-        );
+        let text = match &p.subdivision {
+            Some(m) => obj_with_corner_uv(
+                &m.positions,
+                m.mesh.faces(),
+                &m.corner_uv,
+                &[
+                    format!("ricci param of {name}"),
+                    format!(
+                        "the common subdivision of the input and the flat intrinsic \
+                         triangulation ({} points on the input surface, {} triangles, each \
+                         inside one input face; the input's own faces would have {} flipped \
+                         UV triangle(s))",
+                        m.positions.len(),
+                        m.mesh.n_faces(),
+                        m.input_stats.flipped_faces
+                    ),
+                    "vt: conformal UVs in [0,1]^2 per corner; several vt per vertex along the \
+                     seams"
+                        .to_string(),
+                ],
+            ),
+            None => obj_with_corner_uv(
+                &surface.positions,
+                surface.mesh.faces(),
+                &p.corner_uv,
+                &[
+                    format!("ricci param of {name}"),
+                    "vt: conformal UVs in [0,1]^2 per corner of the input's faces; several vt \
+                     per vertex along the seams"
+                        .to_string(),
+                ],
+            ),
+        };
         write_atomic(path, text.as_bytes())?;
     }
     if let Some(path) = &a.svg {
         let cv: Vec<u32> = cones.iter().map(|c| c.vertex).collect();
-        let svg = uv_svg(&surface.mesh, &p.corner_uv, &p.seam, &cv, 1024.0, 300_000);
+        let svg = match &p.subdivision {
+            Some(m) => {
+                let cv: Vec<u32> = cv.iter().map(|&v| m.input_vertex[v as usize]).collect();
+                uv_svg(&m.mesh, &m.corner_uv, &m.seam, &cv, 1024.0, 300_000)
+            }
+            None => uv_svg(&surface.mesh, &p.corner_uv, &p.seam, &cv, 1024.0, 300_000),
+        };
         write_atomic(path, svg.as_bytes())?;
     }
+    let uv = match &p.subdivision {
+        Some(m) => json!({
+            "on": p.uv_on(), "vertices": m.positions.len(), "triangles": m.mesh.n_faces(),
+            "flipped_faces": p.stats.flipped_faces,
+            "input_flipped_faces": m.input_stats.flipped_faces,
+        }),
+        None => json!({
+            "on": p.uv_on(), "vertices": surface.mesh.n_vertices(),
+            "triangles": surface.mesh.n_faces(), "flipped_faces": p.stats.flipped_faces,
+            "input_flipped_faces": p.stats.flipped_faces,
+        }),
+    };
     let seam_length: f64 = p.charts.iter().map(|c| c.seam_length).sum();
     let out = json!({
         "file": name, "mode": "plane", "vertices": surface.mesh.n_vertices(),
-        "faces": surface.mesh.n_faces(), "charts": p.charts.len(), "uv_faces": "input",
+        "faces": surface.mesh.n_faces(), "charts": p.charts.len(), "uv_faces": p.uv_on(),
+        "uv": uv,
         "flipped_faces": p.stats.flipped_faces, "qc_mean": p.stats.qc_mean,
         "qc_p95": p.stats.qc_p95, "qc_max": p.stats.qc_max,
         "log_area_sigma": p.stats.log_area_sigma, "distortion": p.stats,

@@ -29,34 +29,38 @@
 //!    Newton's method on the convex energy). The result is a flat metric with cones on a
 //!    triangulation `T` of the same surface (same vertices; some edges flipped).
 //! 3. **Cut** ([`seams`]): a shortest-path cut graph through every cone and the homology
-//!    generators, built from input edges that `T` kept, so that the input mesh and `T`
-//!    are opened along the same curves.
+//!    generators, first on input edges that `T` kept, so that the input mesh and `T` are
+//!    opened along the same curves ([`transfer`]).
 //! 4. **Layout** of the opened `T` in the plane ([`crate::layout::place::layout`]), exact up to
 //!    rounding because the metric is flat off the cones, which lie on the cut.
 //! 5. **UVs on the input's own faces**: every input corner takes the layout position of its
-//!    vertex in the same wedge between cut edges ([`seams::wedge_key`]); seams are vertices
-//!    with several `vt`. The map is exact at the vertices and linear on input faces; the
-//!    report counts the faces whose UV triangle is not positive (`flipped_faces`, the
-//!    measure of [`crate::analysis::distortion`]). [`input_face_map`] is the one place this
-//!    transfer happens (the common subdivision of the input and `T` is the exact map).
+//!    vertex in the same wedge between cut edges ([`seams::wedge_key`], [`input_face_map`]);
+//!    seams are vertices with several `vt`. The map is exact at the vertices and linear on
+//!    input faces. When an input face's UV triangle would fold (`T` flipped input edges
+//!    there), or no cut on kept input edges reaches every cone, the cut runs on `T`'s own
+//!    edges and the UVs are written on the **common subdivision** of the input and `T`
+//!    (Gillespie–Springborn–Crane 2021 §5; [`crate::metric::common_subdivision`]): every
+//!    piece lies in one input face and one face of `T` and none folds
+//!    ([`Parametrization::subdivision`], [`Chart::uv_faces`]).
 //! 6. **Packing**: each chart scaled to its surface area, rotated to its smallest bounding
 //!    box (not with `--seamless`), shelf-packed and scaled into `[margin, 1 − margin]²`.
 
+mod chart;
 pub mod cones;
 pub mod seams;
 pub mod sphere;
 pub mod svg;
+mod transfer;
+mod unfold;
+
+pub use transfer::input_face_map;
 
 use crate::analysis::distortion::{uv_stats, DistortionStats};
 use crate::error::{Error, Result};
-use crate::flow::{ricci_flow, FlowOptions, TargetSpec};
-use crate::layout::place::layout;
 use crate::mesh::{topology, Mesh, Surface, NONE};
-use crate::metric::{Euclidean, Geometry, Scheme};
 use crate::progress::Progress;
-use cones::{correct_cone_curvatures, greedy_cones, round_to_quarter_turns, ConeBudget};
+use cones::round_to_quarter_turns;
 use serde::Serialize;
-use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::time::Instant;
 
@@ -116,6 +120,9 @@ pub struct ParamOptions {
     /// scale factor and runs the flow again, kept only when `σ(2u)` drops (default 0: each
     /// round costs one more flow).
     pub cone_corrections: usize,
+    /// Write every chart on the common subdivision of the input and the flat triangulation,
+    /// also where the input's own faces would not fold (default false: only where needed).
+    pub on_subdivision: bool,
 }
 
 impl Default for ParamOptions {
@@ -128,6 +135,7 @@ impl Default for ParamOptions {
             margin: 0.01,
             max_cones: 64,
             cone_corrections: 0,
+            on_subdivision: false,
         }
     }
 }
@@ -163,8 +171,13 @@ pub struct Chart {
     /// Intrinsic flips of the flow (isometric + Ptolemy) and splits of its simplicial mesh.
     pub flips: usize,
     pub splits: usize,
-    /// Which faces carry the UVs: `"input"`.
+    /// Which faces carry the UVs: `"input"` (the input's own faces) or
+    /// `"common_subdivision"` (the input's faces would fold, or the cut needs edges the flow
+    /// flipped; [`Parametrization::subdivision`]).
     pub uv_faces: String,
+    /// Input faces whose own UV triangle is not positive (with the cut on input edges; all
+    /// faces when no such cut exists) — the reason for `common_subdivision`.
+    pub input_flipped_faces: usize,
     /// Cut edges (input edges) and their total 3D length.
     pub seam_edges: usize,
     pub seam_length: f64,
@@ -176,8 +189,8 @@ pub struct Chart {
     /// Largest distance of a transition's rotation from a multiple of π/2.
     pub quarter_turn_error: f64,
     pub flow_seconds: f64,
-    /// Cones moved to a neighbour because the flow flipped away all their input edges (the
-    /// cut runs on kept input edges), and flows run.
+    /// Always 0: cones are no longer moved (a cut that needs edges the flow flipped runs on
+    /// the flat triangulation, and the UVs go on the common subdivision). Flows run.
     pub moved_cones: usize,
     pub flow_runs: usize,
     /// Rounds of the cone-curvature correction on the nonlinear flow that ran, and the
@@ -190,13 +203,52 @@ pub struct Chart {
 /// The result of [`parametrize`].
 #[derive(Debug, Clone)]
 pub struct Parametrization {
-    /// `corner_uv[3f + i]`: UV of corner `i` of input face `f`, packed into `[0, 1]²`.
+    /// `corner_uv[3f + i]`: UV of corner `i` of input face `f`, packed into `[0, 1]²`. In a
+    /// chart on the common subdivision these are the subdivision's UVs at the input vertices
+    /// (exact there, but the input face's own UV triangle may fold).
     pub corner_uv: Vec<[f64; 2]>,
     /// Input edges along which the surface was cut.
     pub seam: Vec<bool>,
     pub charts: Vec<Chart>,
+    /// Distortion of what carries the map: the common subdivision when there is one, else
+    /// the input's faces.
     pub stats: DistortionStats,
+    /// The map on the common subdivision of the input and the flat triangulations, when some
+    /// chart needs it (charts on the input's faces are copied into it unchanged).
+    pub subdivision: Option<SubdivisionMap>,
     pub seconds: f64,
+}
+
+/// A UV map on the common subdivision (see [`transfer`]): vertices are points of the input
+/// surface, every triangle lies in one input face and is mapped linearly.
+#[derive(Debug, Clone)]
+pub struct SubdivisionMap {
+    /// Points on the input surface.
+    pub positions: Vec<[f64; 3]>,
+    /// The triangles (counter-clockwise on the input surface), as a mesh.
+    pub mesh: Mesh,
+    /// Input face of every triangle.
+    pub input_face: Vec<u32>,
+    /// `corner_uv[3t + i]`, packed into `[0, 1]²` with the other charts.
+    pub corner_uv: Vec<[f64; 2]>,
+    /// Seam edges of `mesh` (interior edges whose two sides' UVs differ).
+    pub seam: Vec<bool>,
+    /// Vertex of `mesh` at each input vertex.
+    pub input_vertex: Vec<u32>,
+    /// Distortion of the input's own faces (`corner_uv` of the parametrization).
+    pub input_stats: DistortionStats,
+}
+
+impl Parametrization {
+    /// `"common_subdivision"` when the map is carried by [`Parametrization::subdivision`],
+    /// else `"input"`.
+    pub fn uv_on(&self) -> &'static str {
+        if self.subdivision.is_some() {
+            "common_subdivision"
+        } else {
+            "input"
+        }
+    }
 }
 
 /// One connected component as a surface of its own, with the maps back to the input.
@@ -299,473 +351,10 @@ fn log_scale_sigma(surface: &Surface, u: &[f64]) -> f64 {
     (s2 / w - m * m).max(0.0).sqrt()
 }
 
-/// The map of the input's faces into the layout of the opened intrinsic triangulation: one
-/// UV per input corner (see the module docs, step 5). `t_mesh` is the simplicial mesh of the
-/// flow (input vertices first, same ids), `t_cut` its cut flags, `t_uv[3f + i]` the layout
-/// position of corner `i` of its face `f`; `cut` are the cut flags of `input`.
-///
-/// The one place where input UVs are taken from the intrinsic triangulation, so that the
-/// exact transfer (the common subdivision) can replace it.
-pub fn input_face_map(
-    input: &Mesh,
-    cut: &[bool],
-    t_mesh: &Mesh,
-    t_cut: &[bool],
-    t_uv: &[[f64; 2]],
-) -> Result<Vec<[f64; 2]>> {
-    let nv = input.n_vertices();
-    let mut table: HashMap<(u32, u32), [f64; 2]> = HashMap::with_capacity(nv + nv / 4);
-    for h in 0..t_mesh.n_corners() as u32 {
-        let v = t_mesh.he_origin(h);
-        if (v as usize) < nv {
-            let key = seams::wedge_key(t_mesh, h, t_cut);
-            table.entry((v, key)).or_insert(t_uv[h as usize]);
-        }
-    }
-    let mut out = Vec::with_capacity(input.n_corners());
-    for h in 0..input.n_corners() as u32 {
-        let v = input.he_origin(h);
-        let key = seams::wedge_key(input, h, cut);
-        let uv = table.get(&(v, key)).ok_or_else(|| {
-            Error::numerical(format!(
-                "input vertex {v} (face {}) has no position in the layout of the intrinsic \
-                 triangulation",
-                h / 3
-            ))
-        })?;
-        out.push(*uv);
-    }
-    Ok(out)
-}
-
-/// A flow result kept while the cone correction tries another: flow, cut, cones, `σ(2u)`.
-type Candidate = (crate::flow::FlowResult, Vec<bool>, Vec<(u32, f64)>, f64);
-
-struct ChartUv {
-    corner_uv: Vec<[f64; 2]>,
-    cut: Vec<bool>,
-    chart: Chart,
-}
-
-fn chart_uv(
-    piece: &Piece,
-    component: usize,
-    opts: &ParamOptions,
-    progress: &mut dyn Progress,
-) -> Result<ChartUv> {
-    let t0 = Instant::now();
-    let mesh = &piece.surface.mesh;
-    let n = mesh.n_vertices();
-    let topo = topology(mesh);
-    let comp = &topo.components[0];
-    let lengths = piece.surface.edge_lengths();
-    let to_local: HashMap<u32, u32> = piece
-        .vertices
-        .iter()
-        .enumerate()
-        .map(|(i, &v)| (v, i as u32))
-        .collect();
-    let mut history = Vec::new();
-    let mut cone_source = "none".to_string();
-    let mut cone_list: Vec<(u32, f64)> = Vec::new();
-    let target = if comp.boundary_loops > 0 {
-        match &opts.cones {
-            ConeSpec::Given(c) if c.iter().any(|x| to_local.contains_key(&x.0)) => {
-                return Err(Error::input(format!(
-                    "component {component} has a boundary; cones on surfaces with boundary \
-                     are not supported yet (the boundary takes the curvature)"
-                )));
-            }
-            ConeSpec::Count(k) if *k > 0 => {
-                return Err(Error::input(format!(
-                    "component {component} has a boundary; cones on surfaces with boundary \
-                     are not supported yet (the boundary takes the curvature)"
-                )));
-            }
-            _ => {}
-        }
-        match (opts.boundary, opts.seamless) {
-            (BoundaryMode::Free, false) => TargetSpec::FreeBoundary,
-            (BoundaryMode::Round, false) => TargetSpec::RoundBoundary,
-            (BoundaryMode::FixedAngles, _) | (_, true) => {
-                TargetSpec::PerVertex(fixed_angle_targets(mesh, &lengths, opts.seamless))
-            }
-        }
-    } else {
-        let chi = 2.0 - 2.0 * comp.genus as f64;
-        let spec = match &opts.cones {
-            ConeSpec::Default if comp.genus == 1 => ConeSpec::None,
-            ConeSpec::Default => ConeSpec::Auto {
-                max_area_distortion: 1.0,
-            },
-            c => c.clone(),
-        };
-        match spec {
-            ConeSpec::None | ConeSpec::Default => {}
-            ConeSpec::Given(c) => {
-                for (v, k) in c {
-                    if let Some(&l) = to_local.get(&v) {
-                        cone_list.push((l, k));
-                    }
-                }
-                cone_source = "given".into();
-            }
-            ConeSpec::Count(k) => {
-                progress.report("cones", None, "greedy cone placement");
-                let p = greedy_cones(mesh, &lengths, ConeBudget::Count(k))?;
-                cone_list = p.cones;
-                history = p.distortion_history;
-                cone_source = "greedy".into();
-            }
-            ConeSpec::Auto {
-                max_area_distortion,
-            } => {
-                progress.report("cones", None, "greedy cone placement");
-                let p = greedy_cones(
-                    mesh,
-                    &lengths,
-                    ConeBudget::AreaDistortion {
-                        bound: max_area_distortion,
-                        max_cones: opts.max_cones,
-                    },
-                )?;
-                cone_list = p.cones;
-                history = p.distortion_history;
-                cone_source = "greedy".into();
-            }
-        }
-        if opts.seamless {
-            cone_list = round_to_quarter_turns(&cone_list, 2.0 * PI * chi, 3);
-        }
-        if cone_list.is_empty() {
-            if comp.genus != 1 {
-                return Err(Error::input(format!(
-                    "component {component} (closed, genus {}) needs cones to be flattened \
-                     (--cones N, auto or V=K,…; or --sphere for genus 0)",
-                    comp.genus
-                )));
-            }
-            TargetSpec::Uniform
-        } else {
-            TargetSpec::Cones(cone_list.clone())
-        }
-    };
-    // The flow, and the cut on input edges the final triangulation kept. A cone whose input
-    // edges were all flipped away cannot be reached by the cut: it moves to the neighbour
-    // with the most kept edges and the flow runs again (at most `CONE_MOVES` rounds).
-    const CONE_MOVES: usize = 3;
-    let mut moved_cones = 0usize;
-    let mut round = 0usize;
-    let mut corrections_left = if cone_source == "greedy" && !opts.seamless {
-        opts.cone_corrections
-    } else {
-        0
-    };
-    let mut best: Option<Candidate> = None;
-    let mut corrections = 0usize;
-    let (r, cut) = loop {
-        round += 1;
-        let target = if cone_list.is_empty() {
-            target.clone()
-        } else {
-            TargetSpec::Cones(cone_list.clone())
-        };
-        progress.report("flow", None, "conformal flow with intrinsic Delaunay flips");
-        let fo = FlowOptions {
-            geometry: Geometry::Euclidean,
-            scheme: Scheme::Conformal,
-            target,
-            tolerance: opts.tolerance,
-            ..FlowOptions::default()
-        };
-        let r = match ricci_flow(mesh, &lengths, &fo, progress) {
-            Ok(r) if !r.converged && best.is_some() => {
-                let (r, cut, c, _) = best.take().expect("checked");
-                cone_list = c;
-                break (r, cut);
-            }
-            Err(_) if best.is_some() => {
-                let (r, cut, c, _) = best.take().expect("checked");
-                cone_list = c;
-                break (r, cut);
-            }
-            x => x?,
-        };
-        if !r.converged {
-            return Err(Error::numerical(format!(
-                "component {component}: the conformal flow did not converge (max |K − K̄| = \
-                 {:.3e} after {} iterations{})",
-                r.max_curvature_error,
-                r.iterations,
-                if r.notes.is_empty() {
-                    String::new()
-                } else {
-                    format!("; {}", r.notes.join("; "))
-                }
-            )));
-        }
-        let tr = r
-            .triangulation
-            .as_ref()
-            .ok_or_else(|| Error::numerical("the conformal flow returned no triangulation"))?;
-        let t_mesh = &tr.simplicial.mesh;
-        // Edges the cut may use: input edges never flipped and not doubled in the Δ-complex.
-        let mut flipped = vec![false; mesh.n_edges()];
-        for &e in &tr.triangulation.flip_log {
-            flipped[e as usize] = true;
-        }
-        let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
-        for e in 0..tr.triangulation.n_edges() as u32 {
-            let [a, b] = tr.triangulation.edge_vertices(e);
-            *pairs.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-        }
-        let allowed: Vec<bool> = (0..mesh.n_edges() as u32)
-            .map(|e| {
-                let [a, b] = mesh.edge_vertices(e);
-                !flipped[e as usize]
-                    && pairs.get(&(a.min(b), a.max(b))) == Some(&1)
-                    && t_mesh.halfedge_between(a, b).is_some()
-            })
-            .collect();
-        if round <= CONE_MOVES && !cone_list.is_empty() {
-            // Components of the graph of kept interior edges; every cone must lie in the
-            // largest one (the cut reaches it without flipped edges). Cones outside move to
-            // the nearest vertex inside (breadth first over the input mesh).
-            let nv = mesh.n_vertices();
-            let mut parent: Vec<u32> = (0..nv as u32).collect();
-            fn find(p: &mut [u32], mut x: u32) -> u32 {
-                while p[x as usize] != x {
-                    p[x as usize] = p[p[x as usize] as usize];
-                    x = p[x as usize];
-                }
-                x
-            }
-            for e in 0..mesh.n_edges() as u32 {
-                if allowed[e as usize] && !mesh.is_boundary_edge(e) {
-                    let [a, b] = mesh.edge_vertices(e);
-                    let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-                    if ra != rb {
-                        parent[ra as usize] = rb;
-                    }
-                }
-            }
-            let mut size = vec![0usize; nv];
-            for v in 0..nv as u32 {
-                let r = find(&mut parent, v);
-                size[r as usize] += 1;
-            }
-            let main = (0..nv).max_by_key(|&v| size[v]).unwrap_or(0) as u32;
-            let mut in_main = vec![false; nv];
-            for v in 0..nv as u32 {
-                in_main[v as usize] = find(&mut parent, v) == main;
-            }
-            let mut is_cone = vec![false; nv];
-            for c in &cone_list {
-                is_cone[c.0 as usize] = true;
-            }
-            let mut moved = false;
-            for cone in cone_list.iter_mut() {
-                let c = cone.0;
-                if in_main[c as usize] {
-                    continue;
-                }
-                let mut seen = vec![false; nv];
-                let mut queue = std::collections::VecDeque::from([c]);
-                seen[c as usize] = true;
-                let mut found = None;
-                while let Some(v) = queue.pop_front() {
-                    if in_main[v as usize] && !is_cone[v as usize] && !mesh.is_boundary_vertex(v) {
-                        found = Some(v);
-                        break;
-                    }
-                    for w in mesh.vertex_neighbors(v) {
-                        if !seen[w as usize] {
-                            seen[w as usize] = true;
-                            queue.push_back(w);
-                        }
-                    }
-                }
-                if let Some(w) = found {
-                    is_cone[c as usize] = false;
-                    is_cone[w as usize] = true;
-                    cone.0 = w;
-                    moved = true;
-                    moved_cones += 1;
-                }
-            }
-            if moved {
-                continue;
-            }
-        }
-        let cone_vertices: Vec<u32> = cone_list.iter().map(|c| c.0).collect();
-        let needs_cut = comp.boundary_loops != 1 || comp.genus > 0 || !cone_vertices.is_empty();
-        let cut = if needs_cut {
-            progress.report("cut", None, "cut graph through the cones and the handles");
-            match seams::cut_graph(mesh, &lengths, &allowed, &cone_vertices) {
-                Ok(c) => c,
-                Err(_) if best.is_some() => {
-                    let (r, cut, c, _) = best.take().expect("checked");
-                    cone_list = c;
-                    break (r, cut);
-                }
-                Err(e) => {
-                    return Err(Error::numerical(format!("component {component}: {e}")));
-                }
-            }
-        } else {
-            vec![false; mesh.n_edges()]
-        };
-        let sigma = log_scale_sigma(&piece.surface, &r.u);
-        let better = best.as_ref().is_none_or(|b| sigma < b.3);
-        if corrections_left > 0 {
-            // Re-solve the cone curvatures on the nonlinear result and flow again.
-            corrections_left -= 1;
-            progress.report("cones", None, "cone curvatures corrected on the flow");
-            if let Ok(next) = correct_cone_curvatures(mesh, &lengths, &cone_list, &r.u, 1.0) {
-                if better {
-                    best = Some((r, cut, cone_list.clone(), sigma));
-                }
-                cone_list = next;
-                corrections += 1;
-                continue;
-            }
-        }
-        if !better {
-            let (r, cut, c, _) = best.take().expect("checked");
-            cone_list = c;
-            break (r, cut);
-        }
-        break (r, cut);
-    };
-    let flow_seconds = r.seconds;
-    let tr = r
-        .triangulation
-        .as_ref()
-        .ok_or_else(|| Error::numerical("the conformal flow returned no triangulation"))?;
-    let t_mesh = &tr.simplicial.mesh;
-    let mut t_cut = vec![false; t_mesh.n_edges()];
-    for e in 0..mesh.n_edges() as u32 {
-        if cut[e as usize] {
-            let [a, b] = mesh.edge_vertices(e);
-            let h = t_mesh.halfedge_between(a, b).ok_or_else(|| {
-                Error::numerical(format!(
-                    "cut edge {a}–{b} is missing in the flat triangulation"
-                ))
-            })?;
-            t_cut[t_mesh.he_edge(h) as usize] = true;
-        }
-    }
-    progress.report("layout", None, "flat layout of the opened surface");
-    let (disk, _origin) = crate::cut::slice(t_mesh, &t_cut)?;
-    let mut dl = vec![0.0; disk.n_edges()];
-    for h in 0..disk.n_corners() as u32 {
-        dl[disk.he_edge(h) as usize] = r.lengths[t_mesh.he_edge(h) as usize];
-    }
-    let lay = layout::<Euclidean>(&disk, &dl, None)?;
-    let t_uv: Vec<[f64; 2]> = (0..disk.n_corners() as u32)
-        .map(|h| {
-            let p = lay.positions[disk.he_origin(h) as usize];
-            [p.re, p.im]
-        })
-        .collect();
-    let mut corner_uv = input_face_map(mesh, &cut, t_mesh, &t_cut, &t_uv)?;
-    // Scale to the surface's area.
-    let (mut a3, mut a2) = (0.0, 0.0);
-    for (f, t) in mesh.faces().iter().enumerate() {
-        let p = |i: usize| piece.surface.positions[t[i] as usize];
-        a3 += 0.5
-            * crate::numeric::vec3::norm(crate::numeric::vec3::cross(
-                crate::numeric::vec3::sub(p(1), p(0)),
-                crate::numeric::vec3::sub(p(2), p(0)),
-            ));
-        let q = &corner_uv[3 * f..3 * f + 3];
-        a2 += 0.5
-            * ((q[1][0] - q[0][0]) * (q[2][1] - q[0][1])
-                - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]));
-    }
-    if a2 > 0.0 && a3 > 0.0 {
-        let s = (a3 / a2).sqrt();
-        for q in corner_uv.iter_mut() {
-            q[0] *= s;
-            q[1] *= s;
-        }
-    }
-    // Seams: transitions between the two sides of every cut edge.
-    let (mut seam_edges, mut seam_length, mut mismatch, mut qerr) = (0usize, 0.0, 0.0f64, 0.0f64);
-    let mut angles: Vec<f64> = Vec::new();
-    for e in 0..mesh.n_edges() as u32 {
-        if !cut[e as usize] {
-            continue;
-        }
-        seam_edges += 1;
-        seam_length += lengths[e as usize];
-        let h = mesh.edge_halfedge(e);
-        let g = mesh.he_twin(h);
-        // h: a→b in face h/3; g: b→a.
-        let (pa, pb) = (corner_uv[h as usize], corner_uv[mesh.he_next(h) as usize]);
-        let (qb, qa) = (corner_uv[g as usize], corner_uv[mesh.he_next(g) as usize]);
-        let d1 = [pb[0] - pa[0], pb[1] - pa[1]];
-        let d2 = [qb[0] - qa[0], qb[1] - qa[1]];
-        let (l1, l2) = (d1[0].hypot(d1[1]), d2[0].hypot(d2[1]));
-        mismatch = mismatch.max((l1 - l2).abs() / l1.max(l2).max(1e-300));
-        let ang = (d1[0] * d2[1] - d1[1] * d2[0]).atan2(d1[0] * d2[0] + d1[1] * d2[1]);
-        let q = (ang / (PI / 2.0)).round() * (PI / 2.0);
-        qerr = qerr.max((ang - q).abs());
-        if !angles.iter().any(|&a| {
-            let d = (a - ang).abs();
-            d < 1e-6 || (2.0 * PI - d).abs() < 1e-6
-        }) && angles.len() < 64
-        {
-            angles.push(ang);
-        }
-    }
-    angles.sort_by(f64::total_cmp);
-    let cones_out: Vec<Cone> = cone_list
-        .iter()
-        .map(|&(v, k)| Cone {
-            vertex: piece.vertices[v as usize],
-            curvature: k,
-            angle: 2.0 * PI - k,
-        })
-        .collect();
-    let chart = Chart {
-        component,
-        faces: mesh.n_faces(),
-        vertices: n,
-        genus: comp.genus,
-        boundary_loops: comp.boundary_loops,
-        target: r.target_description.clone(),
-        cones: cones_out,
-        cone_source,
-        cone_distortion_history: history,
-        flow_iterations: r.iterations,
-        flow_converged: r.converged,
-        max_curvature_error: r.max_curvature_error,
-        flips: tr.initial_flips + tr.flips,
-        splits: tr.splits,
-        uv_faces: "input".into(),
-        seam_edges,
-        seam_length,
-        seam_length_mismatch: mismatch,
-        transition_angles: angles,
-        quarter_turn_error: qerr,
-        flow_seconds,
-        moved_cones,
-        flow_runs: round,
-        cone_corrections: corrections,
-        log_scale_sigma: log_scale_sigma(&piece.surface, &r.u),
-        seconds: t0.elapsed().as_secs_f64(),
-    };
-    Ok(ChartUv {
-        corner_uv,
-        cut,
-        chart,
-    })
-}
-
 /// Rotate corner UVs (in place) to the smallest-area axis-aligned bounding box among 90
-/// rotations by 1°, and move it to the origin; returns (width, height).
-fn orient(uv: &mut [[f64; 2]], rotate: bool) -> (f64, f64) {
+/// rotations by 1°, and move it to the origin; `also` (points inside the same chart) gets the
+/// same motion; returns (width, height).
+fn orient(uv: &mut [[f64; 2]], also: &mut [[f64; 2]], rotate: bool) -> (f64, f64) {
     let bbox = |uv: &[[f64; 2]], c: f64, s: f64| -> [f64; 4] {
         let mut b = [
             f64::INFINITY,
@@ -798,7 +387,7 @@ fn orient(uv: &mut [[f64; 2]], rotate: bool) -> (f64, f64) {
     }
     let (c, s) = (best.1.cos(), best.1.sin());
     let b = bbox(uv, c, s);
-    for p in uv.iter_mut() {
+    for p in uv.iter_mut().chain(also.iter_mut()) {
         let x = c * p[0] - s * p[1];
         let y = s * p[0] + c * p[1];
         *p = [x - b[0], y - b[1]];
@@ -839,8 +428,11 @@ pub fn parametrize(
     let mut boxes = Vec::new();
     let mut chart_uvs = Vec::new();
     for (c, p) in ps.iter().enumerate() {
-        let mut cu = chart_uv(p, c, opts, progress)?;
-        let wh = orient(&mut cu.corner_uv, !opts.seamless);
+        let mut cu = chart::chart_uv(p, c, opts, progress)?;
+        let wh = match cu.subdivision.as_mut() {
+            Some(sub) => orient(&mut sub.corner_uv, &mut cu.corner_uv, !opts.seamless),
+            None => orient(&mut cu.corner_uv, &mut [], !opts.seamless),
+        };
         boxes.push(wh);
         for e in 0..p.surface.mesh.n_edges() as u32 {
             if cu.cut[e as usize] {
@@ -852,7 +444,7 @@ pub fn parametrize(
             }
         }
         charts.push(cu.chart);
-        chart_uvs.push(cu.corner_uv);
+        chart_uvs.push((cu.corner_uv, cu.subdivision));
     }
     // Shelf packing, tallest first.
     let gap = 0.02 * boxes.iter().map(|b| b.0 * b.1).sum::<f64>().sqrt();
@@ -878,23 +470,95 @@ pub fn parametrize(
     let h_max = y + row_h;
     let side = w_max.max(h_max).max(1e-300);
     let s = (1.0 - 2.0 * opts.margin) / side;
+    let place = |c: usize, q: [f64; 2]| {
+        [
+            opts.margin + s * (q[0] + offset[c][0]),
+            opts.margin + s * (q[1] + offset[c][1]),
+        ]
+    };
     for (c, p) in ps.iter().enumerate() {
         for (lf, &f) in p.faces.iter().enumerate() {
             for i in 0..3 {
-                let q = chart_uvs[c][3 * lf + i];
-                corner_uv[3 * f as usize + i] = [
-                    opts.margin + s * (q[0] + offset[c][0]),
-                    opts.margin + s * (q[1] + offset[c][1]),
-                ];
+                corner_uv[3 * f as usize + i] = place(c, chart_uvs[c].0[3 * lf + i]);
             }
         }
     }
-    let stats = uv_stats(&surface.positions, surface.mesh.faces(), &corner_uv);
+    let input_stats = uv_stats(&surface.positions, surface.mesh.faces(), &corner_uv);
+    let subdivision = if chart_uvs.iter().any(|x| x.1.is_some()) {
+        Some(subdivision_map(
+            &ps,
+            &chart_uvs,
+            &place,
+            input_stats.clone(),
+        )?)
+    } else {
+        None
+    };
     Ok(Parametrization {
         corner_uv,
         seam,
         charts,
-        stats,
+        stats: subdivision.as_ref().map_or(input_stats, |m| {
+            uv_stats(&m.positions, m.mesh.faces(), &m.corner_uv)
+        }),
+        subdivision,
         seconds: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// A chart's points, triangles, input faces and corner UVs.
+type ChartParts<'a> = (&'a [[f64; 3]], &'a [[u32; 3]], Vec<u32>, &'a [[f64; 2]]);
+
+/// The whole map on the common subdivision: every chart's subdivision, or its input faces
+/// when it has none, with the packed UVs (`place(chart, uv)`).
+fn subdivision_map(
+    ps: &[Piece],
+    charts: &[(Vec<[f64; 2]>, Option<transfer::SubdivisionChart>)],
+    place: &dyn Fn(usize, [f64; 2]) -> [f64; 2],
+    input_stats: DistortionStats,
+) -> Result<SubdivisionMap> {
+    let (mut positions, mut triangles, mut input_face, mut corner_uv) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let n_input = ps
+        .iter()
+        .flat_map(|p| &p.vertices)
+        .max()
+        .map_or(0, |&v| v as usize + 1);
+    let mut input_vertex = vec![NONE; n_input];
+    for (c, (p, (uv, sub))) in ps.iter().zip(charts).enumerate() {
+        let o = positions.len() as u32;
+        // Input vertices come first, in the piece's order, in both meshes.
+        for (l, &v) in p.vertices.iter().enumerate() {
+            input_vertex[v as usize] = o + l as u32;
+        }
+        let (pos, tris, faces, uv): ChartParts = match sub {
+            Some(x) => (
+                &x.positions,
+                &x.triangles,
+                x.input_face.iter().map(|&f| p.faces[f as usize]).collect(),
+                &x.corner_uv,
+            ),
+            None => (
+                &p.surface.positions,
+                p.surface.mesh.faces(),
+                p.faces.clone(),
+                uv,
+            ),
+        };
+        positions.extend_from_slice(pos);
+        triangles.extend(tris.iter().map(|t| t.map(|v| v + o)));
+        input_face.extend(faces);
+        corner_uv.extend(uv.iter().map(|&q| place(c, q)));
+    }
+    let mesh = Mesh::from_triangles(positions.len(), triangles)?;
+    let seam = transfer::seam_edges(&mesh, &corner_uv);
+    Ok(SubdivisionMap {
+        positions,
+        mesh,
+        input_face,
+        corner_uv,
+        seam,
+        input_vertex,
+        input_stats,
     })
 }

@@ -1,0 +1,363 @@
+//! One chart of [`super::parametrize`]: the target curvature of a connected component (step
+//! 1 of the [module docs](super)), the conformal flow with the optional cone-curvature
+//! corrections (step 2), and the UVs through [`super::transfer`] (steps 3–5), on the input's
+//! own faces when they do not fold, otherwise on the common subdivision of the input and the
+//! flat triangulation.
+
+use super::cones::{correct_cone_curvatures, greedy_cones, round_to_quarter_turns, ConeBudget};
+use super::transfer::{
+    folded_faces, input_route, scale_to_area, seam_edges, seam_report, subdivision_route,
+    SubdivisionChart,
+};
+use super::{fixed_angle_targets, log_scale_sigma, BoundaryMode, Chart, Cone, ConeSpec};
+use super::{ParamOptions, Piece};
+use crate::error::{Error, Result};
+use crate::flow::{ricci_flow, FlowOptions, FlowResult, TargetSpec};
+use crate::mesh::{topology, Mesh};
+use crate::metric::{Geometry, Scheme};
+use crate::progress::Progress;
+use std::collections::HashMap;
+use std::f64::consts::PI;
+use std::time::Instant;
+
+/// The UVs of one chart: `corner_uv[3f + i]` per corner of the piece's faces, and — when the
+/// input's faces fold — the common subdivision that carries the map instead.
+pub(super) struct ChartUv {
+    pub corner_uv: Vec<[f64; 2]>,
+    pub cut: Vec<bool>,
+    pub subdivision: Option<SubdivisionChart>,
+    pub chart: Chart,
+}
+
+/// Target curvature of a chart, with its cones, how they were chosen and the greedy's
+/// distortion history.
+struct ConePlan {
+    target: TargetSpec,
+    cones: Vec<(u32, f64)>,
+    source: String,
+    history: Vec<f64>,
+}
+
+fn boundary_target(
+    piece: &Piece,
+    component: usize,
+    opts: &ParamOptions,
+    lengths: &[f64],
+) -> Result<ConePlan> {
+    let has_cones = match &opts.cones {
+        ConeSpec::Given(c) => c.iter().any(|x| piece.vertices.contains(&x.0)),
+        ConeSpec::Count(k) => *k > 0,
+        _ => false,
+    };
+    if has_cones {
+        return Err(Error::input(format!(
+            "component {component} has a boundary; cones on surfaces with boundary are not \
+             supported yet (the boundary takes the curvature)"
+        )));
+    }
+    let mesh = &piece.surface.mesh;
+    let target = match (opts.boundary, opts.seamless) {
+        (BoundaryMode::Free, false) => TargetSpec::FreeBoundary,
+        (BoundaryMode::Round, false) => TargetSpec::RoundBoundary,
+        (BoundaryMode::FixedAngles, _) | (_, true) => {
+            TargetSpec::PerVertex(fixed_angle_targets(mesh, lengths, opts.seamless))
+        }
+    };
+    Ok(ConePlan {
+        target,
+        cones: Vec::new(),
+        source: "none".into(),
+        history: Vec::new(),
+    })
+}
+
+fn closed_target(
+    piece: &Piece,
+    component: usize,
+    genus: i64,
+    opts: &ParamOptions,
+    lengths: &[f64],
+    progress: &mut dyn Progress,
+) -> Result<ConePlan> {
+    let mesh = &piece.surface.mesh;
+    let chi = 2.0 - 2.0 * genus as f64;
+    let spec = match &opts.cones {
+        ConeSpec::Default if genus == 1 => ConeSpec::None,
+        ConeSpec::Default => ConeSpec::Auto {
+            max_area_distortion: 1.0,
+        },
+        c => c.clone(),
+    };
+    let (mut cones, mut source, mut history) = (Vec::new(), "none".to_string(), Vec::new());
+    let budget = match spec {
+        ConeSpec::Count(k) => Some(ConeBudget::Count(k)),
+        ConeSpec::Auto {
+            max_area_distortion,
+        } => Some(ConeBudget::AreaDistortion {
+            bound: max_area_distortion,
+            max_cones: opts.max_cones,
+        }),
+        ConeSpec::Given(c) => {
+            let to_local: HashMap<u32, u32> = piece
+                .vertices
+                .iter()
+                .enumerate()
+                .map(|(i, &v)| (v, i as u32))
+                .collect();
+            cones = c
+                .iter()
+                .filter_map(|(v, k)| to_local.get(v).map(|&l| (l, *k)))
+                .collect();
+            source = "given".into();
+            None
+        }
+        ConeSpec::None | ConeSpec::Default => None,
+    };
+    if let Some(b) = budget {
+        progress.report("cones", None, "greedy cone placement");
+        let p = greedy_cones(mesh, lengths, b)?;
+        cones = p.cones;
+        history = p.distortion_history;
+        source = "greedy".into();
+    }
+    if opts.seamless {
+        cones = round_to_quarter_turns(&cones, 2.0 * PI * chi, 3);
+    }
+    if cones.is_empty() && genus != 1 {
+        return Err(Error::input(format!(
+            "component {component} (closed, genus {genus}) needs cones to be flattened \
+             (--cones N, auto or V=K,…; or --sphere for genus 0)"
+        )));
+    }
+    let target = if cones.is_empty() {
+        TargetSpec::Uniform
+    } else {
+        TargetSpec::Cones(cones.clone())
+    };
+    Ok(ConePlan {
+        target,
+        cones,
+        source,
+        history,
+    })
+}
+
+/// The flow that was kept: its result, cones, correction rounds run and flows run.
+struct KeptFlow {
+    r: FlowResult,
+    cones: Vec<(u32, f64)>,
+    corrections: usize,
+    runs: usize,
+}
+
+fn flow_once(
+    mesh: &Mesh,
+    lengths: &[f64],
+    target: TargetSpec,
+    tolerance: f64,
+    progress: &mut dyn Progress,
+) -> Result<FlowResult> {
+    progress.report("flow", None, "conformal flow with intrinsic Delaunay flips");
+    let fo = FlowOptions {
+        geometry: Geometry::Euclidean,
+        scheme: Scheme::Conformal,
+        target,
+        tolerance,
+        ..FlowOptions::default()
+    };
+    let r = ricci_flow(mesh, lengths, &fo, progress)?;
+    if !r.converged {
+        return Err(Error::numerical(format!(
+            "the conformal flow did not converge (max |K − K̄| = {:.3e} after {} iterations{})",
+            r.max_curvature_error,
+            r.iterations,
+            if r.notes.is_empty() {
+                String::new()
+            } else {
+                format!("; {}", r.notes.join("; "))
+            }
+        )));
+    }
+    Ok(r)
+}
+
+/// The conformal flow to `plan`'s target, then up to `opts.cone_corrections` rounds of
+/// [`correct_cone_curvatures`] (greedy cones only), each kept only while the area-weighted
+/// `σ(2u)` drops and the flow converges.
+fn flow_with_corrections(
+    piece: &Piece,
+    component: usize,
+    lengths: &[f64],
+    plan: &ConePlan,
+    opts: &ParamOptions,
+    progress: &mut dyn Progress,
+) -> Result<KeptFlow> {
+    let mesh = &piece.surface.mesh;
+    let r = flow_once(mesh, lengths, plan.target.clone(), opts.tolerance, progress)
+        .map_err(|e| Error::numerical(format!("component {component}: {e}")))?;
+    let mut sigma = log_scale_sigma(&piece.surface, &r.u);
+    let mut kept = KeptFlow {
+        r,
+        cones: plan.cones.clone(),
+        corrections: 0,
+        runs: 1,
+    };
+    let rounds = if plan.source == "greedy" && !opts.seamless {
+        opts.cone_corrections
+    } else {
+        0
+    };
+    for _ in 0..rounds {
+        progress.report("cones", None, "cone curvatures corrected on the flow");
+        let Ok(next) = correct_cone_curvatures(mesh, lengths, &kept.cones, &kept.r.u, 1.0) else {
+            break;
+        };
+        kept.runs += 1;
+        let target = TargetSpec::Cones(next.clone());
+        let Ok(r) = flow_once(mesh, lengths, target, opts.tolerance, progress) else {
+            break;
+        };
+        let s = log_scale_sigma(&piece.surface, &r.u);
+        if s >= sigma {
+            break;
+        }
+        sigma = s;
+        kept.r = r;
+        kept.cones = next;
+        kept.corrections += 1;
+    }
+    Ok(kept)
+}
+
+/// UVs of one connected component (module docs, steps 1–5).
+pub(super) fn chart_uv(
+    piece: &Piece,
+    component: usize,
+    opts: &ParamOptions,
+    progress: &mut dyn Progress,
+) -> Result<ChartUv> {
+    let t0 = Instant::now();
+    let s = &piece.surface;
+    let mesh = &s.mesh;
+    let topo = topology(mesh);
+    let comp = &topo.components[0];
+    let lengths = s.edge_lengths();
+    let plan = if comp.boundary_loops > 0 {
+        boundary_target(piece, component, opts, &lengths)?
+    } else {
+        closed_target(piece, component, comp.genus, opts, &lengths, progress)?
+    };
+    let kept = flow_with_corrections(piece, component, &lengths, &plan, opts, progress)?;
+    let r = &kept.r;
+    let cone_vertices: Vec<u32> = kept.cones.iter().map(|c| c.0).collect();
+    let needs_cut = comp.boundary_loops != 1 || comp.genus > 0 || !cone_vertices.is_empty();
+    progress.report("cut", None, "cut graph through the cones and the handles");
+    let faces = mesh.faces();
+    let on_input = input_route(s, &lengths, r, &cone_vertices, needs_cut);
+    let input_folds = match &on_input {
+        Ok((_, uv)) => folded_faces(faces, uv),
+        Err(_) => faces.len(),
+    };
+    let (cut, mut corner_uv, mut subdivision) = match on_input {
+        Ok((cut, uv)) if input_folds == 0 && !opts.on_subdivision => (cut, uv, None),
+        first => {
+            progress.report("layout", None, "UVs on the common subdivision");
+            match (
+                subdivision_route(s, &lengths, r, &cone_vertices, needs_cut),
+                first,
+            ) {
+                (Ok(sub), Ok((cut, uv))) if sub.flipped > input_folds => (cut, uv, None),
+                (Ok(sub), _) => (sub.input_cut.clone(), Vec::new(), Some(sub)),
+                (Err(_), Ok((cut, uv))) => (cut, uv, None),
+                (Err(e), Err(first)) => {
+                    return Err(Error::numerical(format!(
+                        "component {component}: no cut on the input's edges ({first}), and \
+                         none on the common subdivision ({e})"
+                    )));
+                }
+            }
+        }
+    };
+    let seams = match subdivision.as_mut() {
+        Some(sub) => {
+            scale_to_area(&sub.positions, &sub.triangles, &mut sub.corner_uv);
+            corner_uv = input_corners_of(mesh, sub);
+            let m = Mesh::from_triangles(sub.positions.len(), sub.triangles.clone())?;
+            let seam = seam_edges(&m, &sub.corner_uv);
+            seam_report(&m, &sub.positions, &sub.corner_uv, &seam)
+        }
+        None => {
+            scale_to_area(&s.positions, faces, &mut corner_uv);
+            seam_report(mesh, &s.positions, &corner_uv, &cut)
+        }
+    };
+    let tr = r
+        .triangulation
+        .as_ref()
+        .ok_or_else(|| Error::numerical("the conformal flow returned no triangulation"))?;
+    let cones: Vec<Cone> = kept
+        .cones
+        .iter()
+        .map(|&(v, k)| Cone {
+            vertex: piece.vertices[v as usize],
+            curvature: k,
+            angle: 2.0 * PI - k,
+        })
+        .collect();
+    let chart = Chart {
+        component,
+        faces: mesh.n_faces(),
+        vertices: mesh.n_vertices(),
+        genus: comp.genus,
+        boundary_loops: comp.boundary_loops,
+        target: r.target_description.clone(),
+        cones,
+        cone_source: plan.source,
+        cone_distortion_history: plan.history,
+        flow_iterations: r.iterations,
+        flow_converged: r.converged,
+        max_curvature_error: r.max_curvature_error,
+        flips: tr.initial_flips + tr.flips,
+        splits: tr.splits,
+        uv_faces: if subdivision.is_some() {
+            "common_subdivision".into()
+        } else {
+            "input".into()
+        },
+        input_flipped_faces: input_folds,
+        moved_cones: 0,
+        seam_edges: seams.edges,
+        seam_length: seams.length,
+        seam_length_mismatch: seams.mismatch,
+        transition_angles: seams.angles,
+        quarter_turn_error: seams.quarter_turn_error,
+        flow_seconds: r.seconds,
+        flow_runs: kept.runs,
+        cone_corrections: kept.corrections,
+        log_scale_sigma: log_scale_sigma(s, &r.u),
+        seconds: t0.elapsed().as_secs_f64(),
+    };
+    Ok(ChartUv {
+        corner_uv,
+        cut,
+        subdivision,
+        chart,
+    })
+}
+
+/// UV per corner of the input's faces from the common subdivision: the corner of the piece
+/// at that input vertex inside that face (the map is exact at the input vertices; the input
+/// face's own UV triangle may still fold).
+fn input_corners_of(mesh: &Mesh, sub: &SubdivisionChart) -> Vec<[f64; 2]> {
+    let mut uv = vec![[f64::NAN; 2]; mesh.n_corners()];
+    for (t, tri) in sub.triangles.iter().enumerate() {
+        let f = sub.input_face[t] as usize;
+        let face = mesh.face(f as u32);
+        for (c, &v) in tri.iter().enumerate() {
+            if let Some(i) = face.iter().position(|&w| w == v) {
+                uv[3 * f + i] = sub.corner_uv[3 * t + c];
+            }
+        }
+    }
+    uv
+}
