@@ -21,9 +21,9 @@
 //!    (Soliman–Slepčev–Crane 2018 §4 with the positions fixed) and the flow runs again.
 //!    `--seamless` rounds cone curvatures to multiples of π/2 ([`cones::round_to_quarter_turns`];
 //!    Campen–Shen–Zhou–Zorin 2019 §3): on genus 0 every transition across a seam is then a
-//!    rotation by a multiple of 90° (the holonomy around a cone is its curvature). On genus
-//!    ≥ 1 the holonomy of the homology loops is not constrained by the flow here, and the
-//!    report says how far the transitions are from quarter turns.
+//!    rotation by a multiple of 90° (the holonomy around a cone is its curvature). On closed
+//!    genus ≥ 1 the flow's metric is then changed by the least change of log lengths that
+//!    makes the holonomy of `2g` homology loops multiples of π/2 as well ([`seamless`]).
 //! 2. **Conformal flow** with intrinsic Delaunay flips ([`crate::flow`], `Scheme::Conformal`:
 //!    discrete conformal equivalence of Gu–Luo–Sun–Wu 2018 / Springborn 2020, solved by
 //!    Newton's method on the convex energy). The result is a flat metric with cones on a
@@ -42,7 +42,9 @@
 //! 6. **Packing**: each chart scaled to its surface area, rotated to its smallest bounding
 //!    box (not with `--seamless`), shelf-packed and scaled into `[margin, 1 − margin]²`.
 
+pub mod boundary;
 pub mod cones;
+pub mod seamless;
 pub mod seams;
 pub mod sphere;
 pub mod svg;
@@ -241,44 +243,6 @@ fn pieces(s: &Surface) -> Result<Vec<Piece>> {
     Ok(out)
 }
 
-/// Boundary targets of `fixed-angles` (module docs), optionally rounded to quarter turns.
-fn fixed_angle_targets(mesh: &Mesh, lengths: &[f64], seamless: bool) -> Vec<f64> {
-    let k = cones::angle_defects(mesh, lengths);
-    let n = mesh.n_vertices();
-    let chi = crate::metric::euler_characteristic(mesh) as f64;
-    let mut dual = vec![0.0; n];
-    for e in 0..mesh.n_edges() as u32 {
-        if mesh.is_boundary_edge(e) {
-            let [a, b] = mesh.edge_vertices(e);
-            dual[a as usize] += 0.5 * lengths[e as usize];
-            dual[b as usize] += 0.5 * lengths[e as usize];
-        }
-    }
-    let total_dual: f64 = dual.iter().sum();
-    let kb: f64 = (0..n)
-        .filter(|&v| mesh.is_boundary_vertex(v as u32))
-        .map(|v| k[v])
-        .sum();
-    let rest = 2.0 * PI * chi - kb;
-    let mut t = vec![0.0; n];
-    for v in 0..n {
-        if mesh.is_boundary_vertex(v as u32) {
-            t[v] = k[v] + rest * dual[v] / total_dual;
-        }
-    }
-    if seamless {
-        let list: Vec<(u32, f64)> = (0..n as u32)
-            .filter(|&v| mesh.is_boundary_vertex(v))
-            .map(|v| (v, t[v as usize]))
-            .collect();
-        t = vec![0.0; n];
-        for (v, x) in round_to_quarter_turns(&list, 2.0 * PI * chi, 1) {
-            t[v as usize] = x;
-        }
-    }
-    t
-}
-
 /// Area-weighted standard deviation of the log area ratio `2u` of a conformal factor `u` per
 /// vertex (face value: the mean of its corners), the quantity the cone correction lowers.
 fn log_scale_sigma(surface: &Surface, u: &[f64]) -> f64 {
@@ -388,7 +352,7 @@ fn chart_uv(
             (BoundaryMode::Free, false) => TargetSpec::FreeBoundary,
             (BoundaryMode::Round, false) => TargetSpec::RoundBoundary,
             (BoundaryMode::FixedAngles, _) | (_, true) => {
-                TargetSpec::PerVertex(fixed_angle_targets(mesh, &lengths, opts.seamless))
+                TargetSpec::PerVertex(boundary::fixed_angle_targets(mesh, &lengths, opts.seamless))
             }
         }
     } else {
@@ -655,11 +619,16 @@ fn chart_uv(
             t_cut[t_mesh.he_edge(h) as usize] = true;
         }
     }
+    let t_lengths = if opts.seamless && comp.genus > 0 && comp.boundary_loops == 0 {
+        seamless::chart_holonomy(t_mesh, &r.lengths, n, &cone_list, progress)?
+    } else {
+        r.lengths.clone()
+    };
     progress.report("layout", None, "flat layout of the opened surface");
     let (disk, _origin) = crate::cut::slice(t_mesh, &t_cut)?;
     let mut dl = vec![0.0; disk.n_edges()];
     for h in 0..disk.n_corners() as u32 {
-        dl[disk.he_edge(h) as usize] = r.lengths[t_mesh.he_edge(h) as usize];
+        dl[disk.he_edge(h) as usize] = t_lengths[t_mesh.he_edge(h) as usize];
     }
     let lay = layout::<Euclidean>(&disk, &dl, None)?;
     let t_uv: Vec<[f64; 2]> = (0..disk.n_corners() as u32)
