@@ -41,11 +41,12 @@ fn check(s: &ricci::mesh::Surface, name: &str) -> ricci::param::sphere::SphereMa
     let bad = faces
         .iter()
         .filter(|t| {
-            !(det(
+            let d = det(
                 points[t[0] as usize],
                 points[t[1] as usize],
                 points[t[2] as usize],
-            ) > 0.0)
+            );
+            d.is_nan() || d <= 0.0
         })
         .count();
     assert_eq!(

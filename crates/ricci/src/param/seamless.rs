@@ -170,11 +170,11 @@ pub fn loop_value(l: &DualLoop, theta: &[f64]) -> f64 {
 fn angle_derivatives(theta: &[f64], f: usize) -> [[f64; 3]; 3] {
     let cot = |i: usize| 1.0 / theta[3 * f + i].tan();
     let mut d = [[0.0; 3]; 3];
-    for i in 0..3 {
+    for (i, row) in d.iter_mut().enumerate() {
         let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-        d[i][i] = cot(j) + cot(k);
-        d[i][j] = -cot(k);
-        d[i][k] = -cot(j);
+        row[i] = cot(j) + cot(k);
+        row[j] = -cot(k);
+        row[k] = -cot(j);
     }
     d
 }
@@ -208,12 +208,10 @@ fn jacobian(mesh: &Mesh, theta: &[f64], loops: &[DualLoop]) -> Vec<Vec<(u32, f64
     for f in 0..mesh.n_faces() {
         let d = angle_derivatives(theta, f);
         let e = edges(f);
-        for i in 0..3 {
+        for (i, di) in d.iter().enumerate() {
             let v = mesh.corner_vertex((3 * f + i) as u32) as usize;
             if v > 0 {
-                for j in 0..3 {
-                    rows[v - 1].push((e[j], d[i][j]));
-                }
+                rows[v - 1].extend(e.iter().zip(di).map(|(&ej, &x)| (ej, x)));
             }
         }
     }
@@ -222,9 +220,7 @@ fn jacobian(mesh: &Mesh, theta: &[f64], loops: &[DualLoop]) -> Vec<Vec<(u32, f64
             let (f, i) = (c as usize / 3, c as usize % 3);
             let d = angle_derivatives(theta, f);
             let e = edges(f);
-            for j in 0..3 {
-                rows[nv - 1 + k].push((e[j], s * d[i][j]));
-            }
+            rows[nv - 1 + k].extend(e.iter().zip(&d[i]).map(|(&ej, &x)| (ej, s * x)));
         }
     }
     rows

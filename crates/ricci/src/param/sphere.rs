@@ -29,6 +29,10 @@ use crate::progress::Progress;
 use serde::Serialize;
 use std::time::Instant;
 
+/// The common subdivision of [`SphereMap`]: its points on the input surface, its points on
+/// the sphere, its triangles.
+pub type Subdivision = (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<[u32; 3]>);
+
 /// The result of [`sphere_map`].
 #[derive(Debug, Clone, Serialize)]
 pub struct SphereMap {
@@ -41,7 +45,7 @@ pub struct SphereMap {
     /// With `uv_faces = "common-subdivision"`: its points on the input surface, its points
     /// on the sphere and its triangles (counter-clockwise seen from outside).
     #[serde(skip)]
-    pub subdivision: Option<(Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<[u32; 3]>)>,
+    pub subdivision: Option<Subdivision>,
     /// Input faces not positively oriented as chord triangles of their vertices' points.
     pub input_flipped_faces: usize,
     pub scheme: String,
