@@ -534,21 +534,6 @@ const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
         "Newton step, line search and stopping rules inline; flow branch",
     ),
     (
-        "crates/ricci/src/flow/sphere.rs",
-        "",
-        "puncture, flow and Möbius normalization in one file; flow branch",
-    ),
-    (
-        "crates/ricci/src/flow/sphere.rs",
-        "puncture_route",
-        "the puncture's route search inline; flow branch",
-    ),
-    (
-        "crates/ricci/src/flow/sphere.rs",
-        "conformal_sphere",
-        "the whole spherical pipeline inline; flow branch",
-    ),
-    (
         "crates/ricci/src/layout/deck.rs",
         "deck_group",
         "generators, relation check and report inline; layout branch",

@@ -1,4 +1,4 @@
-//! `ricci param MESH [--out UV.obj] [--svg UV.svg] [--cones auto|none|N|V=K,…|file:PATH]
+//! `ricci param MESH [--out UV.obj] [--svg UV.svg] [--png UV.png] [--cones auto|none|N|V=K,…|file:PATH]
 //! [--max-area-distortion D] [--boundary free|round|fixed-angles] [--sphere] [--seamless]
 //! [--cone-corrections R] [--margin M] [--json]`: a conformal UV map of the mesh in one command
 //! (`ricci::param::parametrize`): conformal flow with intrinsic Delaunay flips, a cut through
@@ -21,14 +21,15 @@
 //! (σmax/σmin per face), `log_area_sigma` (σ of log(A_uv/A_3d)), `cones`, `seam_length`,
 //! per-chart details and `seconds`.
 
+mod picture;
+
 use crate::util::read_surface;
 use crate::util::{print_json, write_atomic, UsageError};
 use ricci::flow::target::{parse_angle, resolve};
 use ricci::flow::TargetSpec;
 use ricci::layout::export::obj_with_corner_uv;
 use ricci::metric::Geometry;
-use ricci::param::sphere::sphere_map;
-use ricci::param::svg::uv_svg;
+use ricci::param::sphere::{sphere_map, SphereMap};
 use ricci::param::{parametrize, BoundaryMode, ConeSpec, ParamOptions};
 use serde_json::json;
 use std::path::PathBuf;
@@ -44,6 +45,9 @@ pub struct Args {
     /// Output SVG picture of the UV layout (seams blue, cones red, flipped faces red).
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    /// Output PNG picture of the UV layout (the same picture as --svg).
+    #[arg(long)]
+    pub png: Option<PathBuf>,
     /// Cones of closed components: auto | none | N | V=K,... | file:PATH.
     #[arg(long)]
     pub cones: Option<String>,
@@ -140,19 +144,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let m = sphere_map(&surface, &mut bar).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
         bar.0.finish_and_clear();
         if let Some(path) = &a.out {
-            let mut text = format!("# ricci param --sphere of {name}: points on the unit sphere\n");
-            for p in &m.positions {
-                text.push_str(&format!("v {:e} {:e} {:e}\n", p[0], p[1], p[2]));
-            }
-            for t in surface.mesh.faces() {
-                text.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
-            }
-            write_atomic(path, text.as_bytes())?;
+            write_atomic(path, sphere_obj(&name, &surface, &m).as_bytes())?;
         }
         let out = json!({
             "file": name, "mode": "sphere", "vertices": surface.mesh.n_vertices(),
-            "faces": surface.mesh.n_faces(), "uv_faces": "input",
-            "flipped_faces": m.stats.flipped_faces, "qc_mean": m.stats.qc_mean,
+            "faces": surface.mesh.n_faces(), "uv_faces": m.uv_faces,
+            "flipped_faces": m.stats.flipped_faces,
+            "input_flipped_faces": m.input_flipped_faces, "qc_mean": m.stats.qc_mean,
             "qc_p95": m.stats.qc_p95, "qc_max": m.stats.qc_max,
             "log_area_sigma": m.stats.log_area_sigma, "sphere": m,
             "seconds": t0.elapsed().as_secs_f64(),
@@ -210,16 +208,21 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         };
         write_atomic(path, text.as_bytes())?;
     }
-    if let Some(path) = &a.svg {
+    if a.svg.is_some() || a.png.is_some() {
         let cv: Vec<u32> = cones.iter().map(|c| c.vertex).collect();
-        let svg = match &p.subdivision {
+        let fig = match &p.subdivision {
             Some(m) => {
                 let cv: Vec<u32> = cv.iter().map(|&v| m.input_vertex[v as usize]).collect();
-                uv_svg(&m.mesh, &m.corner_uv, &m.seam, &cv, 1024.0, 300_000)
+                picture::uv_figure(&m.mesh, &m.corner_uv, &m.seam, &cv, 1024.0)
             }
-            None => uv_svg(&surface.mesh, &p.corner_uv, &p.seam, &cv, 1024.0, 300_000),
+            None => picture::uv_figure(&surface.mesh, &p.corner_uv, &p.seam, &cv, 1024.0),
         };
-        write_atomic(path, svg.as_bytes())?;
+        if let Some(path) = &a.svg {
+            write_atomic(path, fig.to_svg().as_bytes())?;
+        }
+        if let Some(path) = &a.png {
+            write_atomic(path, &fig.to_png(1.0)?)?;
+        }
     }
     let uv = match &p.subdivision {
         Some(m) => json!({
@@ -247,6 +250,26 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "seconds": t0.elapsed().as_secs_f64(),
     });
     report(&a, &out)
+}
+
+/// The OBJ of `--sphere`: the input's faces on the sphere, or the common subdivision's.
+fn sphere_obj(name: &str, surface: &ricci::mesh::Surface, m: &SphereMap) -> String {
+    let (points, faces, what) = match &m.subdivision {
+        Some((_, p, t)) => (
+            &p[..],
+            &t[..],
+            "the common subdivision of the input and the flow's triangulation",
+        ),
+        None => (&m.positions[..], surface.mesh.faces(), "the input's faces"),
+    };
+    let mut text = format!("# ricci param --sphere of {name}: {what} on the unit sphere\n");
+    for p in points {
+        text.push_str(&format!("v {:e} {:e} {:e}\n", p[0], p[1], p[2]));
+    }
+    for t in faces {
+        text.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+    }
+    text
 }
 
 fn report(a: &Args, out: &serde_json::Value) -> anyhow::Result<()> {

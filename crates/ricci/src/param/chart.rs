@@ -4,12 +4,13 @@
 //! own faces when they do not fold, otherwise on the common subdivision of the input and the
 //! flat triangulation.
 
+use super::boundary::fixed_angle_targets;
 use super::cones::{correct_cone_curvatures, greedy_cones, round_to_quarter_turns, ConeBudget};
 use super::transfer::{
     folded_faces, input_route, scale_to_area, seam_edges, seam_report, subdivision_route,
     SubdivisionChart,
 };
-use super::{fixed_angle_targets, log_scale_sigma, BoundaryMode, Chart, Cone, ConeSpec};
+use super::{log_scale_sigma, BoundaryMode, Chart, Cone, ConeSpec};
 use super::{ParamOptions, Piece};
 use crate::error::{Error, Result};
 use crate::flow::{ricci_flow, FlowOptions, FlowResult, TargetSpec};
@@ -248,7 +249,32 @@ pub(super) fn chart_uv(
         closed_target(piece, component, comp.genus, opts, &lengths, progress)?
     };
     let kept = flow_with_corrections(piece, component, &lengths, &plan, opts, progress)?;
-    let r = &kept.r;
+    let seamless_metric;
+    let r = if opts.seamless && comp.genus > 0 && comp.boundary_loops == 0 {
+        // Closed genus ≥ 1: the least change of log lengths that makes the holonomy of the
+        // homology loops quarter turns too (`seamless`, CSZZ 2019).
+        let t_mesh = &kept
+            .r
+            .triangulation
+            .as_ref()
+            .ok_or_else(|| Error::numerical("the conformal flow returned no triangulation"))?
+            .simplicial
+            .mesh;
+        let lengths = super::seamless::chart_holonomy(
+            t_mesh,
+            &kept.r.lengths,
+            mesh.n_vertices(),
+            &kept.cones,
+            progress,
+        )?;
+        seamless_metric = FlowResult {
+            lengths,
+            ..kept.r.clone()
+        };
+        &seamless_metric
+    } else {
+        &kept.r
+    };
     let cone_vertices: Vec<u32> = kept.cones.iter().map(|c| c.0).collect();
     let needs_cut = comp.boundary_loops != 1 || comp.genus > 0 || !cone_vertices.is_empty();
     progress.report("cut", None, "cut graph through the cones and the handles");

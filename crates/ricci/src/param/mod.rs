@@ -21,9 +21,9 @@
 //!    (Soliman–Slepčev–Crane 2018 §4 with the positions fixed) and the flow runs again.
 //!    `--seamless` rounds cone curvatures to multiples of π/2 ([`cones::round_to_quarter_turns`];
 //!    Campen–Shen–Zhou–Zorin 2019 §3): on genus 0 every transition across a seam is then a
-//!    rotation by a multiple of 90° (the holonomy around a cone is its curvature). On genus
-//!    ≥ 1 the holonomy of the homology loops is not constrained by the flow here, and the
-//!    report says how far the transitions are from quarter turns.
+//!    rotation by a multiple of 90° (the holonomy around a cone is its curvature). On closed
+//!    genus ≥ 1 the flow's metric is then changed by the least change of log lengths that
+//!    makes the holonomy of `2g` homology loops multiples of π/2 as well ([`seamless`]).
 //! 2. **Conformal flow** with intrinsic Delaunay flips ([`crate::flow`], `Scheme::Conformal`:
 //!    discrete conformal equivalence of Gu–Luo–Sun–Wu 2018 / Springborn 2020, solved by
 //!    Newton's method on the convex energy). The result is a flat metric with cones on a
@@ -45,8 +45,10 @@
 //! 6. **Packing**: each chart scaled to its surface area, rotated to its smallest bounding
 //!    box (not with `--seamless`), shelf-packed and scaled into `[margin, 1 − margin]²`.
 
+pub mod boundary;
 mod chart;
 pub mod cones;
+pub mod seamless;
 pub mod seams;
 pub mod sphere;
 pub mod svg;
@@ -59,9 +61,7 @@ use crate::analysis::distortion::{uv_stats, DistortionStats};
 use crate::error::{Error, Result};
 use crate::mesh::{topology, Mesh, Surface, NONE};
 use crate::progress::Progress;
-use cones::round_to_quarter_turns;
 use serde::Serialize;
-use std::f64::consts::PI;
 use std::time::Instant;
 
 /// Which cones a closed chart gets.
@@ -291,44 +291,6 @@ fn pieces(s: &Surface) -> Result<Vec<Piece>> {
         });
     }
     Ok(out)
-}
-
-/// Boundary targets of `fixed-angles` (module docs), optionally rounded to quarter turns.
-fn fixed_angle_targets(mesh: &Mesh, lengths: &[f64], seamless: bool) -> Vec<f64> {
-    let k = cones::angle_defects(mesh, lengths);
-    let n = mesh.n_vertices();
-    let chi = crate::metric::euler_characteristic(mesh) as f64;
-    let mut dual = vec![0.0; n];
-    for e in 0..mesh.n_edges() as u32 {
-        if mesh.is_boundary_edge(e) {
-            let [a, b] = mesh.edge_vertices(e);
-            dual[a as usize] += 0.5 * lengths[e as usize];
-            dual[b as usize] += 0.5 * lengths[e as usize];
-        }
-    }
-    let total_dual: f64 = dual.iter().sum();
-    let kb: f64 = (0..n)
-        .filter(|&v| mesh.is_boundary_vertex(v as u32))
-        .map(|v| k[v])
-        .sum();
-    let rest = 2.0 * PI * chi - kb;
-    let mut t = vec![0.0; n];
-    for v in 0..n {
-        if mesh.is_boundary_vertex(v as u32) {
-            t[v] = k[v] + rest * dual[v] / total_dual;
-        }
-    }
-    if seamless {
-        let list: Vec<(u32, f64)> = (0..n as u32)
-            .filter(|&v| mesh.is_boundary_vertex(v))
-            .map(|v| (v, t[v as usize]))
-            .collect();
-        t = vec![0.0; n];
-        for (v, x) in round_to_quarter_turns(&list, 2.0 * PI * chi, 1) {
-            t[v as usize] = x;
-        }
-    }
-    t
 }
 
 /// Area-weighted standard deviation of the log area ratio `2u` of a conformal factor `u` per
