@@ -648,16 +648,6 @@ const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
         "run",
         "CLI render: options, fields and pictures inline; to split",
     ),
-    (
-        "crates/ricci-render/src/plot.rs",
-        "",
-        "plots of every kind in one file; to split by plot kind",
-    ),
-    (
-        "crates/ricci-render/src/plot.rs",
-        "layout_figure",
-        "the layout figure's panels inline; to split",
-    ),
 ];
 
 /// Byte ranges of the inline `#[cfg(test)] mod … { … }` blocks of stripped code.
