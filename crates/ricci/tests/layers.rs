@@ -643,11 +643,6 @@ const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
         "run",
         "forms: report assembly inline; split next",
     ),
-    (
-        "crates/ricci-cli/src/cmd/render.rs",
-        "run",
-        "CLI render: options, fields and pictures inline; to split",
-    ),
 ];
 
 /// Byte ranges of the inline `#[cfg(test)] mod … { … }` blocks of stripped code.
