@@ -579,11 +579,6 @@ const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
         "the whole spherical pipeline inline; flow branch",
     ),
     (
-        "crates/ricci/src/layout/deck.rs",
-        "deck_group",
-        "generators, relation check and report inline; layout branch",
-    ),
-    (
         "crates/ricci/src/metric/common_subdivision.rs",
         "",
         "tracing, overlay and its checks in one file; rewritten on another branch",
