@@ -549,21 +549,6 @@ const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
         "one handle's loops found and fixed inline; cut branch",
     ),
     (
-        "crates/ricci/src/flow/conformal.rs",
-        "solve",
-        "flips, Newton and line search of the conformal solve inline; flow branch",
-    ),
-    (
-        "crates/ricci/src/flow/mod.rs",
-        "ricci_flow",
-        "scheme setup, solve and report inline; flow branch",
-    ),
-    (
-        "crates/ricci/src/flow/newton.rs",
-        "newton",
-        "Newton step, line search and stopping rules inline; flow branch",
-    ),
-    (
         "crates/ricci/src/flow/sphere.rs",
         "",
         "puncture, flow and Möbius normalization in one file; flow branch",
