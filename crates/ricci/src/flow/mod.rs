@@ -38,9 +38,13 @@ pub mod newton;
 pub mod polish;
 pub mod sphere;
 pub mod target;
+pub mod uniformize;
 
 pub use adaptive::ricci_flow_refined;
 pub use target::{separated_vertices, Target, TargetSpec};
+pub use uniformize::{
+    flow_with_fallback, Fallback, FallbackFlow, TargetPolicy, UniformizationOptions,
+};
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
