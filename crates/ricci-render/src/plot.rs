@@ -22,6 +22,7 @@ pub use layout::{
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::color::{self, Colormap};
     use crate::shapes;
 
     fn parse(svg: &str) -> roxmltree::Document<'_> {
