@@ -16,6 +16,8 @@
 //! * [`gltf`] — glTF 2.0 binary (`.glb`) with positions, normals, UVs and an embedded checker
 //!   texture.
 //! * [`loops`] — closed curves on a surface as an SVG sketch (the canonical cut's loops).
+//! * [`atlas`] — the charts of a flat atlas as SVG (one chart, or all mapped into the
+//!   central chart).
 //! * [`fields`] — per-vertex and per-face quantities worth looking at (angle defect, mean
 //!   curvature, area distortion, angle ratios), computed from the same plain slices.
 //!
@@ -24,6 +26,7 @@
 
 #![allow(clippy::needless_range_loop)] // index loops over xyz read best in numeric code
 
+pub mod atlas;
 pub mod camera;
 pub mod color;
 pub mod fields;

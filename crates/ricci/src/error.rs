@@ -51,6 +51,27 @@ impl fmt::Display for Location {
     }
 }
 
+/// The record of an input file an error is about (a mesh file's vertex, face, …). Indices are
+/// 0-based, in the order the records appear in the file (the message may show a format's own
+/// numbering, e.g. OBJ's 1-based vertices).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Record {
+    /// The file as a whole (nothing to read, a statement that is not of this format, …).
+    #[default]
+    File,
+    /// A header line (OFF header and counts, PLY header, STL binary header).
+    Header,
+    /// The vertex with this index.
+    Vertex(usize),
+    /// The texture coordinate (`vt`) with this index.
+    TextureCoordinate(usize),
+    /// The face (polygon, facet, triangle) with this index.
+    Face(usize),
+    /// Another element of a PLY file: its name and the index of the record.
+    Element { name: String, index: usize },
+}
+
 /// All errors of the library.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
@@ -61,9 +82,14 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
-    /// A file could not be parsed.
+    /// A file could not be parsed: where, which record (as data; [`Record::File`] when the
+    /// error is not about one record) and what is wrong.
     #[error("{location}: {message}")]
-    Parse { location: Location, message: String },
+    Parse {
+        location: Location,
+        record: Record,
+        message: String,
+    },
     /// The mesh is not a valid oriented 2-manifold triangle mesh (non-manifold, non-orientable, …).
     #[error("{}{message}", prefix(.file))]
     InvalidMesh {
@@ -98,6 +124,7 @@ impl Error {
     pub fn parse(location: Location, message: impl Into<String>) -> Self {
         Error::Parse {
             location,
+            record: Record::File,
             message: message.into(),
         }
     }
@@ -122,6 +149,13 @@ impl Error {
             message: message.into(),
         }
     }
+    /// The record of an input file a [`Error::Parse`] is about (`None` for other errors).
+    pub fn record(&self) -> Option<&Record> {
+        match self {
+            Error::Parse { record, .. } => Some(record),
+            _ => None,
+        }
+    }
     /// Attach a file name to an error that does not carry one yet.
     pub fn in_file(self, file: &str) -> Self {
         match self {
@@ -134,10 +168,15 @@ impl Error {
             },
             Error::Parse {
                 mut location,
+                record,
                 message,
             } if location.file.is_none() => {
                 location.file = Some(file.to_string());
-                Error::Parse { location, message }
+                Error::Parse {
+                    location,
+                    record,
+                    message,
+                }
             }
             other => other,
         }

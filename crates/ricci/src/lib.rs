@@ -27,9 +27,9 @@
 //!
 //! [`error`] and [`progress`] are utilities every module may use. The order is checked by
 //! `tests/layers.rs` (every `crate::…` path of every source file); the few paths kept
-//! for code written against the old layout (`layout::dd::{Dd, Cdd}`, `flow::linear`,
-//! `mesh::refine`, `crate::simd`, `atlas::heron`, `spline::fit::{SplineSpace, evaluate, …}`)
-//! are marked *compatibility re-exports*.
+//! for code written against the old layout (`layout::dd::{Dd, Cdd}`, `mesh::refine`,
+//! `crate::simd`, `spline::fit::{SplineSpace, evaluate, …}`) are marked *compatibility
+//! re-exports*.
 //!
 //! Connectivity, metric and embedding are separate types: a [`mesh::Mesh`] knows who is next
 //! to whom, edge lengths live in plain `Vec<f64>` indexed by edge id, and positions live in a

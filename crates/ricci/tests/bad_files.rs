@@ -555,6 +555,11 @@ fn read_errors_carry_the_record_and_its_place_as_data() {
         ),
         "{e}"
     );
-    // The conversion into ricci::Error keeps the sentence.
+    // The conversion into ricci::Error keeps the sentence and the record.
     assert_eq!(ricci::Error::from(e.clone()).to_string(), e.to_string());
+    assert_eq!(ricci::Error::from(e.clone()).record(), Some(&e.record));
+    // So does the library's reader that returns ricci::Error (the OFF face 3 above).
+    let off = TETRA_OFF.replace("3 2 0 3", "3 2 0 -1");
+    let e = ricci::mesh::io::parse(off.as_bytes(), Format::Off).unwrap_err();
+    assert_eq!(e.record(), Some(&Record::Face(3)), "{e}");
 }

@@ -11,7 +11,7 @@
 use crate::util::read_surface;
 use crate::util::{print_json, write_atomic, UsageError};
 use indicatif::{ProgressBar, ProgressStyle};
-use ricci::atlas::{svg, AffineAtlas, AtlasOptions, FlatCharts, Singularity};
+use ricci::atlas::{AffineAtlas, AtlasOptions, FlatCharts, Singularity};
 use ricci::flow::TargetSpec;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -235,4 +235,42 @@ fn print_summary(a: &Args, atlas: &AffineAtlas) {
         r.faces_without_home
     );
     println!("  wrote {}", a.out.display());
+}
+
+/// SVG pictures of an affine atlas: the library's charts and overview drawn by
+/// `ricci_render::atlas`.
+pub mod svg {
+    use ricci::atlas::{AffineAtlas, ChartId, FlatCharts};
+    use ricci_render::atlas::{self as pictures, FaceRole};
+
+    /// What face `f` is to chart `c`.
+    fn role(atlas: &AffineAtlas, c: ChartId, f: u32) -> FaceRole {
+        match atlas.home_chart(f) {
+            Some(h) if h == c => FaceRole::Home,
+            None => FaceRole::Singular,
+            _ => FaceRole::Other,
+        }
+    }
+
+    /// Chart `c` in its own coordinates (`None` if there is no such chart).
+    pub fn chart_svg(atlas: &AffineAtlas, c: ChartId, size: f64) -> Option<String> {
+        let (faces, coords) = atlas.chart_faces(c)?;
+        let roles: Vec<FaceRole> = faces.iter().map(|&f| role(atlas, c, f)).collect();
+        Some(pictures::chart_svg(c as usize, coords, &roles, size))
+    }
+
+    /// The central chart with every other chart's home faces mapped into it (empty if the
+    /// atlas has no chart).
+    pub fn overview_svg(atlas: &AffineAtlas, size: f64) -> String {
+        let Some((faces, coords)) = atlas.chart_faces(0) else {
+            return String::new();
+        };
+        let roles: Vec<FaceRole> = faces.iter().map(|&f| role(atlas, 0, f)).collect();
+        let others: Vec<(usize, Vec<pictures::Corners>)> = atlas
+            .overview()
+            .into_iter()
+            .map(|(c, tris)| (c as usize, tris))
+            .collect();
+        pictures::overview_svg(coords, &roles, &others, atlas.n_charts(), size)
+    }
 }

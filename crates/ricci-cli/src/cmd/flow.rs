@@ -166,7 +166,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 /// The flow's options from the arguments: the geometry, target and scheme the surface's
 /// topology calls for unless given.
 fn flow_options(a: &Args, surface: &ricci::mesh::Surface) -> anyhow::Result<FlowOptions> {
-    let bordered = surface.mesh.has_boundary();
     // Targets that name a flat metric (cones, free or round boundary) or a hyperbolic one.
     let flat = matches!(
         a.target,
@@ -179,14 +178,12 @@ fn flow_options(a: &Args, surface: &ricci::mesh::Surface) -> anyhow::Result<Flow
         Some(g) => g,
         None if flat => Geometry::Euclidean,
         None if matches!(a.target, Some(TargetSpec::GeodesicBoundary)) => Geometry::Hyperbolic,
-        None => ricci::layout::pipeline::uniformization_geometry(&surface.mesh)
+        None => ricci::flow::uniformize::uniformization_geometry(&surface.mesh)
             .map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?,
     };
     let target = match &a.target {
         Some(t) => t.clone(),
-        None if !bordered => TargetSpec::Uniform,
-        None if geometry == Geometry::Hyperbolic => TargetSpec::GeodesicBoundary,
-        None => TargetSpec::FreeBoundary,
+        None => ricci::flow::uniformize::topology_target(&surface.mesh, geometry),
     };
     Ok(FlowOptions {
         geometry,

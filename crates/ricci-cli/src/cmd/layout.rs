@@ -285,30 +285,21 @@ fn metric_and_flow(
         Some(g) => g,
         None => uniformization_geometry(&surface.mesh)?,
     };
-    // H²: 1e-12 (Newton's last step then lands near the double-precision floor ~5e-15 on the
-    // shared meshes; the deck group's accuracy is limited by this residual times ~sinh of
-    // the polygon's size, e.g. genus3's relation error is 7e-7 at 3e-12 and 5e-10 at 5e-15).
-    // E² and S²: 1e-11 (1e-12 stalls at rounding on some 20k-face meshes).
-    let mut opts = ricci::flow::FlowOptions {
-        geometry: g,
-        scheme: scheme.unwrap_or_else(|| ricci::flow::default_scheme(g)),
-        // S² (conformal): 1e-10, the bound — the spherical angles of horse's tiny
-        // triangles (legs shrunk ~1e-5 by the map) carry ~1e-11 of rounding.
-        tolerance: match g {
-            Geometry::Hyperbolic => 1e-12,
-            Geometry::Spherical => 1e-10,
-            Geometry::Euclidean => 1e-11,
-        },
-        ..Default::default()
-    };
-    opts.target = match target {
-        Some(t) => t
-            .parse()
-            .map_err(|e: String| UsageError(format!("--target: {e}")))?,
-        None if !surface.mesh.has_boundary() => ricci::flow::TargetSpec::Uniform,
-        None if g == Geometry::Hyperbolic => ricci::flow::TargetSpec::GeodesicBoundary,
-        None => ricci::flow::TargetSpec::FreeBoundary,
-    };
+    // The uniformization options of the layout pipeline: the tolerance per geometry
+    // (`layout_tolerance`) and the topology's target unless one is given.
+    let scheme = scheme.unwrap_or_else(|| ricci::flow::default_scheme(g));
+    let mut uniformization = ricci::flow::UniformizationOptions::single(
+        Some(g),
+        scheme,
+        ricci::flow::uniformize::layout_tolerance(g),
+    );
+    if let Some(t) = target {
+        uniformization.target = ricci::flow::TargetPolicy::Given(
+            t.parse()
+                .map_err(|e: String| UsageError(format!("--target: {e}")))?,
+        );
+    }
+    let opts = uniformization.flow_options(&surface.mesh, scheme, None)?;
     let r = ricci::flow::ricci_flow(&surface.mesh, &surface.edge_lengths(), &opts, progress)?;
     let mut report = json!({
         "source": "flow", "scheme": r.scheme, "target": r.target_description,

@@ -62,8 +62,8 @@ mod cover;
 pub mod develop;
 mod distortion;
 mod flat;
+mod overview;
 pub mod placement;
-pub mod svg;
 mod valence;
 
 pub use charts::{fit_rigid, ChartId, FlatCharts};
@@ -362,7 +362,3 @@ impl FlatCharts for AffineAtlas {
         (h != NONE).then_some(h)
     }
 }
-
-/// Compatibility re-export: Heron's formula (Kahan's stable form) moved to
-/// [`crate::numeric::heron`]; the path `ricci::atlas::heron` keeps working.
-pub use crate::numeric::heron;

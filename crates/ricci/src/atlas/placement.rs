@@ -284,8 +284,8 @@ fn log_area_derivatives(
         let fv = mesh.face(f);
         let e = mesh.face_edges_opposite(f);
         let s = e.map(|e| l[e as usize]);
-        let a0 = super::heron(s);
-        let a_in = super::heron(e.map(|e| lengths[e as usize]));
+        let a0 = crate::numeric::heron(s);
+        let a_in = crate::numeric::heron(e.map(|e| lengths[e as usize]));
         if !(a0 > 0.0 && a_in > 0.0) {
             continue;
         }

@@ -36,7 +36,6 @@
 
 #![allow(clippy::needless_range_loop)]
 
-use super::linear::SymmetricSolver;
 use super::newton::max_error;
 use super::target::Target;
 use super::IterationRecord;
@@ -45,6 +44,7 @@ use crate::mesh::NONE;
 use crate::metric::intrinsic::{length_of_lambda, IntrinsicTriangulation};
 use crate::metric::kernel::angle_derivatives;
 use crate::metric::{Euclidean, Geometry, HessianPattern, Hyperbolic, Spherical};
+use crate::numeric::sparse::SymmetricSolver;
 use crate::progress::Progress;
 use std::f64::consts::PI;
 use std::time::Instant;
@@ -307,7 +307,6 @@ pub fn solve(
 ) -> Result<ConformalOutcome> {
     let t0 = Instant::now();
     let n = tri.n_vertices;
-    let geometry = settings.geometry;
     if target.curvature.len() != n || target.fixed.len() != n {
         return Err(Error::input(format!(
             "target has {} values for {} vertices",
@@ -320,48 +319,30 @@ pub fn solve(
         held[p as usize] = true;
     }
     let dynamic = target.is_dynamic();
-    let mut pattern = GrowingPattern::new(&held);
-    let exact_round = dynamic;
+    let mut cn = ConformalNewton::new(tri, settings, held);
     let mut exact_steps = 0usize;
     let mut chord_steps = 0usize;
-    let mut values = Vec::new();
-    let mut u = vec![0.0; n];
-    let mut st = ConformalState::default();
-    let mut trial_st = ConformalState::default();
-    let mut mid_st = ConformalState::default();
     let mut history = Vec::new();
     let mut notes = Vec::new();
-    let mut flips = 0usize;
     let mut converged = false;
     let mut err;
     let mut it = 0;
-    let mut last_step = 0.0;
-    let mut energy = 0.0;
-    let mut delta = vec![0.0; n];
-    let mut trial = vec![0.0; n];
-    let mut rhs = vec![0.0; pattern.n()];
-    let c_armijo = 1e-4;
-    if !evaluate(tri, geometry, &u, settings.flip_budget, &mut st) {
+    if !cn.evaluate_at_u() {
         return Err(Error::numerical(format!(
             "the initial metric needed more than {} Delaunay flips",
             settings.flip_budget
         )));
     }
-    flips += st.flips;
-    let update_round = |tri: &IntrinsicTriangulation, u: &[f64], target: &mut Target| {
-        let lengths = tri.lengths(Geometry::Euclidean, u);
-        target.update_round(&lengths, &[], &[]);
-    };
     if dynamic {
-        update_round(tri, &u, target);
+        update_round(cn.tri, &cn.u, target);
     }
     loop {
-        err = max_error(&st.curvature, target);
+        err = max_error(&cn.st.curvature, target);
         history.push(IterationRecord {
             iteration: it,
             max_curvature_error: err,
-            energy: (!dynamic).then_some(energy),
-            step: last_step,
+            energy: (!dynamic).then_some(cn.energy),
+            step: cn.last_step,
             seconds: t0.elapsed().as_secs_f64(),
         });
         progress.report(
@@ -381,163 +362,52 @@ pub fn solve(
             break;
         }
         it += 1;
-        pattern.cover(tri)?;
-        pattern.assemble(tri, &st, &mut values);
-        // r = K̄ − K on the free vertices; with a scale pin the mean is removed (Gauss–Bonnet
-        // makes it vanish up to rounding, which would otherwise pile up at the pin).
-        let shift = if settings.pinned.is_empty() {
-            0.0
-        } else {
-            let (s, c) = (0..n)
-                .filter(|&i| !target.fixed[i])
-                .fold((0.0, 0usize), |(s, c), i| {
-                    (s + target.curvature[i] - st.curvature[i], c + 1)
-                });
-            s / c.max(1) as f64
-        };
-        for (c, &v) in pattern.free_vertex.iter().enumerate() {
-            rhs[c] = target.curvature[v as usize] - st.curvature[v as usize] - shift;
-        }
-        if dynamic && exact_round {
+        cn.assemble()?;
+        cn.newton_rhs(target);
+        if dynamic {
             // Exact Newton step on K(u) − K̄(u) = 0 with a residual line search; on failure a
             // chord step (target frozen) follows.
-            let mut accepted = false;
-            if let Some(d) = round_jacobian_step(&mut pattern, &values, tri, &u, target, &rhs) {
-                let r0 = residual_norm2(&st.curvature, target, &held);
-                let mut t = 1.0;
-                let mut trial_target = target.clone();
-                // Full and half steps only: a damped exact step makes little progress where
-                // the chord step does better.
-                for _ in 0..2 {
-                    for i in 0..n {
-                        trial[i] = u[i] + t * d[i];
-                    }
-                    if evaluate(tri, geometry, &trial, settings.flip_budget, &mut trial_st)
-                        && trial_st.degenerate_faces == 0
-                    {
-                        flips += trial_st.flips;
-                        update_round(tri, &trial, &mut trial_target);
-                        let r1 = residual_norm2(&trial_st.curvature, &trial_target, &held);
-                        let e1 = max_error(&trial_st.curvature, &trial_target);
-                        if r1 <= (1.0 - 2e-4 * t) * r0 || e1 <= 0.5 * err {
-                            accepted = true;
-                            break;
-                        }
-                    } else {
-                        flips += trial_st.flips;
-                    }
-                    t *= 0.5;
-                }
-                if accepted {
-                    last_step = d.iter().map(|x| (t * x).abs()).fold(0.0, f64::max);
-                    std::mem::swap(&mut st, &mut trial_st);
-                    std::mem::swap(&mut u, &mut trial);
-                    *target = trial_target;
-                    exact_steps += 1;
-                    continue;
-                }
+            if cn.exact_round_step(target, err) {
+                exact_steps += 1;
+                continue;
             }
             chord_steps += 1;
             // The triangulation may have moved during the trials: back to Delaunay at u.
-            if !evaluate(tri, geometry, &u, settings.flip_budget, &mut st) {
+            if !cn.evaluate_at_u() {
                 notes.push(format!("iteration {it}: flip budget exceeded"));
                 break;
             }
-            flips += st.flips;
-            pattern.cover(tri)?;
-            pattern.assemble(tri, &st, &mut values);
+            cn.assemble()?;
         }
-        let solver = pattern.solver.as_mut().expect("pattern covered");
-        let mut step = rhs.clone();
-        if solver.factor_llt(&values) {
-            solver.solve(&mut step);
-        } else {
+        if !cn.newton_direction() {
             notes.push(format!(
                 "iteration {it}: the Hessian was not numerically positive definite; gradient step"
             ));
         }
-        delta.iter_mut().for_each(|x| *x = 0.0);
-        for (c, &v) in pattern.free_vertex.iter().enumerate() {
-            delta[v as usize] = step[c];
-        }
-        // g(t) = (K(u + tδ) − K̄)·δ.
-        let grad = |s: &ConformalState, target: &Target| -> f64 {
-            let mut g = 0.0;
-            for i in 0..n {
-                if !held[i] {
-                    g += (s.curvature[i] - target.curvature[i]) * delta[i];
-                }
-            }
-            g
-        };
-        let g0 = grad(&st, target);
+        let g0 = cn.slope(&cn.st, target);
         if g0.is_nan() || g0 >= 0.0 {
             notes.push(format!(
                 "iteration {it}: the Newton direction is not a descent direction (g = {g0:.3e})"
             ));
             break;
         }
-        let mut t = 1.0;
-        let mut accepted = false;
-        let mut need_reevaluation = false;
-        for _ in 0..40 {
-            for i in 0..n {
-                trial[i] = u[i] + t * delta[i];
-            }
-            // Faces violating the triangle inequality (angles extended by 0, 0, π; the energy
-            // stays convex and C¹) are accepted only if the start had as many: a start outside
-            // the domain can come back, a valid iterate never leaves it.
-            if evaluate(tri, geometry, &trial, settings.flip_budget, &mut trial_st)
-                && trial_st.degenerate_faces <= st.degenerate_faces
-            {
-                flips += trial_st.flips;
-                let gt = grad(&trial_st, target);
-                let et = max_error(&trial_st.curvature, target);
-                let mut ok = gt <= c_armijo * g0 || et <= 0.5 * err;
-                let mut de = t * gt;
-                if !ok {
-                    need_reevaluation = true;
-                    for i in 0..n {
-                        trial[i] = u[i] + 0.5 * t * delta[i];
-                    }
-                    if evaluate(tri, geometry, &trial, settings.flip_budget, &mut mid_st) {
-                        flips += mid_st.flips;
-                        let gh = grad(&mid_st, target);
-                        de = t * (g0 + 4.0 * gh + gt) / 6.0;
-                        ok = de <= c_armijo * t * g0;
-                    }
-                    for i in 0..n {
-                        trial[i] = u[i] + t * delta[i];
-                    }
-                }
-                if ok {
-                    energy += de.min(0.0);
-                    accepted = true;
-                    break;
-                }
-            } else {
-                flips += trial_st.flips;
-            }
-            t *= 0.5;
-        }
-        if !accepted {
+        let Some((t, need_reevaluation)) = cn.line_search(target, err, g0) else {
             notes.push(format!("iteration {it}: the line search found no decrease"));
             break;
-        }
+        };
         if need_reevaluation {
             // The triangulation may have moved on at t/2: make it Delaunay at the accepted u.
-            if !evaluate(tri, geometry, &trial, settings.flip_budget, &mut st) {
+            if !cn.evaluate_at_trial() {
                 notes.push(format!("iteration {it}: flip budget exceeded"));
                 break;
             }
-            flips += st.flips;
         } else {
-            std::mem::swap(&mut st, &mut trial_st);
+            std::mem::swap(&mut cn.st, &mut cn.trial_st);
         }
-        last_step = delta.iter().map(|x| (t * x).abs()).fold(0.0, f64::max);
-        std::mem::swap(&mut u, &mut trial);
+        cn.last_step = cn.delta.iter().map(|x| (t * x).abs()).fold(0.0, f64::max);
+        std::mem::swap(&mut cn.u, &mut cn.trial);
         if dynamic {
-            update_round(tri, &u, target);
+            update_round(cn.tri, &cn.u, target);
         }
     }
     if dynamic {
@@ -552,16 +422,240 @@ pub fn solve(
         ));
     }
     Ok(ConformalOutcome {
-        u,
+        u: cn.u,
         iterations: it,
         history,
         converged,
         max_error: err,
-        flips,
-        symbolic_factorizations: pattern.symbolic_count,
-        state: st,
+        flips: cn.flips,
+        symbolic_factorizations: cn.pattern.symbolic_count,
+        state: cn.st,
         notes,
     })
+}
+
+/// Round boundaries: the target `K̄` re-evaluated from the boundary lengths of the metric `u`.
+fn update_round(tri: &IntrinsicTriangulation, u: &[f64], target: &mut Target) {
+    let lengths = tri.lengths(Geometry::Euclidean, u);
+    target.update_round(&lengths, &[], &[]);
+}
+
+/// Armijo's constant of the line searches.
+const C_ARMIJO: f64 = 1e-4;
+
+/// The state of one Newton solve of [`solve`]: the triangulation, the iterate `u` and its
+/// evaluation `st`, trial points, the growing Hessian pattern and its values, the step.
+struct ConformalNewton<'a> {
+    tri: &'a mut IntrinsicTriangulation,
+    settings: &'a ConformalSettings,
+    held: Vec<bool>,
+    pattern: GrowingPattern,
+    values: Vec<f64>,
+    /// `K̄ − K` on the free vertices (with the scale pin's mean removed).
+    rhs: Vec<f64>,
+    u: Vec<f64>,
+    trial: Vec<f64>,
+    /// The Newton direction on all vertices.
+    delta: Vec<f64>,
+    st: ConformalState,
+    trial_st: ConformalState,
+    mid_st: ConformalState,
+    /// Ptolemy flips made so far.
+    flips: usize,
+    last_step: f64,
+    /// `E(u) − E(0)` as estimated by the accepted line searches.
+    energy: f64,
+}
+
+impl<'a> ConformalNewton<'a> {
+    fn new(
+        tri: &'a mut IntrinsicTriangulation,
+        settings: &'a ConformalSettings,
+        held: Vec<bool>,
+    ) -> Self {
+        let n = tri.n_vertices;
+        let pattern = GrowingPattern::new(&held);
+        ConformalNewton {
+            tri,
+            settings,
+            rhs: vec![0.0; pattern.n()],
+            pattern,
+            held,
+            values: Vec::new(),
+            u: vec![0.0; n],
+            trial: vec![0.0; n],
+            delta: vec![0.0; n],
+            st: ConformalState::default(),
+            trial_st: ConformalState::default(),
+            mid_st: ConformalState::default(),
+            flips: 0,
+            last_step: 0.0,
+            energy: 0.0,
+        }
+    }
+
+    /// Delaunay at `u` and its evaluation into `st`; false when the flip budget ran out.
+    fn evaluate_at_u(&mut self) -> bool {
+        let (geometry, budget) = (self.settings.geometry, self.settings.flip_budget);
+        if !evaluate(self.tri, geometry, &self.u, budget, &mut self.st) {
+            return false;
+        }
+        self.flips += self.st.flips;
+        true
+    }
+
+    /// Delaunay at `trial` and its evaluation into `st`; false when the flip budget ran out.
+    fn evaluate_at_trial(&mut self) -> bool {
+        let (geometry, budget) = (self.settings.geometry, self.settings.flip_budget);
+        if !evaluate(self.tri, geometry, &self.trial, budget, &mut self.st) {
+            return false;
+        }
+        self.flips += self.st.flips;
+        true
+    }
+
+    /// The Hessian of the current triangulation at `u` into `values`.
+    fn assemble(&mut self) -> Result<()> {
+        self.pattern.cover(self.tri)?;
+        self.pattern.assemble(self.tri, &self.st, &mut self.values);
+        Ok(())
+    }
+
+    /// r = K̄ − K on the free vertices; with a scale pin the mean is removed (Gauss–Bonnet
+    /// makes it vanish up to rounding, which would otherwise pile up at the pin).
+    fn newton_rhs(&mut self, target: &Target) {
+        let n = self.u.len();
+        let st = &self.st;
+        let shift = if self.settings.pinned.is_empty() {
+            0.0
+        } else {
+            let (s, c) = (0..n)
+                .filter(|&i| !target.fixed[i])
+                .fold((0.0, 0usize), |(s, c), i| {
+                    (s + target.curvature[i] - st.curvature[i], c + 1)
+                });
+            s / c.max(1) as f64
+        };
+        for (c, &v) in self.pattern.free_vertex.iter().enumerate() {
+            self.rhs[c] = target.curvature[v as usize] - st.curvature[v as usize] - shift;
+        }
+    }
+
+    /// Round boundaries: the exact Newton step on `K(u) − K̄(u) = 0`, tried at `t = 1` and
+    /// `½` with the residual test. When accepted, `u`, `st` and `target` move to it (true).
+    fn exact_round_step(&mut self, target: &mut Target, err: f64) -> bool {
+        let (geometry, budget) = (self.settings.geometry, self.settings.flip_budget);
+        let rhs = &self.rhs;
+        let Some(d) = round_jacobian_step(
+            &mut self.pattern,
+            &self.values,
+            self.tri,
+            &self.u,
+            target,
+            rhs,
+        ) else {
+            return false;
+        };
+        let r0 = residual_norm2(&self.st.curvature, target, &self.held);
+        let mut t = 1.0;
+        let mut trial_target = target.clone();
+        // Full and half steps only: a damped exact step makes little progress where the
+        // chord step does better.
+        for _ in 0..2 {
+            for i in 0..self.u.len() {
+                self.trial[i] = self.u[i] + t * d[i];
+            }
+            let ok = evaluate(self.tri, geometry, &self.trial, budget, &mut self.trial_st);
+            self.flips += self.trial_st.flips;
+            if ok && self.trial_st.degenerate_faces == 0 {
+                update_round(self.tri, &self.trial, &mut trial_target);
+                let r1 = residual_norm2(&self.trial_st.curvature, &trial_target, &self.held);
+                let e1 = max_error(&self.trial_st.curvature, &trial_target);
+                if r1 <= (1.0 - 2e-4 * t) * r0 || e1 <= 0.5 * err {
+                    self.last_step = d.iter().map(|x| (t * x).abs()).fold(0.0, f64::max);
+                    std::mem::swap(&mut self.st, &mut self.trial_st);
+                    std::mem::swap(&mut self.u, &mut self.trial);
+                    *target = trial_target;
+                    return true;
+                }
+            }
+            t *= 0.5;
+        }
+        false
+    }
+
+    /// The Newton direction `H δ = r` into `delta` (sparse Cholesky); when `H` does not
+    /// factorize, the gradient direction `δ = r` (false).
+    fn newton_direction(&mut self) -> bool {
+        let solver = self.pattern.solver.as_mut().expect("pattern covered");
+        let mut step = self.rhs.clone();
+        let factored = solver.factor_llt(&self.values);
+        if factored {
+            solver.solve(&mut step);
+        }
+        self.delta.iter_mut().for_each(|x| *x = 0.0);
+        for (c, &v) in self.pattern.free_vertex.iter().enumerate() {
+            self.delta[v as usize] = step[c];
+        }
+        factored
+    }
+
+    /// g(t) = (K(u + tδ) − K̄)·δ for the evaluation `s` at `u + tδ`.
+    fn slope(&self, s: &ConformalState, target: &Target) -> f64 {
+        let mut g = 0.0;
+        for i in 0..self.u.len() {
+            if !self.held[i] {
+                g += (s.curvature[i] - target.curvature[i]) * self.delta[i];
+            }
+        }
+        g
+    }
+
+    /// Backtracking along `delta` (module doc): `Some((t, whether st must be re-evaluated at
+    /// trial))` with `trial = u + tδ` evaluated in `trial_st`, or `None` after 40 halvings.
+    fn line_search(&mut self, target: &Target, err: f64, g0: f64) -> Option<(f64, bool)> {
+        let (geometry, budget) = (self.settings.geometry, self.settings.flip_budget);
+        let n = self.u.len();
+        let mut t = 1.0;
+        let mut need_reevaluation = false;
+        for _ in 0..40 {
+            for i in 0..n {
+                self.trial[i] = self.u[i] + t * self.delta[i];
+            }
+            // Faces violating the triangle inequality (angles extended by 0, 0, π; the energy
+            // stays convex and C¹) are accepted only if the start had as many: a start outside
+            // the domain can come back, a valid iterate never leaves it.
+            let ok = evaluate(self.tri, geometry, &self.trial, budget, &mut self.trial_st);
+            self.flips += self.trial_st.flips;
+            if ok && self.trial_st.degenerate_faces <= self.st.degenerate_faces {
+                let gt = self.slope(&self.trial_st, target);
+                let et = max_error(&self.trial_st.curvature, target);
+                let mut ok = gt <= C_ARMIJO * g0 || et <= 0.5 * err;
+                let mut de = t * gt;
+                if !ok {
+                    need_reevaluation = true;
+                    for i in 0..n {
+                        self.trial[i] = self.u[i] + 0.5 * t * self.delta[i];
+                    }
+                    if evaluate(self.tri, geometry, &self.trial, budget, &mut self.mid_st) {
+                        self.flips += self.mid_st.flips;
+                        let gh = self.slope(&self.mid_st, target);
+                        de = t * (g0 + 4.0 * gh + gt) / 6.0;
+                        ok = de <= C_ARMIJO * t * g0;
+                    }
+                    for i in 0..n {
+                        self.trial[i] = self.u[i] + t * self.delta[i];
+                    }
+                }
+                if ok {
+                    self.energy += de.min(0.0);
+                    return Some((t, need_reevaluation));
+                }
+            }
+            t *= 0.5;
+        }
+        None
+    }
 }
 
 /// `Σ (K_i − K̄_i)²` over the vertices that are not held.

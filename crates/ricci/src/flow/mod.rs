@@ -34,14 +34,17 @@
 
 pub mod adaptive;
 pub mod conformal;
-pub mod linear;
 pub mod newton;
 pub mod polish;
 pub mod sphere;
 pub mod target;
+pub mod uniformize;
 
 pub use adaptive::ricci_flow_refined;
 pub use target::{separated_vertices, Target, TargetSpec};
+pub use uniformize::{
+    flow_with_fallback, Fallback, FallbackFlow, TargetPolicy, UniformizationOptions,
+};
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
@@ -315,14 +318,9 @@ fn scale_pin(mesh: &Mesh, geometry: Geometry, target: &Target) -> (bool, Vec<u32
     (has_fixed, pinned)
 }
 
-/// Run discrete Ricci flow on a connected mesh with Euclidean edge `lengths` (by edge id).
-pub fn ricci_flow(
-    mesh: &Mesh,
-    lengths: &[f64],
-    options: &FlowOptions,
-    progress: &mut dyn Progress,
-) -> Result<FlowResult> {
-    let t0 = Instant::now();
+/// The input checks of [`ricci_flow`]: one component, one length per edge, a positive
+/// tolerance.
+fn check_flow_input(mesh: &Mesh, lengths: &[f64], options: &FlowOptions) -> Result<()> {
     let topo = crate::mesh::topology(mesh);
     if topo.components.len() != 1 {
         return Err(Error::topology(format!(
@@ -343,12 +341,21 @@ pub fn ricci_flow(
             options.tolerance
         )));
     }
+    Ok(())
+}
+
+/// The factor applied to the input lengths: `options.input_scale`, else 1 in E²; in H²/S² the
+/// factor that gives the area Gauss–Bonnet asks for, or mean edge length 0.1 with free
+/// boundaries.
+fn input_scale(
+    options: &FlowOptions,
+    chi: i64,
+    target: &Target,
+    lengths: &[f64],
+    euclid_area: f64,
+) -> f64 {
     let geometry = options.geometry;
-    let chi = euler_characteristic(mesh);
-    let mut target = target::resolve(mesh, geometry, &options.target)?;
-    // Input scale.
-    let euclid_area = crate::metric::total_area(mesh, Geometry::Euclidean, lengths);
-    let scale = match (options.input_scale, geometry) {
+    match (options.input_scale, options.geometry) {
         (Some(s), _) => s,
         (None, Geometry::Euclidean) => 1.0,
         (None, _) => {
@@ -363,7 +370,122 @@ pub fn ricci_flow(
                 0.1 / mean
             }
         }
-    };
+    }
+}
+
+/// The solver part of [`ricci_flow`] for the schemes other than [`Scheme::Conformal`].
+struct SolverCase<'a> {
+    mesh: &'a Mesh,
+    lengths: &'a [f64],
+    options: &'a FlowOptions,
+    chi: i64,
+    has_fixed: bool,
+    pinned: &'a [u32],
+}
+
+impl SolverCase<'_> {
+    /// Newton's method (with the puncture route for spheres) or the gradient flow from the
+    /// structure's `u0`: the outcome and the route taken; notes of the setup go to `notes`.
+    fn run(
+        &self,
+        ev: &mut Evaluator,
+        target: &mut Target,
+        notes: &mut Vec<String>,
+        progress: &mut dyn Progress,
+    ) -> Result<(newton::SolveOutcome, String)> {
+        let SolverCase {
+            mesh,
+            lengths,
+            options,
+            chi,
+            has_fixed,
+            pinned,
+        } = *self;
+        let geometry = options.geometry;
+        let u0 = ev.structure.u0.clone();
+        let line_search = if target.is_dynamic() || geometry == Geometry::Spherical {
+            newton::LineSearch::Residual
+        } else {
+            newton::LineSearch::Energy
+        };
+        let max_it = options.max_iterations.unwrap_or(match options.solver {
+            Solver::Newton => 30,
+            Solver::Gradient => 200_000,
+        });
+        let mut route = options.solver.name().to_string();
+        if ev.structure.clamped_edges > 0 {
+            notes.push(format!(
+                "{} of {} edges had their Thurston intersection angle clamped into [0, π/2] \
+                 (circles that did not meet were made tangent); the initial metric differs from the \
+                 input there (initial length error up to {:.1}%)",
+                ev.structure.clamped_edges,
+                mesh.n_edges(),
+                100.0 * ev.structure.initial_length_error
+            ));
+        }
+        let outcome = match options.solver {
+            Solver::Gradient => newton::gradient_flow(
+                ev,
+                target,
+                u0,
+                &newton::GradientSettings {
+                    tolerance: options.tolerance,
+                    max_iterations: max_it,
+                    step: options.gradient_step,
+                    keep_mean: geometry == Geometry::Euclidean && !has_fixed,
+                },
+                progress,
+            )?,
+            Solver::Newton => {
+                let settings = newton::NewtonSettings {
+                    tolerance: options.tolerance,
+                    max_iterations: max_it,
+                    line_search,
+                    pinned: pinned.to_vec(),
+                    indefinite: geometry == Geometry::Spherical,
+                };
+                let sphere_case = geometry == Geometry::Spherical && chi == 2 && !has_fixed;
+                if sphere_case && options.sphere_route == SphereRoute::Puncture {
+                    route = "puncture".into();
+                    sphere::puncture_route(mesh, lengths, ev, target, &settings, options, progress)?
+                } else {
+                    let out = newton::newton(ev, target, u0, &settings, progress)?;
+                    if sphere_case && !out.converged && options.sphere_route == SphereRoute::Auto {
+                        notes.push(format!(
+                            "spherical Newton did not converge (max |K − K̄| = {:.3e} after {} \
+                             iterations); switched to the puncture route",
+                            out.max_error, out.iterations
+                        ));
+                        notes.extend(out.notes.iter().cloned());
+                        route = "puncture".into();
+                        sphere::puncture_route(
+                            mesh, lengths, ev, target, &settings, options, progress,
+                        )?
+                    } else {
+                        out
+                    }
+                }
+            }
+        };
+        Ok((outcome, route))
+    }
+}
+
+/// Run discrete Ricci flow on a connected mesh with Euclidean edge `lengths` (by edge id).
+pub fn ricci_flow(
+    mesh: &Mesh,
+    lengths: &[f64],
+    options: &FlowOptions,
+    progress: &mut dyn Progress,
+) -> Result<FlowResult> {
+    let t0 = Instant::now();
+    check_flow_input(mesh, lengths, options)?;
+    let geometry = options.geometry;
+    let chi = euler_characteristic(mesh);
+    let mut target = target::resolve(mesh, geometry, &options.target)?;
+    // Input scale.
+    let euclid_area = crate::metric::total_area(mesh, Geometry::Euclidean, lengths);
+    let scale = input_scale(options, chi, &target, lengths, euclid_area);
     if options.scheme == Scheme::Conformal {
         return conformal_flow(
             mesh,
@@ -395,85 +517,16 @@ pub fn ricci_flow(
     target::check_chow_luo(mesh, geometry, &target, &phi)?;
 
     let (has_fixed, pinned) = scale_pin(mesh, geometry, &target);
-    let line_search = if target.is_dynamic() || geometry == Geometry::Spherical {
-        newton::LineSearch::Residual
-    } else {
-        newton::LineSearch::Energy
+    let case = SolverCase {
+        mesh,
+        lengths,
+        options,
+        chi,
+        has_fixed,
+        pinned: &pinned,
     };
-    let max_it = options.max_iterations.unwrap_or(match options.solver {
-        Solver::Newton => 30,
-        Solver::Gradient => 200_000,
-    });
-    let mut route = options.solver.name().to_string();
     let mut notes = Vec::new();
-    if ev.structure.clamped_edges > 0 {
-        notes.push(format!(
-            "{} of {} edges had their Thurston intersection angle clamped into [0, π/2] \
-             (circles that did not meet were made tangent); the initial metric differs from the \
-             input there (initial length error up to {:.1}%)",
-            ev.structure.clamped_edges,
-            mesh.n_edges(),
-            100.0 * ev.structure.initial_length_error
-        ));
-    }
-    let outcome = match options.solver {
-        Solver::Gradient => newton::gradient_flow(
-            &mut ev,
-            &mut target,
-            u0.clone(),
-            &newton::GradientSettings {
-                tolerance: options.tolerance,
-                max_iterations: max_it,
-                step: options.gradient_step,
-                keep_mean: geometry == Geometry::Euclidean && !has_fixed,
-            },
-            progress,
-        )?,
-        Solver::Newton => {
-            let settings = newton::NewtonSettings {
-                tolerance: options.tolerance,
-                max_iterations: max_it,
-                line_search,
-                pinned: pinned.clone(),
-                indefinite: geometry == Geometry::Spherical,
-            };
-            let sphere_case = geometry == Geometry::Spherical && chi == 2 && !has_fixed;
-            if sphere_case && options.sphere_route == SphereRoute::Puncture {
-                route = "puncture".into();
-                sphere::puncture_route(
-                    mesh,
-                    lengths,
-                    &mut ev,
-                    &mut target,
-                    &settings,
-                    options,
-                    progress,
-                )?
-            } else {
-                let out = newton::newton(&mut ev, &mut target, u0.clone(), &settings, progress)?;
-                if sphere_case && !out.converged && options.sphere_route == SphereRoute::Auto {
-                    notes.push(format!(
-                        "spherical Newton did not converge (max |K − K̄| = {:.3e} after {} \
-                         iterations); switched to the puncture route",
-                        out.max_error, out.iterations
-                    ));
-                    notes.extend(out.notes.iter().cloned());
-                    route = "puncture".into();
-                    sphere::puncture_route(
-                        mesh,
-                        lengths,
-                        &mut ev,
-                        &mut target,
-                        &settings,
-                        options,
-                        progress,
-                    )?
-                } else {
-                    out
-                }
-            }
-        }
-    };
+    let (outcome, route) = case.run(&mut ev, &mut target, &mut notes, progress)?;
     notes.extend(outcome.notes.iter().cloned());
     let mut u = outcome.u;
     // Final evaluation and normalization.

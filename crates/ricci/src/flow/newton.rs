@@ -35,12 +35,15 @@
 //! domain or increases the largest error tenfold; in E² without fixed vertices the mean of `u`
 //! is kept (the papers' normalization `Σ u = const`).
 
+mod line_search;
+
 use super::target::Target;
 use super::IterationRecord;
 use crate::error::Result;
 use crate::metric::{Evaluator, HessianPattern};
 use crate::numeric::sparse::{SparseLu, SymmetricSolver};
 use crate::progress::Progress;
+use line_search::{eval, LineSearchScratch, StepSearch};
 use std::time::Instant;
 
 /// How steps are accepted.
@@ -91,18 +94,6 @@ fn progress_fraction(e0: f64, e: f64, tol: f64) -> f64 {
     ((e0 / e).ln() / (e0 / tol).ln()).clamp(0.0, 1.0)
 }
 
-/// Evaluate at `u` (with targets following the metric unless `frozen`); false outside the
-/// domain.
-fn eval(ev: &mut Evaluator, target: &mut Target, u: &[f64], update_targets: bool) -> bool {
-    if !ev.evaluate(u) {
-        return false;
-    }
-    if update_targets && target.is_dynamic() {
-        target.update_round(&ev.ws.lengths, &ev.ws.dlengths, &ev.data.edges);
-    }
-    true
-}
-
 /// Newton's method from `u_start`.
 pub fn newton(
     ev: &mut Evaluator,
@@ -117,15 +108,9 @@ pub fn newton(
     for &p in &settings.pinned {
         held[p as usize] = true;
     }
-    let pattern = HessianPattern::new(&ev.data, &held);
-    let mut solver = SymmetricSolver::new(&pattern)?;
-    let nf = pattern.n();
-    let mut values = vec![0.0; pattern.nnz()];
-    let mut shifted = vec![0.0; pattern.nnz()];
-    let mut rhs = vec![0.0; nf];
+    let mut sys = NewtonSystem::new(HessianPattern::new(&ev.data, &held), n)?;
     let mut delta = vec![0.0; n];
-    let mut trial = vec![0.0; n];
-    let mut half = vec![0.0; n];
+    let mut scratch = LineSearchScratch::new(n);
     let mut frozen = target.curvature.clone();
     let mut u = u_start;
     let mut history = Vec::new();
@@ -136,15 +121,11 @@ pub fn newton(
     let mut err = f64::INFINITY;
     let mut e0 = f64::NAN;
     let mut it = 0;
-    let mut shifted_steps = 0usize;
-    let mut chord_steps = 0usize;
+    let mut counts = StepCounts::default();
     let mut exact_failed = false;
-    let mut rejected_exact = 0usize;
-    let mut mass = vec![0.0; n];
     let dynamic = target.is_dynamic();
-    let mut lu = SparseLu::new();
     loop {
-        if !ev.evaluate_with_hessian(&u, &pattern, &mut values) {
+        if !ev.evaluate_with_hessian(&u, &sys.pattern, &mut sys.values) {
             notes.push("the metric left the domain of the scheme".into());
             break;
         }
@@ -183,197 +164,55 @@ pub fn newton(
         // step on the convex energy after an exact step was rejected.
         let exact = !dynamic || !exact_failed;
         exact_failed = false;
-        let line_search = if dynamic && !exact {
-            LineSearch::Energy
-        } else {
-            settings.line_search
-        };
-        if dynamic && !exact {
-            chord_steps += 1;
+        let chord = dynamic && !exact;
+        if chord {
+            counts.chord += 1;
             frozen.copy_from_slice(&target.curvature);
         }
-        // Right-hand side r = K̄ − K on the free vertices. With a scale pin (E²), Gauss–Bonnet
-        // makes Σ r vanish over the prescribed vertices up to rounding; the rounding would
-        // accumulate at the pinned vertex (≈ 1e-10 on a million faces), so its mean is
-        // removed and spread evenly instead.
-        let shift = if settings.pinned.is_empty() {
-            0.0
-        } else {
-            let (sum, count) = (0..n)
-                .filter(|&i| !target.fixed[i])
-                .fold((0.0, 0usize), |(s, c), i| {
-                    (s + target.curvature[i] - ev.ws.curvature[i], c + 1)
-                });
-            sum / count.max(1) as f64
-        };
-        for (c, &v) in pattern.free_vertex.iter().enumerate() {
-            rhs[c] = target.curvature[v as usize] - ev.ws.curvature[v as usize] - shift;
-        }
-        let r0 = rhs.clone();
-        // Round boundaries, exact steps: solve J δ = K̄ − K with the full Jacobian by sparse
-        // LU ([`exact_round_step`]); if that fails, take a chord step instead.
-        let mut exact_delta = None;
-        if dynamic && exact {
-            match exact_round_step(ev, target, &pattern, &values, &r0, &mut lu) {
-                Some(d) => exact_delta = Some(d),
-                None => {
-                    exact_failed = true;
-                    rejected_exact += 1;
-                    continue;
-                }
+        let exact_round = dynamic && exact;
+        let r0 = match sys.direction(ev, target, settings, exact_round, err, &mut delta) {
+            Direction::Step(r0) => r0,
+            Direction::Rejected => {
+                exact_failed = true;
+                counts.rejected_exact += 1;
+                continue;
             }
-        }
-        let indefinite = settings.indefinite;
-        if settings.indefinite {
-            // S²: Levenberg–Marquardt damping with the lumped spherical mass matrix,
-            // (H + μM)δ = K̄ − K. On a round sphere H ≈ L − 2M has generalized eigenvalues
-            // l(l+1) − 2 = −2, 0 (×3, Möbius), 4, 10, …: μ < 1 keeps the system regular and
-            // bounds the steps along the Möbius near-kernel.
-            let mu = err.sqrt().min(0.5);
-            mass.iter_mut().for_each(|m| *m = 0.0);
-            for (f, t) in ev.data.faces.iter().enumerate() {
-                let a = (ev.ws.angles[3 * f] + ev.ws.angles[3 * f + 1] + ev.ws.angles[3 * f + 2]
-                    - std::f64::consts::PI)
-                    .max(0.0)
-                    / 3.0;
-                for &w in t {
-                    mass[w as usize] += a;
-                }
-            }
-            for &w in &pattern.free_vertex {
-                values[pattern.diag_slot[w as usize] as usize] += mu * mass[w as usize];
-            }
-        }
-        if let Some(d) = exact_delta {
-            rhs.copy_from_slice(&d);
-        } else {
-            let mut ok = if indefinite {
-                solver.factor_ldlt(&values)
-            } else {
-                solver.factor_llt(&values)
-            };
-            if !ok {
-                let dmax = pattern
-                    .free_vertex
-                    .iter()
-                    .map(|&v| values[pattern.diag_slot[v as usize] as usize].abs())
-                    .fold(0.0, f64::max);
-                let mut mu = 1e-12 * dmax.max(1e-300);
-                for _ in 0..6 {
-                    shifted.copy_from_slice(&values);
-                    for &v in &pattern.free_vertex {
-                        shifted[pattern.diag_slot[v as usize] as usize] += mu;
-                    }
-                    let good = if indefinite {
-                        solver.factor_ldlt(&shifted)
-                    } else {
-                        solver.factor_llt(&shifted)
-                    };
-                    if good {
-                        ok = true;
-                        shifted_steps += 1;
-                        break;
-                    }
-                    mu *= 100.0;
-                }
-            }
-            if !ok {
-                notes.push(format!(
-                    "iteration {it}: the Hessian could not be factorized (singular or indefinite)"
-                ));
+            Direction::Failed(why) => {
+                notes.push(format!("iteration {it}: {why}"));
                 break;
             }
-            solver.solve(&mut rhs);
-        }
-        delta.iter_mut().for_each(|d| *d = 0.0);
-        for (c, &v) in pattern.free_vertex.iter().enumerate() {
-            delta[v as usize] = rhs[c];
-        }
-        if delta.iter().any(|d| !d.is_finite()) {
-            notes.push(format!("iteration {it}: the Newton step is not finite"));
-            break;
-        }
-        // Line search. `tk` is the target the step is measured against (frozen for chords).
-        let use_frozen = dynamic && !exact;
-        let g0: f64 = -r0.iter().zip(&rhs).map(|(r, d)| r * d).sum::<f64>(); // ∇E·δ < 0
+        };
+        // Line search, against the frozen target for chord steps.
+        let g0: f64 = -r0.iter().zip(&sys.rhs).map(|(r, d)| r * d).sum::<f64>(); // ∇E·δ < 0
         let res0: f64 = r0.iter().map(|r| r * r).sum();
         // S² and exact round-boundary steps (indefinite systems): a trust region of 2 in u
         // (radii change by at most e²), against wild steps from a nearly singular system.
         let dmax = delta.iter().fold(0.0f64, |m, d| m.max(d.abs()));
-        let mut t: f64 = if (indefinite || (dynamic && exact)) && dmax > 2.0 {
+        let t_start: f64 = if (settings.indefinite || exact_round) && dmax > 2.0 {
             2.0 / dmax
         } else {
             1.0
         };
-        let mut accepted = false;
-        for _ in 0..40 {
-            for i in 0..n {
-                trial[i] = u[i] + t * delta[i];
-            }
-            if !eval(ev, target, &trial, !use_frozen) {
-                t *= 0.5;
-                continue;
-            }
-            let tk: &[f64] = if use_frozen {
-                &frozen
+        let search = StepSearch {
+            u: &u,
+            delta: &delta,
+            held: &held,
+            frozen: chord.then_some(&frozen[..]),
+            kind: if chord {
+                LineSearch::Energy
             } else {
-                &target.curvature
-            };
-            let err_t = max_error_against(&ev.ws.curvature, tk, &target.fixed);
-            let gt: f64 = (0..n)
-                .filter(|&i| !held[i])
-                .map(|i| (ev.ws.curvature[i] - tk[i]) * delta[i])
-                .sum();
-            let res_t: f64 = (0..n)
-                .filter(|&i| !held[i])
-                .map(|i| (ev.ws.curvature[i] - tk[i]).powi(2))
-                .sum();
-            let halves = err_t <= 0.5 * err && err_t.is_finite();
-            let good = match line_search {
-                LineSearch::Energy => {
-                    if halves {
-                        true
-                    } else {
-                        for i in 0..n {
-                            half[i] = u[i] + 0.5 * t * delta[i];
-                        }
-                        if !eval(ev, target, &half, !use_frozen) {
-                            t *= 0.5;
-                            continue;
-                        }
-                        let tk: &[f64] = if use_frozen {
-                            &frozen
-                        } else {
-                            &target.curvature
-                        };
-                        let gh: f64 = (0..n)
-                            .filter(|&i| !held[i])
-                            .map(|i| (ev.ws.curvature[i] - tk[i]) * delta[i])
-                            .sum();
-                        let de = t / 6.0 * (g0 + 4.0 * gh + gt);
-                        if de <= 1e-4 * t * g0 {
-                            energy += de;
-                            true
-                        } else {
-                            false
-                        }
-                    }
-                }
-                LineSearch::Residual => {
-                    (res_t <= (1.0 - 2e-4 * t) * res0 && err_t <= 2.0 * err) || halves
-                }
-            };
-            if good {
-                accepted = true;
-                break;
-            }
-            t *= 0.5;
-        }
-        if !accepted {
+                settings.line_search
+            },
+            g0,
+            res0,
+            err,
+            t_start,
+        };
+        let Some((t, de)) = search.run(ev, target, &mut scratch) else {
             if dynamic && exact {
                 // Take a frozen-target step instead.
                 exact_failed = true;
-                rejected_exact += 1;
+                counts.rejected_exact += 1;
                 continue;
             }
             notes.push(format!(
@@ -381,35 +220,17 @@ pub fn newton(
                  |K − K̄| = {err:.3e})"
             ));
             break;
+        };
+        if let Some(de) = de {
+            energy += de;
         }
         for i in 0..n {
             u[i] += t * delta[i];
         }
         last_step = t * delta.iter().fold(0.0f64, |m, d| m.max(d.abs()));
     }
-    if shifted_steps > 0 {
-        notes.push(format!(
-            "{shifted_steps} Newton step(s) needed a diagonal shift to factorize the Hessian"
-        ));
-    }
-    if settings.indefinite && it > 0 {
-        notes.push(
-            "spherical steps were damped: (H + μM)δ = K̄ − K with M the lumped area matrix and \
-             μ = min(½, √max|K − K̄|), LDLᵀ factorization"
-                .into(),
-        );
-    }
-    if rejected_exact > 0 {
-        notes.push(format!(
-            "{rejected_exact} exact round-boundary Newton step(s) were rejected by the line \
-             search and replaced by frozen-target steps"
-        ));
-    }
-    if chord_steps > 0 {
-        notes.push(format!(
-            "{chord_steps} step(s) with the round-boundary target frozen (convex chord steps)"
-        ));
-    }
+    counts.shifted = sys.shifted_steps;
+    counts.push_notes(settings.indefinite && it > 0, &mut notes);
     Ok(SolveOutcome {
         u,
         iterations: it,
@@ -420,15 +241,236 @@ pub fn newton(
     })
 }
 
-/// Largest |K − target| over the vertices that are not fixed.
-fn max_error_against(curvature: &[f64], target: &[f64], fixed: &[bool]) -> f64 {
-    curvature
+/// The linear algebra of the Newton steps: the Hessian's pattern and values, its sparse
+/// Cholesky/LDLᵀ solver, the sparse LU of the round-boundary Jacobian, and work vectors.
+struct NewtonSystem {
+    pattern: HessianPattern,
+    solver: SymmetricSolver,
+    lu: SparseLu,
+    values: Vec<f64>,
+    shifted: Vec<f64>,
+    /// `K̄ − K` on the free vertices, then the step on them.
+    rhs: Vec<f64>,
+    mass: Vec<f64>,
+    /// Factorizations that needed a diagonal shift.
+    shifted_steps: usize,
+}
+
+/// What [`NewtonSystem::direction`] found.
+enum Direction {
+    /// A step (in the caller's `delta`), with the right-hand side it solved for.
+    Step(Vec<f64>),
+    /// The exact round-boundary Jacobian could not be solved: take a chord step next.
+    Rejected,
+    /// No step (the reason, for the notes).
+    Failed(String),
+}
+
+impl NewtonSystem {
+    fn new(pattern: HessianPattern, n: usize) -> Result<NewtonSystem> {
+        Ok(NewtonSystem {
+            solver: SymmetricSolver::new(&pattern)?,
+            lu: SparseLu::new(),
+            values: vec![0.0; pattern.nnz()],
+            shifted: vec![0.0; pattern.nnz()],
+            rhs: vec![0.0; pattern.n()],
+            mass: vec![0.0; n],
+            shifted_steps: 0,
+            pattern,
+        })
+    }
+
+    /// The Newton direction at the evaluated metric (Hessian in `values`) into `delta`:
+    /// the exact round-boundary step when `exact_round`, else `H δ = K̄ − K` (damped on S²).
+    fn direction(
+        &mut self,
+        ev: &Evaluator,
+        target: &Target,
+        settings: &NewtonSettings,
+        exact_round: bool,
+        err: f64,
+        delta: &mut [f64],
+    ) -> Direction {
+        let pattern = &self.pattern;
+        newton_rhs(
+            ev,
+            target,
+            pattern,
+            !settings.pinned.is_empty(),
+            &mut self.rhs,
+        );
+        let r0 = self.rhs.clone();
+        // Round boundaries, exact steps: solve J δ = K̄ − K with the full Jacobian by sparse
+        // LU ([`exact_round_step`]); if that fails, take a chord step instead.
+        let mut exact_delta = None;
+        if exact_round {
+            match exact_round_step(ev, target, pattern, &self.values, &r0, &mut self.lu) {
+                Some(d) => exact_delta = Some(d),
+                None => return Direction::Rejected,
+            }
+        }
+        let indefinite = settings.indefinite;
+        if indefinite {
+            add_spherical_damping(ev, pattern, &mut self.values, &mut self.mass, err);
+        }
+        if let Some(d) = exact_delta {
+            self.rhs.copy_from_slice(&d);
+        } else {
+            let (solver, values, shifted) = (&mut self.solver, &self.values, &mut self.shifted);
+            match factor_with_shift(solver, pattern, values, shifted, indefinite) {
+                Some(shift_used) => self.shifted_steps += usize::from(shift_used),
+                None => {
+                    return Direction::Failed(
+                        "the Hessian could not be factorized (singular or indefinite)".into(),
+                    )
+                }
+            }
+            self.solver.solve(&mut self.rhs);
+        }
+        delta.iter_mut().for_each(|d| *d = 0.0);
+        for (c, &v) in pattern.free_vertex.iter().enumerate() {
+            delta[v as usize] = self.rhs[c];
+        }
+        if delta.iter().any(|d| !d.is_finite()) {
+            return Direction::Failed("the Newton step is not finite".into());
+        }
+        Direction::Step(r0)
+    }
+}
+
+/// How many Newton steps needed special treatment (reported in the notes).
+#[derive(Debug, Default)]
+struct StepCounts {
+    /// Factorizations that needed a diagonal shift.
+    shifted: usize,
+    /// Steps with the round-boundary target frozen.
+    chord: usize,
+    /// Exact round-boundary steps the line search (or the LU solve) rejected.
+    rejected_exact: usize,
+}
+
+impl StepCounts {
+    fn push_notes(&self, damped: bool, notes: &mut Vec<String>) {
+        let shifted_steps = self.shifted;
+        if shifted_steps > 0 {
+            notes.push(format!(
+                "{shifted_steps} Newton step(s) needed a diagonal shift to factorize the Hessian"
+            ));
+        }
+        if damped {
+            notes.push(
+                "spherical steps were damped: (H + μM)δ = K̄ − K with M the lumped area matrix \
+                 and μ = min(½, √max|K − K̄|), LDLᵀ factorization"
+                    .into(),
+            );
+        }
+        let rejected_exact = self.rejected_exact;
+        if rejected_exact > 0 {
+            notes.push(format!(
+                "{rejected_exact} exact round-boundary Newton step(s) were rejected by the line \
+                 search and replaced by frozen-target steps"
+            ));
+        }
+        let chord_steps = self.chord;
+        if chord_steps > 0 {
+            notes.push(format!(
+                "{chord_steps} step(s) with the round-boundary target frozen (convex chord steps)"
+            ));
+        }
+    }
+}
+
+/// Right-hand side `r = K̄ − K` on the free vertices. With a scale pin (E²), Gauss–Bonnet
+/// makes `Σ r` vanish over the prescribed vertices up to rounding; the rounding would
+/// accumulate at the pinned vertex (≈ 1e-10 on a million faces), so its mean is removed and
+/// spread evenly instead.
+fn newton_rhs(
+    ev: &Evaluator,
+    target: &Target,
+    pattern: &HessianPattern,
+    pinned: bool,
+    rhs: &mut [f64],
+) {
+    let n = ev.data.n_vertices();
+    let shift = if !pinned {
+        0.0
+    } else {
+        let (sum, count) = (0..n)
+            .filter(|&i| !target.fixed[i])
+            .fold((0.0, 0usize), |(s, c), i| {
+                (s + target.curvature[i] - ev.ws.curvature[i], c + 1)
+            });
+        sum / count.max(1) as f64
+    };
+    for (c, &v) in pattern.free_vertex.iter().enumerate() {
+        rhs[c] = target.curvature[v as usize] - ev.ws.curvature[v as usize] - shift;
+    }
+}
+
+/// S²: Levenberg–Marquardt damping with the lumped spherical mass matrix, (H + μM)δ = K̄ − K.
+/// On a round sphere H ≈ L − 2M has generalized eigenvalues l(l+1) − 2 = −2, 0 (×3, Möbius),
+/// 4, 10, …: μ < 1 keeps the system regular and bounds the steps along the Möbius
+/// near-kernel. Adds `μ M` to the diagonal of `values` (`mass` is scratch).
+fn add_spherical_damping(
+    ev: &Evaluator,
+    pattern: &HessianPattern,
+    values: &mut [f64],
+    mass: &mut [f64],
+    err: f64,
+) {
+    let mu = err.sqrt().min(0.5);
+    mass.iter_mut().for_each(|m| *m = 0.0);
+    for (f, t) in ev.data.faces.iter().enumerate() {
+        let a = (ev.ws.angles[3 * f] + ev.ws.angles[3 * f + 1] + ev.ws.angles[3 * f + 2]
+            - std::f64::consts::PI)
+            .max(0.0)
+            / 3.0;
+        for &w in t {
+            mass[w as usize] += a;
+        }
+    }
+    for &w in &pattern.free_vertex {
+        values[pattern.diag_slot[w as usize] as usize] += mu * mass[w as usize];
+    }
+}
+
+/// Factorize `values` (LDLᵀ when `indefinite`, else LLᵀ); if that fails, retry up to six
+/// times with a diagonal shift `μ = 10⁻¹² max|H_ii|`, growing ×100. `Some(shift used)`, or
+/// `None` when no factorization succeeded.
+fn factor_with_shift(
+    solver: &mut SymmetricSolver,
+    pattern: &HessianPattern,
+    values: &[f64],
+    shifted: &mut [f64],
+    indefinite: bool,
+) -> Option<bool> {
+    let factor = |solver: &mut SymmetricSolver, v: &[f64]| {
+        if indefinite {
+            solver.factor_ldlt(v)
+        } else {
+            solver.factor_llt(v)
+        }
+    };
+    if factor(solver, values) {
+        return Some(false);
+    }
+    let dmax = pattern
+        .free_vertex
         .iter()
-        .zip(target)
-        .zip(fixed)
-        .filter(|(_, &f)| !f)
-        .map(|((k, t), _)| (k - t).abs())
-        .fold(0.0, f64::max)
+        .map(|&v| values[pattern.diag_slot[v as usize] as usize].abs())
+        .fold(0.0, f64::max);
+    let mut mu = 1e-12 * dmax.max(1e-300);
+    for _ in 0..6 {
+        shifted.copy_from_slice(values);
+        for &v in &pattern.free_vertex {
+            shifted[pattern.diag_slot[v as usize] as usize] += mu;
+        }
+        if factor(solver, shifted) {
+            return Some(true);
+        }
+        mu *= 100.0;
+    }
+    None
 }
 
 /// The exact Newton step of a round-boundary target: solve `J δ = r` (free vertices) with

@@ -295,74 +295,13 @@ pub fn deck_group<S: Space>(
         if side.inverse || side_pairing[s].is_some() {
             continue;
         }
-        let v: Vec<ExtPoint<S>> = side
-            .vertices
-            .iter()
-            .map(|&x| ext_position::<S>(layout, x as usize))
-            .collect();
-        let w: Vec<ExtPoint<S>> = poly.sides[m]
-            .vertices
-            .iter()
-            .rev()
-            .map(|&x| ext_position::<S>(layout, x as usize))
-            .collect();
-        // Now w[t] ↔ v[t].
-        let k = v.len() - 1;
-        let endpoints = F::<S>::from_pairs(w[0], w[k], v[0], v[k]);
-        let mut spread = 0.0f64;
-        let mut spread_matrix = 0.0f64;
-        let probes = [w[0], w[k / 2], w[k]].map(|p| (p, endpoints.apply(p)));
-        for t in 0..k {
-            let e = F::<S>::from_pairs(w[t], w[t + 1], v[t], v[t + 1]);
-            spread_matrix = spread_matrix.max(e.distance(&endpoints));
-            for &(p, q) in &probes {
-                spread = spread.max(F::<S>::point_distance(e.apply(p), q));
-            }
-        }
-        let pairs: Vec<(ExtPoint<S>, ExtPoint<S>)> =
-            w.iter().copied().zip(v.iter().copied()).collect();
-        let map = F::<S>::fit(&pairs)
-            .map_err(|e| Error::numerical(format!("side {} ({}): {e}", s, side.label)))?;
-        let verr = pairs
-            .iter()
-            .map(|&(x, y)| F::<S>::point_distance(map.apply(x), y))
-            .fold(0.0, f64::max);
+        let (pairing, map) = pair_sides::<S>(layout, poly, s, m)?;
         side_pairing[s] = Some(pairings.len());
         side_pairing[m] = Some(pairings.len());
         precise_maps.push(map);
-        pairings.push(SidePairing {
-            side: s,
-            partner: m,
-            endpoints: endpoints.round(),
-            map: map.round(),
-            edge_spread: spread,
-            edge_spread_matrix: spread_matrix,
-            max_vertex_error: verr,
-        });
+        pairings.push(pairing);
     }
-    // Corner maps: Q_s = S_s Q_{m+1}, Q_{s+1} = S_s Q_m for a positive side s with partner m.
-    let mut adj: Vec<Vec<(usize, F<S>)>> = vec![Vec::new(); n + 1];
-    for (p, &t) in pairings.iter().zip(&precise_maps) {
-        let (s, m) = (p.side, p.partner);
-        let ti = t.inverse();
-        // Q_u = T Q_v  ⇒ edge u → v with Q_v = T⁻¹ Q_u, and v → u with Q_u = T Q_v.
-        for (u, v) in [(s, m + 1), (s + 1, m)] {
-            adj[u].push((v, ti));
-            adj[v].push((u, t));
-        }
-    }
-    let mut q: Vec<Option<F<S>>> = vec![None; n + 1];
-    q[0] = Some(F::<S>::identity());
-    let mut stack = vec![0usize];
-    while let Some(u) = stack.pop() {
-        let qu = q[u].expect("visited nodes have maps");
-        for &(v, t) in &adj[u] {
-            if q[v].is_none() {
-                q[v] = Some(t.compose(&qu).normalized());
-                stack.push(v);
-            }
-        }
-    }
+    let q = corner_maps::<S>(n, &pairings, &precise_maps);
     let mut precise_generators: Vec<Option<F<S>>> = vec![None; poly.letters.len()];
     for (s, side) in poly.sides.iter().enumerate() {
         let (Some(l), Some(_)) = (side.letter, side.partner) else {
@@ -385,18 +324,7 @@ pub fn deck_group<S: Space>(
         .filter_map(|s| generators.get(s.letter?).copied().flatten())
         .map(|g| g.size())
         .product();
-    let relation_error = if poly.is_closed() && precise_generators.iter().all(|g| g.is_some()) {
-        let mut prod = F::<S>::identity();
-        for side in &poly.sides {
-            let g = precise_generators[side.letter.unwrap_or(0)].unwrap_or_else(F::<S>::identity);
-            prod = prod
-                .compose(&if side.inverse { g.inverse() } else { g })
-                .normalized();
-        }
-        Some(prod.distance(&F::<S>::identity()))
-    } else {
-        None
-    };
+    let relation_error = relation_error::<S>(poly, &precise_generators);
     let max_edge_spread = pairings.iter().map(|p| p.edge_spread).fold(0.0, f64::max);
     let max_edge_spread_matrix = pairings
         .iter()
@@ -418,4 +346,114 @@ pub fn deck_group<S: Space>(
         max_edge_spread_matrix,
         max_vertex_error,
     })
+}
+
+/// Working-precision isometries of the space `S`.
+type WorkingFrame<S> = <S as Space>::Frame;
+
+/// The pairing of the positive side `s` with its partner `m`: end-point map, per-edge spreads
+/// and the least-squares map (also returned in the working precision).
+fn pair_sides<S: Space>(
+    layout: &Layout<S::Point>,
+    poly: &Polygon,
+    s: usize,
+    m: usize,
+) -> Result<(SidePairing<S::Iso>, WorkingFrame<S>)> {
+    type F<S> = WorkingFrame<S>;
+    let side = &poly.sides[s];
+    let v: Vec<ExtPoint<S>> = side
+        .vertices
+        .iter()
+        .map(|&x| ext_position::<S>(layout, x as usize))
+        .collect();
+    let w: Vec<ExtPoint<S>> = poly.sides[m]
+        .vertices
+        .iter()
+        .rev()
+        .map(|&x| ext_position::<S>(layout, x as usize))
+        .collect();
+    // Now w[t] ↔ v[t].
+    let k = v.len() - 1;
+    let endpoints = F::<S>::from_pairs(w[0], w[k], v[0], v[k]);
+    let mut spread = 0.0f64;
+    let mut spread_matrix = 0.0f64;
+    let probes = [w[0], w[k / 2], w[k]].map(|p| (p, endpoints.apply(p)));
+    for t in 0..k {
+        let e = F::<S>::from_pairs(w[t], w[t + 1], v[t], v[t + 1]);
+        spread_matrix = spread_matrix.max(e.distance(&endpoints));
+        for &(p, q) in &probes {
+            spread = spread.max(F::<S>::point_distance(e.apply(p), q));
+        }
+    }
+    let pairs: Vec<(ExtPoint<S>, ExtPoint<S>)> = w.iter().copied().zip(v.iter().copied()).collect();
+    let map = F::<S>::fit(&pairs)
+        .map_err(|e| Error::numerical(format!("side {} ({}): {e}", s, side.label)))?;
+    let verr = pairs
+        .iter()
+        .map(|&(x, y)| F::<S>::point_distance(map.apply(x), y))
+        .fold(0.0, f64::max);
+    let pairing = SidePairing {
+        side: s,
+        partner: m,
+        endpoints: endpoints.round(),
+        map: map.round(),
+        edge_spread: spread,
+        edge_spread_matrix: spread_matrix,
+        max_vertex_error: verr,
+    };
+    Ok((pairing, map))
+}
+
+/// Corner maps `Q_0 = id, …, Q_n` from the pairings: `Q_s = S_s Q_{m+1}`,
+/// `Q_{s+1} = S_s Q_m` for a positive side `s` with partner `m` (a search over the corners).
+fn corner_maps<S: Space>(
+    n: usize,
+    pairings: &[SidePairing<S::Iso>],
+    precise_maps: &[WorkingFrame<S>],
+) -> Vec<Option<WorkingFrame<S>>> {
+    type F<S> = WorkingFrame<S>;
+    let mut adj: Vec<Vec<(usize, F<S>)>> = vec![Vec::new(); n + 1];
+    for (p, &t) in pairings.iter().zip(precise_maps) {
+        let (s, m) = (p.side, p.partner);
+        let ti = t.inverse();
+        // Q_u = T Q_v  ⇒ edge u → v with Q_v = T⁻¹ Q_u, and v → u with Q_u = T Q_v.
+        for (u, v) in [(s, m + 1), (s + 1, m)] {
+            adj[u].push((v, ti));
+            adj[v].push((u, t));
+        }
+    }
+    let mut q: Vec<Option<F<S>>> = vec![None; n + 1];
+    q[0] = Some(F::<S>::identity());
+    let mut stack = vec![0usize];
+    while let Some(u) = stack.pop() {
+        let qu = q[u].expect("visited nodes have maps");
+        for &(v, t) in &adj[u] {
+            if q[v].is_none() {
+                q[v] = Some(t.compose(&qu).normalized());
+                stack.push(v);
+            }
+        }
+    }
+    q
+}
+
+/// Distance of the product of the generators along the boundary word from the identity,
+/// when the polygon is closed and every generator is known.
+fn relation_error<S: Space>(
+    poly: &Polygon,
+    precise_generators: &[Option<WorkingFrame<S>>],
+) -> Option<f64> {
+    type F<S> = WorkingFrame<S>;
+    if poly.is_closed() && precise_generators.iter().all(|g| g.is_some()) {
+        let mut prod = F::<S>::identity();
+        for side in &poly.sides {
+            let g = precise_generators[side.letter.unwrap_or(0)].unwrap_or_else(F::<S>::identity);
+            prod = prod
+                .compose(&if side.inverse { g.inverse() } else { g })
+                .normalized();
+        }
+        Some(prod.distance(&F::<S>::identity()))
+    } else {
+        None
+    }
 }

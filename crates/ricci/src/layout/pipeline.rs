@@ -22,33 +22,17 @@ use super::deck::Polygon;
 use crate::cut::{canonical_cut, CanonicalCut, Construction, CutOptions};
 use crate::error::{Error, Result};
 use crate::flow::polish::{polish_metric, PolishSettings, PolishedMetric};
-use crate::flow::{ricci_flow, FlowOptions, FlowResult, TargetSpec};
-use crate::mesh::{topology, Mesh};
+use crate::flow::{flow_with_fallback, FlowResult, UniformizationOptions};
+use crate::mesh::Mesh;
 use crate::metric::{ConformalStructure, Geometry, Scheme};
 use crate::progress::Progress;
 
-/// The geometry of the uniformization metric of a connected surface: S² for closed genus 0,
-/// E² for genus 1 and for disks, H² otherwise.
-pub fn uniformization_geometry(mesh: &Mesh) -> Result<Geometry> {
-    let t = topology(mesh);
-    if t.components.len() != 1 {
-        return Err(Error::topology(format!(
-            "the surface has {} components; lay out one at a time",
-            t.components.len()
-        )));
-    }
-    let c = &t.components[0];
-    Ok(match (c.genus, c.boundary_loops) {
-        (0, 0) => Geometry::Spherical,
-        (0, 1) | (1, 0) => Geometry::Euclidean,
-        _ => Geometry::Hyperbolic,
-    })
-}
+pub use crate::flow::uniformize::uniformization_geometry;
 
 /// Run the uniformization flow (Newton, conformal scheme `scheme` — the papers use Thurston
 /// circle packing — tolerance `tolerance`) with the
 /// target that suits the topology: `uniform` for closed surfaces, `free-boundary` for disks in
-/// E², `geodesic-boundary` for other bordered surfaces in H².
+/// E², `geodesic-boundary` for other bordered surfaces in H² ([`crate::flow::uniformize`]).
 pub fn uniformization_metric(
     mesh: &Mesh,
     lengths: &[f64],
@@ -57,20 +41,8 @@ pub fn uniformization_metric(
     tolerance: f64,
     progress: &mut dyn Progress,
 ) -> Result<FlowResult> {
-    let bordered = mesh.has_boundary();
-    let target = match (geometry, bordered) {
-        (_, false) => TargetSpec::Uniform,
-        (Geometry::Hyperbolic, true) => TargetSpec::GeodesicBoundary,
-        (_, true) => TargetSpec::FreeBoundary,
-    };
-    let opts = FlowOptions {
-        geometry,
-        scheme,
-        target,
-        tolerance,
-        ..FlowOptions::default()
-    };
-    ricci_flow(mesh, lengths, &opts, progress)
+    let opts = UniformizationOptions::single(Some(geometry), scheme, tolerance);
+    Ok(flow_with_fallback(mesh, lengths, &opts, None, progress)?.result)
 }
 
 /// A surface cut open into a disk, with the metric on the cut mesh.

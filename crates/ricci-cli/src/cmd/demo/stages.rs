@@ -4,9 +4,9 @@
 
 use super::report::{num, Picture, Section, Status, Table};
 use super::Env;
-use crate::cmd::{cut::cut_obj, flow::metric_json, info::info_json};
+use crate::cmd::{atlas::svg as atlas_svg, cut::cut_obj, flow::metric_json, info::info_json};
 use ricci::analysis::spectrum::fuchsian_spectrum;
-use ricci::atlas::{svg as atlas_svg, AffineAtlas, AtlasOptions, FlatCharts};
+use ricci::atlas::{AffineAtlas, AtlasOptions, FlatCharts};
 use ricci::flow::{ricci_flow, FlowOptions, FlowResult, TargetSpec};
 use ricci::layout::cover::{tiles_by_radius, word_string};
 use ricci::layout::export::obj_with_uv;

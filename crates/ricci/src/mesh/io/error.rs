@@ -5,31 +5,13 @@
 //! known, 1-based line of a text file, byte offset of a binary file) and the [`Record`] at
 //! fault (a vertex, a face, a texture coordinate, another PLY element, the header, or the file
 //! as a whole), so that a caller can point at the record without parsing the message. It
-//! converts into [`crate::Error::Parse`] with the same location and message, so its `Display`
-//! and the converted error's `Display` are the same sentence (`file, line N: message`).
+//! converts into [`crate::Error::Parse`] with the same location, record and message, so its
+//! `Display` and the converted error's `Display` are the same sentence (`file, line N:
+//! message`), and the record survives the conversion ([`crate::Error::record`]).
 
+pub use crate::error::Record;
 use crate::error::{Error, Location};
 use std::fmt;
-
-/// The record of a mesh file an error is about. Indices are 0-based, in the order the records
-/// appear in the file (the message may show a format's own numbering, e.g. OBJ's 1-based
-/// vertices).
-#[derive(Debug, Clone, PartialEq, Eq)]
-#[non_exhaustive]
-pub enum Record {
-    /// The file as a whole (nothing to read, a statement that is not of this format, …).
-    File,
-    /// A header line (OFF header and counts, PLY header, STL binary header).
-    Header,
-    /// The vertex with this index.
-    Vertex(usize),
-    /// The texture coordinate (`vt`) with this index.
-    TextureCoordinate(usize),
-    /// The face (polygon, facet, triangle) with this index.
-    Face(usize),
-    /// Another element of a PLY file: its name and the index of the record.
-    Element { name: String, index: usize },
-}
 
 /// A mesh file that cannot be read: what is wrong (`message`, one sentence), where
 /// (`location`: file, line, byte) and which record ([`Record`]).
@@ -97,7 +79,11 @@ impl std::error::Error for ReadError {}
 
 impl From<ReadError> for Error {
     fn from(e: ReadError) -> Error {
-        Error::parse(e.location, e.message)
+        Error::Parse {
+            location: e.location,
+            record: e.record,
+            message: e.message,
+        }
     }
 }
 
@@ -121,6 +107,7 @@ mod tests {
         assert_eq!(shown, "a.obj, line 7: face 3 refers to vertex 9");
         let converted = Error::from(e.clone());
         assert!(matches!(&converted, Error::Parse { location, .. } if location.line == Some(7)));
+        assert_eq!(converted.record(), Some(&Record::Face(3)));
         assert_eq!(converted.to_string(), shown);
         // A file name already there is kept.
         assert_eq!(e.in_file("b.obj").location.file.as_deref(), Some("a.obj"));
