@@ -389,6 +389,29 @@ fn batch_over_the_shared_meshes_with_flow() {
         );
         assert_eq!(x["status"] == "ok", x["error"].is_null());
     }
+    // Issue 22 item 2: `ricci flow MESH` without flags chooses its geometry and boundary
+    // condition and converges on every shared mesh that `ricci layout` accepts: every mesh the
+    // flow did not converge on (or refused) is refused by `layout` too.
+    for x in &l {
+        let mesh = x["mesh"].as_str().unwrap();
+        if x["status"] == "ok" {
+            assert_eq!(x["result"]["converged"], true, "{mesh}: {x}");
+            assert!(
+                x["result"]["gauss_bonnet_error"].as_f64().unwrap() < 1e-6,
+                "{mesh}: {x}"
+            );
+        } else if !x["error"].as_str().unwrap_or("").contains("time limit") {
+            let o = Command::new(env!("CARGO_BIN_EXE_ricci"))
+                .args(["layout", mesh])
+                .output()
+                .unwrap();
+            assert!(
+                !o.status.success(),
+                "{mesh}: layout succeeds but flow failed: {}",
+                x["error"]
+            );
+        }
+    }
     // The second run does nothing.
     let s = summary(&ricci(&args));
     assert_eq!(

@@ -281,3 +281,69 @@ fn checker_without_uvs_is_explained() {
     let o = ricci(&w[1..]);
     assert!(o.status.success(), "`{t}` fails: {}", err(&o));
 }
+
+/// With `--json`, every subcommand that reads a mesh answers a failure with exactly one JSON
+/// object `{"error": SENTENCE}` on stdout (docs/DESIGN.md §4) — the same sentence as the
+/// `error:` line on stderr — both for a refusal (exit 1: a file that does not exist) and for a
+/// bad argument (exit 2).
+#[test]
+fn json_failures_print_one_error_object() {
+    let d = tmp("json-errors");
+    let missing = d.join("no-such-mesh.off");
+    let m = missing.to_str().unwrap();
+    let out = d.join("out");
+    let o = out.to_str().unwrap();
+    let png = d.join("out.png");
+    let p = png.to_str().unwrap();
+    let obj = d.join("out.obj");
+    let c = obj.to_str().unwrap();
+    let cases: Vec<Vec<&str>> = vec![
+        vec!["info", m],
+        vec!["cut", m, "--out", c],
+        vec!["flow", m],
+        vec!["layout", m],
+        vec!["param", m, "--out", o],
+        vec!["spectrum", m],
+        vec!["forms", m],
+        vec!["teichmuller", m],
+        vec!["atlas", m, "--out", o],
+        vec!["spline", m],
+        vec!["pou", m],
+        vec!["tspline", m],
+        vec!["render", m, "--out", p],
+    ];
+    for args in cases {
+        for (extra, code) in [(None, 1), (Some("--no-such-flag"), 2)] {
+            let mut a = args.clone();
+            a.push("--json");
+            a.extend(extra);
+            let r = ricci(&a);
+            assert_eq!(r.status.code(), Some(code), "{a:?}: {}", err(&r));
+            let text = String::from_utf8_lossy(&r.stdout);
+            let v: serde_json::Value = serde_json::from_str(text.trim())
+                .unwrap_or_else(|e| panic!("{a:?}: stdout is not one JSON object ({e}): {text}"));
+            let e = v["error"]
+                .as_str()
+                .unwrap_or_else(|| panic!("{a:?}: no \"error\" string in {v}"));
+            assert!(!e.is_empty(), "{a:?}");
+            // Progress lines may come first on stderr; the sentence is the `error:` line.
+            let stderr = err(&r);
+            let first = stderr
+                .lines()
+                .find(|l| l.starts_with("error: "))
+                .unwrap_or("")
+                .to_string();
+            assert!(
+                first.contains(e.lines().next().unwrap()),
+                "{a:?}: stderr {first:?} vs JSON {e:?}"
+            );
+            if code == 1 {
+                assert!(e.contains("no-such-mesh.off"), "{a:?}: {e}");
+            }
+        }
+    }
+    assert!(
+        !out.exists() && !png.exists() && !obj.exists(),
+        "nothing written"
+    );
+}

@@ -14,16 +14,25 @@
 //! For tests of that path, the environment variable `RICCI_DEMO_FAIL=ID` makes stage `ID`
 //! fail at its start (as if the library had returned an error).
 //!
-//! Adding a stage (e.g. the affine atlas, `ricci atlas`, and the manifold spline,
-//! `ricci spline`): write `fn atlas(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section>` in
-//! [`stages`], put what later stages need into [`Ctx`], and add one line to [`STAGES`] (the
-//! marked places below); remove its entry from [`PLACEHOLDERS`].
+//! Adding a stage: write `pub fn NAME(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section>`
+//! in its own file `demo/NAME.rs` (shared helpers are in `demo/common.rs`), declare it with
+//! `mod NAME;` below, put what later stages need into [`Ctx`], and add one entry to
+//! [`STAGES`], the one list of stages; remove its entry from [`PLACEHOLDERS`].
 
+// One file per stage (in the order of [`STAGES`]); `common` holds what several share.
+mod atlas;
+mod common;
+mod cone;
+mod flow;
+mod layout;
+mod loops;
 mod pou;
+mod spectrum;
+mod spline;
+mod surface;
 
 mod param_stage;
 mod report;
-mod stages;
 mod tspline_stage;
 
 use crate::util::{print_json, write_atomic, UsageError};
@@ -33,7 +42,7 @@ use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-pub use stages::Ctx;
+pub use common::Ctx;
 
 /// Where a stage writes its files and reports its progress.
 pub struct Env<'a> {
@@ -75,56 +84,56 @@ pub const STAGES: &[Stage] = &[
         title: "Surface",
         reference: "built-in genus-2 surface (ricci::mesh::generate::genus), validation and topology",
         needs: &[],
-        run: stages::surface,
+        run: surface::surface,
     },
     Stage {
         id: "flow",
         title: "Hyperbolic uniformization",
         reference: "discrete conformal equivalence in H² (the default scheme; Gu–Luo–Sun–Wu 2018), Newton; the uniformization of paper 001 §V, paper 002 §4.3",
         needs: &["surface"],
-        run: stages::hyperbolic_flow,
+        run: flow::hyperbolic_flow,
     },
     Stage {
         id: "cone",
         title: "Flat metric with a single cone",
         reference: "Euclidean Ricci flow (Thurston circle packing, the papers' scheme) with all curvature 2πχ on one vertex (paper 000 §4 Steps 2–3)",
         needs: &["surface"],
-        run: stages::single_cone,
+        run: cone::single_cone,
     },
     Stage {
         id: "loops",
         title: "Canonical loops",
         reference: "canonical fundamental group generators through a base vertex (paper 001 §V, paper 002 §4.3.2)",
         needs: &["flow"],
-        run: stages::loops,
+        run: loops::loops,
     },
     Stage {
         id: "layout",
         title: "Fundamental polygon and universal cover",
         reference: "isometric layout in the Poincaré disk, deck group, tiling (paper 001 §V–VI, paper 002 §4.3.3)",
         needs: &["loops"],
-        run: stages::layout,
+        run: layout::layout,
     },
     Stage {
         id: "spectrum",
         title: "Geodesic length spectrum",
         reference: "closed geodesics from the Fuchsian group, ℓ = 2 acosh(|tr|/2) (paper 002 §6.3.3)",
         needs: &["layout"],
-        run: stages::spectrum,
+        run: spectrum::spectrum,
     },
     Stage {
         id: "atlas",
         title: "Affine atlas with one extraordinary point",
         reference: "singularity placement, connectivity modification, flat cone metric (Thurston circle packing, the papers' scheme), charts and transitions (paper 000 §4 Steps 1–5, paper 002 §5.2)",
         needs: &["surface"],
-        run: stages::atlas,
+        run: atlas::atlas,
     },
     Stage {
         id: "spline",
         title: "Manifold spline with one extraordinary point",
         reference: "manifold triangular B-splines (DMS) over the affine structure (flat cone metric by Thurston circle packing, the papers' scheme), fairing, G¹ hole filling (paper 000 §5)",
         needs: &["surface"],
-        run: stages::spline,
+        run: spline::spline,
     },
     Stage {
         id: "pou",
@@ -267,56 +276,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let n = STAGES.len();
     for (k, st) in STAGES.iter().enumerate() {
         bar.stage(k + 1, n, st.title);
-        let missing: Vec<&str> = st
-            .needs
-            .iter()
-            .copied()
-            .filter(|id| {
-                !sections
-                    .iter()
-                    .any(|s: &Section| s.id == *id && s.status.usable())
-            })
-            .collect();
-        let ts = Instant::now();
-        let cpu0 = crate::util::process_cpu_seconds();
-        let mut section = if missing.is_empty() {
-            let keep = out.files.len();
-            let mut env = Env {
-                out: &mut out,
-                bar: &mut bar,
-            };
-            let result = match std::env::var("RICCI_DEMO_FAIL") {
-                Ok(id) if id == st.id => {
-                    Err(anyhow::anyhow!("failure injected by RICCI_DEMO_FAIL={id}"))
-                }
-                _ => (st.run)(&mut ctx, &mut env),
-            };
-            match result {
-                Ok(s) => s,
-                Err(e) => {
-                    out.drop_after(keep);
-                    let mut s = Section::new(st.id, st.title, st.reference);
-                    s.status =
-                        Status::Failed(format!("this stage failed: {}", crate::util::sentence(&e)));
-                    s
-                }
-            }
-        } else {
-            let mut s = Section::new(st.id, st.title, st.reference);
-            s.status = Status::Skipped(format!(
-                "not run: it needs the stage{} {}, which did not succeed",
-                if missing.len() == 1 { "" } else { "s" },
-                missing.join(", ")
-            ));
-            s
-        };
-        section.id = st.id;
-        section.title = st.title.to_string();
-        section.reference = st.reference.to_string();
-        section.seconds = ts.elapsed().as_secs_f64();
-        section.cpu_seconds = cpu0
-            .zip(crate::util::process_cpu_seconds())
-            .map(|(a, b)| b - a);
+        let section = run_stage(st, &sections, &mut ctx, &mut out, &mut bar);
         bar.bar.println(format!(
             "{} [{}/{n}] {} ({:.2} s){}",
             match section.status {
@@ -377,30 +337,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     out.write("index.html", report::index_html(&page).as_bytes())?;
     out.commit()?;
 
-    if a.json {
-        print_json(&summary);
-    } else {
-        println!(
-            "{}: {} stages in {:.2} s",
-            a.out.join("index.html").display(),
-            sections.len(),
-            total
-        );
-        for s in &sections {
-            println!(
-                "  {:<9} {:<8} {:6.2} s  {}",
-                s.id,
-                s.status.name(),
-                s.seconds,
-                s.status.message().unwrap_or(&s.title)
-            );
-        }
-    }
-    for s in &sections {
-        if let Status::Warning(m) = &s.status {
-            eprintln!("warning: demo stage {}: {m}", s.id);
-        }
-    }
+    print_outcome(&a, &summary, &sections, total);
     if let Some(first) = failed.first() {
         anyhow::bail!(
             "{} of {} demo stages did not succeed (first: {}: {}); the report of the others is in {}",
@@ -412,6 +349,89 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// Run one stage (or skip it when a stage it needs did not succeed) and time it; a failure
+/// drops the files the stage wrote and becomes the section's status.
+fn run_stage(
+    st: &Stage,
+    done: &[Section],
+    ctx: &mut Ctx,
+    out: &mut Out,
+    bar: &mut StageBar,
+) -> Section {
+    let missing: Vec<&str> = st
+        .needs
+        .iter()
+        .copied()
+        .filter(|id| !done.iter().any(|s| s.id == *id && s.status.usable()))
+        .collect();
+    let ts = Instant::now();
+    let cpu0 = crate::util::process_cpu_seconds();
+    let mut section = if missing.is_empty() {
+        let keep = out.files.len();
+        let mut env = Env { out, bar };
+        let result = match std::env::var("RICCI_DEMO_FAIL") {
+            Ok(id) if id == st.id => {
+                Err(anyhow::anyhow!("failure injected by RICCI_DEMO_FAIL={id}"))
+            }
+            _ => (st.run)(ctx, &mut env),
+        };
+        match result {
+            Ok(s) => s,
+            Err(e) => {
+                out.drop_after(keep);
+                let mut s = Section::new(st.id, st.title, st.reference);
+                s.status =
+                    Status::Failed(format!("this stage failed: {}", crate::util::sentence(&e)));
+                s
+            }
+        }
+    } else {
+        let mut s = Section::new(st.id, st.title, st.reference);
+        s.status = Status::Skipped(format!(
+            "not run: it needs the stage{} {}, which did not succeed",
+            if missing.len() == 1 { "" } else { "s" },
+            missing.join(", ")
+        ));
+        s
+    };
+    section.id = st.id;
+    section.title = st.title.to_string();
+    section.reference = st.reference.to_string();
+    section.seconds = ts.elapsed().as_secs_f64();
+    section.cpu_seconds = cpu0
+        .zip(crate::util::process_cpu_seconds())
+        .map(|(a, b)| b - a);
+    section
+}
+
+/// The JSON summary (`--json`) or one line per stage on stdout; warnings on stderr.
+fn print_outcome(a: &Args, summary: &Value, sections: &[Section], total: f64) {
+    if a.json {
+        print_json(summary);
+    } else {
+        println!(
+            "{}: {} stages in {:.2} s",
+            a.out.join("index.html").display(),
+            sections.len(),
+            total
+        );
+        for s in sections {
+            println!(
+                "  {:<9} {:<8} {:6.2} s  {}",
+                s.id,
+                s.status.name(),
+                s.seconds,
+                s.status.message().unwrap_or(&s.title)
+            );
+        }
+    }
+    for s in sections {
+        if let Status::Warning(m) = &s.status {
+            eprintln!("warning: demo stage {}: {m}", s.id);
+        }
+    }
 }
 
 fn summary_json(a: &Args, sections: &[Section], files: &[String], total: f64) -> Value {

@@ -28,7 +28,7 @@
 //! matrix needs the basis to ~1e-10 of its terms, not the 1e-12 chart independence of a
 //! single partial that the extended recurrence gives.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 use faer::linalg::matmul::triangular::BlockStructure;
 use faer::sparse::{SparseColMat, Triplet};
@@ -97,10 +97,12 @@ pub struct FitReport {
     pub relative_residual: f64,
 }
 
-/// Dense `nb × nb` blocks of a symmetric matrix over triangle pairs `(I ≥ J)`.
+/// Dense `nb × nb` blocks of a symmetric matrix over triangle pairs `(I ≥ J)`, indexed in
+/// the order of the pairs (a `BTreeMap`: every sum over the blocks runs in the same order from
+/// call to call, so the fit is reproducible to the last bit).
 struct Blocks {
     nb: usize,
-    index: HashMap<(u32, u32), usize>,
+    index: BTreeMap<(u32, u32), usize>,
     data: Vec<f64>,
 }
 
@@ -108,7 +110,7 @@ impl Blocks {
     fn new(nb: usize) -> Blocks {
         Blocks {
             nb,
-            index: HashMap::new(),
+            index: BTreeMap::new(),
             data: Vec::new(),
         }
     }
@@ -400,7 +402,7 @@ fn normal_matrix(
 ) -> Result<SparseColMat<usize, f64>> {
     // Assemble H = D + λ T + γ I (lower triangle).
     let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::new();
-    let mut merged: HashMap<(u32, u32), usize> = data_blocks.index.clone();
+    let mut merged: BTreeMap<(u32, u32), usize> = data_blocks.index.clone();
     for k in energy_blocks.index.keys() {
         merged.entry(*k).or_insert(usize::MAX);
     }

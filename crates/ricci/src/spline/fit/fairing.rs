@@ -2,7 +2,7 @@
 //! triangle's control points to its neighbours' blossoms, and the projection of control points
 //! onto them (see the parent module [`super`] for the formulas and the method).
 
-use std::collections::HashMap;
+use std::collections::BTreeMap;
 
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
@@ -118,10 +118,6 @@ pub fn fair<S: SplineSpace + ?Sized>(
     let cons = fairness_constraints(space, r)?;
     let nb = space.per_triangle();
     let m = cons.len();
-    let scale = control
-        .iter()
-        .fold(0.0f64, |a, b| a.max(b.abs()))
-        .max(1e-300);
     let tolerance = 1e-10;
     if m == 0 {
         return Ok((
@@ -138,30 +134,84 @@ pub fn fair<S: SplineSpace + ?Sized>(
             },
         ));
     }
+    let sys = ConstraintSystem::new(&cons, nb, nc, control);
+    let (trip, diag_max) = normal_triplets(&cons, nb, space.n_triangles());
+    // Factor A Aᵀ + shift·I; a shift that is too small for the rounding errors of the
+    // factorisation spoils the preconditioner, so it grows until the iteration converges.
+    let mut best: Option<(Vec<f64>, f64, usize)> = None;
+    for shift_rel in [1e-10, 1e-8, 1e-6, 1e-4] {
+        let shift = shift_rel * diag_max;
+        let mut t2 = trip.clone();
+        for i in 0..m {
+            t2.push(Triplet::new(i, i, shift));
+        }
+        let aat = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &t2)
+            .map_err(|e| Error::numerical(format!("fairing: could not assemble A Aᵀ ({e:?})")))?;
+        drop(t2);
+        let Ok(llt) = Cholesky::factor(aat.as_ref()) else {
+            continue;
+        };
+        let (x, worst, steps) = sys.project(&llt, control, dim, tolerance);
+        let better = best.as_ref().is_none_or(|b| worst < b.1);
+        if better && worst.is_finite() {
+            best = Some((x, worst, steps));
+        }
+        if best.as_ref().is_some_and(|b| b.1 <= tolerance) {
+            break;
+        }
+    }
+    let Some((x, worst, steps)) = best else {
+        return Err(Error::numerical(
+            "fairing: the Cholesky factorisation of A Aᵀ failed for every diagonal shift",
+        ));
+    };
+    if !worst.is_finite() {
+        return Err(Error::numerical(
+            "fairing: the constrained least-squares solve produced non-finite values",
+        ));
+    }
+    let objective: f64 = x.iter().zip(control).map(|(a, b)| (a - b) * (a - b)).sum();
+    Ok((
+        x,
+        FairingReport {
+            fairness: r,
+            constraints: m,
+            max_constraint_residual: worst,
+            tolerance,
+            rms_change: (objective / nc as f64).sqrt(),
+            objective,
+            refinement_steps: steps,
+            converged: worst <= tolerance,
+        },
+    ))
+}
+
+/// The lower triangle of `A Aᵀ` as triplets (duplicates are summed by faer; the triplets come
+/// in a fixed order, so the sums are reproducible) and the largest diagonal entry.
+fn normal_triplets(
+    cons: &[Constraint],
+    nb: usize,
+    nf: usize,
+) -> (Vec<Triplet<usize, usize, f64>>, f64) {
     // Rows touching each triangle's control points (as target) and rows whose single lies in
     // each triangle.
-    let nf = space.n_triangles();
     let mut by_target: Vec<Vec<u32>> = vec![Vec::new(); nf];
     let mut by_single_face: Vec<Vec<u32>> = vec![Vec::new(); nf];
-    let mut by_single: HashMap<u32, Vec<u32>> = HashMap::new();
+    let mut by_single: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
     for (i, c) in cons.iter().enumerate() {
         by_target[c.target as usize].push(i as u32);
         by_single_face[c.single as usize / nb].push(i as u32);
         by_single.entry(c.single).or_default().push(i as u32);
     }
-    // A Aᵀ, lower triangle, as triplets (duplicates are summed by faer).
     let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::new();
     let push = |a: u32, b: u32, v: f64, trip: &mut Vec<Triplet<usize, usize, f64>>| {
         let (i, j) = if a >= b { (a, b) } else { (b, a) };
         trip.push(Triplet::new(i as usize, j as usize, v));
     };
     let mut diag_max: f64 = 0.0;
-    for c in &cons {
-        let d = 1.0 + c.weights.iter().map(|w| w * w).sum::<f64>();
-        diag_max = diag_max.max(d);
-    }
     for (i, c) in cons.iter().enumerate() {
         let d = 1.0 + c.weights.iter().map(|w| w * w).sum::<f64>();
+        diag_max = diag_max.max(d);
         push(i as u32, i as u32, d, &mut trip);
     }
     for f in 0..nf {
@@ -195,43 +245,115 @@ pub fn fair<S: SplineSpace + ?Sized>(
             }
         }
     }
-    // A and Aᵀ on one coordinate.
-    let apply_a = |x: &[f64], out: &mut [f64]| {
-        for (i, c) in cons.iter().enumerate() {
+    (trip, diag_max)
+}
+
+/// The constraint matrix `A` (rows [`Constraint`]) on one coordinate, with what the projection
+/// measures residuals against.
+struct ConstraintSystem<'a> {
+    cons: &'a [Constraint],
+    nb: usize,
+    nc: usize,
+    /// `1 + ‖w‖₁` per row: residuals are measured relative to the size of their terms,
+    /// `|A_i x| / (‖A_i‖₁ max|c|)`.
+    row_norm: Vec<f64>,
+    /// `max |c|` of the input control points.
+    scale: f64,
+}
+
+impl<'a> ConstraintSystem<'a> {
+    fn new(cons: &'a [Constraint], nb: usize, nc: usize, control: &[f64]) -> Self {
+        ConstraintSystem {
+            cons,
+            nb,
+            nc,
+            row_norm: cons
+                .iter()
+                .map(|c| 1.0 + c.weights.iter().map(|w| w.abs()).sum::<f64>())
+                .collect(),
+            scale: control
+                .iter()
+                .fold(0.0f64, |a, b| a.max(b.abs()))
+                .max(1e-300),
+        }
+    }
+
+    /// `out = A x`.
+    fn apply_a(&self, x: &[f64], out: &mut [f64]) {
+        for (i, c) in self.cons.iter().enumerate() {
             let mut s = x[c.single as usize];
-            let base = c.target as usize * nb;
+            let base = c.target as usize * self.nb;
             for (b, w) in c.weights.iter().enumerate() {
                 s -= w * x[base + b];
             }
             out[i] = s;
         }
-    };
-    let apply_at = |y: &[f64], out: &mut [f64]| {
+    }
+
+    /// `out = Aᵀ y`.
+    fn apply_at(&self, y: &[f64], out: &mut [f64]) {
         out.fill(0.0);
-        for (i, c) in cons.iter().enumerate() {
+        for (i, c) in self.cons.iter().enumerate() {
             let v = y[i];
             out[c.single as usize] += v;
-            let base = c.target as usize * nb;
+            let base = c.target as usize * self.nb;
             for (b, w) in c.weights.iter().enumerate() {
                 out[base + b] -= w * v;
             }
         }
-    };
-    // Factor A Aᵀ + shift·I; a shift that is too small for the rounding errors of the
-    // factorisation spoils the preconditioner, so it grows until the iteration converges.
-    let mut best: Option<(Vec<f64>, f64, usize)> = None;
-    for shift_rel in [1e-10, 1e-8, 1e-6, 1e-4] {
-        let shift = shift_rel * diag_max;
-        let mut t2 = trip.clone();
-        for i in 0..m {
-            t2.push(Triplet::new(i, i, shift));
+    }
+
+    /// The largest relative residual of `r = A x`.
+    fn rel_max(&self, r: &[f64]) -> f64 {
+        r.iter()
+            .zip(&self.row_norm)
+            .fold(0.0f64, |a, (v, n)| a.max(v.abs() / n))
+            / self.scale
+    }
+
+    /// `c − Aᵀ y` with `A Aᵀ y = A c` solved by preconditioned conjugate gradients (the shifted
+    /// factorisation `llt` as preconditioner), one coordinate at a time; the projected control
+    /// points, the largest relative residual of the result and the most CG steps taken.
+    fn project(
+        &self,
+        llt: &Cholesky,
+        control: &[f64],
+        dim: usize,
+        tolerance: f64,
+    ) -> (Vec<f64>, f64, usize) {
+        let (m, nc) = (self.cons.len(), self.nc);
+        let mut x = control.to_vec();
+        let mut steps = 0;
+        let mut xc = vec![0.0; nc];
+        let mut tmp = vec![0.0; nc];
+        for d in 0..dim {
+            for k in 0..nc {
+                xc[k] = control[k * dim + d];
+            }
+            let (y, it) = self.pcg(llt, &xc, tolerance);
+            steps = steps.max(it);
+            self.apply_at(&y, &mut tmp);
+            for k in 0..nc {
+                x[k * dim + d] = control[k * dim + d] - tmp[k];
+            }
         }
-        let aat = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &t2)
-            .map_err(|e| Error::numerical(format!("fairing: could not assemble A Aᵀ ({e:?})")))?;
-        drop(t2);
-        let Ok(llt) = Cholesky::factor(aat.as_ref()) else {
-            continue;
-        };
+        // Report the true residual of the result.
+        let mut worst: f64 = 0.0;
+        let mut r = vec![0.0; m];
+        for d in 0..dim {
+            for k in 0..nc {
+                xc[k] = x[k * dim + d];
+            }
+            self.apply_a(&xc, &mut r);
+            worst = worst.max(self.rel_max(&r));
+        }
+        (x, worst, steps)
+    }
+
+    /// Restarted PCG on the consistent system `A Aᵀ y = A c` for one coordinate `c`; each
+    /// restart recomputes the true residual `A(c − Aᵀ y)`. `y` and the number of steps.
+    fn pcg(&self, llt: &Cholesky, c: &[f64], tolerance: f64) -> (Vec<f64>, usize) {
+        let m = self.cons.len();
         let precond = |r: &[f64]| -> Vec<f64> {
             let mut z = Mat::<f64>::zeros(m, 1);
             for i in 0..m {
@@ -240,117 +362,50 @@ pub fn fair<S: SplineSpace + ?Sized>(
             llt.solve_in_place(z.as_mut());
             (0..m).map(|i| z[(i, 0)]).collect()
         };
-        // Preconditioned conjugate gradients on the consistent system A Aᵀ y = A c, one coordinate
-        // at a time; the shifted factorisation is the preconditioner.
-        let mut x = control.to_vec();
-        let mut steps = 0;
-        let mut worst: f64 = 0.0;
-        // Residuals are measured relative to the size of their terms: |A_i x| / (‖A_i‖₁ max|c|).
-        let row_norm: Vec<f64> = cons
-            .iter()
-            .map(|c| 1.0 + c.weights.iter().map(|w| w.abs()).sum::<f64>())
-            .collect();
-        let rel_max = |r: &[f64]| {
-            r.iter()
-                .zip(&row_norm)
-                .fold(0.0f64, |a, (v, n)| a.max(v.abs() / n))
-                / scale
-        };
         let dotp = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();
-        let mut xc = vec![0.0; nc];
-        let mut tmp = vec![0.0; nc];
-        for d in 0..dim {
-            for k in 0..nc {
-                xc[k] = control[k * dim + d];
+        let mut tmp = vec![0.0; self.nc];
+        let mut y = vec![0.0; m];
+        let mut it = 0;
+        for _restart in 0..4 {
+            let mut r = vec![0.0; m];
+            self.apply_at(&y, &mut tmp);
+            for k in 0..self.nc {
+                tmp[k] = c[k] - tmp[k];
             }
-            let mut y = vec![0.0; m];
-            let mut it = 0;
-            // Restarted PCG: each restart recomputes the true residual A(c − Aᵀ y).
-            for _restart in 0..4 {
-                let mut r = vec![0.0; m];
-                apply_at(&y, &mut tmp);
-                for k in 0..nc {
-                    tmp[k] = xc[k] - tmp[k];
-                }
-                apply_a(&tmp, &mut r);
-                let mut rmax = rel_max(&r);
-                if rmax <= tolerance {
+            self.apply_a(&tmp, &mut r);
+            let mut rmax = self.rel_max(&r);
+            if rmax <= tolerance {
+                break;
+            }
+            let mut z = precond(&r);
+            let mut p = z.clone();
+            let mut rz = dotp(&r, &z);
+            let mut q = vec![0.0; m];
+            let mut inner = 0;
+            while rmax > tolerance && inner < 40 {
+                inner += 1;
+                it += 1;
+                self.apply_at(&p, &mut tmp);
+                self.apply_a(&tmp, &mut q);
+                let pq = dotp(&p, &q);
+                if !(pq > 0.0) {
                     break;
                 }
-                let mut z = precond(&r);
-                let mut p = z.clone();
-                let mut rz = dotp(&r, &z);
-                let mut q = vec![0.0; m];
-                let mut inner = 0;
-                while rmax > tolerance && inner < 40 {
-                    inner += 1;
-                    it += 1;
-                    apply_at(&p, &mut tmp);
-                    apply_a(&tmp, &mut q);
-                    let pq = dotp(&p, &q);
-                    if !(pq > 0.0) {
-                        break;
-                    }
-                    let alpha = rz / pq;
-                    for i in 0..m {
-                        y[i] += alpha * p[i];
-                        r[i] -= alpha * q[i];
-                    }
-                    rmax = rel_max(&r);
-                    z = precond(&r);
-                    let rz_new = dotp(&r, &z);
-                    let beta = rz_new / rz;
-                    rz = rz_new;
-                    for i in 0..m {
-                        p[i] = z[i] + beta * p[i];
-                    }
+                let alpha = rz / pq;
+                for i in 0..m {
+                    y[i] += alpha * p[i];
+                    r[i] -= alpha * q[i];
+                }
+                rmax = self.rel_max(&r);
+                z = precond(&r);
+                let rz_new = dotp(&r, &z);
+                let beta = rz_new / rz;
+                rz = rz_new;
+                for i in 0..m {
+                    p[i] = z[i] + beta * p[i];
                 }
             }
-            steps = steps.max(it);
-            apply_at(&y, &mut tmp);
-            for k in 0..nc {
-                x[k * dim + d] = control[k * dim + d] - tmp[k];
-            }
         }
-        // Report the true residual of the result.
-        for d in 0..dim {
-            for k in 0..nc {
-                xc[k] = x[k * dim + d];
-            }
-            let mut r = vec![0.0; m];
-            apply_a(&xc, &mut r);
-            worst = worst.max(rel_max(&r));
-        }
-        let better = best.as_ref().is_none_or(|b| worst < b.1);
-        if better && worst.is_finite() {
-            best = Some((x, worst, steps));
-        }
-        if best.as_ref().is_some_and(|b| b.1 <= tolerance) {
-            break;
-        }
+        (y, it)
     }
-    let Some((x, worst, steps)) = best else {
-        return Err(Error::numerical(
-            "fairing: the Cholesky factorisation of A Aᵀ failed for every diagonal shift",
-        ));
-    };
-    if !worst.is_finite() {
-        return Err(Error::numerical(
-            "fairing: the constrained least-squares solve produced non-finite values",
-        ));
-    }
-    let objective: f64 = x.iter().zip(control).map(|(a, b)| (a - b) * (a - b)).sum();
-    Ok((
-        x,
-        FairingReport {
-            fairness: r,
-            constraints: m,
-            max_constraint_residual: worst,
-            tolerance,
-            rms_change: (objective / nc as f64).sqrt(),
-            objective,
-            refinement_steps: steps,
-            converged: worst <= tolerance,
-        },
-    ))
 }

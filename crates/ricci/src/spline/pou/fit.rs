@@ -64,6 +64,9 @@ pub struct PouFitReport {
 /// One sparse row: `(column, value)`, columns merged.
 type Row = Vec<(u32, f64)>;
 
+/// Three fairness rows of a face, their targets, its chart area and edge-length sum.
+type Fair = ([Row; 3], [[f64; 3]; 3], f64, f64);
+
 fn merge(mut r: Row) -> Row {
     r.sort_unstable_by_key(|e| e.0);
     let mut out: Row = Vec::with_capacity(r.len());
@@ -106,9 +109,91 @@ pub fn fit(
         control: vec![[0.0; 3]; nv],
         local: local.to_vec(),
     };
-    let has_local = !local.is_empty();
-    // Data rows: vertices, then face centres.
-    let data: Vec<(Row, [f64; 3])> = (0..nv + nf)
+    let data = data_rows(basis, &g)?;
+    let fair = fairness_rows(basis, &g)?;
+    let area: f64 = fair.iter().map(|f| f.2).sum();
+    let hbar = fair.iter().map(|f| f.3).sum::<f64>() / (3 * nf).max(1) as f64;
+    let kdata = data.len() as f64;
+    let lam = opts.smoothing * hbar * hbar / area.max(1e-300);
+    // Weighted rows of the stacked system.
+    let mut rows: Vec<Row> = Vec::with_capacity(data.len() + 3 * nf);
+    let sd = 1.0 / kdata.sqrt();
+    let mut rhs = vec![[0.0; 3]; nv];
+    for (r, x) in &data {
+        for &(c, v) in r {
+            for d in 0..3 {
+                rhs[c as usize][d] += v * x[d] / kdata;
+            }
+        }
+        rows.push(r.iter().map(|&(c, v)| (c, v * sd)).collect());
+    }
+    let n_data_rows = rows.len();
+    for (rs, ts, a, _) in &fair {
+        let s = (lam * a).sqrt();
+        for (r, t) in rs.iter().zip(ts) {
+            for &(c, v) in r {
+                for d in 0..3 {
+                    rhs[c as usize][d] += v * t[d] * lam * a;
+                }
+            }
+            rows.push(r.iter().map(|&(c, v)| (c, v * s)).collect());
+        }
+    }
+    let mean_bases = data.iter().map(|d| d.0.len()).sum::<usize>() as f64 / kdata;
+    // Data-term diagonal for the ridge.
+    let mut diag_data = 0.0;
+    for r in &rows[..n_data_rows] {
+        for &(_, v) in r {
+            diag_data += v * v;
+        }
+    }
+    let gamma = opts.ridge * (diag_data / nv as f64).max(1e-300);
+    let (trip, nnz) = normal_triplets(&rows, nv, gamma);
+    for (k, x) in rhs.iter_mut().enumerate() {
+        for d in 0..3 {
+            x[d] += gamma * pos[k][d];
+        }
+    }
+    let control = solve_normal(&trip, &rhs)?;
+    let relative_residual = normal_residual(&rows, &control, gamma, &rhs);
+    let errs: Vec<f64> = data
+        .iter()
+        .map(|(r, x)| {
+            let mut p = [0.0; 3];
+            for &(c, v) in r {
+                for d in 0..3 {
+                    p[d] += v * control[c as usize][d];
+                }
+            }
+            ((p[0] - x[0]).powi(2) + (p[1] - x[1]).powi(2) + (p[2] - x[2]).powi(2)).sqrt()
+        })
+        .collect();
+    let rms = (errs.iter().map(|e| e * e).sum::<f64>() / kdata).sqrt();
+    let max = errs.iter().fold(0.0f64, |a, &b| a.max(b));
+    Ok((
+        control,
+        PouFitReport {
+            data_points: data.len(),
+            fairness_points: nf,
+            normal_nonzeros: nnz,
+            mean_bases_per_point: mean_bases,
+            rms_error: rms,
+            max_error: max,
+            relative_residual,
+            seconds: t0.elapsed().as_secs_f64(),
+        },
+    ))
+}
+
+/// Data rows (vertices, then face centres) with their targets minus `G` (the surface `g` with
+/// zero constants; nothing is subtracted without local polynomials).
+fn data_rows(basis: &PouBasis, g: &PouSurface) -> Result<Vec<(Row, [f64; 3])>> {
+    let atlas = basis.atlas;
+    let m = &atlas.mesh;
+    let (nv, nf) = (m.n_vertices(), m.n_faces());
+    let pos = &atlas.positions;
+    let has_local = !g.local.is_empty();
+    (0..nv + nf)
         .into_par_iter()
         .map(|k| -> Result<(Row, [f64; 3])> {
             let mut w = Vec::new();
@@ -139,10 +224,18 @@ pub fn fit(
                 Ok((merge(w), minus_g(vs[0], z, x)?))
             }
         })
-        .collect::<Result<_>>()?;
-    // Fairness rows: three per face, with the chart area and the scale.
-    type Fair = ([Row; 3], [[f64; 3]; 3], f64, f64);
-    let fair: Vec<Fair> = (0..nf as u32)
+        .collect::<Result<_>>()
+}
+
+/// Fairness rows: three per face (the scaled second partials of the weights at the face
+/// centre in the chart of its first vertex), their targets (`−∂²G`), the face's chart area
+/// and the sum of its chart edge lengths.
+fn fairness_rows(basis: &PouBasis, g: &PouSurface) -> Result<Vec<Fair>> {
+    let atlas = basis.atlas;
+    let m = &atlas.mesh;
+    let nf = m.n_faces();
+    let has_local = !g.local.is_empty();
+    (0..nf as u32)
         .into_par_iter()
         .map(|f| -> Result<Fair> {
             let v = m.face(f)[0];
@@ -175,36 +268,16 @@ pub fn fit(
             }
             Ok((rows, targets, area, edges))
         })
-        .collect::<Result<_>>()?;
-    let area: f64 = fair.iter().map(|f| f.2).sum();
-    let hbar = fair.iter().map(|f| f.3).sum::<f64>() / (3 * nf).max(1) as f64;
-    let kdata = data.len() as f64;
-    let lam = opts.smoothing * hbar * hbar / area.max(1e-300);
-    // Weighted rows of the stacked system.
-    let mut rows: Vec<Row> = Vec::with_capacity(data.len() + 3 * nf);
-    let sd = 1.0 / kdata.sqrt();
-    let mut rhs = vec![[0.0; 3]; nv];
-    for (r, x) in &data {
-        for &(c, v) in r {
-            for d in 0..3 {
-                rhs[c as usize][d] += v * x[d] / kdata;
-            }
-        }
-        rows.push(r.iter().map(|&(c, v)| (c, v * sd)).collect());
-    }
-    let n_data_rows = rows.len();
-    for (rs, ts, a, _) in &fair {
-        let s = (lam * a).sqrt();
-        for (r, t) in rs.iter().zip(ts) {
-            for &(c, v) in r {
-                for d in 0..3 {
-                    rhs[c as usize][d] += v * t[d] * lam * a;
-                }
-            }
-            rows.push(r.iter().map(|&(c, v)| (c, v * s)).collect());
-        }
-    }
-    let mean_bases = data.iter().map(|d| d.0.len()).sum::<usize>() as f64 / kdata;
+        .collect::<Result<_>>()
+}
+
+/// The lower triangle of `H = Aᵀ A + γ I` (rows `rows` of the stacked matrix `A`, `nv`
+/// columns) as triplets, column by column, and their number.
+fn normal_triplets(
+    rows: &[Row],
+    nv: usize,
+    gamma: f64,
+) -> (Vec<Triplet<usize, usize, f64>>, usize) {
     // Columns of the stacked matrix.
     let mut col_rows: Vec<Vec<(u32, f64)>> = vec![Vec::new(); nv];
     for (ri, r) in rows.iter().enumerate() {
@@ -212,14 +285,6 @@ pub fn fit(
             col_rows[c as usize].push((ri as u32, v));
         }
     }
-    // Data-term diagonal for the ridge.
-    let mut diag_data = 0.0;
-    for r in &rows[..n_data_rows] {
-        for &(_, v) in r {
-            diag_data += v * v;
-        }
-    }
-    let gamma = opts.ridge * (diag_data / nv as f64).max(1e-300);
     // H = Aᵀ A + γ I, lower triangle, column by column.
     let cols: Vec<Vec<(u32, f64)>> = (0..nv)
         .into_par_iter()
@@ -260,12 +325,13 @@ pub fn fit(
         }
     }
     let nnz = trip.len();
-    for (k, x) in rhs.iter_mut().enumerate() {
-        for d in 0..3 {
-            x[d] += gamma * pos[k][d];
-        }
-    }
-    let h = SparseColMat::<usize, f64>::try_new_from_triplets(nv, nv, &trip).map_err(|e| {
+    (trip, nnz)
+}
+
+/// Solve `H P = b` (lower triangle of `H` as triplets) by faer's sparse Cholesky.
+fn solve_normal(trip: &[Triplet<usize, usize, f64>], rhs: &[[f64; 3]]) -> Result<Vec<[f64; 3]>> {
+    let nv = rhs.len();
+    let h = SparseColMat::<usize, f64>::try_new_from_triplets(nv, nv, trip).map_err(|e| {
         Error::numerical(format!(
             "pou fit: could not assemble the normal matrix ({e:?})"
         ))
@@ -292,9 +358,14 @@ pub fn fit(
             "pou fit: the normal equations produced non-finite control points",
         ));
     }
-    // Residual of the normal equations: H P − b = Aᵀ(A P) + γ P − b.
+    Ok(control)
+}
+
+/// `‖H P − b‖ / ‖b‖` with `H P = Aᵀ(A P) + γ P`.
+fn normal_residual(rows: &[Row], control: &[[f64; 3]], gamma: f64, rhs: &[[f64; 3]]) -> f64 {
+    let nv = rhs.len();
     let mut hp = vec![[0.0; 3]; nv];
-    for r in &rows {
+    for r in rows {
         let mut ap = [0.0; 3];
         for &(c, v) in r {
             for d in 0..3 {
@@ -315,31 +386,5 @@ pub fn fit(
             b2 += rhs[k][d] * rhs[k][d];
         }
     }
-    let errs: Vec<f64> = data
-        .iter()
-        .map(|(r, x)| {
-            let mut p = [0.0; 3];
-            for &(c, v) in r {
-                for d in 0..3 {
-                    p[d] += v * control[c as usize][d];
-                }
-            }
-            ((p[0] - x[0]).powi(2) + (p[1] - x[1]).powi(2) + (p[2] - x[2]).powi(2)).sqrt()
-        })
-        .collect();
-    let rms = (errs.iter().map(|e| e * e).sum::<f64>() / kdata).sqrt();
-    let max = errs.iter().fold(0.0f64, |a, &b| a.max(b));
-    Ok((
-        control,
-        PouFitReport {
-            data_points: data.len(),
-            fairness_points: nf,
-            normal_nonzeros: nnz,
-            mean_bases_per_point: mean_bases,
-            rms_error: rms,
-            max_error: max,
-            relative_residual: (res2 / b2.max(1e-300)).sqrt(),
-            seconds: t0.elapsed().as_secs_f64(),
-        },
-    ))
+    (res2 / b2.max(1e-300)).sqrt()
 }
