@@ -584,16 +584,6 @@ const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
         "generators, relation check and report inline; layout branch",
     ),
     (
-        "crates/ricci/src/metric/common_subdivision.rs",
-        "",
-        "tracing, overlay and its checks in one file; rewritten on another branch",
-    ),
-    (
-        "crates/ricci/src/metric/common_subdivision.rs",
-        "build",
-        "the overlay built inline; rewritten on another branch",
-    ),
-    (
         "crates/ricci/src/param/mod.rs",
         "chart_uv",
         "param: flow, cut, layout and transfer of one chart in one function; split next",
