@@ -98,11 +98,17 @@ fn flipped_in_obj(text: &str, geometry: &str) -> (usize, usize) {
         .iter()
         .filter(|(fv, ft)| {
             let s = if geometry == "spherical" {
+                // ((b − a) × (c − a)) · a = det[a, b, c]; differences first, so that tiny
+                // triangles keep their relative accuracy.
                 let [a, b, c] = fv.map(|i| v[i]);
+                let (d1, d2) = (
+                    [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+                    [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+                );
                 let n = [
-                    b[1] * c[2] - b[2] * c[1],
-                    b[2] * c[0] - b[0] * c[2],
-                    b[0] * c[1] - b[1] * c[0],
+                    d1[1] * d2[2] - d1[2] * d2[1],
+                    d1[2] * d2[0] - d1[0] * d2[2],
+                    d1[0] * d2[1] - d1[1] * d2[0],
                 ];
                 a[0] * n[0] + a[1] * n[1] + a[2] * n[2]
             } else {
