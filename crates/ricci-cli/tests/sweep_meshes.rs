@@ -122,7 +122,7 @@ fn flipped_in_obj(text: &str, geometry: &str) -> (usize, usize) {
                     (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
                 }
             };
-            !(s > 0.0)
+            s.is_nan() || s <= 0.0
         })
         .count();
     (bad, f.len())
