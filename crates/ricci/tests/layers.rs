@@ -509,16 +509,6 @@ const MAX_FN_LINES: usize = 150;
 /// with the one that edits this list).
 const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
     (
-        "crates/ricci/src/analysis/spectrum.rs",
-        "fuchsian_spectrum",
-        "group search, classes and report in one loop; analysis is rewritten on another branch",
-    ),
-    (
-        "crates/ricci/src/analysis/spectrum/surface.rs",
-        "surface_spectrum",
-        "cut, layout and search of one surface in one function; analysis branch",
-    ),
-    (
         "crates/ricci/src/cut/mod.rs",
         "",
         "homotopy basis, cut and slicing in one file; cut is rewritten on another branch",
@@ -637,11 +627,6 @@ const SIZE_ALLOWED: &[(&str, &str, &str)] = &[
         "crates/ricci-cli/src/cmd/demo/stages.rs",
         "spline",
         "demo stage inline; demo branch",
-    ),
-    (
-        "crates/ricci-cli/src/cmd/forms.rs",
-        "run",
-        "forms: report assembly inline; split next",
     ),
     (
         "crates/ricci-cli/src/cmd/render.rs",
