@@ -244,8 +244,10 @@ fn axis_frame(g: &Mobius) -> Option<Mobius> {
 /// (words composed in double-double: products of side pairings that move the centre far lose
 /// in double the 1e-7 that tells two tiles apart). A tile is found again by the position of
 /// `g o` (`o_h`: the centre on the hyperboloid); `keep(g, g o)` decides whether a new tile is
-/// kept, and each tile is tested once (the rejected ones are remembered too). `None` when more
-/// than `max_tiles` tiles are kept.
+/// kept (a tile already found is not tested again; a rejected one is, from each neighbour:
+/// remembering the rejected tiles in a second index made seahorse2_100K more than 10× slower,
+/// probably because the index's distance bands got crowded). `None` when more than
+/// `max_tiles` tiles are kept.
 struct TileSearch {
     elems_dd: Vec<MobiusDd>,
     elems: Vec<Mobius>,
@@ -260,7 +262,6 @@ impl TileSearch {
         mut keep: impl FnMut(&Mobius, [f64; 3]) -> bool,
     ) -> Option<TileSearch> {
         let mut index = TileIndex::new();
-        let mut rejected = TileIndex::new();
         let mut elems_dd: Vec<MobiusDd> = vec![MobiusDd::IDENTITY];
         let mut elems: Vec<Mobius> = vec![Mobius::identity()];
         index.insert(o_h);
@@ -270,11 +271,10 @@ impl TileSearch {
                 let gd = elems_dd[t].compose(sm).normalized();
                 let g = gd.round();
                 let go = apply_h(&g.klein_matrix(), o_h);
-                if index.find(go).is_some() || rejected.find(go).is_some() {
+                if index.find(go).is_some() {
                     continue;
                 }
                 if !keep(&g, go) {
-                    rejected.insert(go);
                     continue;
                 }
                 index.insert(go);
