@@ -2,8 +2,9 @@
 //! [--out UV.obj] [--png PIC.png] [--json]`: holomorphic 1-forms of a closed surface of genus
 //! ≥ 1 (paper 002 §4.2, `ricci::analysis::forms`): the basis normalized on the a-cycles, the
 //! Riemann period matrix (genus 1: the modulus τ), the zeros of the integrated form, and its
-//! conformal net — uv per face corner on the cut mesh (OBJ), a checkerboard picture with the
-//! zeros circled in red.
+//! conformal net — uv per face corner on the cut mesh (OBJ, with the critical horizontal
+//! trajectories through the zeros as `l` lines), a checkerboard picture with the zeros circled
+//! in red and the critical trajectories in blue (`ricci::analysis::forms::trajectories`).
 //!
 //! The form integrated is `ω_1` (`--form K`: `ω_K`), with `--zeros` the combination with zeros
 //! at the given vertices (at most g − 1 exactly, paper 002 §4.2.4), with `--uniform` the
@@ -16,8 +17,12 @@
 use super::layout::spinner;
 use crate::util::{print_json, read_surface, write_atomic, UsageError};
 use ricci::analysis::forms::placement::form_with_zeros;
-use ricci::analysis::forms::uniform::uniform_combination;
-use ricci::analysis::forms::{holomorphic_forms, FormsOptions, FormsTriangulation};
+use ricci::analysis::forms::trajectories::critical_trajectories;
+use ricci::analysis::forms::uniform::{uniform_combination, UniformCombination};
+use ricci::analysis::forms::{
+    holomorphic_forms, ConformalNet, FormsOptions, FormsTriangulation, HolomorphicForm,
+    HolomorphicForms, ZeroSet,
+};
 use ricci::cut::CutOptions;
 use ricci::layout::export::obj_with_corner_uv;
 use ricci::layout::isometry::Complex;
@@ -59,7 +64,8 @@ pub struct Args {
     /// Write the conformal net: the surface with one uv per face corner (OBJ).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Write a picture: checkerboard of the net on the surface, zeros circled.
+    /// Write a picture: checkerboard of the net on the surface, zeros circled, critical
+    /// horizontal trajectories through them.
     #[arg(long)]
     pub png: Option<PathBuf>,
     /// Checks per unit period (the a-period of ω_1 is 1).
@@ -95,46 +101,197 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         &opts,
         &mut bar,
     )?;
+    let chosen = choose_form(&a, &h, surface.mesh.n_vertices())?;
+    bar.0
+        .set_message("zeros, conformal net and critical trajectories");
+    let zeros = h.zeros(&chosen.form)?;
+    let net = h.net(&chosen.form)?;
+    let cut_mesh = &h.cut.cut_mesh;
+    let corner_uv: Vec<[f64; 2]> = (0..cut_mesh.n_corners() as u32)
+        .map(|c| net.uv[cut_mesh.corner_vertex(c) as usize])
+        .collect();
+    let scale = chosen.scale();
+    let trajectories = critical_lines(&h, &chosen.form, &zeros, scale);
+    if let Some(path) = &a.out {
+        let pos = refined_positions(&h)?;
+        let mut text = obj_with_corner_uv(
+            pos,
+            h.cut.refined.mesh.faces(),
+            &corner_uv,
+            &[
+                format!(
+                    "ricci forms: conformal net of a holomorphic 1-form, genus {}",
+                    h.genus
+                ),
+                format!("triangulation {}", h.report.triangulation.name()),
+                "critical horizontal trajectories through the zeros as `l` lines".into(),
+            ],
+        );
+        append_obj_lines(&mut text, pos.len(), &trajectories);
+        write_atomic(path, text.as_bytes())?;
+    }
+    if let Some(path) = &a.png {
+        let png = net_picture(&h, &zeros, &corner_uv, a.checks / scale, &trajectories)?;
+        write_atomic(path, &png)?;
+    }
+    bar.0.finish_and_clear();
+    let v = report_json(&a, &h, &chosen, &zeros, &net, trajectories.len(), t0)?;
+    if a.json {
+        print_json(&v);
+    } else {
+        print_text(&h, &zeros, &net, t0);
+    }
+    Ok(())
+}
+
+/// The form integrated and how it was chosen.
+struct ChosenForm {
+    form: HolomorphicForm,
+    coefficients: Vec<Complex>,
+    placement_residual: Option<f64>,
+    uniform: Option<UniformCombination>,
+}
+
+impl ChosenForm {
+    /// `|λ|`: the length of the coefficients (1 for a basis form).
+    fn scale(&self) -> f64 {
+        let s: f64 = self.coefficients.iter().map(|c| c.norm_sqr()).sum();
+        s.sqrt().max(1e-300)
+    }
+}
+
+/// `--uniform`, `--zeros` or `--form`.
+fn choose_form(a: &Args, h: &HolomorphicForms, n_vertices: usize) -> anyhow::Result<ChosenForm> {
     let g = h.genus;
-    let mut uniform_report = None;
-    let (form, coefficients, placement_residual) = if a.uniform {
-        let (u, w) = uniform_combination(&h, 200)?;
-        let c = u.coefficients.clone();
-        uniform_report = Some(u);
-        (w, c, None)
-    } else if a.zeros.is_empty() {
+    if a.uniform {
+        let (u, w) = uniform_combination(h, 200)?;
+        return Ok(ChosenForm {
+            form: w,
+            coefficients: u.coefficients.clone(),
+            placement_residual: None,
+            uniform: Some(u),
+        });
+    }
+    if a.zeros.is_empty() {
         if a.form == 0 || a.form > g {
             return Err(UsageError(format!("--form must be between 1 and the genus {g}")).into());
         }
         let mut c = vec![Complex::new(0.0, 0.0); g];
         c[a.form - 1] = Complex::new(1.0, 0.0);
-        (h.combination(&c), c, None)
-    } else {
-        if a.zeros.len() > g {
-            return Err(UsageError(format!(
-                "--zeros: at most {g} positions on a genus-{g} surface"
-            ))
-            .into());
-        }
-        if let Some(&v) = a
-            .zeros
-            .iter()
-            .find(|&&v| v as usize >= surface.mesh.n_vertices())
-        {
-            return Err(UsageError(format!(
-                "--zeros: vertex {v} does not exist (the mesh has {} vertices)",
-                surface.mesh.n_vertices()
-            ))
-            .into());
-        }
-        let (c, w, r) = form_with_zeros(&h, &a.zeros)?;
-        (w, c, Some(r))
+        return Ok(ChosenForm {
+            form: h.combination(&c),
+            coefficients: c,
+            placement_residual: None,
+            uniform: None,
+        });
+    }
+    if a.zeros.len() > g {
+        return Err(UsageError(format!(
+            "--zeros: at most {g} positions on a genus-{g} surface"
+        ))
+        .into());
+    }
+    if let Some(&v) = a.zeros.iter().find(|&&v| v as usize >= n_vertices) {
+        return Err(UsageError(format!(
+            "--zeros: vertex {v} does not exist (the mesh has {n_vertices} vertices)"
+        ))
+        .into());
+    }
+    let (c, w, r) = form_with_zeros(h, &a.zeros)?;
+    Ok(ChosenForm {
+        form: w,
+        coefficients: c,
+        placement_residual: Some(r),
+        uniform: None,
+    })
+}
+
+fn refined_positions(h: &HolomorphicForms) -> anyhow::Result<&[[f64; 3]]> {
+    h.cut.refined.positions.as_deref().ok_or_else(|| {
+        anyhow::anyhow!(
+            "the working triangulation has vertices without positions; use --triangulation input"
+        )
+    })
+}
+
+/// The critical horizontal trajectories of `form` through its zeros, each traced for 1.5
+/// times `scale` (the a-period of a basis form is 1), as polylines on the refined surface.
+pub fn critical_lines(
+    h: &HolomorphicForms,
+    form: &HolomorphicForm,
+    zeros: &ZeroSet,
+    scale: f64,
+) -> Vec<Vec<[f64; 3]>> {
+    let Some(pos) = h.cut.refined.positions.as_deref() else {
+        return Vec::new();
     };
-    bar.0.set_message("zeros and conformal net");
-    let zeros = h.zeros(&form)?;
-    let net = h.net(&form)?;
-    let refined = &h.cut.refined;
+    let at: Vec<u32> = zeros.zeros.iter().map(|z| z.vertex).collect();
+    critical_trajectories(h.mesh(), form, &at, 1.5 * scale, 200_000)
+        .iter()
+        .map(|t| t.points.iter().map(|p| p.position(pos)).collect())
+        .collect()
+}
+
+/// Append polylines to an OBJ text as new vertices and `l` elements (`first` vertices are
+/// already written).
+fn append_obj_lines(text: &mut String, first: usize, lines: &[Vec<[f64; 3]>]) {
+    use std::fmt::Write;
+    let mut next = first + 1;
+    for l in lines.iter().filter(|l| l.len() >= 2) {
+        for p in l {
+            let _ = writeln!(text, "v {} {} {}", p[0], p[1], p[2]);
+        }
+        let ids: Vec<String> = (next..next + l.len()).map(|i| i.to_string()).collect();
+        let _ = writeln!(text, "l {}", ids.join(" "));
+        next += l.len();
+    }
+}
+
+/// Checkerboard of the net on the surface (`freq` checks per unit of uv), the zeros circled
+/// in red, the critical trajectories in dark blue; PNG bytes.
+pub fn net_picture(
+    h: &HolomorphicForms,
+    zeros: &ZeroSet,
+    corner_uv: &[[f64; 2]],
+    freq: f64,
+    trajectories: &[Vec<[f64; 3]>],
+) -> anyhow::Result<Vec<u8>> {
+    let pos = refined_positions(h)?;
+    let tris = h.cut.refined.mesh.faces();
+    let mut polylines: Vec<Polyline> = trajectories
+        .iter()
+        .map(|l| Polyline {
+            points: l.clone(),
+            color: [0.05, 0.15, 0.6],
+            width: 2.5,
+            closed: false,
+        })
+        .collect();
+    polylines.extend(zeros.zeros.iter().map(|z| marker(pos, tris, z.vertex)));
+    let style = Style {
+        paint: Paint::Checker(Checker::new(Uvs::PerCorner(corner_uv), freq)),
+        polylines,
+        ..Default::default()
+    };
+    Ok(ricci_render::render_png(
+        pos,
+        tris,
+        &style,
+        &RenderOptions::default(),
+    )?)
+}
+
+fn report_json(
+    a: &Args,
+    h: &HolomorphicForms,
+    chosen: &ChosenForm,
+    zeros: &ZeroSet,
+    net: &ConformalNet,
+    trajectories: usize,
+    t0: Instant,
+) -> anyhow::Result<serde_json::Value> {
     let n_work = h.working.mesh.n_vertices() as u32;
+    let refined = &h.cut.refined;
     let zero_json: Vec<_> = zeros
         .zeros
         .iter()
@@ -147,55 +304,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             })
         })
         .collect();
-    let cut_mesh = &h.cut.cut_mesh;
-    let corner_uv: Vec<[f64; 2]> = (0..cut_mesh.n_corners() as u32)
-        .map(|c| net.uv[cut_mesh.corner_vertex(c) as usize])
-        .collect();
-    if let Some(path) = &a.out {
-        let pos = refined.positions.as_ref().ok_or_else(|| {
-            anyhow::anyhow!("the working triangulation has vertices without positions; use --triangulation input")
-        })?;
-        let text = obj_with_corner_uv(
-            pos,
-            refined.mesh.faces(),
-            &corner_uv,
-            &[
-                format!("ricci forms: conformal net of a holomorphic 1-form, genus {g}"),
-                format!("triangulation {}", h.report.triangulation.name()),
-            ],
-        );
-        write_atomic(path, text.as_bytes())?;
-    }
-    if let Some(path) = &a.png {
-        let pos = refined.positions.as_ref().ok_or_else(|| {
-            anyhow::anyhow!("the working triangulation has vertices without positions; use --triangulation input")
-        })?;
-        let tris = refined.mesh.faces();
-        // Scale: `checks` per unit of the a₁-period of ω_1 (per unit of |λ| otherwise).
-        let scale: f64 = coefficients
-            .iter()
-            .map(|c| c.norm_sqr())
-            .sum::<f64>()
-            .sqrt();
-        let freq = a.checks / scale.max(1e-300);
-        let style = Style {
-            paint: Paint::Checker(Checker::new(Uvs::PerCorner(&corner_uv), freq)),
-            polylines: zeros
-                .zeros
-                .iter()
-                .map(|z| marker(pos, tris, z.vertex))
-                .collect(),
-            ..Default::default()
-        };
-        let png = ricci_render::render_png(pos, tris, &style, &RenderOptions::default())?;
-        write_atomic(path, &png)?;
-    }
-    bar.0.finish_and_clear();
     let om = &h.period_matrix;
     let r = &h.report;
-    let v = json!({
+    Ok(json!({
         "mesh": a.mesh.display().to_string(),
-        "genus": g,
+        "genus": h.genus,
         "period_matrix": {"re": om.re, "im": om.im},
         "modulus": h.modulus().map(|t| [t.0, t.1]),
         "im_eigenvalues": om.im_eigenvalues()?,
@@ -203,11 +316,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "zeros": zero_json,
         "zero_count": zeros.count,
         "spurious_singularities": zeros.spurious,
+        "critical_trajectories": trajectories,
         "form": {
-            "coefficients": coefficients.iter().map(|c| [c.re, c.im]).collect::<Vec<_>>(),
+            "coefficients": chosen.coefficients.iter().map(|c| [c.re, c.im]).collect::<Vec<_>>(),
             "placed_zeros": a.zeros,
-            "placement_residual": placement_residual,
-            "uniform": uniform_report,
+            "placement_residual": chosen.placement_residual,
+            "uniform": chosen.uniform,
         },
         "quality": {
             "star_defect": r.star_defect,
@@ -229,48 +343,47 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "out": a.out.as_ref().map(|p| p.display().to_string()),
         "png": a.png.as_ref().map(|p| p.display().to_string()),
         "seconds": t0.elapsed().as_secs_f64(),
-    });
-    if a.json {
-        print_json(&v);
-    } else {
-        println!(
-            "genus {g}, {} vertices ({} triangulation, {} flips)",
-            r.vertices,
-            r.triangulation.name(),
-            r.flips
-        );
-        for i in 0..g {
-            let row: Vec<String> = (0..g)
-                .map(|j| format!("{:+.6} {:+.6}i", om.re[i][j], om.im[i][j]))
-                .collect();
-            println!("  Ω[{}] = {}", i + 1, row.join(", "));
-        }
-        if let Some(t) = h.modulus() {
-            println!("modulus τ = {:.6} + {:.6}i", t.0, t.1);
-        }
-        println!(
-            "zeros ({}): {}",
-            zeros.count,
-            zeros
-                .zeros
-                .iter()
-                .map(|z| format!("{}×{}", z.vertex, z.multiplicity))
-                .collect::<Vec<_>>()
-                .join(" ")
-        );
-        println!(
-            "star defect {:.1e}, net angle distortion mean {:.3} p95 {:.3}; {:.2} s",
-            r.star_defect,
-            net.quality.qc_mean,
-            net.quality.qc_p95,
-            t0.elapsed().as_secs_f64()
-        );
+    }))
+}
+
+fn print_text(h: &HolomorphicForms, zeros: &ZeroSet, net: &ConformalNet, t0: Instant) {
+    let (g, r, om) = (h.genus, &h.report, &h.period_matrix);
+    println!(
+        "genus {g}, {} vertices ({} triangulation, {} flips)",
+        r.vertices,
+        r.triangulation.name(),
+        r.flips
+    );
+    for i in 0..g {
+        let row: Vec<String> = (0..g)
+            .map(|j| format!("{:+.6} {:+.6}i", om.re[i][j], om.im[i][j]))
+            .collect();
+        println!("  Ω[{}] = {}", i + 1, row.join(", "));
     }
-    Ok(())
+    if let Some(t) = h.modulus() {
+        println!("modulus τ = {:.6} + {:.6}i", t.0, t.1);
+    }
+    println!(
+        "zeros ({}): {}",
+        zeros.count,
+        zeros
+            .zeros
+            .iter()
+            .map(|z| format!("{}×{}", z.vertex, z.multiplicity))
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
+    println!(
+        "star defect {:.1e}, net angle distortion mean {:.3} p95 {:.3}; {:.2} s",
+        r.star_defect,
+        net.quality.qc_mean,
+        net.quality.qc_p95,
+        t0.elapsed().as_secs_f64()
+    );
 }
 
 /// A small circle around vertex `v` (in the plane orthogonal to its normal).
-fn marker(pos: &[[f64; 3]], tris: &[[u32; 3]], v: u32) -> Polyline {
+pub fn marker(pos: &[[f64; 3]], tris: &[[u32; 3]], v: u32) -> Polyline {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for p in pos {
         for k in 0..3 {

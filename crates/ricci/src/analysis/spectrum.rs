@@ -240,6 +240,168 @@ fn axis_frame(g: &Mobius) -> Option<Mobius> {
     Some(Mobius::rotation(-a.arg()).compose(&t))
 }
 
+/// The tiles `gF` kept by a breadth-first search from `F` through the side pairings `maps`
+/// (words composed in double-double: products of side pairings that move the centre far lose
+/// in double the 1e-7 that tells two tiles apart). A tile is found again by the position of
+/// `g o` (`o_h`: the centre on the hyperboloid); `keep(g, g o)` decides whether a new tile is
+/// kept (a tile already found is not tested again; a rejected one is, from each neighbour:
+/// remembering the rejected tiles in a second index made seahorse2_100K more than 10× slower,
+/// probably because the index's distance bands got crowded). `None` when more than
+/// `max_tiles` tiles are kept.
+struct TileSearch {
+    elems_dd: Vec<MobiusDd>,
+    elems: Vec<Mobius>,
+    index: TileIndex,
+}
+
+impl TileSearch {
+    fn run(
+        o_h: [f64; 3],
+        maps: &[MobiusDd],
+        max_tiles: usize,
+        mut keep: impl FnMut(&Mobius, [f64; 3]) -> bool,
+    ) -> Option<TileSearch> {
+        let mut index = TileIndex::new();
+        let mut elems_dd: Vec<MobiusDd> = vec![MobiusDd::IDENTITY];
+        let mut elems: Vec<Mobius> = vec![Mobius::identity()];
+        index.insert(o_h);
+        let mut queue = VecDeque::from([0usize]);
+        while let Some(t) = queue.pop_front() {
+            for sm in maps {
+                let gd = elems_dd[t].compose(sm).normalized();
+                let g = gd.round();
+                let go = apply_h(&g.klein_matrix(), o_h);
+                if index.find(go).is_some() {
+                    continue;
+                }
+                if !keep(&g, go) {
+                    continue;
+                }
+                index.insert(go);
+                elems.push(g);
+                elems_dd.push(gd);
+                queue.push_back(elems.len() - 1);
+                if elems.len() > max_tiles {
+                    return None;
+                }
+            }
+        }
+        Some(TileSearch {
+            elems_dd,
+            elems,
+            index,
+        })
+    }
+
+    /// Candidates of the class search: the hyperbolic tiles with `ℓ ≤ l` whose axis passes
+    /// `near` (a conservative test) and crosses the boundary cycle `bnd`, with the sides it
+    /// crosses.
+    fn candidates(
+        &self,
+        l: f64,
+        bnd: &[(Complex, usize)],
+        near: impl Fn(&Mobius) -> bool,
+    ) -> (Vec<usize>, Vec<Vec<usize>>) {
+        let tol = 1e-8;
+        let mut cand: Vec<usize> = Vec::new();
+        let mut crossings: Vec<Vec<usize>> = Vec::new();
+        for (i, g) in self.elems.iter().enumerate().skip(1) {
+            let len = g.translation_length();
+            if !(len > 0.0 && len <= l) {
+                continue;
+            }
+            let Some(fr) = axis_frame(g) else { continue };
+            if !near(&fr) {
+                continue;
+            }
+            let sides = sides_crossed(&fr, bnd, tol);
+            if !sides.is_empty() {
+                cand.push(i);
+                crossings.push(sides);
+            }
+        }
+        (cand, crossings)
+    }
+
+    /// The classes of the candidates; `Some` when at least `count` were found.
+    fn spectrum(
+        &self,
+        l: f64,
+        bnd: &[(Complex, usize)],
+        maps: &[MobiusDd],
+        o_h: [f64; 3],
+        count: usize,
+        near: impl Fn(&Mobius) -> bool,
+    ) -> Option<HyperbolicSpectrum> {
+        let (cand, crossings) = self.candidates(l, bnd, near);
+        let (mut classes, unmatched) =
+            group_classes(&self.elems_dd, &cand, &crossings, maps, &self.index, o_h);
+        classes.sort_by(|a, b| a.length.total_cmp(&b.length));
+        if classes.len() < count {
+            return None;
+        }
+        classes.truncate(count);
+        Some(HyperbolicSpectrum {
+            classes,
+            complete_up_to: l,
+            tiles: self.elems.len(),
+            unmatched_links: unmatched,
+        })
+    }
+}
+
+/// Centre of a finite set of disk points (Badoiu–Clarkson iterations towards the minimax
+/// centre) and the largest distance from it to one of them.
+fn minimax_centre(points: &[Complex]) -> (Complex, f64) {
+    let mut o = points[0];
+    for it in 1..200 {
+        let far = points
+            .iter()
+            .copied()
+            .max_by(|p, q| disk_distance(o, *p).total_cmp(&disk_distance(o, *q)))
+            .unwrap_or(o);
+        let t = Mobius::to_origin(o);
+        let w = t.apply(far);
+        let d = disk_distance(o, far);
+        let step = Complex::from_polar((0.5 * d / (it as f64 + 1.0)).tanh(), w.arg());
+        o = t.inverse().apply(step);
+    }
+    let rho = points
+        .iter()
+        .map(|&p| disk_distance(o, p))
+        .fold(0.0, f64::max);
+    (o, rho)
+}
+
+/// Cover of a closed boundary cycle by balls of radius about 0.2 (greedy along the cycle):
+/// (centre, radius) such that every point of the cycle's edges is in a ball (edges shorter
+/// than the gaps are covered by the ball of their first end point widened by the edge).
+fn cycle_balls(bnd: &[(Complex, usize)]) -> Vec<(Complex, f64)> {
+    let nb = bnd.len();
+    let mut balls: Vec<(Complex, f64)> = Vec::new();
+    let mut i = 0;
+    while i < nb {
+        let c = bnd[i].0;
+        let mut r: f64 = 0.0;
+        let mut j = i;
+        loop {
+            let nxt = bnd[(j + 1) % nb].0;
+            let d = disk_distance(c, nxt);
+            if d > 0.2 && j > i {
+                break;
+            }
+            r = r.max(d);
+            j += 1;
+            if j >= nb {
+                break;
+            }
+        }
+        balls.push((c, r));
+        i = j.max(i + 1);
+    }
+    balls
+}
+
 /// Length spectrum of a closed hyperbolic surface from the layout of its fundamental polygon
 /// (Poincaré disk) and its deck group: at least the `count` shortest classes (see the module
 /// documentation for the completeness argument). `max_tiles` bounds the search.
@@ -256,9 +418,14 @@ pub fn fuchsian_spectrum(
         ));
     }
     let n_sides = poly.sides.len();
-    let side_maps: Vec<Mobius> = (0..n_sides)
-        .map(|s| group.side_map(s).expect("closed polygon"))
-        .collect();
+    let mut side_maps: Vec<Mobius> = Vec::with_capacity(n_sides);
+    for s in 0..n_sides {
+        side_maps.push(group.side_map(s).ok_or_else(|| {
+            Error::topology(format!(
+                "side {s} of the fundamental polygon has no pairing"
+            ))
+        })?);
+    }
     // Boundary cycle: (position, side of the edge starting there).
     let mut bnd: Vec<(Complex, usize)> = Vec::new();
     for (s, side) in poly.sides.iter().enumerate() {
@@ -266,57 +433,11 @@ pub fn fuchsian_spectrum(
             bnd.push((layout.positions[v as usize], s));
         }
     }
-    let nb = bnd.len();
-    // Centre o of the boundary points (Badoiu–Clarkson iterations for the minimax centre).
-    let mut o = bnd[0].0;
-    for it in 1..200 {
-        let far = bnd
-            .iter()
-            .map(|b| b.0)
-            .max_by(|p, q| disk_distance(o, *p).total_cmp(&disk_distance(o, *q)))
-            .unwrap_or(o);
-        let t = Mobius::to_origin(o);
-        let w = t.apply(far);
-        let d = disk_distance(o, far);
-        let step = Complex::from_polar((0.5 * d / (it as f64 + 1.0)).tanh(), w.arg());
-        o = t.inverse().apply(step);
-    }
-    let rho = bnd
-        .iter()
-        .map(|b| disk_distance(o, b.0))
-        .fold(0.0, f64::max);
-    // Ball cover of ∂F with radius about 0.2 (greedy along the cycle).
-    let mut balls: Vec<(Complex, f64)> = Vec::new();
-    {
-        let mut i = 0;
-        while i < nb {
-            let c = bnd[i].0;
-            let mut r: f64 = 0.0;
-            let mut j = i;
-            loop {
-                let nxt = bnd[(j + 1) % nb].0;
-                let d = disk_distance(c, nxt);
-                if d > 0.2 && j > i {
-                    break;
-                }
-                r = r.max(d);
-                j += 1;
-                if j >= nb {
-                    break;
-                }
-            }
-            balls.push((c, r));
-            i = j.max(i + 1);
-        }
-    }
+    let points: Vec<Complex> = bnd.iter().map(|b| b.0).collect();
+    let (o, rho) = minimax_centre(&points);
+    let balls = cycle_balls(&bnd);
     let ball_h: Vec<[f64; 3]> = balls.iter().map(|b| poincare_to_hyperboloid(b.0)).collect();
     let o_h = poincare_to_hyperboloid(o);
-    let hdist = |x: [f64; 3], y: [f64; 3]| -> f64 {
-        let ex = TileIndex::entry(x);
-        let ey = TileIndex::entry(y);
-        TileIndex::dist(&ex, &ey)
-    };
-
     let mut l = group
         .named_generators()
         .iter()
@@ -328,114 +449,54 @@ pub fn fuchsian_spectrum(
             "the deck generators are not hyperbolic isometries (is the metric hyperbolic?)",
         ));
     }
-    let mut last_err = None;
     // cosh of the hyperbolic distance from the Lorentz product (X₀ is the last coordinate).
     let cosh_d = |x: [f64; 3], y: [f64; 3]| x[2] * y[2] - x[0] * y[0] - x[1] * y[1];
     let nballs = balls.len();
     let r_max = balls.iter().map(|b| b.1).fold(0.0, f64::max);
     // Thresholds are widened by a relative 1e-9 so that rounding can only keep a tile more.
     let widen = |x: f64| x.cosh() * (1.0 + 1e-9) + 1e-9;
+    let maps_dd: Vec<MobiusDd> = side_maps.iter().map(|&g| g.into()).collect();
     for _round in 0..12 {
         let pair_limit: Vec<f64> = (0..nballs * nballs)
             .map(|i| widen(l + balls[i / nballs].1 + balls[i % nballs].1))
             .collect();
         let reach: Vec<f64> = balls.iter().map(|b| widen(l + b.1 + rho + r_max)).collect();
-        // Breadth-first search over tiles.
-        let mut index = TileIndex::new();
-        let mut elems: Vec<Mobius> = vec![Mobius::identity()];
-        index.insert(o_h);
-        let mut queue = VecDeque::from([0usize]);
-        let mut overflow = false;
-        while let Some(t) = queue.pop_front() {
-            for sm in &side_maps {
-                let g = elems[t].compose(sm).normalized();
-                let k = g.klein_matrix();
-                let go = apply_h(&k, o_h);
-                if index.find(go).is_some() {
-                    continue;
-                }
-                // Conservative distance test between F and gF.
-                let dcoarse = hdist(o_h, go) - 2.0 * rho;
-                if dcoarse > l {
-                    continue;
-                }
-                // Pairs of balls, in cosh form (no acosh per pair): d(c_j, g c_k) ≤ L + r_j + r_k
-                // ⟺ cosh d ≤ cosh(L + r_j + r_k). Balls c_j farther than L + r_j + ρ + r_max
-                // from g o cannot be near any ball of gF (which lies in the ball of radius
-                // ρ + r_max around g o) and are skipped.
-                let gb: Vec<[f64; 3]> = ball_h.iter().map(|&b| apply_h(&k, b)).collect();
-                let mut near = false;
-                'outer: for (j, &cj) in ball_h.iter().enumerate() {
-                    if cosh_d(cj, go) > reach[j] {
-                        continue;
-                    }
+        let coarse = widen(l + 2.0 * rho);
+        // Conservative distance test between F and gF: F lies in B(o, ρ), and ∂F in the
+        // balls; in cosh form (no acosh per pair): d(c_j, g c_k) ≤ L + r_j + r_k. Balls c_j
+        // farther than L + r_j + ρ + r_max from g o cannot be near any ball of gF (which lies
+        // in the ball of radius ρ + r_max around g o) and are skipped.
+        let keep = |g: &Mobius, go: [f64; 3]| {
+            if cosh_d(o_h, go) > coarse {
+                return false;
+            }
+            let k = g.klein_matrix();
+            let gb: Vec<[f64; 3]> = ball_h.iter().map(|&b| apply_h(&k, b)).collect();
+            ball_h.iter().enumerate().any(|(j, &cj)| {
+                cosh_d(cj, go) <= reach[j] && {
                     let row = &pair_limit[j * nballs..(j + 1) * nballs];
-                    for (kk, &gk) in gb.iter().enumerate() {
-                        if cosh_d(cj, gk) <= row[kk] {
-                            near = true;
-                            break 'outer;
-                        }
-                    }
+                    gb.iter().zip(row).any(|(&gk, &lim)| cosh_d(cj, gk) <= lim)
                 }
-                if !near {
-                    continue;
-                }
-                index.insert(go);
-                elems.push(g);
-                queue.push_back(elems.len() - 1);
-                if elems.len() > max_tiles {
-                    overflow = true;
-                    break;
-                }
-            }
-            if overflow {
-                break;
-            }
-        }
-        if overflow {
-            last_err = Some(Error::numerical(format!(
+            })
+        };
+        let Some(search) = TileSearch::run(o_h, &maps_dd, max_tiles, keep) else {
+            return Err(Error::numerical(format!(
                 "the spectrum search exceeded {max_tiles} tiles of the universal cover at \
                  length bound {l:.3} (the fundamental polygon is very distorted)"
             )));
-            break;
-        }
-        // Candidates: hyperbolic, ℓ ≤ L, axis meets F (crosses ∂F).
-        let tol = 1e-8;
-        let mut cand: Vec<usize> = Vec::new();
-        let mut crossings: Vec<Vec<usize>> = Vec::new();
-        for (i, g) in elems.iter().enumerate().skip(1) {
-            let len = g.translation_length();
-            if !(len > 0.0 && len <= l) {
-                continue;
-            }
-            let Some(fr) = axis_frame(g) else { continue };
-            let sides = sides_crossed(&fr, &bnd, tol);
-            if !sides.is_empty() {
-                cand.push(i);
-                crossings.push(sides);
-            }
-        }
-        let elems_dd: Vec<MobiusDd> = elems.iter().map(|&g| g.into()).collect();
-        let maps_dd: Vec<MobiusDd> = side_maps.iter().map(|&g| g.into()).collect();
-        let (mut classes, unmatched) =
-            group_classes(&elems_dd, &cand, &crossings, &maps_dd, &index, o_h);
-        classes.sort_by(|a, b| a.length.total_cmp(&b.length));
-        if classes.len() >= count {
-            classes.truncate(count);
-            return Ok(HyperbolicSpectrum {
-                classes,
-                complete_up_to: l,
-                tiles: elems.len(),
-                unmatched_links: unmatched,
-            });
+        };
+        if let Some(sp) = search.spectrum(l, &bnd, &maps_dd, o_h, count, |_| true) {
+            return Ok(sp);
         }
         l *= 1.25;
     }
-    Err(last_err
-        .unwrap_or_else(|| Error::numerical("the spectrum search did not find enough classes")))
+    Err(Error::numerical(
+        "the spectrum search did not find enough classes within 12 enlargements of its length bound",
+    ))
 }
 
 mod surface;
+pub mod trace;
 pub use surface::{surface_spectrum, CompactDomain};
 
 /// Union of candidates into classes (see [`fuchsian_spectrum`]): each candidate is joined

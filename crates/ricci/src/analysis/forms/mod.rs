@@ -24,6 +24,7 @@ pub mod net;
 pub mod period;
 pub mod placement;
 pub mod small;
+pub mod trajectories;
 pub mod uniform;
 pub mod working;
 pub mod zeros;

@@ -104,10 +104,9 @@ impl BallCover {
     }
 
     /// False only if `d(F, gF) > L` is certain.
-    fn may_be_within(&self, g: &Mobius, lim: &CoverLimits) -> bool {
+    fn may_be_within(&self, g: &Mobius, go: [f64; 3], lim: &CoverLimits) -> bool {
         let cosh_d = |x: &[f64; 3], y: &[f64; 3]| x[2] * y[2] - x[0] * y[0] - x[1] * y[1];
         let k = g.klein_matrix();
-        let go = apply_h(&k, self.centre);
         let n = self.balls.len();
         let mut moved: Vec<Option<[f64; 3]>> = vec![None; n];
         for (j, bj) in self.balls.iter().enumerate() {
@@ -172,11 +171,6 @@ pub fn surface_spectrum(
     count: usize,
     max_tiles: usize,
 ) -> Result<(HyperbolicSpectrum, CompactDomain)> {
-    use crate::layout::dd::Cdd;
-    use crate::layout::place::layout_dd;
-    use crate::metric::Hyperbolic;
-    use std::cmp::Reverse;
-    use std::collections::BinaryHeap;
     let ne = mesh.n_edges();
     if lengths.len() != ne || lengths_lo.is_some_and(|l| l.len() != ne) {
         return Err(Error::input(format!(
@@ -189,7 +183,6 @@ pub fn surface_spectrum(
             "the length spectrum needs a closed surface (the mesh has a boundary or no faces)",
         ));
     }
-    // Centre: a central vertex (double sweep), and edge-path distances from it.
     let o = match centre {
         Some(v) if (v as usize) < mesh.n_vertices() => v,
         Some(v) => {
@@ -200,11 +193,68 @@ pub fn surface_spectrum(
         }
         None => crate::cut::central_vertex(mesh, lengths)?,
     };
-    // Dirichlet-like growth: develop the faces in the hyperbolic plane (double precision,
-    // for the order only) from a face at `o`, attaching next the face whose developed copy
-    // lies nearest to `o` (largest |z| of its corners: the hyperbolic distance 2 atanh|z| is
-    // monotone in |z|).
-    let nf = mesh.n_faces();
+    let (seed, crossed) = grow_domain(mesh, lengths, o)?;
+    let dom = DomainPairings::new(mesh, lengths, lengths_lo, o, seed, &crossed)?;
+    let max_edge = lengths.iter().copied().fold(0.0, f64::max);
+    let cover = BallCover::of_points(&dom.positions, dom.centre, 1.0, max_edge, 400);
+    let radius = cover.radius;
+    let domain = CompactDomain {
+        radius,
+        faces: mesh.n_faces(),
+        boundary_edges: dom.boundary.len(),
+        generators: dom.generators.len(),
+        balls: cover.balls.len(),
+    };
+    let mut l = dom
+        .generators
+        .iter()
+        .map(|g| g.round().translation_length())
+        .filter(|x| *x > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    if !l.is_finite() {
+        return Err(Error::numerical(
+            "the side pairings are not hyperbolic isometries (is the metric hyperbolic?)",
+        ));
+    }
+    let o_h = cover.centre;
+    for _round in 0..16 {
+        let bound = ((l + 2.0 * radius) * (1.0 + 1e-9) + 1e-9).cosh();
+        let limits = cover.limits(l, radius);
+        let cosh_d = |x: [f64; 3], y: [f64; 3]| x[2] * y[2] - x[0] * y[0] - x[1] * y[1];
+        let keep = |g: &Mobius, go: [f64; 3]| {
+            cosh_d(o_h, go) <= bound && cover.may_be_within(g, go, &limits)
+        };
+        let Some(search) = TileSearch::run(o_h, &dom.generators, max_tiles, keep) else {
+            return Err(Error::numerical(format!(
+                "the spectrum search exceeded its budget of {max_tiles} tiles of the \
+                 universal cover at length bound {l:.3} (domain radius {radius:.2}); \
+                 ask for fewer lengths"
+            )));
+        };
+        // The axis is the real diameter in the frame: skip it when it misses every ball.
+        let near = |fr: &Mobius| cover.meets_axis(fr);
+        if let Some(sp) = search.spectrum(l, &dom.boundary, &dom.generators, o_h, count, near) {
+            return Ok((sp, domain));
+        }
+        l *= 1.25;
+    }
+    Err(Error::numerical(format!(
+        "the spectrum search did not find {count} classes within its budget of 16 \
+         enlargements of the length bound (last bound {l:.3})"
+    )))
+}
+
+/// Dirichlet-like growth of a fundamental domain around vertex `o`: develop the faces in the
+/// hyperbolic plane (double precision, for the order only) from a face at `o`, attaching next
+/// the face whose developed copy lies nearest to `o` (largest |z| of its corners: the
+/// hyperbolic distance 2 atanh|z| is monotone in |z|). Returns the seed face and the edges
+/// the spanning tree of the dual graph crosses.
+fn grow_domain(mesh: &crate::mesh::Mesh, lengths: &[f64], o: u32) -> Result<(u32, Vec<bool>)> {
+    use crate::layout::place::Space;
+    use crate::metric::Hyperbolic;
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+    let (nf, ne) = (mesh.n_faces(), mesh.n_edges());
     let seed = mesh
         .outgoing(o)
         .map(|h| mesh.he_face(h))
@@ -213,13 +263,11 @@ pub fn surface_spectrum(
     let mut developed = vec![false; nf];
     let mut crossed = vec![false; ne];
     let mut corner = vec![Complex::new(0.0, 0.0); 3 * nf];
+    let len = |h: u32| lengths[mesh.he_edge(h) as usize];
     {
-        use crate::layout::place::Space;
-        let len = |h: u32| lengths[mesh.he_edge(h) as usize];
-        let [h0, h1, h2] = mesh.face_halfedges(seed);
+        let hs = mesh.face_halfedges(seed);
         // Rotate the seed so that `o` is its first corner (at the centre of the disk).
         let i0 = mesh.face(seed).iter().position(|&v| v == o).unwrap_or(0);
-        let hs = [h0, h1, h2];
         let p = Hyperbolic::seed(len(hs[i0]), len(hs[(i0 + 1) % 3]), len(hs[(i0 + 2) % 3]));
         for r in 0..3 {
             corner[3 * seed as usize + (i0 + r) % 3] = p[r];
@@ -231,7 +279,6 @@ pub fn surface_spectrum(
     let mut heap: BinaryHeap<Entry> = BinaryHeap::new();
     let push_neighbours =
         |f: u32, corner: &[Complex], developed: &[bool], heap: &mut BinaryHeap<Entry>| {
-            use crate::layout::place::Space;
             for h in mesh.face_halfedges(f) {
                 let t = mesh.he_twin(h);
                 let g = mesh.he_face(t);
@@ -242,23 +289,13 @@ pub fn surface_spectrum(
                 let pa = corner[h as usize];
                 let pb = corner[mesh.he_next(h) as usize];
                 let tn = mesh.he_next(t);
-                let pc = Hyperbolic::third(
-                    pb,
-                    pa,
-                    lengths[mesh.he_edge(t) as usize],
-                    lengths[mesh.he_edge(tn) as usize],
-                    lengths[mesh.he_edge(mesh.he_next(tn)) as usize],
-                );
+                let pc = Hyperbolic::third(pb, pa, len(t), len(tn), len(mesh.he_next(tn)));
                 if pc.norm_sqr().is_nan() || pc.norm_sqr() >= 1.0 {
                     continue; // numerically outside the disk: never the nearest copy
                 }
                 let key = pa.norm_sqr().max(pb.norm_sqr()).max(pc.norm_sqr());
-                heap.push((
-                    Reverse(key.to_bits()),
-                    g,
-                    t,
-                    (pc.re.to_bits(), pc.im.to_bits()),
-                ));
+                let pc_bits = (pc.re.to_bits(), pc.im.to_bits());
+                heap.push((Reverse(key.to_bits()), g, t, pc_bits));
             }
         };
     developed[seed as usize] = true;
@@ -279,165 +316,97 @@ pub fn surface_spectrum(
     if developed.iter().any(|&d| !d) {
         return Err(Error::topology("the surface is not connected"));
     }
-    let cut: Vec<bool> = crossed.iter().map(|&c| !c).collect();
-    let (cm, origin) = crate::cut::slice(mesh, &cut)?;
-    let mut cl = vec![0.0; cm.n_edges()];
-    let mut cl_lo = vec![0.0; cm.n_edges()];
-    for h in 0..cm.n_corners() as u32 {
-        let e = mesh.he_edge(h) as usize;
-        cl[cm.he_edge(h) as usize] = lengths[e];
-        cl_lo[cm.he_edge(h) as usize] = lengths_lo.map_or(0.0, |l| l[e]);
-    }
-    let lay = layout_dd::<Hyperbolic>(&cm, &cl, Some(&cl_lo), Some(seed))?;
-    if !lay.flipped_faces.is_empty() {
-        return Err(Error::numerical(format!(
-            "the compact fundamental domain has {} flipped faces (face {}); is the metric \
-             hyperbolic and converged?",
-            lay.flipped_faces.len(),
-            lay.flipped_faces[0]
-        )));
-    }
-    let pos = |v: u32| Cdd::from_parts(lay.positions[v as usize], lay.positions_lo[v as usize]);
-    // Side pairings: the sliced edge h (face f) and its twin t (face f') are two sides; the
-    // map S_h takes F onto the tile across h, i.e. t's copy onto h's copy, reversed.
-    let loops = cm.boundary_loop_halfedges();
-    if loops.len() != 1 {
-        return Err(Error::numerical(format!(
-            "internal error: the sliced surface has {} boundary loops",
-            loops.len()
-        )));
-    }
-    let bloop = &loops[0];
-    let mut gens: Vec<MobiusDd> = Vec::new();
-    let mut gen_index = TileIndex::new();
-    // The centre: the copy of `o` in the seed face (the domain was grown around it).
-    let o_pt = {
+    Ok((seed, crossed))
+}
+
+/// The compact fundamental domain laid out in double-double and its side pairings.
+struct DomainPairings {
+    /// Layout of the sliced surface (double part).
+    positions: Vec<Complex>,
+    /// The copy of the centre vertex in the seed face.
+    centre: Complex,
+    /// Distinct side pairings (a generating set of the deck group).
+    generators: Vec<MobiusDd>,
+    /// Boundary cycle: (position, generator of the side starting there).
+    boundary: Vec<(Complex, usize)>,
+}
+
+impl DomainPairings {
+    /// Slice `mesh` along the edges the tree does not cross, lay the disk out in double-double
+    /// from `seed`, and read the side pairings: the sliced edge h (face f) and its twin t (face
+    /// f') are two sides; the map S_h takes F onto the tile across h, i.e. t's copy onto h's
+    /// copy, reversed.
+    fn new(
+        mesh: &crate::mesh::Mesh,
+        lengths: &[f64],
+        lengths_lo: Option<&[f64]>,
+        o: u32,
+        seed: u32,
+        crossed: &[bool],
+    ) -> Result<Self> {
+        use crate::layout::dd::Cdd;
+        use crate::layout::place::layout_dd;
+        use crate::metric::Hyperbolic;
+        let cut: Vec<bool> = crossed.iter().map(|&c| !c).collect();
+        let (cm, origin) = crate::cut::slice(mesh, &cut)?;
+        let mut cl = vec![0.0; cm.n_edges()];
+        let mut cl_lo = vec![0.0; cm.n_edges()];
+        for h in 0..cm.n_corners() as u32 {
+            let e = mesh.he_edge(h) as usize;
+            cl[cm.he_edge(h) as usize] = lengths[e];
+            cl_lo[cm.he_edge(h) as usize] = lengths_lo.map_or(0.0, |l| l[e]);
+        }
+        let lay = layout_dd::<Hyperbolic>(&cm, &cl, Some(&cl_lo), Some(seed))?;
+        if !lay.flipped_faces.is_empty() {
+            return Err(Error::numerical(format!(
+                "the compact fundamental domain has {} flipped faces (face {}); is the metric \
+                 hyperbolic and converged?",
+                lay.flipped_faces.len(),
+                lay.flipped_faces[0]
+            )));
+        }
+        let pos = |v: u32| Cdd::from_parts(lay.positions[v as usize], lay.positions_lo[v as usize]);
+        let loops = cm.boundary_loop_halfedges();
+        if loops.len() != 1 {
+            return Err(Error::numerical(format!(
+                "internal error: the sliced surface has {} boundary loops",
+                loops.len()
+            )));
+        }
         let i0 = cm
             .face(seed)
             .iter()
             .position(|&v| origin[v as usize] == o)
             .unwrap_or(0);
-        lay.positions[cm.face(seed)[i0] as usize]
-    };
-    let o_h = poincare_to_hyperboloid(o_pt);
-    let mut bnd: Vec<(Complex, usize)> = Vec::with_capacity(bloop.len());
-    for &h in bloop {
-        let t = mesh.he_twin(h);
-        let m = MobiusDd::from_pairs(
-            pos(cm.he_origin(t)),
-            pos(cm.he_tip(t)),
-            pos(cm.he_tip(h)),
-            pos(cm.he_origin(h)),
-        )
-        .normalized();
-        let go = apply_h(&m.round().klein_matrix(), o_h);
-        let k = match gen_index.find(go) {
-            Some(k) => k,
-            None => {
-                gens.push(m);
-                gen_index.insert(go)
-            }
-        };
-        bnd.push((lay.positions[cm.he_origin(h) as usize], k));
-    }
-    let max_edge = lengths.iter().copied().fold(0.0, f64::max);
-    let cover = BallCover::of_points(&lay.positions, o_pt, 1.0, max_edge, 400);
-    let radius = cover.radius;
-    let domain = CompactDomain {
-        radius,
-        faces: nf,
-        boundary_edges: bnd.len(),
-        generators: gens.len(),
-        balls: cover.balls.len(),
-    };
-    let mut l = gens
-        .iter()
-        .map(|g| g.round().translation_length())
-        .filter(|x| *x > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    if !l.is_finite() {
-        return Err(Error::numerical(
-            "the side pairings are not hyperbolic isometries (is the metric hyperbolic?)",
-        ));
-    }
-    let hdist = |x: [f64; 3], y: [f64; 3]| -> f64 {
-        TileIndex::dist(&TileIndex::entry(x), &TileIndex::entry(y))
-    };
-    for _round in 0..16 {
-        let bound = (l + 2.0 * radius) * (1.0 + 1e-9) + 1e-9;
-        let limits = cover.limits(l, radius);
-        let mut index = TileIndex::new();
-        // Words are composed in double-double: the side pairings of a compact domain move
-        // its centre by up to twice its radius, and double-precision products of a few of
-        // them lose the 1e-7 that tells tiles apart.
-        let mut elems_dd: Vec<MobiusDd> = vec![MobiusDd::IDENTITY];
-        let mut elems: Vec<Mobius> = vec![Mobius::identity()];
-        index.insert(o_h);
-        let mut queue = VecDeque::from([0usize]);
-        while let Some(t) = queue.pop_front() {
-            for sm in &gens {
-                let gd = elems_dd[t].compose(sm).normalized();
-                let g = gd.round();
-                let go = apply_h(&g.klein_matrix(), o_h);
-                if hdist(o_h, go) > bound || !cover.may_be_within(&g, &limits) {
-                    continue;
+        let centre = lay.positions[cm.face(seed)[i0] as usize];
+        let o_h = poincare_to_hyperboloid(centre);
+        let mut generators: Vec<MobiusDd> = Vec::new();
+        let mut gen_index = TileIndex::new();
+        let mut boundary: Vec<(Complex, usize)> = Vec::with_capacity(loops[0].len());
+        for &h in &loops[0] {
+            let t = mesh.he_twin(h);
+            let m = MobiusDd::from_pairs(
+                pos(cm.he_origin(t)),
+                pos(cm.he_tip(t)),
+                pos(cm.he_tip(h)),
+                pos(cm.he_origin(h)),
+            )
+            .normalized();
+            let go = apply_h(&m.round().klein_matrix(), o_h);
+            let k = match gen_index.find(go) {
+                Some(k) => k,
+                None => {
+                    generators.push(m);
+                    gen_index.insert(go)
                 }
-                if index.find(go).is_some() {
-                    continue;
-                }
-                index.insert(go);
-                elems.push(g);
-                elems_dd.push(gd);
-                queue.push_back(elems.len() - 1);
-                if elems.len() > max_tiles {
-                    return Err(Error::numerical(format!(
-                        "the spectrum search exceeded its budget of {max_tiles} tiles of the \
-                         universal cover at length bound {l:.3} (domain radius {radius:.2}); \
-                         ask for fewer lengths"
-                    )));
-                }
-            }
+            };
+            boundary.push((lay.positions[cm.he_origin(h) as usize], k));
         }
-        // Candidates: hyperbolic, ℓ ≤ L, axis meets F (crosses ∂F).
-        let tol = 1e-8;
-        let mut cand: Vec<usize> = Vec::new();
-        let mut crossings: Vec<Vec<usize>> = Vec::new();
-        for (i, g) in elems.iter().enumerate().skip(1) {
-            let len = g.translation_length();
-            if !(len > 0.0 && len <= l) {
-                continue;
-            }
-            let Some(fr) = axis_frame(g) else { continue };
-            // The axis is the real diameter in the frame: skip it when it passes farther
-            // than the domain's radius from o (sinh d = 2|Im w|/(1 − |w|²)).
-            if !cover.meets_axis(&fr) {
-                continue;
-            }
-            let sides = sides_crossed(&fr, &bnd, tol);
-            if !sides.is_empty() {
-                cand.push(i);
-                crossings.push(sides);
-            }
-        }
-        let classes = group_classes(&elems_dd, &cand, &crossings, &gens, &index, o_h);
-        let (mut classes, unmatched) = classes;
-        classes.sort_by(|a, b| a.length.total_cmp(&b.length));
-        if classes.len() >= count {
-            classes.truncate(count);
-            return Ok((
-                HyperbolicSpectrum {
-                    classes,
-                    complete_up_to: l,
-                    tiles: elems.len(),
-                    unmatched_links: unmatched,
-                },
-                domain,
-            ));
-        }
-        l *= 1.25;
+        Ok(DomainPairings {
+            positions: lay.positions,
+            centre,
+            generators,
+            boundary,
+        })
     }
-    Err(Error::numerical(format!(
-        "the spectrum search did not find {count} classes within its budget of 16 \
-         enlargements of the length bound (last bound {l:.3})"
-    )))
 }
