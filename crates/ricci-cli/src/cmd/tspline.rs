@@ -243,6 +243,13 @@ fn check_ranges(a: &Args) -> anyhow::Result<()> {
         ))
         .into());
     }
+    if a.parameter_correction > 10 {
+        return Err(UsageError(format!(
+            "--parameter-correction {} is not in 0..=10",
+            a.parameter_correction
+        ))
+        .into());
+    }
     if !(4..=100_000).contains(&a.initial_faces) {
         return Err(UsageError(format!(
             "--initial-faces {} is not in 4..=100000",
@@ -280,7 +287,7 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         max_control_points: a.max_control_points,
         mark_fraction: a.mark_fraction,
         max_points_per_face: a.max_points_per_face,
-        parameter_correction: a.parameter_correction.min(10),
+        parameter_correction: a.parameter_correction,
         ..FitOptions::default()
     };
     bar.0.set_message("fitting");
