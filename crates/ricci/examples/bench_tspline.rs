@@ -2,8 +2,8 @@
 //! marking strategies of `FitOptions::mark_fraction`.
 //!
 //! `cargo run --release -p ricci --example bench_tspline -- MESH TOLERANCE [mark_fraction …]`
-//! (TOLERANCE as a fraction, e.g. 0.0044; env SMOOTHING, INITIAL_FACES, MAX_POINTS_PER_FACE
-//! override the defaults). Prints, per strategy: control points, rms %, L∞ %,
+//! (TOLERANCE as a fraction, e.g. 0.0044; env SMOOTHING, INITIAL_FACES, MAX_POINTS_PER_FACE,
+//! PARAMETER_CORRECTION override the defaults). Prints, per strategy: control points, rms %, L∞ %,
 //! iterations, converged, CPU seconds of the fit (the domain is computed once, timed apart).
 use ricci::progress::NoProgress;
 use ricci::spline::tspline::fit::{fit, flat_torus_domain, FitOptions};
@@ -54,6 +54,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .ok()
                 .and_then(|s| s.parse().ok())
                 .unwrap_or(FitOptions::default().initial_faces),
+            parameter_correction: std::env::var("PARAMETER_CORRECTION")
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(0),
             ..FitOptions::default()
         };
         let t = Instant::now();

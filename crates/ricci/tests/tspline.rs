@@ -470,3 +470,72 @@ fn torus_of_revolution_domain_has_the_closed_form_modulus_and_fits_c2() {
     let c = continuity(&patches, lat, 3);
     assert_eq!(c.class(1e-8), Some(2), "{c:?}");
 }
+
+#[test]
+fn chart_independence_holds_for_the_lattice_and_sees_a_wrong_transition() {
+    use ricci::spline::tspline::chart_independence;
+    for (shift, seed) in [(0.0, 21u64), (0.37, 22)] {
+        let ts = random_surface(shift, seed);
+        let lat = ts.basis.mesh.lattice;
+        let c = chart_independence(&ts, lat, 12);
+        assert!(
+            c.max_relative() <= 1e-10,
+            "shift {shift}: charts differ by {:?}",
+            c.relative()
+        );
+        assert_eq!(c.comparisons, (12 * 12 + 4 * 12) * 6);
+        // the same comparison through a wrong transition (shift off by a tenth of the width)
+        let wrong = Lattice {
+            shift: lat.shift + 0.1 * lat.width,
+            ..lat
+        };
+        let bad = chart_independence(&ts, wrong, 12);
+        assert!(
+            bad.relative()[0] > 1e-3,
+            "shift {shift}: a wrong transition went unseen: {:?}",
+            bad.relative()
+        );
+    }
+}
+
+/// Must-show of issue 18 on kitten (genus 1, paper 003 Table 1 tolerance 0.44 %): C² across
+/// every side shared by two Bézier patches (relative jumps of orders 0..=2 at rounding level,
+/// order 3 a real jump), and the spline the same in every chart to 1e-10.
+#[test]
+fn kitten_fit_is_c2_across_every_patch_side_and_chart_independent() {
+    use ricci::spline::tspline::chart_independence;
+    use ricci::spline::tspline::fit::{fit, flat_torus_domain, FitOptions};
+    let Ok(dir) = std::env::var("RICCI_MESHES") else {
+        eprintln!("RICCI_MESHES is not set: skipping kitten_fit_is_c2_across_every_patch_side_and_chart_independent");
+        return;
+    };
+    let path = std::path::Path::new(&dir).join("kitten.nf20k.off");
+    let (s, _) = ricci::mesh::io::read_surface(&path).unwrap();
+    let mut quiet = ricci::progress::NoProgress;
+    let (uv, lat) = flat_torus_domain(&s, &mut quiet).unwrap();
+    let opts = FitOptions {
+        tolerance: 0.0044,
+        ..Default::default()
+    };
+    let r = fit(&s.positions, &uv, lat, &opts, &mut quiet).unwrap();
+    assert!(r.converged, "kitten did not reach 0.44 %");
+    let patches = extract(&r.spline);
+    let c = continuity(&patches, lat, 3);
+    // every patch's right and top side (3 points each) found the neighbour across it
+    assert_eq!(c.comparisons, 6 * patches.len(), "{c:?}");
+    let jumps = c.relative();
+    assert!(
+        jumps[0] < 1e-12 && jumps[1] < 1e-10 && jumps[2] < 1e-8,
+        "kitten: jumps {jumps:?}"
+    );
+    assert!(
+        jumps[3] > 1e-4,
+        "kitten: third derivatives do not jump: {jumps:?}"
+    );
+    let charts = chart_independence(&r.spline, lat, 24);
+    assert!(
+        charts.max_relative() <= 1e-10,
+        "kitten: charts differ by {:?}",
+        charts.relative()
+    );
+}

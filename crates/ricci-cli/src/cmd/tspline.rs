@@ -18,7 +18,9 @@ use ricci::mesh::io::read_surface;
 use ricci::spline::tspline::curves::{tmesh_on_surface, torus_tessellation};
 use ricci::spline::tspline::export::{iges, step, torus_obj};
 use ricci::spline::tspline::fit::{fit, flat_torus_domain, FitOptions};
-use ricci::spline::tspline::{continuity, extract, BezierPatch, TSpline};
+use ricci::spline::tspline::{
+    chart_independence, continuity, extract, BezierPatch, ChartIndependence, Continuity, TSpline,
+};
 use ricci_render::{render, Image, Paint, Polyline, RenderOptions, Style, View};
 use serde_json::json;
 use std::fmt::Write as _;
@@ -46,6 +48,10 @@ pub struct Args {
     /// start).
     #[arg(long, default_value_t = 80)]
     pub max_points_per_face: usize,
+    /// Rounds of parameter correction after every fit (each data point's parameter moved to
+    /// the foot of its perpendicular on the surface, then refit); 0 = the conformal parameters.
+    #[arg(long, default_value_t = 0)]
+    pub parameter_correction: usize,
     /// Budget: refinement iterations.
     #[arg(long, default_value_t = 30)]
     pub max_iterations: usize,
@@ -185,6 +191,39 @@ fn samples_json(ts: &TSpline, patches: &[BezierPatch]) -> serde_json::Value {
     json!({"samples": out, "patches": bounds, "samples_per_patch": 2})
 }
 
+/// The `continuity` report: derivative jumps per order across every side shared by two Bézier
+/// patches, and the largest difference between charts (genus 1: lattice translations).
+fn continuity_json(
+    class: &str,
+    jumps: &Continuity,
+    charts: &ChartIndependence,
+) -> serde_json::Value {
+    let rel = jumps.relative();
+    let per_order: Vec<_> = (0..4)
+        .map(|k| json!({"order": k, "max_jump": jumps.jumps[k], "max_partial": jumps.magnitudes[k], "relative_jump": rel[k]}))
+        .collect();
+    let crel = charts.relative();
+    json!({
+        "class": class,
+        "jumps": jumps.jumps,
+        "magnitudes": jumps.magnitudes,
+        "relative_jumps": rel,
+        "orders": [0, 1, 2, 3],
+        "per_order": per_order,
+        "side_points_compared": jumps.comparisons,
+        "extraordinary_points": 0,
+        "chart_independence": {
+            "max": charts.max_relative(),
+            "relative_differences": crel,
+            "differences": charts.differences,
+            "magnitudes": charts.magnitudes,
+            "orders": [0, 1, 2],
+            "comparisons": charts.comparisons,
+            "transitions": "lattice translations"
+        }
+    })
+}
+
 /// The ranges of the numeric arguments (usage errors, exit 2).
 fn check_ranges(a: &Args) -> anyhow::Result<()> {
     if !(a.smoothing >= 0.0 && a.smoothing.is_finite()) {
@@ -201,6 +240,13 @@ fn check_ranges(a: &Args) -> anyhow::Result<()> {
         return Err(UsageError(format!(
             "--tessellation {} is not in 1..=64",
             a.tessellation
+        ))
+        .into());
+    }
+    if a.parameter_correction > 10 {
+        return Err(UsageError(format!(
+            "--parameter-correction {} is not in 0..=10",
+            a.parameter_correction
         ))
         .into());
     }
@@ -241,6 +287,7 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         max_control_points: a.max_control_points,
         mark_fraction: a.mark_fraction,
         max_points_per_face: a.max_points_per_face,
+        parameter_correction: a.parameter_correction,
         ..FitOptions::default()
     };
     bar.0.set_message("fitting");
@@ -249,6 +296,7 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
     bar.0.set_message("Bézier extraction");
     let patches = extract(&r.spline);
     let jumps = continuity(&patches, lattice, 3);
+    let charts = chart_independence(&r.spline, lattice, 24);
     bar.0.finish_and_clear();
     let rel = jumps.relative();
     // C^k: jumps of orders ≤ k below 1e-8 of the largest partial of that order (the patches
@@ -276,9 +324,9 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         "converged": r.converged,
         "iterations": r.steps.len(),
         "steps": r.steps,
-        "continuity": {"class": class, "jumps": jumps.jumps, "magnitudes": jumps.magnitudes, "relative_jumps": rel,
-                        "orders": [0, 1, 2, 3]},
+        "continuity": continuity_json(&class, &jumps, &charts),
         "data_points": surface.positions.len(),
+        "parameter_correction": opts.parameter_correction,
         "scale": r.scale,
         "seconds_fit": fit_seconds,
         "seconds": t0.elapsed().as_secs_f64(),

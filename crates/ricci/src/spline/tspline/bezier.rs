@@ -185,6 +185,8 @@ pub struct Continuity {
     pub jumps: [f64; 4],
     /// Largest norm of a partial of each order at the sampled points (the scale of the jumps).
     pub magnitudes: [f64; 4],
+    /// Side points compared (each with its neighbour across the side).
+    pub comparisons: usize,
 }
 
 impl Continuity {
@@ -243,6 +245,7 @@ pub fn continuity(
     };
     let mut jumps = [0.0f64; 4];
     let mut mags = [0.0f64; 4];
+    let mut comparisons = 0;
     for q in patches {
         let dmin = (q.u1 - q.u0).min(q.v1 - q.v0) * 1e-6;
         for s in 0..samples {
@@ -256,6 +259,7 @@ pub fn continuity(
                     continue;
                 };
                 let other = &patches[o];
+                comparisons += 1;
                 // the same point in the neighbour's copy of the domain
                 let (cu, cv) = lattice.canonical(u + nu, v + nv);
                 let (ou, ov) = (cu - nu, cv - nv);
@@ -278,5 +282,6 @@ pub fn continuity(
     Continuity {
         jumps,
         magnitudes: mags,
+        comparisons,
     }
 }

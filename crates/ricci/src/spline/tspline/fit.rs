@@ -23,6 +23,7 @@
 //! iterations / control points is spent (reported, not hidden).
 
 use super::bezier::elements;
+use super::correction::correct_parameters;
 use super::surface::{TBasis, TSpline};
 use super::tmesh::{Lattice, TMesh};
 use crate::error::{Error, Result};
@@ -57,6 +58,10 @@ pub struct FitOptions {
     /// Relative residual of the conjugate gradients and their iteration budget.
     pub cg_tolerance: f64,
     pub cg_max_iterations: usize,
+    /// Parameter correction after every fit ([`super::correction`]): this many rounds of
+    /// (move each parameter to the foot of its perpendicular, refit). `0` keeps the
+    /// parameters of the domain (paper 003 §3.3 as written).
+    pub parameter_correction: usize,
 }
 
 impl Default for FitOptions {
@@ -71,6 +76,7 @@ impl Default for FitOptions {
             max_points_per_face: 80,
             cg_tolerance: 1e-10,
             cg_max_iterations: 5000,
+            parameter_correction: 0,
         }
     }
 }
@@ -96,6 +102,9 @@ pub struct FitResult {
     pub scale: f64,
     /// Per data point: `|S(u_k) − p_k|`.
     pub errors: Vec<f64>,
+    /// The parameters the errors are measured at (canonical; corrected when
+    /// [`FitOptions::parameter_correction`] > 0).
+    pub params: Vec<[f64; 2]>,
     pub converged: bool,
 }
 
@@ -310,7 +319,7 @@ pub fn fit(
     let nu = ((opts.initial_faces as f64 / nv as f64).round() as usize).max(4);
     let mut mesh = TMesh::uniform(lattice, nu, nv)?;
     mesh.make_analysis_suitable(10_000)?;
-    let params: Vec<[f64; 2]> = params
+    let mut params: Vec<[f64; 2]> = params
         .iter()
         .map(|p| {
             let (u, v) = lattice.canonical(p[0], p[1]);
@@ -350,15 +359,7 @@ pub fn fit(
         let guess: Option<Vec<[f64; 3]>> = prev
             .as_ref()
             .map(|p| basis.anchors.iter().map(|a| p.point(a.u, a.v)).collect());
-        let (ts, cg_it, cg_res) = fit_fixed(
-            basis,
-            points,
-            &params,
-            opts.smoothing,
-            guess.as_deref(),
-            opts.cg_tolerance,
-            opts.cg_max_iterations,
-        )?;
+        let (ts, cg_it, cg_res) = fit_corrected(basis, points, &mut params, opts, guess)?;
         let errors = errors_of(&ts, points, &params);
         let max = errors.iter().cloned().fold(0.0, f64::max);
         let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
@@ -381,6 +382,7 @@ pub fn fit(
                 steps,
                 scale,
                 errors,
+                params,
                 converged,
             });
         }
@@ -406,6 +408,7 @@ pub fn fit(
                 steps,
                 scale,
                 errors,
+                params,
                 converged,
             });
         }
@@ -413,6 +416,42 @@ pub fn fit(
         mesh.make_analysis_suitable(50_000)?;
         prev = Some(ts);
     }
+}
+
+/// [`fit_fixed`], then `opts.parameter_correction` rounds of parameter correction and refit.
+fn fit_corrected(
+    basis: TBasis,
+    points: &[[f64; 3]],
+    params: &mut Vec<[f64; 2]>,
+    opts: &FitOptions,
+    guess: Option<Vec<[f64; 3]>>,
+) -> Result<(TSpline, usize, f64)> {
+    let (mut ts, mut cg_it, mut cg_res) = fit_fixed(
+        basis,
+        points,
+        params,
+        opts.smoothing,
+        guess.as_deref(),
+        opts.cg_tolerance,
+        opts.cg_max_iterations,
+    )?;
+    for _ in 0..opts.parameter_correction {
+        let (corrected, moved) = correct_parameters(&ts, points, params, 3);
+        if moved == 0 {
+            break;
+        }
+        *params = corrected;
+        (ts, cg_it, cg_res) = fit_fixed(
+            ts.basis.clone(),
+            points,
+            params,
+            opts.smoothing,
+            Some(&ts.control),
+            opts.cg_tolerance,
+            opts.cg_max_iterations,
+        )?;
+    }
+    Ok((ts, cg_it, cg_res))
 }
 
 /// The genus-1 domain: flat metric (default conformal flow), cut along a canonical basis, flat

@@ -8,25 +8,34 @@
 //! * [`surface`] — blending functions `B_i = N[u⃗_i](u) N[v⃗_i](v)` summed over lattice
 //!   translates, T-spline surfaces with derivatives up to order two;
 //! * [`bezier`] — Bézier extraction to bicubic patches, continuity across patch sides;
+//! * [`correction`] — parameter correction (feet of perpendiculars) between fits;
+//! * [`cylinders`] — genus ≥ 2: the cylinders cut out by the critical horizontal trajectories
+//!   of a holomorphic 1-form with integer imaginary periods (paper 003 §2, Fig. 2);
+//! * [`charts`] — chart independence: the spline in the charts `p + λ` of the universal cover;
 //! * [`curves`] — the T-mesh drawn on the surface (paper 003 Fig. 5/7), the torus tessellation;
 //! * [`export`] — STEP (AP214 `B_SPLINE_SURFACE_WITH_KNOTS` faces), IGES (entity 128), OBJ;
 //! * [`fit`] — paper 003 §3.3: least squares to the data points plus thin-plate fairness
 //!   (conjugate gradients), adaptive refinement (1-to-4 where `L∞ > 2ε`, else 1-to-2), and the
 //!   genus-1 domain from the flat metric (the flat torus *is* the conformal net for genus 1).
 //!
-//! What is not here yet: domains of genus 0 and ≥ 2 (they need the holomorphic 1-forms and
-//! the conformal net with its zeros, paper 003 §2).
+//! What is not here yet: domains of genus 0, and for genus ≥ 2 the T-mesh over the cylinders
+//! (glued along the critical trajectories, extraordinary points at the zeros) and the fit over
+//! it; only the cylinder decomposition is computed.
 
 #![allow(clippy::needless_range_loop)]
 
 pub mod basis;
 pub mod bezier;
+pub mod charts;
+pub mod correction;
 pub mod curves;
+pub mod cylinders;
 pub mod export;
 pub mod fit;
 pub mod surface;
 pub mod tmesh;
 
 pub use bezier::{continuity, extract, BezierPatch, Continuity};
+pub use charts::{chart_independence, ChartIndependence};
 pub use surface::{TBasis, TSpline};
 pub use tmesh::{Anchor, Lattice, TMesh};

@@ -1,0 +1,89 @@
+//! Parameter correction of a fit (Hoschek, "Intrinsic parametrization for approximation",
+//! CAGD 1988; the standard companion of least-squares surface fitting): each data point's
+//! parameter `u_k` moves to the foot of the perpendicular from `p_k` to the current surface, so
+//! that `|S(u_k) − p_k|` measures the distance to the surface rather than also the tangential
+//! slip of the fixed conformal parameters (paper 003 §3.3 fits at the parameters `u_k ∈ M`
+//! without saying how they are chosen; the conformal net gives the start).
+//!
+//! Gauss–Newton on `|S(u) − p|²`: `δ = −(JᵀJ)⁻¹ Jᵀ r` with `J = [S_u S_v]`, `r = S(u) − p`;
+//! a step is at most half the smaller side of the T-mesh face holding `u` and is halved (at
+//! most `HALVINGS` times) until the distance decreases; otherwise the parameter stays.
+
+use super::surface::TSpline;
+
+const HALVINGS: usize = 4;
+
+/// `steps` Gauss–Newton steps per point; returns the corrected parameters (canonical
+/// representatives) and how many of them moved.
+pub fn correct_parameters(
+    ts: &TSpline,
+    points: &[[f64; 3]],
+    params: &[[f64; 2]],
+    steps: usize,
+) -> (Vec<[f64; 2]>, usize) {
+    let mesh = &ts.basis.mesh;
+    let lattice = mesh.lattice;
+    let faces = mesh.faces();
+    let mut moved = 0;
+    let out = points
+        .iter()
+        .zip(params)
+        .map(|(p, &uv)| {
+            let mut uv = uv;
+            let mut changed = false;
+            for _ in 0..steps {
+                let Some(f) = mesh.locate(uv[0], uv[1]) else {
+                    break;
+                };
+                let face = &faces[f];
+                let limit = 0.5 * (face.u1 - face.u0).min(face.v1 - face.v0);
+                let jet = ts.jet(uv[0], uv[1]);
+                let r = sub(&jet[0], p);
+                let (su, sv) = (jet[1], jet[2]);
+                let (a, b, c) = (dot(&su, &su), dot(&su, &sv), dot(&sv, &sv));
+                let det = a * c - b * b;
+                if !(det > 1e-300) {
+                    break;
+                }
+                let (gu, gv) = (dot(&su, &r), dot(&sv, &r));
+                let mut d = [-(c * gu - b * gv) / det, -(a * gv - b * gu) / det];
+                let len = d[0].hypot(d[1]);
+                if !len.is_finite() || len == 0.0 {
+                    break;
+                }
+                if len > limit {
+                    d = [d[0] * limit / len, d[1] * limit / len];
+                }
+                let before = dot(&r, &r);
+                let mut accepted = false;
+                for _ in 0..=HALVINGS {
+                    let (u, v) = lattice.canonical(uv[0] + d[0], uv[1] + d[1]);
+                    let q = sub(&ts.point(u, v), p);
+                    if dot(&q, &q) < before {
+                        uv = [u, v];
+                        accepted = true;
+                        break;
+                    }
+                    d = [0.5 * d[0], 0.5 * d[1]];
+                }
+                if !accepted {
+                    break;
+                }
+                changed = true;
+            }
+            if changed {
+                moved += 1;
+            }
+            uv
+        })
+        .collect();
+    (out, moved)
+}
+
+fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
