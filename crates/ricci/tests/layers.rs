@@ -632,12 +632,7 @@ fn size_allowed(rel: &str, name: &str, used: &mut [bool]) -> bool {
 
 /// Whether `list` excuses finding `name` ("" for the file's length) in file `rel`; marks the
 /// entry used.
-fn size_allowed_in(
-    list: &[(&str, &str, &str)],
-    rel: &str,
-    name: &str,
-    used: &mut [bool],
-) -> bool {
+fn size_allowed_in(list: &[(&str, &str, &str)], rel: &str, name: &str, used: &mut [bool]) -> bool {
     for (k, &(path, func, _)) in list.iter().enumerate() {
         if rel == path && func == name {
             used[k] = true;
@@ -727,13 +722,43 @@ fn the_size_check_counts_functions_and_files_without_tests() {
         ("crates/ricci/src/a/b.rs", "long_one", "one function"),
     ];
     let mut used = vec![false; list.len()];
-    assert!(size_allowed_in(&list, "crates/ricci/src/a/b.rs", "", &mut used));
+    assert!(size_allowed_in(
+        &list,
+        "crates/ricci/src/a/b.rs",
+        "",
+        &mut used
+    ));
     // Exact entries: no directory prefix, and a file's length does not excuse its functions.
-    assert!(!size_allowed_in(&list, "crates/ricci/src/a/other.rs", "", &mut used));
-    assert!(!size_allowed_in(&list, "crates/ricci/src/a/", "", &mut used));
-    assert!(!size_allowed_in(&list, "crates/ricci/src/a/b.rs", "new_function", &mut used));
-    assert!(size_allowed_in(&list, "crates/ricci/src/a/b.rs", "long_one", &mut used));
-    assert!(!size_allowed_in(&list, "crates/ricci/src/a/b.rs", "long", &mut used));
+    assert!(!size_allowed_in(
+        &list,
+        "crates/ricci/src/a/other.rs",
+        "",
+        &mut used
+    ));
+    assert!(!size_allowed_in(
+        &list,
+        "crates/ricci/src/a/",
+        "",
+        &mut used
+    ));
+    assert!(!size_allowed_in(
+        &list,
+        "crates/ricci/src/a/b.rs",
+        "new_function",
+        &mut used
+    ));
+    assert!(size_allowed_in(
+        &list,
+        "crates/ricci/src/a/b.rs",
+        "long_one",
+        &mut used
+    ));
+    assert!(!size_allowed_in(
+        &list,
+        "crates/ricci/src/a/b.rs",
+        "long",
+        &mut used
+    ));
     assert_eq!(used, vec![true, true]);
 }
 
