@@ -91,7 +91,7 @@ fn main() {
         });
         let a =
             (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]);
-        if !(a > 0.0) {
+        if a.is_nan() || a <= 0.0 {
             let r = dist(z[0]);
             hist[((r / 5.0) as usize).min(7)] += 1;
             if hist.iter().sum::<usize>() <= 8 {
