@@ -147,8 +147,19 @@ fn every_link_of_the_page_is_a_local_non_empty_file() {
     assert_eq!(
         order,
         [
-            "surface", "flow", "cone", "loops", "layout", "spectrum", "atlas", "spline", "pou",
-            "param", "tspline"
+            "surface",
+            "flow",
+            "cone",
+            "loops",
+            "layout",
+            "spectrum",
+            "atlas",
+            "spline",
+            "pou",
+            "param",
+            "tspline",
+            "forms",
+            "geodesics"
         ]
     );
     let mut at = 0;
