@@ -21,8 +21,8 @@ fn bin() -> PathBuf {
 }
 
 fn meshes() -> Option<PathBuf> {
-    match std::env::var_os("RICCI_MESHES") {
-        Some(d) => Some(PathBuf::from(d)),
+    match ricci_meshes() {
+        Some(d) => Some(d),
         None => {
             eprintln!("RICCI_MESHES is not set: skipping the mesh sweep");
             None
@@ -319,3 +319,7 @@ fn sweep_all_meshes() {
     let all: Vec<(&str, &[&str])> = SMALL.iter().chain(LARGE).copied().collect();
     sweep(&all, REFUSED);
 }
+
+#[path = "../../ricci/tests/ricci_meshes/mod.rs"]
+mod ricci_meshes;
+use ricci_meshes::ricci_meshes;
