@@ -382,54 +382,7 @@ fn print_text(h: &HolomorphicForms, zeros: &ZeroSet, net: &ConformalNet, t0: Ins
     );
 }
 
-/// A small circle around vertex `v` (in the plane orthogonal to its normal).
+/// A small red circle around vertex `v` (radius 1.5 % of the bounding box diagonal).
 pub fn marker(pos: &[[f64; 3]], tris: &[[u32; 3]], v: u32) -> Polyline {
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for p in pos {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    let diag = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
-    let r = 0.015 * diag;
-    let n = ricci_render::render::vertex_normals(pos, tris)
-        .get(v as usize)
-        .copied()
-        .unwrap_or([0.0, 0.0, 1.0]);
-    let a = if n[0].abs() < 0.9 {
-        [1.0, 0.0, 0.0]
-    } else {
-        [0.0, 1.0, 0.0]
-    };
-    let cross = |x: [f64; 3], y: [f64; 3]| {
-        [
-            x[1] * y[2] - x[2] * y[1],
-            x[2] * y[0] - x[0] * y[2],
-            x[0] * y[1] - x[1] * y[0],
-        ]
-    };
-    let unit = |x: [f64; 3]| {
-        let l = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt().max(1e-300);
-        [x[0] / l, x[1] / l, x[2] / l]
-    };
-    let e1 = unit(cross(n, a));
-    let e2 = unit(cross(n, e1));
-    let c = pos[v as usize];
-    Polyline {
-        points: (0..32)
-            .map(|i| {
-                let t = i as f64 * std::f64::consts::TAU / 32.0;
-                let (x, y) = (r * t.cos(), r * t.sin());
-                [
-                    c[0] + x * e1[0] + y * e2[0],
-                    c[1] + x * e1[1] + y * e2[1],
-                    c[2] + x * e1[2] + y * e2[2],
-                ]
-            })
-            .collect(),
-        color: [0.85, 0.1, 0.1],
-        width: 3.0,
-        closed: true,
-    }
+    crate::util::ring_marker(pos, tris, v, 0.015, [0.85, 0.1, 0.1])
 }
