@@ -1,7 +1,7 @@
 //! `ricci flow MESH --geometry … --scheme … --target … --solver … --tolerance T
 //! [--max-iterations N] [--widen-boundary N] [--refine-degenerate N --refined-out MESH]
 //! [--out METRIC.json] [--json]`: discrete Ricci flow (`ricci::flow`), optionally on a
-//! metric-preserving refinement of the input (`ricci::mesh::refine`, `ricci::flow::adaptive`).
+//! metric-preserving refinement of the input (`ricci::metric::refine`, `ricci::flow::adaptive`).
 //!
 //! METRIC.json holds the final discrete metric: geometry, scheme, per-vertex `u`, `curvature`
 //! and `target_curvature` (null where the vertex was held fixed), and per-edge `lengths` with
@@ -229,7 +229,7 @@ fn refine_and_flow(
     let mut refinement = serde_json::Value::Null;
     let mut widen_splits = 0;
     if let Some(n) = a.widen_boundary {
-        let r = ricci::mesh::refine::widen_boundary(
+        let r = ricci::metric::refine::widen_boundary(
             &surface.mesh,
             &lengths,
             Geometry::Euclidean, // the input lengths are Euclidean
@@ -253,7 +253,7 @@ fn refine_and_flow(
         };
     }
     let result = if let Some(rounds) = a.refine_degenerate {
-        let start = ricci::mesh::refine::Refined::identity(
+        let start = ricci::metric::refine::Refined::identity(
             &surface.mesh,
             &lengths,
             Some(&surface.positions),

@@ -158,6 +158,12 @@ impl UniformizationOptions {
         }
     }
 
+    /// The same options with the target `target` (instead of the topology's).
+    pub fn with_target(mut self, target: TargetSpec) -> Self {
+        self.target = TargetPolicy::Given(target);
+        self
+    }
+
     /// The geometry for `mesh`.
     pub fn geometry_for(&self, mesh: &Mesh) -> Result<Geometry> {
         match self.geometry {

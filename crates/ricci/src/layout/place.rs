@@ -41,7 +41,7 @@
 //! largest disagreement between laid-out distances and the metric, which measures how far the
 //! metric is from being exactly flat / hyperbolic / spherical (curvature error).
 
-use super::dd::{disk_distance_dd, disk_orientation_dd, Cdd, MobiusDd};
+use super::dd::{disk_distance_dd, disk_orientation_dd, MobiusDd};
 use super::isometry::{
     cross3, det3, disk_distance, dot3, normalize3, sphere_distance, Complex, Isometry, Mobius,
     RigidMotion, Rotation,
@@ -49,6 +49,7 @@ use super::isometry::{
 use crate::error::{Error, Result};
 use crate::mesh::{topology, Mesh, NONE};
 use crate::metric::geometry::{Background, Euclidean, Geometry, Hyperbolic, Spherical};
+use crate::numeric::dd::Cdd;
 use std::collections::VecDeque;
 
 /// The working precision of layouts and deck groups: the isometries face frames are composed
@@ -342,7 +343,7 @@ impl Space for Hyperbolic {
     // `!(x > 0.0)` is used on purpose: it is also true for NaN.
     #[allow(clippy::neg_cmp_op_on_partial_ord)]
     fn seed_ext(l: [f64; 3], lo: [f64; 3]) -> [Cdd; 3] {
-        use super::dd::Dd;
+        use crate::numeric::dd::Dd;
         let [l01, l12, l20] = [0, 1, 2].map(|m| Dd::new(l[m]) + Dd::new(lo[m]));
         let half = Dd::new(0.5);
         let sig = (l01 + l12 + l20) * half;
@@ -895,15 +896,15 @@ mod tests {
     use super::*;
 
     /// Hyperbolic distance of two disk points, entirely in double-double.
-    fn dist_dd(p: Cdd, q: Cdd) -> super::super::dd::Dd {
-        use super::super::dd::Dd;
+    fn dist_dd(p: Cdd, q: Cdd) -> crate::numeric::dd::Dd {
+        use crate::numeric::dd::Dd;
         let den = (Dd::ONE - p.norm_sqr()) * (Dd::ONE - q.norm_sqr());
         Dd::new(2.0) * ((p - q).norm() / den.sqrt()).asinh()
     }
 
     #[test]
     fn double_double_seed_triangles_have_their_double_double_side_lengths() {
-        use super::super::dd::Dd;
+        use crate::numeric::dd::Dd;
         // Low parts far below double precision must show up in the laid-out distances.
         for (l, lo) in [
             ([0.3, 0.4, 0.5], [1e-17, -2e-17, 3e-18]),
