@@ -42,6 +42,7 @@
 //! metric is from being exactly flat / hyperbolic / spherical (curvature error).
 
 use super::dd::{disk_distance_dd, disk_orientation_dd, MobiusDd};
+use super::error::LayoutError;
 use super::isometry::{
     cross3, det3, disk_distance, dot3, normalize3, sphere_distance, Complex, Isometry, Mobius,
     RigidMotion, Rotation,
@@ -482,11 +483,13 @@ pub fn check_lengths(mesh: &Mesh, lengths: &[f64], geometry: Geometry) -> Result
         let bad = !(l > 0.0 && l.is_finite())
             || (geometry == Geometry::Spherical && l >= std::f64::consts::PI);
         if bad {
-            let [a, b] = mesh.edge_vertices(e as u32);
-            return Err(Error::input(format!(
-                "edge {e} (vertices {a}–{b}) has length {l}, which is not a valid {} length",
-                geometry.name()
-            )));
+            return Err(LayoutError::InvalidLength {
+                edge: e as u32,
+                vertices: mesh.edge_vertices(e as u32),
+                length: l,
+                geometry,
+            }
+            .into());
         }
     }
     Ok(())
@@ -581,10 +584,8 @@ pub fn layout_dd<S: Space>(
             )));
         }
         if let Some(e) = lo.iter().position(|x| !x.is_finite()) {
-            return Err(Error::input(format!(
-                "edge {e}: the low part of its length is {}",
-                lo[e]
-            )));
+            let (edge, value) = (e as u32, lo[e]);
+            return Err(LayoutError::InvalidLowPart { edge, value }.into());
         }
     }
     let nf = mesh.n_faces();
@@ -601,11 +602,12 @@ pub fn layout_dd<S: Space>(
     let c = &topo.components[0];
     let simply_connected = c.genus == 0 && c.boundary_loops <= 1;
     if !simply_connected {
-        return Err(Error::topology(format!(
-            "a layout needs a disk or a closed genus-0 surface, this mesh has genus {} and {} \
-             boundary loops (cut it to a disk first)",
-            c.genus, c.boundary_loops
-        )));
+        let (genus, boundary_loops) = (c.genus, c.boundary_loops);
+        return Err(LayoutError::NotSimplyConnected {
+            genus,
+            boundary_loops,
+        }
+        .into());
     }
     if c.boundary_loops == 0 && S::KIND != Geometry::Spherical {
         return Err(Error::topology(
@@ -615,11 +617,7 @@ pub fn layout_dd<S: Space>(
     }
     let seed = match seed_face {
         Some(f) if (f as usize) < nf => f,
-        Some(f) => {
-            return Err(Error::input(format!(
-                "seed face {f} does not exist (the mesh has {nf} faces)"
-            )))
-        }
+        Some(face) => return Err(LayoutError::SeedFaceMissing { face, n_faces: nf }.into()),
         None => central_face(mesh),
     };
     let canonical = canonical_triangles::<S>(mesh, lengths, lengths_lo);
