@@ -14,9 +14,10 @@ use ricci::atlas::{AffineAtlas, AtlasOptions, FlatCharts};
 use ricci::mesh::io::read_surface;
 use ricci::progress::NoProgress;
 use ricci::spline::dms::{KnotOptions, Workspace};
-use ricci::spline::fit::{evaluate, fair};
+use ricci::spline::fit::fair;
 use ricci::spline::manifold::{rotate_partials, LocalCharts, ManifoldSpace};
 use ricci::spline::simplex::n_partials;
+use ricci::spline::space::evaluate;
 
 fn edge_jumps<A: FlatCharts + Sync>(
     space: &ManifoldSpace<'_, A>,

@@ -3,6 +3,11 @@
 //! Every error is one sentence that names the problem and where it is (file, line, vertex,
 //! face). The library never panics on user data and never prints; the CLI prints
 //! `Error`'s `Display` and exits with code 1.
+//!
+//! Where the fault has a place, the place is also data: [`Error::Parse`] keeps the [`Record`]
+//! of the file (from the mesh readers' `ReadError`), and [`Error::Stage`] keeps a stage's own
+//! error enum ([`StageError`]: `metric::MetricError`, `flow::FlowError`, `cut::CutError`,
+//! `layout::LayoutError`) with the vertex, face or edge; [`Error::stage_error`] gives it back.
 
 use std::fmt;
 
@@ -72,6 +77,27 @@ pub enum Record {
     Element { name: String, index: usize },
 }
 
+/// What kind of problem a pipeline stage's error is: the same three kinds as
+/// [`Error::Topology`], [`Error::InvalidInput`] and [`Error::Numerical`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// The mesh has the wrong topology for the operation.
+    Topology,
+    /// A parameter or an input metric cannot be used (a refusal: every scheme would refuse it).
+    InvalidInput,
+    /// A numerical procedure broke down or did not converge.
+    Numerical,
+}
+
+/// A pipeline stage's error enum (`metric::MetricError`, `flow::FlowError`,
+/// `cut::CutError`, `layout::LayoutError`): one sentence (`Display`) and its [`Kind`], with
+/// the vertex, face, edge or loop it is about kept as data in the enum. It converts into
+/// [`Error::Stage`] (`Error::from` in each stage), and [`Error::stage_error`] gives it back.
+pub trait StageError: std::error::Error + Send + Sync + 'static {
+    /// The kind of problem.
+    fn kind(&self) -> Kind;
+}
+
 /// All errors of the library.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
@@ -105,6 +131,13 @@ pub enum Error {
     /// A numerical procedure broke down (non-finite values, singular system, …).
     #[error("{message}")]
     Numerical { message: String },
+    /// A pipeline stage's error with its data: the stage's enum ([`StageError`]), whose
+    /// `Display` is the sentence; [`Error::stage_error`] gives it back.
+    #[error("{detail}")]
+    Stage {
+        kind: Kind,
+        detail: Box<dyn std::error::Error + Send + Sync>,
+    },
 }
 
 fn prefix(file: &Option<String>) -> String {
@@ -147,6 +180,32 @@ impl Error {
     pub fn numerical(message: impl Into<String>) -> Self {
         Error::Numerical {
             message: message.into(),
+        }
+    }
+    /// A stage's error enum kept whole ([`Error::Stage`]).
+    pub fn stage<E: StageError>(error: E) -> Self {
+        Error::Stage {
+            kind: error.kind(),
+            detail: Box::new(error),
+        }
+    }
+    /// The stage error of type `E` this error carries (`None` for other errors), e.g.
+    /// `e.stage_error::<ricci::flow::FlowError>()`.
+    pub fn stage_error<E: StageError>(&self) -> Option<&E> {
+        match self {
+            Error::Stage { detail, .. } => detail.downcast_ref::<E>(),
+            _ => None,
+        }
+    }
+    /// The kind of a topology, input, numerical or stage error (`None` for I/O, parse and
+    /// invalid-mesh errors).
+    pub fn kind(&self) -> Option<Kind> {
+        match self {
+            Error::Topology { .. } => Some(Kind::Topology),
+            Error::InvalidInput { .. } => Some(Kind::InvalidInput),
+            Error::Numerical { .. } => Some(Kind::Numerical),
+            Error::Stage { kind, .. } => Some(*kind),
+            _ => None,
         }
     }
     /// The record of an input file a [`Error::Parse`] is about (`None` for other errors).

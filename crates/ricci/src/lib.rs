@@ -26,10 +26,10 @@
 //! * [`spline`] — triangular B-splines (DMS) and manifold splines.
 //!
 //! [`error`] and [`progress`] are utilities every module may use. The order is checked by
-//! `tests/layers.rs` (every `crate::…` path of every source file); the few paths kept
-//! for code written against the old layout (`layout::dd::{Dd, Cdd}`, `mesh::refine`,
-//! `crate::simd`, `spline::fit::{SplineSpace, evaluate, …}`) are marked *compatibility
-//! re-exports*.
+//! `tests/layers.rs` (every `crate::…` path of every source file). Every item has one path:
+//! the compatibility re-exports of the old layout are gone (`Dd`, `Cdd` and `simd` are in
+//! [`numeric`], intrinsic refinement in [`metric::refine`], the spline-space interface in
+//! [`spline::space`] and the quadrature rules in [`spline::quadrature`]).
 //!
 //! Connectivity, metric and embedding are separate types: a [`mesh::Mesh`] knows who is next
 //! to whom, edge lengths live in plain `Vec<f64>` indexed by edge id, and positions live in a
@@ -47,9 +47,5 @@ pub mod numeric;
 pub mod param;
 pub mod progress;
 pub mod spline;
-
-/// Compatibility re-export: `simd` moved to [`numeric::simd`]; the path `crate::simd` keeps
-/// working.
-pub use numeric::simd;
 
 pub use error::{Error, Result};

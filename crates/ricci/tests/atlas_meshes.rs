@@ -436,7 +436,7 @@ use ricci_meshes::ricci_meshes;
 fn flip_ring_valence_keeps_the_cut_and_the_metric() {
     use ricci::atlas::flip_ring_valence;
     use ricci::cut::{canonical_cut, CutOptions};
-    use ricci::mesh::refine::Refiner;
+    use ricci::metric::refine::Refiner;
     use ricci::metric::total_area;
     let s = generate::genus(2, 20).unwrap();
     let cone = 11u32;

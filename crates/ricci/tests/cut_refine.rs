@@ -2,8 +2,8 @@
 //! pieces, old vertices keep their curvature, new vertices are flat, and the area is unchanged
 //! — in E², H² and S², with random metrics (seeded).
 
-use ricci::mesh::refine::{Refined, Refiner};
 use ricci::mesh::Mesh;
+use ricci::metric::refine::{Refined, Refiner};
 use ricci::metric::Geometry;
 use std::f64::consts::PI;
 
@@ -190,9 +190,15 @@ fn boundary_edges_split_and_positions_interpolate() {
             ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
         })
         .collect();
-    let r =
-        ricci::mesh::refine::raise_valence(&mesh, &lengths, Geometry::Euclidean, Some(&pos), 0, 15)
-            .unwrap();
+    let r = ricci::metric::refine::raise_valence(
+        &mesh,
+        &lengths,
+        Geometry::Euclidean,
+        Some(&pos),
+        0,
+        15,
+    )
+    .unwrap();
     assert_eq!(r.mesh.valence(0), 15);
     check(Geometry::Euclidean, &mesh, &lengths, &r);
     // Positions are consistent with the lengths (the embedding is planar and exact here).
@@ -205,7 +211,7 @@ fn boundary_edges_split_and_positions_interpolate() {
         assert!((d - r.lengths[e as usize]).abs() < 1e-12);
     }
     // Refusing a boundary base vertex.
-    let e = ricci::mesh::refine::raise_valence(&mesh, &lengths, Geometry::Euclidean, None, 1, 8)
+    let e = ricci::metric::refine::raise_valence(&mesh, &lengths, Geometry::Euclidean, None, 1, 8)
         .unwrap_err();
     assert!(e.to_string().contains("boundary"), "{e}");
 }

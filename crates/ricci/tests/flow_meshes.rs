@@ -10,7 +10,7 @@
 //!   straightened by any scheme without changing the connectivity (refused / stuck here);
 //! * beetle (H² geodesic-boundary): 10 ears and, for Thurston, boundary vertices with two faces
 //!   and φ = π/2; refused as it is, and converges (Thurston, 6 Newton steps) once every boundary
-//!   vertex has three faces (`mesh::refine::widen_boundary`, metric-preserving splits).
+//!   vertex has three faces (`metric::refine::widen_boundary`, metric-preserving splits).
 //! * face (E² round-boundary) still fails after widening its boundary alone: interior one-rings
 //!   next to its thin boundary triangles (angles down to 4.6°) then violate Chow–Luo for
 //!   Thurston, and vertex scaling's convex energy has its minimum at a "metric" with degenerate
@@ -351,7 +351,7 @@ fn beetle_converges_after_widening_the_boundary() {
     };
     let s = flow_support::read_mesh(&dir.join("beetle.off"));
     let l0 = s.edge_lengths();
-    let r = ricci::mesh::refine::widen_boundary(
+    let r = ricci::metric::refine::widen_boundary(
         &s.mesh,
         &l0,
         Geometry::Euclidean,
@@ -444,7 +444,7 @@ fn face_round_boundary_after_adaptive_refinement() {
     let s = flow_support::read_mesh(&dir.join("face.off"));
     let l0 = s.edge_lengths();
     for scheme in [Scheme::Thurston, Scheme::Yamabe] {
-        let widened = ricci::mesh::refine::widen_boundary(
+        let widened = ricci::metric::refine::widen_boundary(
             &s.mesh,
             &l0,
             Geometry::Euclidean,
@@ -475,7 +475,7 @@ fn face_round_boundary_after_adaptive_refinement() {
 }
 
 /// The assertions of `face_round_boundary_after_adaptive_refinement` for one flow.
-fn check_refined_face(s: &Surface, refined: &ricci::mesh::refine::Refined, r: &FlowResult) {
+fn check_refined_face(s: &Surface, refined: &ricci::metric::refine::Refined, r: &FlowResult) {
     let l0 = s.edge_lengths();
     let n0 = s.mesh.n_vertices();
     let surf = Surface {

@@ -18,10 +18,9 @@ use ricci_meshes::ricci_meshes;
 use ricci::mesh::io::read_surface;
 use ricci::progress::NoProgress;
 use ricci::spline::dms::KnotOptions;
-use ricci::spline::fit::{
-    quadrature_barycentric, quadrature_barycentric_graded, thin_plate_energy_with,
-};
+use ricci::spline::fit::thin_plate_energy_with;
 use ricci::spline::manifold::ManifoldSpace;
+use ricci::spline::quadrature::{quadrature_barycentric, quadrature_barycentric_graded};
 use ricci::spline::surface::{
     build, error_percent, flat_domain, tessellate, MeshDistance, Singularity, SplineOptions,
 };

@@ -1,7 +1,7 @@
 //! `ricci flow MESH --geometry … --scheme … --target … --solver … --tolerance T
 //! [--max-iterations N] [--widen-boundary N] [--refine-degenerate N --refined-out MESH]
 //! [--out METRIC.json] [--json]`: discrete Ricci flow (`ricci::flow`), optionally on a
-//! metric-preserving refinement of the input (`ricci::mesh::refine`, `ricci::flow::adaptive`).
+//! metric-preserving refinement of the input (`ricci::metric::refine`, `ricci::flow::adaptive`).
 //!
 //! METRIC.json holds the final discrete metric: geometry, scheme, per-vertex `u`, `curvature`
 //! and `target_curvature` (null where the vertex was held fixed), and per-edge `lengths` with
@@ -10,7 +10,9 @@
 use crate::util::read_surface;
 use crate::util::{print_json, write_json_atomic};
 use indicatif::{ProgressBar, ProgressStyle};
-use ricci::flow::{ricci_flow, FlowOptions, FlowResult, Solver, SphereRoute, TargetSpec};
+use ricci::flow::{
+    ricci_flow, FlowError, FlowOptions, FlowResult, Solver, SphereRoute, TargetSpec,
+};
 use ricci::metric::{Geometry, Scheme};
 use serde_json::json;
 use std::path::PathBuf;
@@ -94,31 +96,6 @@ pub fn metric_json(r: &FlowResult, mesh: &ricci::mesh::Mesh, source: &str) -> se
     r.metric_json(mesh, source)
 }
 
-/// Why a flow result is not converged, in one sentence: the curvature error when that is the
-/// reason, otherwise the faces that violate the triangle inequality (a curvature reached on
-/// such faces is not a metric on this triangulation).
-pub fn not_converged_reason(r: &FlowResult) -> String {
-    if r.max_curvature_error > r.tolerance {
-        format!(
-            "the flow did not converge (max |K − K̄| = {:.3e} > {:.1e} after {} iterations)",
-            r.max_curvature_error, r.tolerance, r.iterations
-        )
-    } else if r.degenerate_faces > 0 {
-        format!(
-            "the flow did not converge: max |K − K̄| = {:.3e} reached the tolerance, but {} \
-             face(s) violate the triangle inequality in the final metric, so it is not a metric \
-             on this triangulation (try --scheme thurston, or --refine-degenerate N with \
-             --refined-out MESH)",
-            r.max_curvature_error, r.degenerate_faces
-        )
-    } else {
-        format!(
-            "the flow did not converge (max |K − K̄| = {:.3e}, tolerance {:.1e}, {} iterations)",
-            r.max_curvature_error, r.tolerance, r.iterations
-        )
-    }
-}
-
 pub fn run(a: Args) -> anyhow::Result<()> {
     if !(a.tolerance.is_finite() && a.tolerance > 0.0) {
         return Err(crate::util::UsageError(format!(
@@ -153,7 +130,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         write_json_atomic(out, metric_json(&r, &surface.mesh, &source))?;
     }
     if !r.converged {
-        eprintln!("warning: {source}: {}", not_converged_reason(&r));
+        eprintln!("warning: {source}: {}", FlowError::not_converged(&r));
     }
     if a.json {
         print_json(&report_json(&a, &r, &surface, &source, refinement));
@@ -229,7 +206,7 @@ fn refine_and_flow(
     let mut refinement = serde_json::Value::Null;
     let mut widen_splits = 0;
     if let Some(n) = a.widen_boundary {
-        let r = ricci::mesh::refine::widen_boundary(
+        let r = ricci::metric::refine::widen_boundary(
             &surface.mesh,
             &lengths,
             Geometry::Euclidean, // the input lengths are Euclidean
@@ -253,7 +230,7 @@ fn refine_and_flow(
         };
     }
     let result = if let Some(rounds) = a.refine_degenerate {
-        let start = ricci::mesh::refine::Refined::identity(
+        let start = ricci::metric::refine::Refined::identity(
             &surface.mesh,
             &lengths,
             Some(&surface.positions),

@@ -17,7 +17,7 @@
 use crate::util::read_surface;
 use crate::util::{print_json, write_atomic, UsageError};
 use indicatif::{ProgressBar, ProgressStyle};
-use ricci::flow::FlowResult;
+use ricci::flow::{FlowError, FlowResult};
 use ricci::layout::cover::{tiles_by_radius, word_string};
 use ricci::layout::export::obj_with_corner_uv;
 use ricci::layout::input_uv::input_face_uvs;
@@ -308,10 +308,7 @@ fn metric_and_flow(
         "gauss_bonnet_error": r.gauss_bonnet_error, "seconds": r.seconds,
     });
     if !r.converged {
-        anyhow::bail!(
-            "{}; no layout computed",
-            super::flow::not_converged_reason(&r)
-        );
+        anyhow::bail!("{}; no layout computed", FlowError::not_converged(&r));
     }
     let own = r.triangulation.as_ref().map(|t| {
         report["triangulation"] = json!({

@@ -80,9 +80,10 @@
 //! markings chosen independently by their cuts.
 
 use crate::error::{Error, Result};
-use crate::layout::dd::{Cdd, MobiusDd};
+use crate::layout::dd::MobiusDd;
 use crate::layout::deck::{DeckGroup, Polygon};
 use crate::layout::isometry::{Complex, Mobius};
+use crate::numeric::dd::Cdd;
 
 /// A word in the canonical generators: `(letter, inverse)` with letter `2(k−1)` for `a_k` and
 /// `2(k−1) + 1` for `b_k`.

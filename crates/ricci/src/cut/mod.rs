@@ -44,6 +44,7 @@
 //! already cut (word `d₁`); with `b ≥ 2` boundary loops, `b` paths join them to `x`.
 
 mod assemble;
+pub mod error;
 pub mod homology;
 pub mod paths;
 pub mod schema;
@@ -59,6 +60,7 @@ use assemble::assemble;
 use serde::Serialize;
 use system::RawPath;
 
+pub use error::CutError;
 pub use homology::Cohomology;
 pub use paths::{
     halfedge_path, intersection_matrix, intersection_number, right_pushoff_crossings,
@@ -304,19 +306,18 @@ impl Setup {
         let nb = comp.boundary_loops;
         let (base, automatic) = match options.base {
             Some(v) if v as usize >= mesh.n_vertices() => {
-                return Err(Error::input(format!(
-                    "base vertex {v} does not exist (the mesh has {} vertices)",
-                    mesh.n_vertices()
-                )));
+                return Err(CutError::BaseVertexMissing {
+                    vertex: v,
+                    n_vertices: mesh.n_vertices(),
+                }
+                .into());
             }
             Some(v) => (v, false),
             None => (central_vertex(mesh, lengths)?, true),
         };
         let needs_base = genus > 0 || nb != 1;
         if needs_base && mesh.is_boundary_vertex(base) {
-            return Err(Error::input(format!(
-                "base vertex {base} lies on the boundary; choose an interior vertex"
-            )));
+            return Err(CutError::BaseVertexOnBoundary { vertex: base }.into());
         }
         let n_connectors = if genus > 0 || nb >= 2 { nb } else { 0 };
         let paths_needed = 4 * genus + n_connectors;
@@ -452,10 +453,12 @@ fn greedy(
         if round_attempt >= max_attempts {
             round += 1;
             if round >= round_valence.len() {
-                return Err(Error::numerical(format!(
-                    "no canonical system through vertex {base} was found after {attempt} attempts ({msg}); \
-                     try another base vertex or a larger --min-valence"
-                )));
+                return Err(CutError::NoCanonicalSystem {
+                    vertex: base,
+                    attempts: attempt,
+                    reason: msg,
+                }
+                .into());
             }
             // Start again with a larger graded neighbourhood of the base vertex.
             min_valence = round_valence[round];

@@ -13,6 +13,7 @@
 //! is a positively oriented frame; on a torus cut along `a b a⁻¹ b⁻¹` (disk on the left),
 //! `a·b = +1`.
 
+use super::CutError;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use std::collections::HashMap;
@@ -23,18 +24,19 @@ pub fn halfedge_path(mesh: &Mesh, vertices: &[u32]) -> Result<Vec<u32>> {
     for w in vertices.windows(2) {
         for &v in w {
             if v as usize >= mesh.n_vertices() {
-                return Err(Error::input(format!(
-                    "path vertex {v} does not exist (the mesh has {} vertices)",
-                    mesh.n_vertices()
-                )));
+                return Err(CutError::PathVertexMissing {
+                    vertex: v,
+                    n_vertices: mesh.n_vertices(),
+                }
+                .into());
             }
         }
-        let h = mesh.halfedge_between(w[0], w[1]).ok_or_else(|| {
-            Error::input(format!(
-                "path vertices {} and {} are not joined by an edge",
-                w[0], w[1]
-            ))
-        })?;
+        let h = mesh
+            .halfedge_between(w[0], w[1])
+            .ok_or(CutError::PathNotAnEdge {
+                from: w[0],
+                to: w[1],
+            })?;
         out.push(h);
     }
     Ok(out)
@@ -96,9 +98,7 @@ pub fn right_pushoff_crossings(mesh: &Mesh, p: &[u32]) -> Result<Vec<u32>> {
                 break;
             }
             if e == stop {
-                return Err(Error::input(format!(
-                    "the path is not simple at vertex {v} (its next edge does not leave {v})"
-                )));
+                return Err(CutError::PathNotSimple { vertex: v }.into());
             }
             out.push(e);
             guard += 1;

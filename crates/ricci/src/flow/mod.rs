@@ -34,6 +34,7 @@
 
 pub mod adaptive;
 pub mod conformal;
+pub mod error;
 pub mod newton;
 pub mod polish;
 pub mod sphere;
@@ -41,6 +42,7 @@ pub mod target;
 pub mod uniformize;
 
 pub use adaptive::ricci_flow_refined;
+pub use error::FlowError;
 pub use target::{separated_vertices, Target, TargetSpec};
 pub use uniformize::{
     flow_with_fallback, Fallback, FallbackFlow, TargetPolicy, UniformizationOptions,
@@ -649,11 +651,12 @@ fn conformal_flow(
             2.0 * PI
         };
         if target.curvature[v as usize] >= max {
-            return Err(Error::input(format!(
-                "target curvature {:.6} at vertex {v} leaves no cone angle (it must be below \
-                 {max:.6})",
-                target.curvature[v as usize]
-            )));
+            return Err(FlowError::NoConeAngle {
+                vertex: v,
+                curvature: target.curvature[v as usize],
+                limit: max,
+            }
+            .into());
         }
     }
     let flip_budget = 200 * mesh.n_edges() + 10_000;

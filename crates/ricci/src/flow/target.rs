@@ -35,6 +35,7 @@
 //! Targets are checked on every single vertex and every closed one-ring (a vertex and its
 //! neighbours); vertex scaling and inversive distance use the φ = 0 bound (angles below π).
 
+use super::FlowError;
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, NONE};
 use crate::metric::{euler_characteristic, Geometry};
@@ -511,8 +512,18 @@ pub fn set_round_totals(
 /// Returns the area the target asks for (0 for E²). Targets with fixed vertices are not
 /// constrained (the fixed vertices' curvature is free).
 pub fn check_gauss_bonnet(mesh: &Mesh, geometry: Geometry, target: &Target) -> Result<f64> {
-    let chi = euler_characteristic(mesh) as f64;
+    let chi_int = euler_characteristic(mesh);
+    let chi = chi_int as f64;
     let sum: f64 = target.curvature.iter().sum();
+    let gauss_bonnet = |message: String| -> Error {
+        FlowError::GaussBonnet {
+            geometry,
+            curvature_sum: sum,
+            euler_characteristic: chi_int,
+            message,
+        }
+        .into()
+    };
     let free_boundary = target
         .fixed
         .iter()
@@ -526,7 +537,7 @@ pub fn check_gauss_bonnet(mesh: &Mesh, geometry: Geometry, target: &Target) -> R
             }
             let tol = 1e-9 * (1.0 + target.curvature.len() as f64).sqrt();
             if (sum - two_pi_chi).abs() > tol {
-                return Err(Error::input(format!(
+                return Err(gauss_bonnet(format!(
                     "target curvature violates Gauss–Bonnet: Σ K̄ = {sum:.6} but a flat metric \
                      needs 2πχ = {two_pi_chi:.6} (χ = {chi}); off by {:.3e}",
                     sum - two_pi_chi
@@ -537,7 +548,7 @@ pub fn check_gauss_bonnet(mesh: &Mesh, geometry: Geometry, target: &Target) -> R
         Geometry::Hyperbolic => {
             let area = sum - two_pi_chi;
             if !free_boundary && area <= 0.0 {
-                return Err(Error::input(format!(
+                return Err(gauss_bonnet(format!(
                     "target curvature violates Gauss–Bonnet for a hyperbolic metric: the area \
                      would be Σ K̄ − 2πχ = {area:.6} (Σ K̄ = {sum:.6}, χ = {chi}), but it must be \
                      positive; off by {:.3e}",
@@ -549,7 +560,7 @@ pub fn check_gauss_bonnet(mesh: &Mesh, geometry: Geometry, target: &Target) -> R
         Geometry::Spherical => {
             let area = two_pi_chi - sum;
             if !free_boundary && area <= 0.0 {
-                return Err(Error::input(format!(
+                return Err(gauss_bonnet(format!(
                     "target curvature violates Gauss–Bonnet for a spherical metric: the area \
                      would be 2πχ − Σ K̄ = {area:.6} (Σ K̄ = {sum:.6}, χ = {chi}), but it must be \
                      positive; off by {:.3e}",
@@ -570,6 +581,16 @@ pub fn check_chow_luo(mesh: &Mesh, geometry: Geometry, target: &Target, phi: &[f
     }
     let n = mesh.n_vertices();
     let mut in_set = vec![false; n];
+    // `set` is a vertex alone or its closed one-ring (the vertex first).
+    let chow_luo = |set: &[u32], message: String, shortfall: f64| -> Error {
+        FlowError::ChowLuo {
+            vertex: set[0],
+            one_ring: set.len() > 1,
+            shortfall,
+            message,
+        }
+        .into()
+    };
     let mut check = |set: &[u32], label: &str| -> Result<()> {
         if set.iter().any(|&v| target.fixed[v as usize]) {
             return Ok(());
@@ -611,15 +632,19 @@ pub fn check_chow_luo(mesh: &Mesh, geometry: Geometry, target: &Target, phi: &[f
         }
         let margin = 1e-12 * (1.0 + bound.abs());
         if sum <= bound + margin {
-            return Err(Error::input(format!(
-                "target curvature is not admissible (Chow–Luo condition, paper 000 eq. 7) at \
+            return Err(chow_luo(
+                set,
+                format!(
+                    "target curvature is not admissible (Chow–Luo condition, paper 000 eq. 7) at \
                  {label}: Σ K̄ = {sum:.6} must exceed −Σ(π − φ) + 2πχ(F_I) = {bound:.6} (short by \
                  {:.3e}): circle packing cannot give these vertices their target on this \
                  triangulation (too few neighbours for the curvature asked; `ricci atlas` \
                  raises the valence around a cone); try: --scheme conformal (the default), \
                  which has no such condition",
-                bound - sum
-            )));
+                    bound - sum
+                ),
+                bound - sum,
+            ));
         }
         Ok(())
     };
@@ -630,7 +655,7 @@ pub fn check_chow_luo(mesh: &Mesh, geometry: Geometry, target: &Target, phi: &[f
         let label = if mesh.is_boundary_vertex(v) && mesh.vertex_faces(v).count() == 1 {
             format!(
                 "the single vertex {v}, a boundary vertex with one face (an ear: its one corner \
-                 would have to open to π − K̄; split the opposite edge to give it two faces: `ricci flow --widen-boundary 2`, `mesh::refine::widen_boundary`)"
+                 would have to open to π − K̄; split the opposite edge to give it two faces: `ricci flow --widen-boundary 2`, `metric::refine::widen_boundary`)"
             )
         } else {
             format!("the single vertex {v} (valence {})", mesh.valence(v))

@@ -14,7 +14,7 @@
 //!   the options ([`Fallback`]), so that each caller keeps its behaviour.
 
 use super::{ricci_flow, FlowOptions, FlowResult, TargetSpec};
-use crate::error::{Error, Result};
+use crate::error::{Error, Kind, Result};
 use crate::mesh::{topology, Mesh};
 use crate::metric::{Geometry, Scheme};
 use crate::progress::Progress;
@@ -83,7 +83,7 @@ impl TargetPolicy {
 /// What [`flow_with_fallback`] does when a scheme does not give a converged metric.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Fallback {
-    /// Keep the last unconverged result; an input refusal (`Error::InvalidInput`: Gauss–Bonnet,
+    /// Keep the last unconverged result; an input refusal (kind `InvalidInput`: Gauss–Bonnet,
     /// Chow–Luo) of the first scheme ends the search (every scheme would refuse it). The
     /// atlas's flat metric ([`crate::atlas::flat_flow_limited`]).
     KeepLast,
@@ -156,6 +156,12 @@ impl UniformizationOptions {
             target: TargetPolicy::Given(target),
             fallback: Fallback::KeepFirst,
         }
+    }
+
+    /// The same options with the target `target` (instead of the topology's).
+    pub fn with_target(mut self, target: TargetSpec) -> Self {
+        self.target = TargetPolicy::Given(target);
+        self
     }
 
     /// The geometry for `mesh`.
@@ -271,7 +277,7 @@ pub fn flow_with_fallback(
             }
             Err(e) => {
                 // A refused target (Gauss–Bonnet, Chow–Luo) is refused by every scheme.
-                let refused = matches!(e, Error::InvalidInput { .. });
+                let refused = e.kind() == Some(Kind::InvalidInput);
                 if k == 0 && refused && opts.fallback == Fallback::KeepLast {
                     return Err(e);
                 }

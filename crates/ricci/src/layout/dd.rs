@@ -11,9 +11,7 @@
 
 use super::isometry::{Complex, Mobius};
 
-/// Compatibility re-export: `Dd` and `Cdd` moved to [`crate::numeric::dd`]; the paths
-/// `crate::layout::dd::{Dd, Cdd}` keep working.
-pub use crate::numeric::dd::{Cdd, Dd};
+use crate::numeric::dd::{Cdd, Dd};
 
 /// Hyperbolic distance between two points of the Poincaré disk given in double-double,
 /// `2 asinh(|p − q| / √((1 − |p|²)(1 − |q|²)))`; the ratio is formed in double-double, so

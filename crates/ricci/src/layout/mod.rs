@@ -22,6 +22,7 @@
 pub mod cover;
 pub mod dd;
 pub mod deck;
+pub mod error;
 pub mod export;
 pub mod input_uv;
 pub mod isometry;
@@ -32,5 +33,6 @@ pub mod svg;
 pub mod synthetic;
 
 pub use deck::{deck_group, DeckGroup, Polygon, Side, SidePairing};
+pub use error::LayoutError;
 pub use isometry::{Isometry, Mobius, RigidMotion, Rotation};
 pub use place::{align, align_layouts, layout, layout_dd, Frame, Layout, Space};

@@ -41,7 +41,8 @@
 //! largest disagreement between laid-out distances and the metric, which measures how far the
 //! metric is from being exactly flat / hyperbolic / spherical (curvature error).
 
-use super::dd::{disk_distance_dd, disk_orientation_dd, Cdd, MobiusDd};
+use super::dd::{disk_distance_dd, disk_orientation_dd, MobiusDd};
+use super::error::LayoutError;
 use super::isometry::{
     cross3, det3, disk_distance, dot3, normalize3, sphere_distance, Complex, Isometry, Mobius,
     RigidMotion, Rotation,
@@ -49,6 +50,7 @@ use super::isometry::{
 use crate::error::{Error, Result};
 use crate::mesh::{topology, Mesh, NONE};
 use crate::metric::geometry::{Background, Euclidean, Geometry, Hyperbolic, Spherical};
+use crate::numeric::dd::Cdd;
 use std::collections::VecDeque;
 
 /// The working precision of layouts and deck groups: the isometries face frames are composed
@@ -342,7 +344,7 @@ impl Space for Hyperbolic {
     // `!(x > 0.0)` is used on purpose: it is also true for NaN.
     #[allow(clippy::neg_cmp_op_on_partial_ord)]
     fn seed_ext(l: [f64; 3], lo: [f64; 3]) -> [Cdd; 3] {
-        use super::dd::Dd;
+        use crate::numeric::dd::Dd;
         let [l01, l12, l20] = [0, 1, 2].map(|m| Dd::new(l[m]) + Dd::new(lo[m]));
         let half = Dd::new(0.5);
         let sig = (l01 + l12 + l20) * half;
@@ -481,11 +483,13 @@ pub fn check_lengths(mesh: &Mesh, lengths: &[f64], geometry: Geometry) -> Result
         let bad = !(l > 0.0 && l.is_finite())
             || (geometry == Geometry::Spherical && l >= std::f64::consts::PI);
         if bad {
-            let [a, b] = mesh.edge_vertices(e as u32);
-            return Err(Error::input(format!(
-                "edge {e} (vertices {a}–{b}) has length {l}, which is not a valid {} length",
-                geometry.name()
-            )));
+            return Err(LayoutError::InvalidLength {
+                edge: e as u32,
+                vertices: mesh.edge_vertices(e as u32),
+                length: l,
+                geometry,
+            }
+            .into());
         }
     }
     Ok(())
@@ -580,10 +584,8 @@ pub fn layout_dd<S: Space>(
             )));
         }
         if let Some(e) = lo.iter().position(|x| !x.is_finite()) {
-            return Err(Error::input(format!(
-                "edge {e}: the low part of its length is {}",
-                lo[e]
-            )));
+            let (edge, value) = (e as u32, lo[e]);
+            return Err(LayoutError::InvalidLowPart { edge, value }.into());
         }
     }
     let nf = mesh.n_faces();
@@ -600,11 +602,12 @@ pub fn layout_dd<S: Space>(
     let c = &topo.components[0];
     let simply_connected = c.genus == 0 && c.boundary_loops <= 1;
     if !simply_connected {
-        return Err(Error::topology(format!(
-            "a layout needs a disk or a closed genus-0 surface, this mesh has genus {} and {} \
-             boundary loops (cut it to a disk first)",
-            c.genus, c.boundary_loops
-        )));
+        let (genus, boundary_loops) = (c.genus, c.boundary_loops);
+        return Err(LayoutError::NotSimplyConnected {
+            genus,
+            boundary_loops,
+        }
+        .into());
     }
     if c.boundary_loops == 0 && S::KIND != Geometry::Spherical {
         return Err(Error::topology(
@@ -614,11 +617,7 @@ pub fn layout_dd<S: Space>(
     }
     let seed = match seed_face {
         Some(f) if (f as usize) < nf => f,
-        Some(f) => {
-            return Err(Error::input(format!(
-                "seed face {f} does not exist (the mesh has {nf} faces)"
-            )))
-        }
+        Some(face) => return Err(LayoutError::SeedFaceMissing { face, n_faces: nf }.into()),
         None => central_face(mesh),
     };
     let canonical = canonical_triangles::<S>(mesh, lengths, lengths_lo);
@@ -895,15 +894,15 @@ mod tests {
     use super::*;
 
     /// Hyperbolic distance of two disk points, entirely in double-double.
-    fn dist_dd(p: Cdd, q: Cdd) -> super::super::dd::Dd {
-        use super::super::dd::Dd;
+    fn dist_dd(p: Cdd, q: Cdd) -> crate::numeric::dd::Dd {
+        use crate::numeric::dd::Dd;
         let den = (Dd::ONE - p.norm_sqr()) * (Dd::ONE - q.norm_sqr());
         Dd::new(2.0) * ((p - q).norm() / den.sqrt()).asinh()
     }
 
     #[test]
     fn double_double_seed_triangles_have_their_double_double_side_lengths() {
-        use super::super::dd::Dd;
+        use crate::numeric::dd::Dd;
         // Low parts far below double precision must show up in the laid-out distances.
         for (l, lo) in [
             ([0.3, 0.4, 0.5], [1e-17, -2e-17, 3e-18]),

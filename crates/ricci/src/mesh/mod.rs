@@ -11,10 +11,6 @@ pub mod io;
 pub mod quality;
 pub mod topology;
 
-/// Compatibility re-export: intrinsic refinement (it needs the background geometries) moved
-/// to [`crate::metric::refine`]; the path `crate::mesh::refine` keeps working.
-pub use crate::metric::refine;
-
 pub use build::{build_surface, BuildReport, PolygonSoup};
 pub use connectivity::{Mesh, NONE};
 pub use topology::{topology, Component, Topology};

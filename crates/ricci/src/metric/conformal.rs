@@ -20,6 +20,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
+use super::error::MetricError;
 use super::geometry::{Background, Euclidean, Geometry, Hyperbolic, Spherical};
 use super::scheme::Scheme;
 use crate::error::{Error, Result};
@@ -81,20 +82,20 @@ pub fn check_triangles(mesh: &Mesh, lengths: &[f64], geometry: Geometry) -> Resu
         let sum = l[0] + l[1] + l[2];
         for i in 0..3 {
             if l[i] >= sum - l[i] {
-                return Err(Error::input(format!(
-                    "face {f} (vertices {:?}) is degenerate: its edge lengths {:.6e}, {:.6e}, \
-                     {:.6e} violate the triangle inequality",
-                    mesh.face(f),
-                    l[0],
-                    l[1],
-                    l[2]
-                )));
+                return Err(MetricError::DegenerateFace {
+                    face: f,
+                    vertices: mesh.face(f),
+                    lengths: l,
+                }
+                .into());
             }
         }
         if geometry == Geometry::Spherical && sum >= 2.0 * std::f64::consts::PI {
-            return Err(Error::input(format!(
-                "face {f} is too large for a spherical triangle (perimeter {sum:.4} ≥ 2π)"
-            )));
+            return Err(MetricError::SphericalFaceTooLarge {
+                face: f,
+                perimeter: sum,
+            }
+            .into());
         }
     }
     Ok(())

@@ -24,6 +24,7 @@
 
 pub mod common_subdivision;
 pub mod conformal;
+pub mod error;
 pub mod file;
 pub mod geometry;
 pub mod intrinsic;
@@ -32,6 +33,7 @@ pub mod refine;
 pub mod scheme;
 
 pub use conformal::ConformalStructure;
+pub use error::MetricError;
 pub use geometry::{Background, Euclidean, Geometry, Hyperbolic, Spherical};
 pub use kernel::{HessianPattern, MeshData, Workspace};
 pub use scheme::{CirclePacking, Law, Scheme, VertexScaling};

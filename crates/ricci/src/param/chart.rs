@@ -13,7 +13,7 @@ use super::transfer::{
 use super::{log_scale_sigma, BoundaryMode, Chart, Cone, ConeSpec};
 use super::{ParamOptions, Piece};
 use crate::error::{Error, Result};
-use crate::flow::{ricci_flow, FlowOptions, FlowResult, TargetSpec};
+use crate::flow::{flow_with_fallback, FlowResult, TargetSpec, UniformizationOptions};
 use crate::mesh::{topology, Mesh};
 use crate::metric::{Geometry, Scheme};
 use crate::progress::Progress;
@@ -159,14 +159,9 @@ fn flow_once(
     progress: &mut dyn Progress,
 ) -> Result<FlowResult> {
     progress.report("flow", None, "conformal flow with intrinsic Delaunay flips");
-    let fo = FlowOptions {
-        geometry: Geometry::Euclidean,
-        scheme: Scheme::Conformal,
-        target,
-        tolerance,
-        ..FlowOptions::default()
-    };
-    let r = ricci_flow(mesh, lengths, &fo, progress)?;
+    let fo = UniformizationOptions::single(Some(Geometry::Euclidean), Scheme::Conformal, tolerance)
+        .with_target(target);
+    let r = flow_with_fallback(mesh, lengths, &fo, None, progress)?.result;
     if !r.converged {
         return Err(Error::numerical(format!(
             "the conformal flow did not converge (max |K − K̄| = {:.3e} after {} iterations{})",

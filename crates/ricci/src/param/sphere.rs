@@ -20,7 +20,7 @@
 
 use crate::analysis::distortion::{face_distortion, stats, DistortionStats};
 use crate::error::{Error, Result};
-use crate::flow::{ricci_flow, FlowOptions, TargetSpec};
+use crate::flow::{flow_with_fallback, TargetSpec, UniformizationOptions};
 use crate::layout::subdivision_uv::{sphere_common_subdivision, sphere_flipped_faces};
 use crate::mesh::{topology, Surface};
 use crate::metric::{Geometry, Scheme};
@@ -125,16 +125,11 @@ pub fn sphere_map(surface: &Surface, progress: &mut dyn Progress) -> Result<Sphe
             "--sphere needs a connected closed surface of genus 0",
         ));
     }
-    let fo = FlowOptions {
-        geometry: Geometry::Spherical,
-        scheme: Scheme::Conformal,
-        target: TargetSpec::Uniform,
-        tolerance: 1e-10,
-        ..FlowOptions::default()
-    };
+    let fo = UniformizationOptions::single(Some(Geometry::Spherical), Scheme::Conformal, 1e-10)
+        .with_target(TargetSpec::Uniform);
     progress.report("flow", None, "conformal map to the sphere");
     let lengths = surface.edge_lengths();
-    let r = ricci_flow(mesh, &lengths, &fo, progress)?;
+    let r = flow_with_fallback(mesh, &lengths, &fo, None, progress)?.result;
     if !r.converged {
         return Err(Error::numerical(format!(
             "the spherical flow did not converge (max |K − K̄| = {:.3e})",

@@ -18,7 +18,7 @@
 //! `(1/K) Σ_k ‖F(u_k) − p_k‖² + λ (h̄² / |D|) E(F) + γ ‖c − c₀‖²`, where `E` is the thin-plate
 //! energy `∫_D |F_xx|² + 2|F_xy|² + |F_yy|²` (quadrature: every domain triangle split into nine,
 //! the three corner pieces split again twice, three points of degree 2 in each piece — see
-//! [`QUADRATURE_SUBDIVISION`] for why so many), `h̄` the mean domain edge length and `|D|` the domain area
+//! [`super::quadrature::QUADRATURE_SUBDIVISION`] for why so many), `h̄` the mean domain edge length and `|D|` the domain area
 //! (so `λ` is scale-free), and `γ` a tiny ridge towards `c₀` that keeps control points that
 //! neither term determines where they were. The normal equations are solved by sparse
 //! Cholesky (faer).
@@ -41,14 +41,10 @@ use crate::progress::{NoProgress, Progress};
 use super::dms::{Precision, Workspace};
 use super::simplex::{n_partials, Point};
 
-/// Compatibility re-exports: the spline-space interface and the quadrature rules moved to
-/// [`super::space`] and [`super::quadrature`] (so that [`super::dms`] and this module no
-/// longer import each other); the paths `spline::fit::…` keep working.
-pub use super::quadrature::{
-    quadrature_barycentric, quadrature_barycentric_graded, quadrature_barycentric_subdivided,
-    QUADRATURE_GRADING, QUADRATURE_SUBDIVISION,
-};
-pub use super::space::{evaluate, SplineSpace};
+// The spline-space interface and the quadrature rules live in their own modules (so that
+// [`super::dms`] and this one do not import each other).
+use super::quadrature::quadrature_barycentric;
+use super::space::{evaluate, SplineSpace};
 
 mod fairing;
 pub use fairing::{constraint_residuals, fair, fairness_constraints, Constraint, FairingReport};
@@ -190,7 +186,7 @@ pub fn thin_plate_energy<S: SplineSpace + ?Sized>(
 }
 
 /// Thin-plate energy of a spline with the quadrature rule `rule` on every triangle (e.g. a
-/// finer [`quadrature_barycentric_subdivided`] to check the fit's rule).
+/// finer [`super::quadrature::quadrature_barycentric_subdivided`] to check the fit's rule).
 pub fn thin_plate_energy_with<S: SplineSpace + ?Sized>(
     space: &S,
     control: &[f64],

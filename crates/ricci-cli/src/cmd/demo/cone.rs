@@ -6,9 +6,9 @@ use super::common::*;
 use super::report::{num, Section, Status, Table};
 use super::Env;
 use crate::cmd::flow::metric_json;
-use ricci::flow::{ricci_flow, FlowOptions, FlowResult, TargetSpec};
-use ricci::mesh::refine::{Refined, Refiner};
+use ricci::flow::{flow_with_fallback, FlowResult, TargetSpec, UniformizationOptions};
 use ricci::mesh::Surface;
+use ricci::metric::refine::{Refined, Refiner};
 use ricci::metric::{Geometry, Scheme};
 use ricci_render::{render, Colormap, Paint, Scalar, Style, View};
 use serde_json::json;
@@ -29,14 +29,10 @@ pub fn single_cone(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     // Without the refinement the flow refuses the target (Chow–Luo); show its reason.
     env.bar.step("the target on the unrefined surface");
     let lengths = s.edge_lengths();
-    let o = FlowOptions {
-        geometry: Geometry::Euclidean,
-        scheme: Scheme::Thurston,
-        target: TargetSpec::SingleCone(Some(v)),
-        tolerance: FLOW_TOLERANCE,
-        ..FlowOptions::default()
-    };
-    let refusal = match ricci_flow(&s.mesh, &lengths, &o, env.bar) {
+    let o =
+        UniformizationOptions::single(Some(Geometry::Euclidean), Scheme::Thurston, FLOW_TOLERANCE)
+            .with_target(TargetSpec::SingleCone(Some(v)));
+    let refusal = match flow_with_fallback(&s.mesh, &lengths, &o, None, env.bar) {
         Err(e) => Some(e.to_string()),
         Ok(_) => None,
     };
@@ -45,7 +41,7 @@ pub fn single_cone(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     ));
     let (refined, raised, graded) = refine_around(s, &lengths, v)?;
     let valence_after = refined.mesh.valence(v);
-    let r = ricci_flow(&refined.mesh, &refined.lengths, &o, env.bar)?;
+    let r = flow_with_fallback(&refined.mesh, &refined.lengths, &o, None, env.bar)?.result;
     if !r.converged {
         sec.status = Status::Warning(format!(
             "the flow did not converge: max |K − K̄| = {:.3e} > {:.0e} after {} steps",

@@ -6,7 +6,7 @@ use super::common::*;
 use super::report::{num, Section, Status, Table};
 use super::Env;
 use crate::cmd::flow::metric_json;
-use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
+use ricci::flow::{flow_with_fallback, TargetSpec, UniformizationOptions};
 use ricci::metric::{Geometry, Scheme};
 use ricci_render::{fields, render, Colormap, Paint, Scalar, ScalarRange, Style, View};
 use std::f64::consts::PI;
@@ -16,14 +16,13 @@ pub fn hyperbolic_flow(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> 
     let s = ctx.surface()?;
     // The default scheme of `ricci flow` (discrete conformal equivalence): the conformal
     // class of the surface's own polyhedral metric.
-    let opts_flow = FlowOptions {
-        geometry: Geometry::Hyperbolic,
-        scheme: Scheme::Conformal,
-        target: TargetSpec::Uniform,
-        tolerance: FLOW_TOLERANCE,
-        ..FlowOptions::default()
-    };
-    let r = ricci_flow(&s.mesh, &s.edge_lengths(), &opts_flow, env.bar)?;
+    let opts_flow = UniformizationOptions::single(
+        Some(Geometry::Hyperbolic),
+        Scheme::Conformal,
+        FLOW_TOLERANCE,
+    )
+    .with_target(TargetSpec::Uniform);
+    let r = flow_with_fallback(&s.mesh, &s.edge_lengths(), &opts_flow, None, env.bar)?.result;
     // The later stages cut and lay out the surface with these lengths, on its own faces: the
     // intrinsic Delaunay triangulation must be the input's (no flip, no split; so it is on
     // the isotropic built-in surface).

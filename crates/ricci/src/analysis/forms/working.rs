@@ -11,7 +11,7 @@
 //!   map is affine on every face and the holomorphic form is exactly `dz`.
 
 use crate::error::{Error, Result};
-use crate::flow::{ricci_flow, FlowOptions, TargetSpec};
+use crate::flow::{flow_with_fallback, TargetSpec, UniformizationOptions};
 use crate::mesh::{topology, Mesh, NONE};
 use crate::metric::intrinsic::IntrinsicTriangulation;
 use crate::metric::{Geometry, Scheme};
@@ -122,14 +122,10 @@ pub fn working_surface(
                     c.genus
                 )));
             }
-            let opts = FlowOptions {
-                geometry: Geometry::Euclidean,
-                scheme: Scheme::Conformal,
-                target: TargetSpec::Uniform,
-                tolerance: 1e-11,
-                ..FlowOptions::default()
-            };
-            let f = ricci_flow(mesh, lengths, &opts, progress)?;
+            let opts =
+                UniformizationOptions::single(Some(Geometry::Euclidean), Scheme::Conformal, 1e-11)
+                    .with_target(TargetSpec::Uniform);
+            let f = flow_with_fallback(mesh, lengths, &opts, None, progress)?.result;
             if !f.converged {
                 return Err(Error::numerical(format!(
                     "the flat metric did not converge (curvature error {:.1e})",

@@ -344,9 +344,9 @@ impl DomainPairings {
         seed: u32,
         crossed: &[bool],
     ) -> Result<Self> {
-        use crate::layout::dd::Cdd;
         use crate::layout::place::layout_dd;
         use crate::metric::Hyperbolic;
+        use crate::numeric::dd::Cdd;
         let cut: Vec<bool> = crossed.iter().map(|&c| !c).collect();
         let (cm, origin) = crate::cut::slice(mesh, &cut)?;
         let mut cl = vec![0.0; cm.n_edges()];

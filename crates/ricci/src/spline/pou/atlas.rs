@@ -29,13 +29,14 @@ use std::collections::HashMap;
 use std::time::Instant;
 
 use crate::error::{Error, Result};
-use crate::flow::{ricci_flow, FlowOptions, TargetSpec};
-use crate::layout::dd::{Cdd, MobiusDd};
+use crate::flow::{flow_with_fallback, TargetSpec, UniformizationOptions};
+use crate::layout::dd::MobiusDd;
 use crate::layout::isometry::{Complex, Isometry, Mobius};
 use crate::layout::pipeline::{cut_disk_polished, polish_uniformization};
 use crate::layout::{deck_group, layout_dd, DeckGroup};
 use crate::mesh::{topology, Mesh, Surface};
-use crate::metric::{Geometry, Hyperbolic};
+use crate::metric::{Geometry, Hyperbolic, Scheme};
+use crate::numeric::dd::Cdd;
 use crate::progress::Progress;
 
 /// A face of a chart's star: its lift's map from the fundamental domain's coordinate to the
@@ -220,14 +221,12 @@ impl HyperbolicAtlas {
             )));
         }
         progress.report("flow", None, "hyperbolic uniformization metric");
-        let opts = FlowOptions {
-            geometry: Geometry::Hyperbolic,
-            target: TargetSpec::Uniform,
-            tolerance: 1e-12,
-            ..FlowOptions::default()
-        };
+        // Thurston's packing (the flow's default scheme), the uniform target.
+        let opts =
+            UniformizationOptions::single(Some(Geometry::Hyperbolic), Scheme::Thurston, 1e-12)
+                .with_target(TargetSpec::Uniform);
         let input = surface.edge_lengths();
-        let flow = ricci_flow(mesh, &input, &opts, progress)?;
+        let flow = flow_with_fallback(mesh, &input, &opts, None, progress)?.result;
         if !flow.converged {
             return Err(Error::numerical(format!(
                 "the hyperbolic Ricci flow did not converge (max curvature error {:.3e})",

@@ -349,7 +349,7 @@ fn solve_normal(trip: &[Triplet<usize, usize, f64>], rhs: &[[f64; 3]]) -> Result
     }
     llt.solve_in_place(sol.as_mut());
     drop(llt);
-    crate::simd::clear_upper_state();
+    crate::numeric::simd::clear_upper_state();
     let control: Vec<[f64; 3]> = (0..nv)
         .map(|k| [sol[(k, 0)], sol[(k, 1)], sol[(k, 2)]])
         .collect();

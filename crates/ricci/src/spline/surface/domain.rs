@@ -4,8 +4,8 @@
 use std::time::Instant;
 
 use crate::error::{Error, Result};
-use crate::flow::{ricci_flow, FlowOptions, FlowResult, TargetSpec};
-use crate::mesh::{topology, Mesh, Surface};
+use crate::flow::{flow_with_fallback, TargetSpec, UniformizationOptions};
+use crate::mesh::{topology, Surface};
 use crate::metric::{Geometry, Scheme};
 use crate::progress::Progress;
 use crate::spline::manifold::LocalCharts;
@@ -131,7 +131,13 @@ pub fn flat_domain(
             TargetSpec::SingleCone(Some(s)),
         )
     };
-    let (flow, scheme) = flow_with_fallback(&m, &l, &target, progress)?;
+    // The papers' schemes in turn (Thurston's packing first; where its clamped intersection
+    // angles make the target unreachable — Chow–Luo at a low-valence vertex, e.g. rocker-arm —
+    // or it does not converge, the exact schemes, which start at the input metric): the first
+    // converged flow, else the first that ran.
+    let papers = UniformizationOptions::papers(target);
+    let ran = flow_with_fallback(&m, &l, &papers, None, progress)?;
+    let (flow, scheme) = (ran.result, ran.scheme);
     if !flow.converged {
         return Err(Error::numerical(format!(
             "manifold spline: the Ricci flow did not converge (max |K − K̄| = {:.2e} after {} iterations)",
@@ -158,52 +164,4 @@ pub fn flat_domain(
         scheme,
         seconds: t0.elapsed().as_secs_f64(),
     })
-}
-
-/// The flat metric of `target`: Thurston's packing first (the papers' scheme); where its
-/// clamped intersection angles make the target unreachable (Chow–Luo at a low-valence vertex,
-/// e.g. rocker-arm) or it does not converge, the exact schemes, which start at the input
-/// metric. Returns the first converged flow, else the first that ran, with its scheme.
-fn flow_with_fallback(
-    m: &Mesh,
-    l: &[f64],
-    target: &TargetSpec,
-    progress: &mut dyn Progress,
-) -> Result<(FlowResult, Scheme)> {
-    let mut flow = None;
-    let mut first_error = None;
-    for scheme in [
-        Scheme::Thurston,
-        Scheme::Inversive,
-        Scheme::Yamabe,
-        Scheme::Tangential,
-    ] {
-        let opts = FlowOptions {
-            target: target.clone(),
-            scheme,
-            tolerance: 1e-11,
-            ..FlowOptions::default()
-        };
-        match ricci_flow(m, l, &opts, progress) {
-            Ok(f) if f.converged => {
-                flow = Some((f, scheme));
-                break;
-            }
-            Ok(f) => {
-                if flow.is_none() {
-                    flow = Some((f, scheme));
-                }
-            }
-            Err(e) => {
-                if first_error.is_none() {
-                    first_error = Some(e);
-                }
-            }
-        }
-    }
-    match (flow, first_error) {
-        (Some(f), _) => Ok(f),
-        (None, Some(e)) => Err(e),
-        (None, None) => Err(Error::numerical("manifold spline: no flow ran")),
-    }
 }

@@ -475,14 +475,20 @@ pub fn flat_torus_domain(
             c.map_or(0, |c| c.boundary_loops)
         )));
     }
-    let opts = crate::flow::FlowOptions {
-        geometry: Geometry::Euclidean,
-        scheme: crate::flow::default_scheme(Geometry::Euclidean),
-        target: crate::flow::TargetSpec::Uniform,
-        tolerance: 1e-11,
-        ..Default::default()
-    };
-    let r = crate::flow::ricci_flow(&surface.mesh, &surface.edge_lengths(), &opts, progress)?;
+    let opts = crate::flow::UniformizationOptions::single(
+        Some(Geometry::Euclidean),
+        crate::flow::default_scheme(Geometry::Euclidean),
+        1e-11,
+    )
+    .with_target(crate::flow::TargetSpec::Uniform);
+    let r = crate::flow::flow_with_fallback(
+        &surface.mesh,
+        &surface.edge_lengths(),
+        &opts,
+        None,
+        progress,
+    )?
+    .result;
     if !r.converged {
         return Err(Error::numerical(format!(
             "the flat-metric flow did not converge (max curvature error {:.3e} after {} iterations)",
