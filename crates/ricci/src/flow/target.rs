@@ -655,7 +655,7 @@ pub fn check_chow_luo(mesh: &Mesh, geometry: Geometry, target: &Target, phi: &[f
         let label = if mesh.is_boundary_vertex(v) && mesh.vertex_faces(v).count() == 1 {
             format!(
                 "the single vertex {v}, a boundary vertex with one face (an ear: its one corner \
-                 would have to open to π − K̄; split the opposite edge to give it two faces: `ricci flow --widen-boundary 2`, `metric::refine::widen_boundary`)"
+                 would have to open to π − K̄; split the opposite edge to give it two faces: `ricci flow --widen-boundary 2`)"
             )
         } else {
             format!("the single vertex {v} (valence {})", mesh.valence(v))
