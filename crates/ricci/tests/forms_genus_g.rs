@@ -191,6 +191,18 @@ fn shared_meshes() {
     }
 }
 
+/// Botijo (genus 5, 41k vertices): the heaviest mesh of the must-show list, in a test of
+/// its own (bilinear relations, 2g − 2 = 8 zeros, another base vertex).
+#[test]
+fn botijo() {
+    let Some(dir) = ricci_meshes::ricci_meshes().filter(|d| d.is_dir()) else {
+        eprintln!("RICCI_MESHES not set; skipped");
+        return;
+    };
+    let (s, _) = ricci::mesh::io::read_surface(&dir.join("botijo.off")).unwrap();
+    check_surface("botijo.off", &s, 20000);
+}
+
 /// Paper 002 §4.2.4: up to g − 1 zeros placed at chosen vertices land within one ring of
 /// them, and the form still has 2g − 2 zeros in all.
 fn check_placement(name: &str, s: &Surface, targets: &[u32]) {

@@ -226,7 +226,7 @@ pub fn critical_lines(
         return Vec::new();
     };
     let at: Vec<u32> = zeros.zeros.iter().map(|z| z.vertex).collect();
-    critical_trajectories(h.mesh(), form, &at, 1.5 * scale, 200_000)
+    critical_trajectories(h.mesh(), h.lengths(), form, &at, 1.5 * scale, 200_000)
         .iter()
         .map(|t| t.points.iter().map(|p| p.position(pos)).collect())
         .collect()

@@ -152,9 +152,13 @@ impl HyperbolicSpectrum {
     }
 }
 
-/// Orbit points of tiles, found again by position (hyperbolic distance below 1e-7).
+/// Orbit points of tiles, found again by position (hyperbolic distance below 1e-7). Points are
+/// filed in cells of width `BAND` in the distance `r` from the origin and about `BAND` in arc
+/// length (at the cell's inner radius) in the angle, so a lookup compares with the points of 9
+/// cells only. (Cells in `r` alone crowd at large `r`, where the tiles of a search are: with
+/// the rejected tiles of seahorse2_100K also filed, lookups made the search 10× slower.)
 struct TileIndex {
-    bands: HashMap<i64, Vec<usize>>,
+    cells: HashMap<(i64, i64), Vec<usize>>,
     points: Vec<([f64; 3], Complex)>,
 }
 
@@ -162,12 +166,21 @@ impl TileIndex {
     const BAND: f64 = 1e-3;
     fn new() -> Self {
         TileIndex {
-            bands: HashMap::new(),
+            cells: HashMap::new(),
             points: Vec::new(),
         }
     }
-    fn key(x: &[f64; 3]) -> i64 {
+    fn band(x: &[f64; 3]) -> i64 {
         (x[2].max(1.0).acosh() / Self::BAND).floor() as i64
+    }
+    /// Number of angular cells of band `k`: its inner circle's length over `BAND`.
+    fn sectors(k: i64) -> i64 {
+        let r = k.max(0) as f64 * Self::BAND;
+        ((2.0 * std::f64::consts::PI * r.sinh() / Self::BAND).ceil() as i64).clamp(1, 1 << 52)
+    }
+    fn sector(x: &[f64; 3], n: i64) -> i64 {
+        let u = (x[1].atan2(x[0]) / (2.0 * std::f64::consts::PI)).rem_euclid(1.0);
+        ((u * n as f64).floor() as i64).rem_euclid(n)
     }
     /// Disk point with 1 − |p|² = 2/(1 + X₀) known exactly, and the accurate distance.
     fn dist(a: &([f64; 3], Complex), b: &([f64; 3], Complex)) -> f64 {
@@ -177,14 +190,21 @@ impl TileIndex {
     fn entry(x: [f64; 3]) -> ([f64; 3], Complex) {
         (x, Complex::new(x[0], x[1]) / (1.0 + x[2]))
     }
+    /// A point within 1e-7 of `x` differs by less than a cell in `r` and in the angle (the
+    /// angular cells of the bands `k ± 1` are wider than `1e-7 / sinh r` by far).
     fn find(&self, x: [f64; 3]) -> Option<usize> {
         let e = Self::entry(x);
-        let k = Self::key(&x);
+        let k = Self::band(&x);
         for kk in k - 1..=k + 1 {
-            if let Some(list) = self.bands.get(&kk) {
-                for &i in list {
-                    if Self::dist(&self.points[i], &e) < 1e-7 {
-                        return Some(i);
+            let n = Self::sectors(kk);
+            let a = Self::sector(&x, n);
+            let span = if n <= 3 { 0..n } else { a - 1..a + 2 };
+            for aa in span {
+                if let Some(list) = self.cells.get(&(kk, aa.rem_euclid(n))) {
+                    for &i in list {
+                        if Self::dist(&self.points[i], &e) < 1e-7 {
+                            return Some(i);
+                        }
                     }
                 }
             }
@@ -194,7 +214,9 @@ impl TileIndex {
     fn insert(&mut self, x: [f64; 3]) -> usize {
         let i = self.points.len();
         self.points.push(Self::entry(x));
-        self.bands.entry(Self::key(&x)).or_default().push(i);
+        let k = Self::band(&x);
+        let cell = (k, Self::sector(&x, Self::sectors(k)));
+        self.cells.entry(cell).or_default().push(i);
         i
     }
 }
@@ -245,52 +267,107 @@ fn axis_frame(g: &Mobius) -> Option<Mobius> {
 /// in double the 1e-7 that tells two tiles apart). A tile is found again by the position of
 /// `g o` (`o_h`: the centre on the hyperboloid); `keep(g, g o)` decides whether a new tile is
 /// kept (a tile already found is not tested again; a rejected one is, from each neighbour:
-/// remembering the rejected tiles in a second index made seahorse2_100K more than 10× slower,
-/// probably because the index's distance bands got crowded). `None` when more than
-/// `max_tiles` tiles are kept.
+/// remembering the millions of rejected tiles of seahorse2_100K cost more than testing them
+/// again, 61 s instead of 15 s and 1.4 GB). The search can be **grown**:
+/// [`TileSearch::grow`] with a weaker `keep` (a larger length bound) continues from the kept
+/// tiles that had a rejected neighbour — every tile kept under the smaller bound is kept
+/// under the larger one, so the grown search is the search that the larger bound alone would
+/// have made, without redoing its inside.
 struct TileSearch {
     elems_dd: Vec<MobiusDd>,
     elems: Vec<Mobius>,
     index: TileIndex,
+    /// Kept tiles with a neighbour that the last `keep` rejected.
+    frontier: Vec<usize>,
+    queue: VecDeque<usize>,
 }
 
 impl TileSearch {
-    fn run(
+    fn new(o_h: [f64; 3]) -> TileSearch {
+        let mut index = TileIndex::new();
+        index.insert(o_h);
+        TileSearch {
+            elems_dd: vec![MobiusDd::IDENTITY],
+            elems: vec![Mobius::identity()],
+            index,
+            frontier: Vec::new(),
+            queue: VecDeque::from([0usize]),
+        }
+    }
+
+    /// Grow the search under a new `keep` (weaker than the previous ones); false when more
+    /// than `max_tiles` tiles are kept.
+    fn grow(
+        &mut self,
         o_h: [f64; 3],
         maps: &[MobiusDd],
         max_tiles: usize,
         mut keep: impl FnMut(&Mobius, [f64; 3]) -> bool,
-    ) -> Option<TileSearch> {
-        let mut index = TileIndex::new();
-        let mut elems_dd: Vec<MobiusDd> = vec![MobiusDd::IDENTITY];
-        let mut elems: Vec<Mobius> = vec![Mobius::identity()];
-        index.insert(o_h);
-        let mut queue = VecDeque::from([0usize]);
-        while let Some(t) = queue.pop_front() {
+    ) -> bool {
+        self.queue.extend(std::mem::take(&mut self.frontier));
+        while let Some(t) = self.queue.pop_front() {
+            if self.elems.len() > max_tiles {
+                return false;
+            }
+            let mut rejected = false;
             for sm in maps {
-                let gd = elems_dd[t].compose(sm).normalized();
+                // Normalized only when kept: the product of two normalized words is
+                // normalized to double-double precision, more than the lookup needs.
+                let gd = self.elems_dd[t].compose(sm);
                 let g = gd.round();
                 let go = apply_h(&g.klein_matrix(), o_h);
-                if index.find(go).is_some() {
+                if self.index.find(go).is_some() {
                     continue;
                 }
-                if !keep(&g, go) {
-                    continue;
-                }
-                index.insert(go);
-                elems.push(g);
-                elems_dd.push(gd);
-                queue.push_back(elems.len() - 1);
-                if elems.len() > max_tiles {
-                    return None;
+                if keep(&g, go) {
+                    self.index.insert(go);
+                    self.elems.push(g);
+                    self.elems_dd.push(gd.normalized());
+                    self.queue.push_back(self.elems.len() - 1);
+                } else {
+                    rejected = true;
                 }
             }
+            if rejected {
+                self.frontier.push(t);
+            }
         }
-        Some(TileSearch {
-            elems_dd,
-            elems,
-            index,
-        })
+        self.elems.len() <= max_tiles
+    }
+
+    fn run(
+        o_h: [f64; 3],
+        maps: &[MobiusDd],
+        max_tiles: usize,
+        keep: impl FnMut(&Mobius, [f64; 3]) -> bool,
+    ) -> Option<TileSearch> {
+        let mut s = TileSearch::new(o_h);
+        s.grow(o_h, maps, max_tiles, keep).then_some(s)
+    }
+
+    /// The next length bound after a bound `l` that gave fewer than `count` classes: the
+    /// `count`-th distinct length among the candidates up to `1.25 l` when there are that
+    /// many (each distinct length is at least one class, so a search up to it is certain to
+    /// find `count` classes), else `1.25 l`.
+    fn next_bound(
+        &self,
+        l: f64,
+        bnd: &[(Complex, usize)],
+        count: usize,
+        near: impl Fn(&Mobius) -> bool,
+    ) -> f64 {
+        let cap = 1.25 * l;
+        let (cand, _) = self.candidates(cap, bnd, near);
+        let mut lens: Vec<f64> = cand
+            .iter()
+            .map(|&i| self.elems[i].translation_length())
+            .collect();
+        lens.sort_by(f64::total_cmp);
+        lens.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * b.abs());
+        match lens.get(count.saturating_sub(1)) {
+            Some(&x) if x > l => (x * (1.0 + 1e-9) + 1e-12).min(cap),
+            _ => cap,
+        }
     }
 
     /// Candidates of the class search: the hyperbolic tiles with `ℓ ≤ l` whose axis passes

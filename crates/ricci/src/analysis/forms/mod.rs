@@ -144,24 +144,113 @@ pub fn holomorphic_forms_on(
             "holomorphic 1-forms are computed for closed surfaces of genus ≥ 1",
         ));
     }
-    let mesh = &cut.refined.mesh;
-    let lengths = &cut.refined.lengths;
-    let n = 2 * g;
+    let loops: Vec<(&str, &[u32])> = cut
+        .loops
+        .iter()
+        .take(2 * g)
+        .map(|lp| (lp.label.as_str(), lp.halfedges.as_slice()))
+        .collect();
+    let lf = forms_of_loops(&cut.refined.mesh, &cut.refined.lengths, &loops, progress)?;
+    let report = FormsReport {
+        triangulation: working.kind,
+        vertices: cut.refined.mesh.n_vertices(),
+        faces: cut.refined.mesh.n_faces(),
+        flips: working.flips,
+        negative_weights: lf.negative_weights,
+        closedness: lf.closedness,
+        harmonic_residual: lf.harmonic_residual,
+        wedge_integrality: lf.wedge_integrality,
+        star_defect: hodge::star_defect(&lf.star),
+        raw_asymmetry: lf.raw_asymmetry,
+        complex_structure_iterations: lf.iterations,
+        seconds: t0.elapsed().as_secs_f64(),
+    };
+    progress.report("forms", Some(1.0), "done");
+    Ok(HolomorphicForms {
+        genus: g,
+        working,
+        weights: lf.weights,
+        harmonic: lf.harmonic,
+        gram: lf.gram,
+        wedge: lf.wedge,
+        star: lf.star,
+        complex_structure: lf.complex_structure,
+        basis: lf.basis,
+        basis_coordinates: lf.basis_coordinates,
+        period_matrix: lf.period_matrix,
+        report,
+        cut,
+    })
+}
+
+/// The Riemann period matrix of the closed surface `mesh` (Euclidean `lengths`, cotangent
+/// weights of this very triangulation) for the homology basis `a₁, b₁, …, a_g, b_g` given as
+/// simple closed edge loops (half-edge cycles) — the computation of [`holomorphic_forms_on`]
+/// with any loops in place of a canonical cut's. Two canonical bases on one triangulation
+/// give period matrices related exactly (up to rounding) by the action of `Sp(2g, Z)`, with
+/// no discretization difference between them.
+pub fn period_matrix_of_loops(
+    mesh: &Mesh,
+    lengths: &[f64],
+    loops: &[Vec<u32>],
+) -> Result<PeriodMatrix> {
+    if loops.is_empty() || !loops.len().is_multiple_of(2) {
+        return Err(Error::input(format!(
+            "{} loops given; a homology basis a1, b1, …, ag, bg has an even, positive number",
+            loops.len()
+        )));
+    }
+    let labelled: Vec<(String, &[u32])> = loops
+        .iter()
+        .enumerate()
+        .map(|(k, l)| (format!("{}{}", ["a", "b"][k % 2], k / 2 + 1), l.as_slice()))
+        .collect();
+    let refs: Vec<(&str, &[u32])> = labelled.iter().map(|(s, l)| (s.as_str(), *l)).collect();
+    let lf = forms_of_loops(mesh, lengths, &refs, &mut crate::progress::NoProgress)?;
+    Ok(lf.period_matrix)
+}
+
+/// What [`forms_of_loops`] computes.
+struct LoopForms {
+    weights: Vec<f64>,
+    negative_weights: usize,
+    harmonic: Vec<Vec<f64>>,
+    closedness: f64,
+    harmonic_residual: f64,
+    gram: Matrix,
+    wedge: Matrix,
+    wedge_integrality: f64,
+    star: Matrix,
+    complex_structure: Matrix,
+    iterations: usize,
+    raw_asymmetry: f64,
+    basis: Vec<HolomorphicForm>,
+    basis_coordinates: Vec<Vec<f64>>,
+    period_matrix: PeriodMatrix,
+}
+
+/// Steps 3–6 of the module docs for the labelled loops `a₁, b₁, …` (simple edge loops).
+fn forms_of_loops(
+    mesh: &Mesh,
+    lengths: &[f64],
+    loops: &[(&str, &[u32])],
+    progress: &mut dyn Progress,
+) -> Result<LoopForms> {
+    let n = loops.len();
     progress.report("forms", Some(0.3), "dual 1-forms of the loops");
     let mut duals = Vec::with_capacity(n);
-    for lp in cut.loops.iter().take(n) {
+    for (label, hs) in loops {
         duals.push(
-            cochain::loop_dual(mesh, &lp.halfedges)
-                .map_err(|e| Error::numerical(format!("loop {}: {e}", lp.label)))?,
+            cochain::loop_dual(mesh, hs)
+                .map_err(|e| Error::numerical(format!("loop {label}: {e}")))?,
         );
     }
     let p: Matrix = duals
         .iter()
         .map(|w| {
-            cut.loops
+            loops
                 .iter()
-                .take(n)
-                .map(|lp| cochain::period(mesh, w, &lp.halfedges))
+                .map(|(_, hs)| cochain::period(mesh, w, hs))
                 .collect()
         })
         .collect();
@@ -202,7 +291,6 @@ pub fn holomorphic_forms_on(
         .map(|x| (x - x.round()).abs())
         .fold(0.0, f64::max);
     let star = hodge::star_matrix(&gram, &wedge)?;
-    let star_defect = hodge::star_defect(&star);
     let (j, iterations) = hodge::complex_structure(&star)?;
     let raw_asymmetry = period::normalized_basis(&star)
         .map(|(_, _, om)| om.asymmetry())
@@ -225,35 +313,22 @@ pub fn holomorphic_forms_on(
             im: combine(jx),
         })
         .collect();
-    let report = FormsReport {
-        triangulation: working.kind,
-        vertices: mesh.n_vertices(),
-        faces: mesh.n_faces(),
-        flips: working.flips,
+    Ok(LoopForms {
+        weights,
         negative_weights,
+        harmonic: zeta,
         closedness,
         harmonic_residual,
-        wedge_integrality,
-        star_defect,
-        raw_asymmetry,
-        complex_structure_iterations: iterations,
-        seconds: t0.elapsed().as_secs_f64(),
-    };
-    progress.report("forms", Some(1.0), "done");
-    Ok(HolomorphicForms {
-        genus: g,
-        working,
-        weights,
-        harmonic: zeta,
         gram,
         wedge,
+        wedge_integrality,
         star,
         complex_structure: j,
+        iterations,
+        raw_asymmetry,
         basis,
         basis_coordinates: re_coords,
         period_matrix,
-        report,
-        cut,
     })
 }
 

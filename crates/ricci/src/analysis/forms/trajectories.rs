@@ -1,19 +1,35 @@
 //! Critical horizontal trajectories of a holomorphic 1-form (paper 002 §4.2.4, the "critical
 //! trajectories through the zeros" of the conformal net; Strebel, *Quadratic differentials*,
-//! ch. IV): the curves along which `ω` is real, i.e. `Im ∫ω` is constant, that leave a zero.
+//! ch. IV): the curves along which `ω` is real and positive, i.e. the gradient lines of
+//! `Re φ` (`φ = ∫ω`), that leave a zero.
 //!
-//! On each face a discrete holomorphic form is constant, so its potential `φ = ∫ω` is affine
-//! and a horizontal trajectory is the segment of the level line `Im φ = const` through the
-//! face. Near a zero of order `m` (`ω ≈ z^m dz`) the level line `Im φ = Im φ(p)` leaves `p` in
-//! `2(m + 1)` directions (alternately with `Re φ` increasing and decreasing), so a form with
-//! zeros of orders `m_i` has `Σ 2(m_i + 1)` critical trajectories. Each is traced face by face
-//! (in the face's own chart of `φ`, so the cut and the periods play no role) for a given
-//! length `∫|ω|` along it, or until it runs into a vertex or a folded face.
+//! A discrete harmonic form is constant on each face, so `Re ω` is a vector `X_f` in the
+//! face's plane ([`super::zeros`]) and a horizontal trajectory is traced face by face as a
+//! straight segment along `±X_f` (`Re φ` increasing: *outgoing*; decreasing: *incoming*),
+//! in each face's own frame (so the cut and the periods play no role). Where the fields of two
+//! faces both point at their common edge the trajectory runs along the edge.
+//!
+//! **Departures from a vertex.** Going once counter-clockwise around vertex `p`, let `ψ` be
+//! the angle of `X` against the radial direction: inside a face it decreases with the radial
+//! angle (by the corner angle `θ`), across an edge it jumps by the turn `δ ∈ (−π, π]` of `X`
+//! — the same `θ` and `δ` from which [`super::zeros`] computes the Poincaré–Hopf index, so the
+//! lifted `ψ` decreases in all by exactly `2π(1 − ind_p) = 2π(m + 1)` at a zero of order `m`
+//! (by `2π` at a regular vertex). The field leaves `p` where `ψ ≡ 0` and arrives where
+//! `ψ ≡ π`; for each of the `m + 1` levels `2πk` (and `π + 2πk`) in the range of the lifted
+//! `ψ`, the trajectory starts where `ψ` passes that level for the last time (inside a face:
+//! along `±X_f`; at a jump: along the edge). Hence exactly `2(m + 1)` critical trajectories
+//! leave a zero of order `m` — `Σ 2(m_i + 1)` in all — even where the discrete field turns
+//! back and forth near the zero (counting the sign changes of `Im φ` around the 1-ring does
+//! not have this property: near a zero `|ω|` is small and the conjugate form's discretization
+//! error moves the saddle of `Im φ` to a neighbouring vertex). A trajectory that runs into a
+//! vertex continues by the same rule (one departure at a regular vertex) and stops at a zero,
+//! after `length` (in `∫|ω| = |Δ Re φ|`), or after `max_faces` steps.
 
 use super::cochain::on_halfedge;
+use super::zeros::{angle_between, face_vector, wrap};
 use super::HolomorphicForm;
-use crate::layout::isometry::Complex;
 use crate::mesh::{Mesh, NONE};
+use std::f64::consts::PI;
 
 /// A point on edge `from → to` of the mesh at `(1 − t)·from + t·to` (`t = 0`: the vertex).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,6 +45,14 @@ impl EdgePoint {
         let (a, b) = (pos[self.from as usize], pos[self.to as usize]);
         std::array::from_fn(|k| a[k] + self.t * (b[k] - a[k]))
     }
+
+    fn vertex(v: u32) -> EdgePoint {
+        EdgePoint {
+            from: v,
+            to: v,
+            t: 0.0,
+        }
+    }
 }
 
 /// One critical horizontal trajectory: it starts at the zero `zero` (the first point) and
@@ -38,188 +62,293 @@ pub struct Trajectory {
     pub zero: u32,
     pub outgoing: bool,
     pub points: Vec<EdgePoint>,
-    /// `∫|ω|` along it.
+    /// `∫|ω|` along it (`|Δ Re φ|`).
     pub length: f64,
 }
 
-/// The value of the form on half-edge `h`.
-fn value(mesh: &Mesh, form: &HolomorphicForm, h: u32) -> Complex {
-    Complex::new(
-        on_halfedge(mesh, &form.re, h),
-        on_halfedge(mesh, &form.im, h),
-    )
+/// How a trajectory leaves a vertex: into the face of an outgoing half-edge (its corner at
+/// the vertex), or along an outgoing half-edge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Departure {
+    Face(u32),
+    Edge(u32),
 }
 
-/// The critical horizontal trajectories from each of the vertices `zeros` (zeros of `form`),
-/// each traced for at most `length` (in `∫|ω|`) and `max_faces` faces.
+/// Where the tracing is: at a vertex, or at parameter `s` on half-edge `h` whose face was just
+/// crossed.
+#[derive(Debug, Clone, Copy)]
+enum At {
+    Vertex(u32),
+    Edge(u32, f64),
+}
+
+type Frame = ([f64; 2], [[f64; 2]; 3]);
+
+/// The face-constant field of `Re ω` with the faces' frames.
+struct Field<'a> {
+    mesh: &'a Mesh,
+    re: &'a [f64],
+    frames: Vec<Option<Frame>>,
+    /// Vertices where trajectories end (the zeros).
+    stop: Vec<bool>,
+}
+
+fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[1] - a[1] * b[0]
+}
+
+fn sub(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    [a[0] - b[0], a[1] - b[1]]
+}
+
+/// Corners of a face in its frame (`c_0 = 0`, `c_{i+1} = c_i + d_i`).
+fn corners(d: &[[f64; 2]; 3]) -> [[f64; 2]; 3] {
+    [[0.0, 0.0], d[0], [d[0][0] + d[1][0], d[0][1] + d[1][1]]]
+}
+
+/// Where the ray `x + s v` (`s > 0`) crosses the segment `a b`: `(s, τ)` with the point at
+/// `a + τ (b − a)`.
+fn hit(x: [f64; 2], v: [f64; 2], a: [f64; 2], b: [f64; 2]) -> Option<(f64, f64)> {
+    let e = sub(b, a);
+    let den = cross(v, e);
+    if den.abs() <= 1e-300 || den.is_nan() {
+        return None;
+    }
+    let ax = sub(a, x);
+    let s = cross(ax, e) / den;
+    let tau = cross(ax, v) / den;
+    (s > 0.0 && (-1e-9..=1.0 + 1e-9).contains(&tau)).then_some((s, tau.clamp(0.0, 1.0)))
+}
+
+impl Field<'_> {
+    fn frame(&self, h: u32) -> Option<Frame> {
+        let f = self.mesh.he_face(h);
+        if f == NONE {
+            return None;
+        }
+        self.frames[f as usize]
+    }
+
+    /// The departures from `p` (module docs): levels `offset + 2πk` of the lifted `ψ`
+    /// (`offset` 0: along `+X`; π: along `−X`).
+    fn departures(&self, p: u32, offset: f64) -> Vec<Departure> {
+        let m = self.mesh;
+        if m.is_isolated(p) || m.is_boundary_vertex(p) {
+            return Vec::new();
+        }
+        let rel = |h: u32| {
+            self.frame(h)
+                .map(|(x, d)| angle_between(d[(h % 3) as usize], x))
+        };
+        let corner = |h: u32| {
+            self.frame(h).map(|(_, d)| {
+                let p = d[((h + 2) % 3) as usize];
+                angle_between(d[(h % 3) as usize], [-p[0], -p[1]])
+            })
+        };
+        let h0 = m.vertex_halfedge(p);
+        let Some(a0) = rel(h0) else {
+            return Vec::new();
+        };
+        // (departure, ψ at its start, ψ at its end) in counter-clockwise order.
+        let mut segs: Vec<(Departure, f64, f64)> = Vec::new();
+        let (mut h, mut a) = (h0, a0);
+        for _ in 0..=m.valence(p) {
+            let (Some(th), Some(rn)) = (corner(h), rel(m.he_twin(m.he_prev(h)))) else {
+                return Vec::new();
+            };
+            let next = m.he_twin(m.he_prev(h));
+            let b = a - th;
+            let an = b + wrap(rn - b);
+            segs.push((Departure::Face(h), a, b));
+            segs.push((Departure::Edge(next), b, an));
+            (h, a) = (next, an);
+            if h == h0 {
+                break;
+            }
+        }
+        if h != h0 {
+            return Vec::new();
+        }
+        let mut out = Vec::new();
+        let mut level = offset + 2.0 * PI * ((a0 - offset) / (2.0 * PI)).floor();
+        while level > a && out.len() <= segs.len() {
+            // The last passage through `level` (after it ψ stays below).
+            if let Some(s) = segs.iter().rev().find(|s| s.1.max(s.2) >= level) {
+                if s.2 < level {
+                    out.push(s.0);
+                }
+            }
+            level -= 2.0 * PI;
+        }
+        out
+    }
+
+    /// Arrive at parameter `tau` of the local edge `k` (half-edge `3f + k`) of face `f`.
+    fn arrive(&self, f: u32, k: u32, tau: f64, tr: &mut Trajectory) -> At {
+        let e = 3 * f + k;
+        let m = self.mesh;
+        let v = if tau < 1e-9 {
+            Some(m.he_origin(e))
+        } else if tau > 1.0 - 1e-9 {
+            Some(m.he_tip(e))
+        } else {
+            None
+        };
+        match v {
+            Some(v) => {
+                tr.points.push(EdgePoint::vertex(v));
+                At::Vertex(v)
+            }
+            None => {
+                tr.points.push(EdgePoint {
+                    from: m.he_origin(e),
+                    to: m.he_tip(e),
+                    t: tau,
+                });
+                At::Edge(e, tau)
+            }
+        }
+    }
+
+    /// Run along half-edge `h` from its origin at parameter `s` to its tip (or back to its
+    /// origin when `Re φ` increases that way), if that is the direction of the trajectory.
+    fn slide(&self, h: u32, s: f64, dir: f64, tr: &mut Trajectory) -> Option<At> {
+        let r = on_halfedge(self.mesh, self.re, h);
+        if r == 0.0 || r.is_nan() {
+            return None;
+        }
+        let (v, frac) = if dir * r > 0.0 {
+            (self.mesh.he_tip(h), 1.0 - s)
+        } else {
+            (self.mesh.he_origin(h), s)
+        };
+        tr.length += r.abs() * frac;
+        tr.points.push(EdgePoint::vertex(v));
+        Some(At::Vertex(v))
+    }
+
+    /// Leave a vertex by a departure.
+    fn leave(&self, dep: Departure, dir: f64, tr: &mut Trajectory) -> Option<At> {
+        match dep {
+            Departure::Edge(h) => {
+                // Only if `Re φ` changes the right way along the edge (it does when the
+                // fields of both faces point at it).
+                if dir * on_halfedge(self.mesh, self.re, h) > 0.0 {
+                    self.slide(h, 0.0, dir, tr)
+                } else {
+                    None
+                }
+            }
+            Departure::Face(h) => {
+                let (x, d) = self.frame(h)?;
+                let c = corners(&d);
+                let i = (h % 3) as usize;
+                let v = [dir * x[0], dir * x[1]];
+                let k = (i + 1) % 3;
+                let (s, tau) = hit(c[i], v, c[k], c[(k + 1) % 3])?;
+                tr.length += s * (x[0] * x[0] + x[1] * x[1]);
+                Some(self.arrive(h / 3, k as u32, tau, tr))
+            }
+        }
+    }
+
+    /// Cross the face beyond half-edge `h` (point at parameter `s` on it).
+    fn cross_face(&self, h: u32, s: f64, dir: f64, tr: &mut Trajectory) -> Option<At> {
+        let t = self.mesh.he_twin(h);
+        let (x, d) = self.frame(t)?;
+        let c = corners(&d);
+        let j = (t % 3) as usize;
+        let (a, b) = (c[j], c[(j + 1) % 3]);
+        let p = [
+            a[0] + (1.0 - s) * (b[0] - a[0]),
+            a[1] + (1.0 - s) * (b[1] - a[1]),
+        ];
+        let v = [dir * x[0], dir * x[1]];
+        if cross(d[j], v) <= 0.0 {
+            // Both faces' fields point at the edge: run along it.
+            return self.slide(t, 1.0 - s, dir, tr);
+        }
+        let best = [(j + 1) % 3, (j + 2) % 3]
+            .into_iter()
+            .filter_map(|k| hit(p, v, c[k], c[(k + 1) % 3]).map(|(s, tau)| (s, k, tau)))
+            .min_by(|a, b| a.0.total_cmp(&b.0))?;
+        tr.length += best.0 * (x[0] * x[0] + x[1] * x[1]);
+        Some(self.arrive(t / 3, best.1 as u32, best.2, tr))
+    }
+
+    fn trace(
+        &self,
+        zero: u32,
+        outgoing: bool,
+        first: Departure,
+        length: f64,
+        max_faces: usize,
+    ) -> Trajectory {
+        let dir = if outgoing { 1.0 } else { -1.0 };
+        let mut tr = Trajectory {
+            zero,
+            outgoing,
+            points: vec![EdgePoint::vertex(zero)],
+            length: 0.0,
+        };
+        let mut at = self.leave(first, dir, &mut tr);
+        for _ in 0..max_faces {
+            if tr.length >= length {
+                break;
+            }
+            at = match at {
+                Some(At::Edge(h, s)) => self.cross_face(h, s, dir, &mut tr),
+                Some(At::Vertex(v)) if !self.stop[v as usize] => {
+                    let offset = if outgoing { 0.0 } else { PI };
+                    match self.departures(v, offset).first() {
+                        Some(&d) => self.leave(d, dir, &mut tr),
+                        None => None,
+                    }
+                }
+                _ => break,
+            };
+        }
+        tr
+    }
+}
+
+/// The critical horizontal trajectories from each of the vertices `zeros` (zeros of `form`
+/// on a mesh with Euclidean edge lengths `lengths`; module docs): `2(m + 1)` from a zero of
+/// order `m`, each traced for at most `length` (in `∫|ω|`) and `max_faces` faces.
 pub fn critical_trajectories(
     mesh: &Mesh,
+    lengths: &[f64],
     form: &HolomorphicForm,
     zeros: &[u32],
     length: f64,
     max_faces: usize,
 ) -> Vec<Trajectory> {
+    let frames = (0..mesh.n_faces() as u32)
+        .map(|f| face_vector(mesh, lengths, &form.re, f))
+        .collect();
+    let mut stop = vec![false; mesh.n_vertices()];
+    for &p in zeros {
+        if let Some(s) = stop.get_mut(p as usize) {
+            *s = true;
+        }
+    }
+    let field = Field {
+        mesh,
+        re: &form.re,
+        frames,
+        stop,
+    };
     let mut out = Vec::new();
     for &p in zeros {
-        if (p as usize) >= mesh.n_vertices() || mesh.is_isolated(p) {
+        if (p as usize) >= mesh.n_vertices() {
             continue;
         }
-        for h in mesh.outgoing(p) {
-            if mesh.he_face(h) == NONE {
-                continue;
+        for (outgoing, offset) in [(true, 0.0), (false, PI)] {
+            for d in field.departures(p, offset) {
+                out.push(field.trace(p, outgoing, d, length, max_faces));
             }
-            // Face (p, b, c) with φ(p) = 0.
-            let hn = mesh.he_next(h);
-            let pb = value(mesh, form, h);
-            let pc = pb + value(mesh, form, hn);
-            let straddle = pb.im * pc.im;
-            if straddle.is_nan() || straddle >= 0.0 {
-                continue;
-            }
-            let s = pb.im / (pb.im - pc.im);
-            let x = pb + (pc - pb) * s;
-            let outgoing = x.re > 0.0;
-            let start = EdgePoint {
-                from: p,
-                to: p,
-                t: 0.0,
-            };
-            let first = EdgePoint {
-                from: mesh.he_origin(hn),
-                to: mesh.he_tip(hn),
-                t: s,
-            };
-            let mut tr = Trajectory {
-                zero: p,
-                outgoing,
-                points: vec![start, first],
-                length: x.norm(),
-            };
-            trace(mesh, form, hn, s, length, max_faces, &mut tr);
-            out.push(tr);
         }
     }
     out
-}
-
-/// Continue `tr` from the point at parameter `s` on half-edge `e` (whose face was just
-/// crossed) into the faces beyond.
-fn trace(
-    mesh: &Mesh,
-    form: &HolomorphicForm,
-    mut e: u32,
-    mut s: f64,
-    length: f64,
-    max_faces: usize,
-    tr: &mut Trajectory,
-) {
-    let dir = if tr.outgoing { 1.0 } else { -1.0 };
-    for _ in 0..max_faces {
-        if tr.length >= length {
-            return;
-        }
-        let t = mesh.he_twin(e);
-        if mesh.he_face(t) == NONE {
-            return; // a boundary
-        }
-        // Face (c, b, d) entered across t = c → b at parameter 1 − s; φ(c) = 0.
-        let tn = mesh.he_next(t);
-        let cb = value(mesh, form, t);
-        let cd = cb + value(mesh, form, tn);
-        let x = cb * (1.0 - s);
-        // The level in this face's chart (φ differs by a constant from the previous chart;
-        // the entry point carries the level over).
-        let level = x.im;
-        let (vb, vd) = (cb.im - level, cd.im - level);
-        let vc = -level;
-        // Exit on b → d or on d → c.
-        let (exit_he, s_exit, y) = if vb * vd < 0.0 {
-            let r = vb / (vb - vd);
-            (tn, r, cb + (cd - cb) * r)
-        } else if vd * vc < 0.0 {
-            let r = vd / (vd - vc);
-            (mesh.he_next(tn), r, cd * (1.0 - r))
-        } else {
-            // Through the vertex d (or a degenerate face): stop there.
-            if vd.abs() <= 1e-12 * (cb.norm() + cd.norm()) {
-                tr.points.push(EdgePoint {
-                    from: mesh.he_tip(tn),
-                    to: mesh.he_tip(tn),
-                    t: 0.0,
-                });
-            }
-            return;
-        };
-        if (y.re - x.re) * dir <= 0.0 {
-            return; // a folded face: the level line turns back
-        }
-        tr.length += (y - x).norm();
-        tr.points.push(EdgePoint {
-            from: mesh.he_origin(exit_he),
-            to: mesh.he_tip(exit_he),
-            t: s_exit,
-        });
-        e = exit_he;
-        s = s_exit;
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// On a flat square grid with ω = e^{iα} dz (no zeros inside), the level line traced from
-    /// a vertex is the straight line of direction e^{−iα}: every point satisfies
-    /// Im(e^{iα} z) = Im(e^{iα} z₀).
-    #[test]
-    fn horizontal_lines_of_a_constant_form_are_straight() {
-        let n = 12usize;
-        let mut pos = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                pos.push([i as f64, j as f64, 0.0]);
-            }
-        }
-        let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-        let mut faces = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                faces.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-            }
-        }
-        let mesh = Mesh::from_triangles(pos.len(), faces).unwrap();
-        let w = Complex::from_polar(1.0, 0.3);
-        let mut form = HolomorphicForm {
-            re: vec![0.0; mesh.n_edges()],
-            im: vec![0.0; mesh.n_edges()],
-        };
-        for e in 0..mesh.n_edges() as u32 {
-            let h = mesh.edge_halfedge(e);
-            let (a, b) = (
-                pos[mesh.he_origin(h) as usize],
-                pos[mesh.he_tip(h) as usize],
-            );
-            let v = w * Complex::new(b[0] - a[0], b[1] - a[1]);
-            form.re[e as usize] = v.re;
-            form.im[e as usize] = v.im;
-        }
-        // A regular point has two horizontal directions (m = 0).
-        let p = id(6, 6);
-        let trs = critical_trajectories(&mesh, &form, &[p], 4.0, 1000);
-        assert_eq!(trs.len(), 2, "{trs:?}");
-        assert!(trs[0].outgoing != trs[1].outgoing);
-        let z0 = Complex::new(6.0, 6.0);
-        for tr in &trs {
-            assert!(tr.points.len() > 4 && tr.length >= 4.0 - 1e-9, "{tr:?}");
-            for q in &tr.points {
-                let x = q.position(&pos);
-                let z = Complex::new(x[0], x[1]);
-                assert!(((w * (z - z0)).im).abs() < 1e-12, "{z} off the line");
-            }
-            let end = tr.points.last().unwrap().position(&pos);
-            let u = (w * (Complex::new(end[0], end[1]) - z0)).re;
-            assert!(if tr.outgoing { u > 0.0 } else { u < 0.0 });
-        }
-    }
 }

@@ -55,7 +55,7 @@ fn face_frame(l: [f64; 3]) -> Option<[[f64; 2]; 3]> {
 }
 
 /// The vector field of `w` on face `f` (in its frame) and the frame's edge directions.
-fn face_vector(
+pub(super) fn face_vector(
     mesh: &Mesh,
     lengths: &[f64],
     w: &[f64],
@@ -73,11 +73,11 @@ fn face_vector(
     Some(([wx, wy], d))
 }
 
-fn angle_between(d: [f64; 2], w: [f64; 2]) -> f64 {
+pub(super) fn angle_between(d: [f64; 2], w: [f64; 2]) -> f64 {
     (d[0] * w[1] - d[1] * w[0]).atan2(d[0] * w[0] + d[1] * w[1])
 }
 
-fn wrap(x: f64) -> f64 {
+pub(super) fn wrap(x: f64) -> f64 {
     let mut y = x % (2.0 * PI);
     if y > PI {
         y -= 2.0 * PI;

@@ -159,7 +159,17 @@ impl BallCover {
 /// are composed in double-double (the side pairings move `o` by up to `2·radius`; double
 /// products lost the 1e-7 that tells two tiles apart). Classes are formed as in [`fuchsian_spectrum`] (the pieces of one closed geodesic
 /// are linked through the sides its axis crosses). `L` starts at the shortest side pairing's
-/// translation length and grows by 1.25 until `count` classes are complete.
+/// translation length; while fewer than `count` classes are complete it grows to the
+/// `count`-th distinct length among the candidates up to `1.25 L` (certain to be enough: each
+/// distinct length is a class), or to `1.25 L`. The search is grown, not redone: tiles kept
+/// under a bound are kept under a larger one, and only the rejected tiles are tested again
+/// (so the rounds cost about as much as the last one alone).
+///
+/// What the result proves: every free homotopy class of closed geodesics of length
+/// `≤ complete_up_to` (= the final `L`) is among the classes found, because every tile `γF`
+/// with `d(F, γF) ≤ L` was kept (the tests only drop tiles with `d(o, γo) > L + 2·radius` or
+/// `d(c_j, γ c_k) > L + r_j + r_k` for all pairs of balls, each implying `d(F, γF) > L`), and
+/// the kept tiles are connected to `F`; the `count` returned are the shortest of them.
 ///
 /// Budgets: at most `max_tiles` tiles per search and 16 enlargements of `L`; exceeding either
 /// is an error that says so.
@@ -217,6 +227,7 @@ pub fn surface_spectrum(
         ));
     }
     let o_h = cover.centre;
+    let mut search = TileSearch::new(o_h);
     for _round in 0..16 {
         let bound = ((l + 2.0 * radius) * (1.0 + 1e-9) + 1e-9).cosh();
         let limits = cover.limits(l, radius);
@@ -224,19 +235,19 @@ pub fn surface_spectrum(
         let keep = |g: &Mobius, go: [f64; 3]| {
             cosh_d(o_h, go) <= bound && cover.may_be_within(g, go, &limits)
         };
-        let Some(search) = TileSearch::run(o_h, &dom.generators, max_tiles, keep) else {
+        if !search.grow(o_h, &dom.generators, max_tiles, keep) {
             return Err(Error::numerical(format!(
                 "the spectrum search exceeded its budget of {max_tiles} tiles of the \
                  universal cover at length bound {l:.3} (domain radius {radius:.2}); \
                  ask for fewer lengths"
             )));
-        };
+        }
         // The axis is the real diameter in the frame: skip it when it misses every ball.
         let near = |fr: &Mobius| cover.meets_axis(fr);
         if let Some(sp) = search.spectrum(l, &dom.boundary, &dom.generators, o_h, count, near) {
             return Ok((sp, domain));
         }
-        l *= 1.25;
+        l = search.next_bound(l, &dom.boundary, count, near);
     }
     Err(Error::numerical(format!(
         "the spectrum search did not find {count} classes within its budget of 16 \
