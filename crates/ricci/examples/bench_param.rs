@@ -8,6 +8,7 @@
 //! ```sh
 //! RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_param
 //! RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_param -- face
+//! RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_param -- =camel-8
 //! ```
 
 use ricci::mesh::io::read_surface;
@@ -33,6 +34,15 @@ fn main() {
         ("rocker-arm", "rocker-arm.off", ConeSpec::Default),
         ("botijo-8", "botijo.off", ConeSpec::Count(8)),
         ("botijo-8+c", "botijo.off", ConeSpec::Count(8)),
+        ("botijo-12", "botijo.off", ConeSpec::Count(12)),
+        ("botijo-16", "botijo.off", ConeSpec::Count(16)),
+        (
+            "botijo-auto-4",
+            "botijo.off",
+            ConeSpec::Auto {
+                max_area_distortion: 4.0,
+            },
+        ),
         ("seahorse-8", "seahorse2_100K.off", ConeSpec::Count(8)),
         ("horse-8", "horse.ply", ConeSpec::Count(8)),
         ("horse-8+c", "horse.ply", ConeSpec::Count(8)),
@@ -57,7 +67,12 @@ fn main() {
         "seconds"
     );
     for (name, file, cones) in cases {
-        if !filter.is_empty() && !filter.iter().any(|f| name.contains(f.as_str())) {
+        // A filter with '=' in front matches the case name exactly (`=camel-8`).
+        let matches = |f: &String| match f.strip_prefix('=') {
+            Some(exact) => name == exact,
+            None => name.contains(f.as_str()),
+        };
+        if !filter.is_empty() && !filter.iter().any(matches) {
             continue;
         }
         let (s, _) = match read_surface(&dir.join(file)) {
@@ -99,9 +114,15 @@ fn main() {
             if let Ok(p) = parametrize(&s, &opts, &mut NoProgress) {
                 for c in &p.charts {
                     println!(
-                        "  chart {}: flow runs {}, cone corrections {}, σ(2u) {:.4}, moved cones {}, flow {:.2} s",
-                        c.component, c.flow_runs, c.cone_corrections, c.log_scale_sigma, c.moved_cones, c.flow_seconds
+                        "  chart {}: flow runs {}, cone corrections {}, σ(2u) {:.4}, moved cones {}, flow {:.2} s, chart {:.2} s, uv on {}, input faces folded {}",
+                        c.component, c.flow_runs, c.cone_corrections, c.log_scale_sigma, c.moved_cones, c.flow_seconds, c.seconds, c.uv_faces, c.input_flipped_faces
                     );
+                    let k: Vec<String> = c
+                        .cones
+                        .iter()
+                        .map(|x| format!("{}:{:.2}", x.vertex, x.curvature))
+                        .collect();
+                    println!("  cones {}", k.join(" "));
                 }
             }
         }

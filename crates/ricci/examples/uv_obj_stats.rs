@@ -5,6 +5,13 @@
 //! prints the same σ without area weights and σ(log area)/2 = σ(log scale factor u), so that
 //! tables from elsewhere can be matched to the definition they used.
 //!
+//! Second line per file: where the flat metric of the UVs has its curvature. Per `v` not on
+//! the mesh's boundary, `K = 2π − Σ` of its UV corner angles over all faces (seams included:
+//! both sides' angles add up), then how many vertices have `|K| > 0.01` rad, the curvature
+//! they carry, and the 8 largest `|K|`. A map with `N` cones has exactly `N` such vertices
+//! (rigid transitions across the seams); a map whose seams bend has curvature spread along
+//! them.
+//!
 //! ```sh
 //! cargo run --release -p ricci --example uv_obj_stats -- uv.obj [more.obj …]
 //! ```
@@ -47,6 +54,38 @@ fn parse(text: &str) -> Result<UvMesh, String> {
         }
     }
     Ok((v, faces, corner))
+}
+
+/// `2π − Σθ` (UV corner angles) per position index; `NaN` on the boundary (edges with one
+/// face) and at unused positions.
+fn uv_angle_defects(n: usize, faces: &[[u32; 3]], corner: &[[f64; 2]]) -> Vec<f64> {
+    let mut k = vec![f64::NAN; n];
+    let mut edges: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    for t in faces {
+        for i in 0..3 {
+            k[t[i] as usize] = 2.0 * std::f64::consts::PI;
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    for (f, t) in faces.iter().enumerate() {
+        for i in 0..3 {
+            let p = corner[3 * f + i];
+            let (q, r) = (corner[3 * f + (i + 1) % 3], corner[3 * f + (i + 2) % 3]);
+            let (a, b) = ([q[0] - p[0], q[1] - p[1]], [r[0] - p[0], r[1] - p[1]]);
+            let ang = (a[0] * b[1] - a[1] * b[0])
+                .abs()
+                .atan2(a[0] * b[0] + a[1] * b[1]);
+            k[t[i] as usize] -= ang;
+        }
+    }
+    for (&(a, b), &c) in &edges {
+        if c == 1 {
+            k[a as usize] = f64::NAN;
+            k[b as usize] = f64::NAN;
+        }
+    }
+    k
 }
 
 fn main() {
@@ -96,6 +135,18 @@ fn main() {
             s.log_area_sigma,
             unw,
             s.log_area_sigma / 2.0
+        );
+        let k = uv_angle_defects(v.len(), &faces, &corner);
+        let mut big: Vec<f64> = k.iter().copied().filter(|x| x.abs() > 0.01).collect();
+        let total: f64 = big.iter().sum();
+        big.sort_by(|a, b| b.abs().total_cmp(&a.abs()));
+        let all: f64 = k.iter().filter(|x| x.is_finite()).sum();
+        println!(
+            "    UV curvature: {} vertices with |K| > 0.01 carry {:.3} of Σ K = {:.3} (interior); largest {:?}",
+            big.len(),
+            total,
+            all,
+            big.iter().take(8).map(|x| (x * 1000.0).round() / 1000.0).collect::<Vec<_>>()
         );
     }
 }

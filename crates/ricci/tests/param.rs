@@ -385,12 +385,15 @@ fn sigma_2u(s: &Surface, u: &[f64]) -> f64 {
     (s2 / w - (s1 / w).powi(2)).max(0.0).sqrt()
 }
 
-/// The cone-curvature correction on the nonlinear flow (`cones::correct_cone_curvatures`):
-/// it keeps Gauss–Bonnet (Σ K̄ = 2πχ), keeps cone angles positive, and the flow with the
-/// corrected curvatures has a smaller spread of its log scale factor than with the greedy's
-/// (the quantity the correction's least-squares step lowers, measured on the flow it did not
-/// see). A constant `u` (nothing to correct) leaves the curvatures alone. The map with one
-/// correction round passes `check_map`.
+/// The cone-curvature correction on the nonlinear flow (`cones::correct_cone_curvatures`),
+/// started from the Dirichlet curvatures of the independent reference greedy
+/// ([`reference_greedy_cones`], BFF's strategy): it keeps Gauss–Bonnet (Σ K̄ = 2πχ), keeps
+/// cone angles positive, and the flow with the corrected curvatures has a smaller spread of
+/// its log scale factor (the quantity the correction's least-squares step lowers, measured
+/// on the flow it did not see). A constant `u` (nothing to correct) leaves the curvatures
+/// alone. The automatic placement's curvatures are already least-squares ones: correcting
+/// them changes the spread by less than 1 %, and its map (with one correction round allowed)
+/// is no worse than the corrected reference.
 #[test]
 fn cone_correction_lowers_the_log_scale_spread() {
     use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
@@ -404,9 +407,7 @@ fn cone_correction_lowers_the_log_scale_spread() {
         .unwrap()
         .0;
     let l = s.edge_lengths();
-    let greedy = greedy_cones(&s.mesh, &l, ConeBudget::Count(8))
-        .unwrap()
-        .cones;
+    let greedy = reference_greedy_cones(&s, 8);
     let flow = |cones: &[(u32, f64)]| {
         let fo = FlowOptions {
             geometry: Geometry::Euclidean,
@@ -438,9 +439,19 @@ fn cone_correction_lowers_the_log_scale_spread() {
         ..ParamOptions::default()
     };
     let p = parametrize(&s, &opts, &mut NoProgress).unwrap();
-    check_map(&s, &p, 0.01, 1e-7);
-    assert_eq!(p.charts[0].cone_corrections, 1);
-    assert!(p.charts[0].log_scale_sigma < 0.9 * s0);
+    check_any(&s, &p, 1e-7);
+    assert!(
+        p.charts[0].log_scale_sigma <= s1 * 1.001,
+        "{:?}",
+        p.charts[0]
+    );
+    let ours = greedy_cones(&s.mesh, &l, ConeBudget::Count(8))
+        .unwrap()
+        .cones;
+    let u2 = flow(&ours);
+    let again = correct_cone_curvatures(&s.mesh, &l, &ours, &u2, 1.0).unwrap();
+    let (s2, s3) = (sigma_2u(&s, &u2), sigma_2u(&s, &flow(&again)));
+    assert!((s3 - s2).abs() < 0.01 * s2, "σ(2u) {s2} → {s3}");
 }
 
 /// The common-subdivision route (forced with `on_subdivision`) on a genus-2 surface with six
@@ -488,4 +499,120 @@ fn heavy_meshes_with_eight_cones_have_no_flipped_faces() {
         assert_eq!(p.charts[0].cones.len(), 8, "{f}");
         check_any(&s, &p, 1e-6);
     }
+}
+
+/// Boundary First Flattening's cone placement (Sawhney–Crane 2017 §6.2, the "CETM"
+/// strategy), written here independently of `ricci::param::cones`: first cone at the most
+/// negative angle defect when χ ≤ 0 (the most positive when χ > 0), then repeatedly the vertex of largest `|u|` of the
+/// Dirichlet problem `(L u)_i = −K_i` off the cones, `u = 0` at the cones (conjugate gradients
+/// on the cotangent Laplacian); the cone curvatures are `K_c + (L u)_c`.
+fn reference_greedy_cones(s: &Surface, count: usize) -> Vec<(u32, f64)> {
+    let n = s.positions.len();
+    let mut k = vec![2.0 * PI; n];
+    let mut edges: Vec<(usize, usize, f64)> = Vec::new();
+    for t in s.mesh.faces() {
+        for i in 0..3 {
+            let (a, b, c) = (
+                t[i] as usize,
+                t[(i + 1) % 3] as usize,
+                t[(i + 2) % 3] as usize,
+            );
+            let (p, q, r) = (s.positions[a], s.positions[b], s.positions[c]);
+            let d = |x: [f64; 3], y: [f64; 3]| [y[0] - x[0], y[1] - x[1], y[2] - x[2]];
+            let (u, v) = (d(p, q), d(p, r));
+            let dot = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+            let cr = [
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            ];
+            let cross = (cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]).sqrt();
+            k[a] -= cross.atan2(dot);
+            // The angle at a weighs the opposite edge (b, c) by cot/2.
+            edges.push((b, c, 0.5 * dot / cross));
+        }
+    }
+    let apply = |x: &[f64], free: &[bool]| -> Vec<f64> {
+        let mut y = vec![0.0; n];
+        for &(a, b, w) in &edges {
+            let d = w * (x[a] - x[b]);
+            y[a] += d;
+            y[b] -= d;
+        }
+        (0..n).map(|v| if free[v] { y[v] } else { 0.0 }).collect()
+    };
+    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
+    let chi = ricci::metric::euler_characteristic(&s.mesh);
+    let first = if chi > 0 {
+        (0..n).max_by(|&a, &b| k[a].total_cmp(&k[b])).unwrap()
+    } else {
+        (0..n).min_by(|&a, &b| k[a].total_cmp(&k[b])).unwrap()
+    };
+    let mut cones = vec![first];
+    loop {
+        let free: Vec<bool> = (0..n).map(|v| !cones.contains(&v)).collect();
+        let b: Vec<f64> = (0..n).map(|v| if free[v] { -k[v] } else { 0.0 }).collect();
+        let mut u = vec![0.0; n];
+        let (mut r, mut p) = (b.clone(), b.clone());
+        let mut rr = dot(&r, &r);
+        for _ in 0..20 * n {
+            if rr.sqrt() < 1e-13 * dot(&b, &b).sqrt() {
+                break;
+            }
+            let ap = apply(&p, &free);
+            let alpha = rr / dot(&p, &ap);
+            for v in 0..n {
+                u[v] += alpha * p[v];
+                r[v] -= alpha * ap[v];
+            }
+            let next = dot(&r, &r);
+            for v in 0..n {
+                p[v] = r[v] + next / rr * p[v];
+            }
+            rr = next;
+        }
+        if cones.len() == count {
+            let lu = apply(&u, &vec![true; n]);
+            return cones.iter().map(|&c| (c as u32, k[c] + lu[c])).collect();
+        }
+        let next = (0..n)
+            .filter(|&v| free[v])
+            .max_by(|&a, &b| u[a].abs().total_cmp(&u[b].abs()))
+            .unwrap();
+        cones.push(next);
+    }
+}
+
+/// Issue 16, must-show 2 on a cheap mesh (RICCI_MESHES): on `eight` (genus 2) with 8 cones,
+/// the automatic placement's map has σ(log area) no larger than the map with the cones of
+/// the independent reference greedy above (BFF's strategy), and both maps are valid.
+#[test]
+fn automatic_cones_are_no_worse_than_the_reference_greedy() {
+    let Some(dir) = ricci_meshes::ricci_meshes() else {
+        eprintln!("RICCI_MESHES not set; skipped");
+        return;
+    };
+    let s = ricci::mesh::io::read_surface(&dir.join("eight.off"))
+        .unwrap()
+        .0;
+    let reference = reference_greedy_cones(&s, 8);
+    let k: f64 = reference.iter().map(|c| c.1).sum();
+    assert!((k + 4.0 * PI).abs() < 1e-6, "reference Gauss–Bonnet {k}");
+    let theirs = run(&s, ConeSpec::Given(reference), false);
+    let ours = run(&s, ConeSpec::Count(8), false);
+    check_any(&s, &theirs, 1e-7);
+    check_any(&s, &ours, 1e-7);
+    eprintln!(
+        "σ(log area): ours {:.4}, reference greedy {:.4}; qc p95 {:.4} / {:.4}",
+        ours.stats.log_area_sigma,
+        theirs.stats.log_area_sigma,
+        ours.stats.qc_p95,
+        theirs.stats.qc_p95
+    );
+    assert!(
+        ours.stats.log_area_sigma <= theirs.stats.log_area_sigma + 1e-9,
+        "ours {:?} reference {:?}",
+        ours.stats,
+        theirs.stats
+    );
 }

@@ -15,17 +15,24 @@
 //! and the curvature left at the cones is `K̄_c = K⁰_c + (L u)_c`; Gauss–Bonnet holds
 //! exactly because `Σ_i (L u)_i = 0`. `2u` is the log area distortion of the flattening.
 //!
-//! **Greedy.** Start from a closed surface's solution with the total curvature spread by area
-//! (`L u = −(K⁰ − 2πχ a_i / A)`, one vertex pinned; the extremum of `u` is the first cone),
-//! then repeatedly put a cone where `|u|` is largest and solve again. Each solve is one
-//! numeric Cholesky factorization of `L + P` (`P` a large diagonal penalty holding `u_c = 0`,
-//! same symbolic pattern every time). With a count `N` the greedy stops after `N` cones; with
-//! a bound `D` on the area distortion it stops at the first cone set whose linearised
-//! `max |2u − mean(2u)| ≤ D` (at most `max_cones` cones).
+//! **Greedy.** Repeatedly put a cone where `|u|` is largest and solve again. On a closed
+//! surface (submodule `closed`) the first cone is Boundary First Flattening's (the most negative
+//! angle defect when `χ < 0`) or the extremum of the smooth solution with the total curvature
+//! spread by area, whichever greedy ends with the smaller area-weighted `σ(2u)`; then the
+//! cones are moved one at a time while `σ(2u)` drops. Every solve uses one factorization of
+//! the Laplacian and the cones' Green's functions (submodule `green`). With a boundary, each solve is
+//! one numeric Cholesky factorization of `L + P` (`P` a large diagonal penalty holding
+//! `u = 0` on the boundary and the cones). With a count `N` the greedy stops after `N`
+//! cones; with a bound `D` on the area distortion it stops at the first cone set whose
+//! linearised `max |2u − mean(2u)| ≤ D` (at most `max_cones` cones).
+
+mod closed;
+mod green;
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::numeric::sparse::{LowerCsc, SymmetricSolver};
+use green::GreenBasis;
 use std::f64::consts::PI;
 
 /// How many cones the greedy places.
@@ -149,12 +156,34 @@ pub fn angle_defects(mesh: &Mesh, lengths: &[f64]) -> Vec<f64> {
     k
 }
 
-/// The greedy placement (module docs) on a connected mesh with Euclidean `lengths`. Boundary
-/// vertices are held at `u = 0` and never become cones.
+/// The greedy placement (module docs) on a connected mesh with Euclidean `lengths`: closed
+/// surfaces by `closed::place_cones`; with a boundary, boundary vertices are held at
+/// `u = 0` and never become cones.
 pub fn greedy_cones(mesh: &Mesh, lengths: &[f64], budget: ConeBudget) -> Result<ConePlacement> {
     let lap = laplacian(mesh, lengths)?;
     let n = lap.n;
     let k0 = angle_defects(mesh, lengths);
+    let used: Vec<bool> = (0..n as u32).map(|v| !mesh.is_isolated(v)).collect();
+    let boundary: Vec<bool> = (0..n as u32).map(|v| mesh.is_boundary_vertex(v)).collect();
+    if !boundary.iter().any(|&b| b) {
+        let chi = crate::metric::euler_characteristic(mesh) as f64;
+        let mut g = GreenBasis::new(&lap, &k0, chi, used.clone())?;
+        let mut p = closed::place_cones(&mut g, &k0, &used, budget)?;
+        keep_angles_positive(&mut p.cones, 2.0 * PI * chi);
+        return Ok(p);
+    }
+    greedy_with_boundary(&lap, &k0, &boundary, &used, budget)
+}
+
+/// The greedy with the boundary held at `u = 0`: one factorization per cone.
+fn greedy_with_boundary(
+    lap: &Laplacian,
+    k0: &[f64],
+    boundary: &[bool],
+    used: &[bool],
+    budget: ConeBudget,
+) -> Result<ConePlacement> {
+    let n = lap.n;
     let pattern = LowerCsc {
         n,
         col_ptr: &lap.col_ptr,
@@ -162,10 +191,6 @@ pub fn greedy_cones(mesh: &Mesh, lengths: &[f64], budget: ConeBudget) -> Result<
     };
     let mut solver = SymmetricSolver::new(pattern)?;
     let total_area: f64 = lap.area.iter().sum();
-    let chi = crate::metric::euler_characteristic(mesh) as f64;
-    let boundary: Vec<bool> = (0..n as u32).map(|v| mesh.is_boundary_vertex(v)).collect();
-    let used: Vec<bool> = (0..n as u32).map(|v| !mesh.is_isolated(v)).collect();
-    let has_boundary = boundary.iter().any(|&b| b);
     let scale = lap.diag.iter().map(|&i| lap.values[i]).fold(0.0, f64::max);
     let penalty = 1e10 * scale.max(1e-300);
     // Solve with u held at 0 on `held` (penalty); `rhs` per vertex.
@@ -194,36 +219,20 @@ pub fn greedy_cones(mesh: &Mesh, lengths: &[f64], budget: ConeBudget) -> Result<
             .map(|v| (2.0 * u[v] - m).abs())
             .fold(0.0, f64::max)
     };
-    let mut held = boundary.clone();
+    let mut held = boundary.to_vec();
     let mut cones: Vec<u32> = Vec::new();
     let mut history = Vec::new();
     let (max_cones, bound) = match budget {
         ConeBudget::Count(c) => (c, -1.0),
         ConeBudget::AreaDistortion { bound, max_cones } => (max_cones, bound),
     };
-    // Initial solution.
-    let mut u = if has_boundary {
-        let rhs: Vec<f64> = k0.iter().map(|&k| -k).collect();
-        solve(&held, &rhs)?
-    } else {
-        let pin = (0..n).find(|&v| used[v]).unwrap_or(0);
-        let mut h = held.clone();
-        h[pin] = true;
-        let rhs: Vec<f64> = (0..n)
-            .map(|v| -(k0[v] - 2.0 * PI * chi * lap.area[v] / total_area))
-            .collect();
-        solve(&h, &rhs)?
-    };
     let rhs: Vec<f64> = k0.iter().map(|&k| -k).collect();
+    let mut u = solve(&held, &rhs)?;
     while cones.len() < max_cones {
         if bound >= 0.0 && !cones.is_empty() && spread(&u) <= bound {
             break;
         }
-        let mean: f64 = if has_boundary || cones.is_empty() {
-            (0..n).map(|v| u[v] * lap.area[v]).sum::<f64>() / total_area
-        } else {
-            0.0
-        };
+        let mean: f64 = (0..n).map(|v| u[v] * lap.area[v]).sum::<f64>() / total_area;
         let next = (0..n)
             .filter(|&v| used[v] && !held[v])
             .max_by(|&a, &b| (u[a] - mean).abs().total_cmp(&(u[b] - mean).abs()));
@@ -245,34 +254,11 @@ pub fn greedy_cones(mesh: &Mesh, lengths: &[f64], budget: ConeBudget) -> Result<
             }
         }
     }
-    let mut out: Vec<(u32, f64)> = cones
-        .iter()
-        .map(|&c| (c, k0[c as usize] + lu[c as usize]))
-        .collect();
-    if !has_boundary {
-        // Exact Gauss–Bonnet (rounding) and cone angles kept positive: the excess of a cone
-        // above 2π − 0.05 goes to the others in proportion to their curvature's magnitude.
-        let limit = 2.0 * PI - 0.05;
-        for _ in 0..8 {
-            let excess: f64 = out.iter().map(|&(_, k)| (k - limit).max(0.0)).sum();
-            for x in out.iter_mut() {
-                x.1 = x.1.min(limit);
-            }
-            if excess <= 0.0 {
-                break;
-            }
-            let share: Vec<usize> = (0..out.len()).filter(|&i| out[i].1 < limit).collect();
-            for &i in &share {
-                out[i].1 += excess / share.len() as f64;
-            }
-        }
-        let sum: f64 = out.iter().map(|x| x.1).sum();
-        if let Some(last) = out.last_mut() {
-            last.1 += 2.0 * PI * chi - sum;
-        }
-    }
     Ok(ConePlacement {
-        cones: out,
+        cones: cones
+            .iter()
+            .map(|&c| (c, k0[c as usize] + lu[c as usize]))
+            .collect(),
         distortion_history: history,
     })
 }
@@ -283,10 +269,11 @@ pub fn greedy_cones(mesh: &Mesh, lengths: &[f64], budget: ConeBudget) -> Result<
 /// `u` is the conformal factor the flow reached with curvatures `cones` (per vertex of the
 /// closed, connected `mesh`); the change `δk` (with `Σ δk = 0`: Gauss–Bonnet kept)
 /// minimises `‖u − ū + G δk‖²_M`, `G` the Green's functions of the input's cotangent
-/// Laplacian (`L g_c = δ_c − a/A`, zero area mean), i.e. the linear response of the flow's
-/// `u` to moving curvature between the cones (normal equations: the `(|C| + 1)²` system
-/// `[GᵀMG 1; 1ᵀ 0] [δk; λ] = [−GᵀM(u − ū); 0]`). `damping ∈ (0, 1]` scales the step.
-/// Returns the new `(vertex, K̄)` list, cone angles kept positive (`K̄ ≤ 2π − 0.05`).
+/// Laplacian (submodule `green`), i.e. the linear response of the flow's `u` to moving curvature
+/// between the cones. `damping ∈ (0, 1]` scales the step. Returns the new `(vertex, K̄)`
+/// list; cone angles are kept positive (`K̄ ≤ 2π − 0.05`) and nothing else is clamped: a
+/// strong negative cone is allowed, because a map whose input faces fold around it is written
+/// on the common subdivision.
 pub fn correct_cone_curvatures(
     mesh: &Mesh,
     lengths: &[f64],
@@ -295,111 +282,36 @@ pub fn correct_cone_curvatures(
     damping: f64,
 ) -> Result<Vec<(u32, f64)>> {
     let lap = laplacian(mesh, lengths)?;
-    let n = lap.n;
-    let pattern = LowerCsc {
-        n,
-        col_ptr: &lap.col_ptr,
-        row_idx: &lap.row_idx,
-    };
-    let mut solver = SymmetricSolver::new(pattern)?;
-    let total_area: f64 = lap.area.iter().sum();
-    let used: Vec<bool> = (0..n as u32).map(|v| !mesh.is_isolated(v)).collect();
-    let scale = lap.diag.iter().map(|&i| lap.values[i]).fold(0.0, f64::max);
-    let penalty = 1e10 * scale.max(1e-300);
-    let pin = (0..n).find(|&v| used[v]).unwrap_or(0);
-    let mut vals = lap.values.clone();
-    for v in 0..n {
-        if v == pin || !used[v] {
-            vals[lap.diag[v]] += penalty;
-        }
-    }
-    if !solver.factor_llt(&vals) && !solver.factor_ldlt(&vals) {
-        return Err(Error::numerical(
-            "the cotangent Laplacian could not be factorized for the cone correction",
-        ));
-    }
-    let area = &lap.area;
-    let mean_u: f64 = (0..n).map(|v| u[v] * area[v]).sum::<f64>() / total_area;
-    let r: Vec<f64> = (0..n)
-        .map(|v| if used[v] { u[v] - mean_u } else { 0.0 })
-        .collect();
-    let m = cones.len();
-    let mut g: Vec<Vec<f64>> = Vec::with_capacity(m);
-    for &(c, _) in cones {
-        let mut x: Vec<f64> = (0..n)
-            .map(|v| {
-                if v == pin || !used[v] {
-                    0.0
-                } else {
-                    (if v == c as usize { 1.0 } else { 0.0 }) - area[v] / total_area
-                }
-            })
-            .collect();
-        solver.solve(&mut x);
-        let mx: f64 = (0..n).map(|v| x[v] * area[v]).sum::<f64>() / total_area;
-        for v in 0..n {
-            x[v] = if used[v] { x[v] - mx } else { 0.0 };
-        }
-        g.push(x);
-    }
-    let dot = |x: &[f64], y: &[f64]| -> f64 { (0..n).map(|v| x[v] * area[v] * y[v]).sum() };
-    let mut a = vec![vec![0.0; m + 1]; m + 1];
-    let mut rhs = vec![0.0; m + 1];
-    for i in 0..m {
-        for j in i..m {
-            let d = dot(&g[i], &g[j]);
-            a[i][j] = d;
-            a[j][i] = d;
-        }
-        a[i][m] = 1.0;
-        a[m][i] = 1.0;
-        rhs[i] = -dot(&g[i], &r);
-    }
-    let x = crate::analysis::forms::small::solve(&a, &rhs);
-    if x.iter().any(|v| !v.is_finite()) {
-        return Err(Error::numerical(
-            "the cone curvature correction is singular (two cones too close?)",
-        ));
-    }
+    let k0 = angle_defects(mesh, lengths);
     let total: f64 = cones.iter().map(|c| c.1).sum();
+    let used: Vec<bool> = (0..lap.n as u32).map(|v| !mesh.is_isolated(v)).collect();
+    let mut g = GreenBasis::new(&lap, &k0, total / (2.0 * PI), used)?;
+    let mean = g.mean(u);
+    let r: Vec<f64> = u.iter().map(|x| x - mean).collect();
+    let vertices: Vec<u32> = cones.iter().map(|c| c.0).collect();
+    let dk = g.least_squares_with(&r, &vertices, 0.0)?;
     let mut out: Vec<(u32, f64)> = cones
         .iter()
-        .zip(&x)
+        .zip(&dk)
         .map(|(&(c, k), &d)| (c, k + damping * d))
         .collect();
-    // Curvatures kept in [K_lo, 2π − 0.05], K_lo the most negative given curvature (no cone
-    // angle grows beyond the largest given one: a stronger cone makes the flow flip its whole
-    // neighbourhood away, where the cut on kept input edges cannot reach it); what is cut off
-    // goes to the cones inside the range, equally.
-    let upper = 2.0 * PI - 0.05;
-    let lower = cones
-        .iter()
-        .map(|c| c.1)
-        .fold(f64::INFINITY, f64::min)
-        .min(upper);
-    for _ in 0..16 {
-        let excess: f64 = out
-            .iter()
-            .map(|&(_, k)| (k - upper).max(0.0) - (lower - k).max(0.0))
-            .sum();
+    keep_angles_positive(&mut out, total);
+    Ok(out)
+}
+
+/// Cone angles kept positive: curvatures above `2π − 0.05` are cut there and the excess goes
+/// to the other cones equally; then the last cone takes the rounding so that `Σ K̄ = total`.
+fn keep_angles_positive(out: &mut [(u32, f64)], total: f64) {
+    let limit = 2.0 * PI - 0.05;
+    for _ in 0..8 {
+        let excess: f64 = out.iter().map(|&(_, k)| (k - limit).max(0.0)).sum();
         for x in out.iter_mut() {
-            x.1 = x.1.clamp(lower, upper);
+            x.1 = x.1.min(limit);
         }
-        if excess.abs() <= 1e-15 {
+        if excess <= 0.0 {
             break;
         }
-        let share: Vec<usize> = (0..out.len())
-            .filter(|&i| {
-                if excess > 0.0 {
-                    out[i].1 < upper
-                } else {
-                    out[i].1 > lower
-                }
-            })
-            .collect();
-        if share.is_empty() {
-            break;
-        }
+        let share: Vec<usize> = (0..out.len()).filter(|&i| out[i].1 < limit).collect();
         for &i in &share {
             out[i].1 += excess / share.len() as f64;
         }
@@ -408,7 +320,6 @@ pub fn correct_cone_curvatures(
     if let Some(last) = out.last_mut() {
         last.1 += total - sum;
     }
-    Ok(out)
 }
 
 /// Round cone curvatures to multiples of `π/2` keeping their sum (a multiple of `π/2` when it
