@@ -64,6 +64,17 @@ pub struct Located {
 /// angle of its centroid.
 type Candidate = (u32, [Point; 3], RigidMotion, f64);
 
+/// Where each face of the sectors' candidate lists first occurs: (sector, position).
+fn first_occurrences(sector_faces: &[Vec<Candidate>]) -> HashMap<u32, (usize, usize)> {
+    let mut first = HashMap::new();
+    for (k, list) in sector_faces.iter().enumerate() {
+        for (i, x) in list.iter().enumerate() {
+            first.entry(x.0).or_insert((k, i));
+        }
+    }
+    first
+}
+
 /// Seam data at one `ψ`: `C(ψ)`, `D(ψ)` and the spline's partials `(S_X, S_Y)`.
 pub type SeamData = ([f64; 3], [f64; 3], [[f64; 3]; 2]);
 
@@ -237,12 +248,7 @@ impl Hole {
             }
             sector_faces.push(list);
         }
-        let mut first_occurrence = HashMap::new();
-        for (k, list) in sector_faces.iter().enumerate() {
-            for (i, x) in list.iter().enumerate() {
-                first_occurrence.entry(x.0).or_insert((k, i));
-            }
-        }
+        let first_occurrence = first_occurrences(&sector_faces);
         let mut hole = Hole {
             vertex: s,
             cone_angle: theta,
