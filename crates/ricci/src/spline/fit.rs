@@ -28,7 +28,7 @@
 //! matrix needs the basis to ~1e-10 of its terms, not the 1e-12 chart independence of a
 //! single partial that the extended recurrence gives.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 
 use faer::linalg::matmul::triangular::BlockStructure;
 use faer::sparse::{SparseColMat, Triplet};
@@ -208,14 +208,15 @@ pub fn thin_plate_energy_with<S: SplineSpace + ?Sized>(
 }
 
 /// Add the thin-plate energy's Gram matrix `Σ_k w_k (∂²_xx N ⊗ ∂²_xx N + 2 ∂²_xy N ⊗ ∂²_xy N +
-/// ∂²_yy N ⊗ ∂²_yy N)(u_k)` over the quadrature to `blocks`. Per triangle, in parallel: the
-/// basis functions met at its points get local columns, the scaled second partials form a
-/// dense matrix `V` (three rows per point) and `VᵀV` is one dense product (faer), scattered
-/// into the blocks once per triangle instead of once per point.
+/// ∂²_yy N ⊗ ∂²_yy N)(u_k)` over the quadrature to `blocks`. Per triangle, in parallel
+/// ([`face_gram`]): the basis functions met at its points get local columns and their Gram
+/// matrix is summed from small dense products, scattered into the blocks once per triangle
+/// instead of once per point.
 ///
 /// The faces are processed in [`GRAM_CHUNKS`] consecutive chunks (each in parallel), with a
 /// progress report on the calling thread after each: the fraction of the quadrature done. The
-/// per-face Gram matrices are scattered in face order as before, so the chunks change nothing.
+/// per-face Gram matrices of a chunk are scattered in face order, so the result does not depend
+/// on the threads.
 fn energy_gram<S: SplineSpace + ?Sized>(
     space: &S,
     blocks: &mut Blocks,
@@ -223,7 +224,6 @@ fn energy_gram<S: SplineSpace + ?Sized>(
 ) -> Result<()> {
     use rayon::prelude::*;
     let nb = blocks.nb;
-    let np2 = n_partials(2);
     let quad = space.quadrature();
     // Runs of consecutive points of one triangle.
     let mut runs = Vec::new();
@@ -234,84 +234,32 @@ fn energy_gram<S: SplineSpace + ?Sized>(
             start = k;
         }
     }
-    type FaceGram = (Vec<u32>, Mat<f64>);
-    // Per worker thread: the basis workspace, the point/function entries and the matrix `V`
-    // (its storage reused from face to face instead of a fresh megabyte of zeroed pages).
-    type Scratch = (Workspace, Vec<(usize, usize, [f64; 3])>, Mat<f64>);
     let chunk = runs.len().div_ceil(GRAM_CHUNKS).max(1);
-    let mut grams: Vec<FaceGram> = Vec::with_capacity(runs.len());
     for (ci, part) in runs.chunks(chunk).enumerate() {
         let done: Vec<FaceGram> = part
             .par_iter()
-            .map_init(
-                || -> Scratch {
-                    // Quadrature and data rows: double precision suffices (module docs,
-                    // *Precision*).
-                    (
-                        Workspace::with_precision(Precision::Double),
-                        Vec::new(),
-                        Mat::zeros(0, 0),
-                    )
-                },
-                |(ws, entries, vbuf), &(a, b)| -> Result<FaceGram> {
-                    let mut groups: Vec<u32> = Vec::new();
-                    let mut local: HashMap<u32, usize> = HashMap::new();
-                    // One entry per (point, basis function): its local column and its scaled second
-                    // partials √w·(∂xx, √2 ∂xy, ∂yy), so that VᵀV sums w(∂xx² + 2∂xy² + ∂yy²).
-                    entries.clear();
-                    for (r, &(f, u, w)) in quad[a..b].iter().enumerate() {
-                        let m = space.basis_at(f, u, 2, ws)?;
-                        let sw = [w.sqrt(), (2.0 * w).sqrt(), w.sqrt()];
-                        for (gi, g) in ws.indices[..m].chunks(nb).enumerate() {
-                            let t = g[0] / nb as u32;
-                            let lg = *local.entry(t).or_insert_with(|| {
-                                groups.push(t);
-                                groups.len() - 1
-                            });
-                            for (p, &gp) in g.iter().enumerate() {
-                                let vals = &ws.values[(gi * nb + p) * np2..];
-                                entries.push((
-                                    r,
-                                    lg * nb + gp as usize % nb,
-                                    [sw[0] * vals[3], sw[1] * vals[4], sw[2] * vals[5]],
-                                ));
-                            }
-                        }
-                    }
-                    let (rows, cols) = (3 * (b - a), groups.len() * nb);
-                    if vbuf.nrows() < rows || vbuf.ncols() < cols {
-                        *vbuf = Mat::zeros(rows.max(vbuf.nrows()), cols.max(vbuf.ncols()));
-                    }
-                    let mut v = vbuf.as_mut().submatrix_mut(0, 0, rows, cols);
-                    v.fill(0.0);
-                    for &(r, col, d) in entries.iter() {
-                        for (c, dc) in d.iter().enumerate() {
-                            v[(3 * r + c, col)] += dc;
-                        }
-                    }
-                    // The lower triangle of VᵀV only (G is symmetric; the scatter below reads it),
-                    // on this thread: the faces are the parallelism, and half the product's work.
-                    let v = v.as_ref();
-                    let mut g = Mat::<f64>::zeros(cols, cols);
-                    faer::linalg::matmul::triangular::matmul(
-                        g.as_mut(),
-                        BlockStructure::TriangularLower,
-                        faer::Accum::Replace,
-                        v.transpose(),
-                        BlockStructure::Rectangular,
-                        v,
-                        BlockStructure::Rectangular,
-                        1.0,
-                        faer::Par::Seq,
-                    );
-                    // Leave this thread's vector registers clean for the next triangle's basis
-                    // evaluations (`crate::numeric::simd`).
-                    crate::numeric::simd::clear_upper_state_here();
-                    Ok((groups, g))
-                },
-            )
+            .map_init(GramScratch::new, |scratch, &(a, b)| {
+                face_gram(space, nb, &quad[a..b], scratch)
+            })
             .collect::<Result<_>>()?;
-        grams.extend(done);
+        // Scatter this chunk's faces in face order (and drop them: the per-face matrices of
+        // all faces at once were most of the fit's memory).
+        for (groups, g) in done {
+            for (la, &ta) in groups.iter().enumerate() {
+                for (lb, &tb) in groups.iter().enumerate() {
+                    if ta < tb {
+                        continue;
+                    }
+                    let blk = blocks.block_mut(ta, tb);
+                    for p in 0..nb {
+                        for q in 0..nb {
+                            let (i, j) = (la * nb + p, lb * nb + q);
+                            blk[p * nb + q] += if i >= j { g[(i, j)] } else { g[(j, i)] };
+                        }
+                    }
+                }
+            }
+        }
         let finished = ((ci + 1) * chunk).min(runs.len());
         progress.report(
             "fit",
@@ -325,23 +273,159 @@ fn energy_gram<S: SplineSpace + ?Sized>(
     }
     // Clean every thread of the pool once after the phase (as the other faer phases do).
     crate::numeric::simd::clear_upper_state();
-    for (groups, g) in grams {
-        for (la, &ta) in groups.iter().enumerate() {
-            for (lb, &tb) in groups.iter().enumerate() {
-                if ta < tb {
-                    continue;
+    Ok(())
+}
+
+/// The triangles whose basis functions one face's quadrature meets, and the lower triangle of
+/// their Gram matrix (local columns `position in the list × nb + β`).
+type FaceGram = (Vec<u32>, Mat<f64>);
+
+/// Per worker thread scratch of [`face_gram`] (reused from face to face).
+struct GramScratch {
+    ws: Workspace,
+    /// Per point: the local triangle ids met there (in the order the space lists them),
+    /// flattened, with `point_groups[r]..point_groups[r + 1]` the range of point `r`.
+    keys: Vec<u32>,
+    point_groups: Vec<usize>,
+    /// Per point and function met: √w·(∂xx, √2 ∂xy, ∂yy), in the order of the point's keys.
+    vals: Vec<[f64; 3]>,
+    point_vals: Vec<usize>,
+    /// The distinct key lists (as ranges of a point's keys) and their points.
+    sets: Vec<(usize, Vec<usize>)>,
+    /// The dense matrix `V` of one key list's points (three rows per point).
+    v: Mat<f64>,
+}
+
+impl GramScratch {
+    fn new() -> GramScratch {
+        GramScratch {
+            // Quadrature and data rows: double precision suffices (module docs, *Precision*).
+            ws: Workspace::with_precision(Precision::Double),
+            keys: Vec::new(),
+            point_groups: Vec::new(),
+            vals: Vec::new(),
+            point_vals: Vec::new(),
+            sets: Vec::new(),
+            v: Mat::zeros(0, 0),
+        }
+    }
+}
+
+/// The thin-plate Gram matrix of one face's quadrature points `quad` ([`energy_gram`]).
+///
+/// Each point meets the basis functions of a few triangles only (those whose support contains
+/// it), and points near the same corner meet the same triangles. So the points are grouped by
+/// the list of triangles they meet (in order of first appearance); each group's scaled second
+/// partials form a dense matrix `V` with no zero columns, and the lower triangle of `VᵀV`
+/// (faer, sequential: the faces are the parallelism) is added into the face's Gram matrix. A
+/// dense `V` over all of the face's points and triangles was mostly zeros: the same products
+/// cost several times the flops, and zeroing it was a visible part of the profile.
+fn face_gram<S: SplineSpace + ?Sized>(
+    space: &S,
+    nb: usize,
+    quad: &[(u32, Point, f64)],
+    sc: &mut GramScratch,
+) -> Result<FaceGram> {
+    let np2 = n_partials(2);
+    let mut groups: Vec<u32> = Vec::new();
+    sc.keys.clear();
+    sc.vals.clear();
+    sc.point_groups.clear();
+    sc.point_vals.clear();
+    sc.point_groups.push(0);
+    sc.point_vals.push(0);
+    for &(f, u, w) in quad {
+        let m = space.basis_at(f, u, 2, &mut sc.ws)?;
+        // Scaled second partials √w·(∂xx, √2 ∂xy, ∂yy): VᵀV sums w(∂xx² + 2∂xy² + ∂yy²).
+        let sw = [w.sqrt(), (2.0 * w).sqrt(), w.sqrt()];
+        for (gi, g) in sc.ws.indices[..m].chunks(nb).enumerate() {
+            let t = g[0] / nb as u32;
+            let lg = match groups.iter().position(|&x| x == t) {
+                Some(i) => i,
+                None => {
+                    groups.push(t);
+                    groups.len() - 1
                 }
-                let blk = blocks.block_mut(ta, tb);
-                for p in 0..nb {
-                    for q in 0..nb {
-                        let (i, j) = (la * nb + p, lb * nb + q);
-                        blk[p * nb + q] += if i >= j { g[(i, j)] } else { g[(j, i)] };
-                    }
+            };
+            sc.keys.push(lg as u32);
+            for p in 0..g.len() {
+                let v = &sc.ws.values[(gi * nb + p) * np2..];
+                sc.vals.push([sw[0] * v[3], sw[1] * v[4], sw[2] * v[5]]);
+            }
+        }
+        sc.point_groups.push(sc.keys.len());
+        sc.point_vals.push(sc.vals.len());
+    }
+    // Group the points by their key lists (first appearance order: deterministic).
+    sc.sets.clear();
+    let n_points = quad.len();
+    for r in 0..n_points {
+        let key = &sc.keys[sc.point_groups[r]..sc.point_groups[r + 1]];
+        let found = sc
+            .sets
+            .iter()
+            .position(|(r0, _)| &sc.keys[sc.point_groups[*r0]..sc.point_groups[*r0 + 1]] == key);
+        match found {
+            Some(i) => sc.sets[i].1.push(r),
+            None => sc.sets.push((r, vec![r])),
+        }
+    }
+    let cols = groups.len() * nb;
+    let mut g = Mat::<f64>::zeros(cols, cols);
+    for (r0, points) in &sc.sets {
+        let key = &sc.keys[sc.point_groups[*r0]..sc.point_groups[*r0 + 1]];
+        let (rows, m) = (
+            3 * points.len(),
+            sc.point_vals[*r0 + 1] - sc.point_vals[*r0],
+        );
+        if m == 0 {
+            continue;
+        }
+        if sc.v.nrows() < rows || sc.v.ncols() < m {
+            sc.v = Mat::zeros(rows.max(sc.v.nrows()), m.max(sc.v.ncols()));
+        }
+        // Every entry of this V is written: each of its points meets exactly these functions.
+        let mut v = sc.v.as_mut().submatrix_mut(0, 0, rows, m);
+        for (i, &r) in points.iter().enumerate() {
+            let vals = &sc.vals[sc.point_vals[r]..sc.point_vals[r + 1]];
+            for (j, d) in vals.iter().enumerate() {
+                for (c, dc) in d.iter().enumerate() {
+                    v[(3 * i + c, j)] = *dc;
+                }
+            }
+        }
+        let v = v.as_ref();
+        let mut gs = Mat::<f64>::zeros(m, m);
+        faer::linalg::matmul::triangular::matmul(
+            gs.as_mut(),
+            BlockStructure::TriangularLower,
+            faer::Accum::Replace,
+            v.transpose(),
+            BlockStructure::Rectangular,
+            v,
+            BlockStructure::Rectangular,
+            1.0,
+            faer::Par::Seq,
+        );
+        // Local column of the set's column j: its triangle's local id × nb + β.
+        let col = |j: usize| key[j / nb] as usize * nb + j % nb;
+        for j2 in 0..m {
+            for j1 in j2..m {
+                let (c1, c2) = (col(j1), col(j2));
+                let x = gs[(j1, j2)];
+                if c1 == c2 && j1 != j2 {
+                    // One triangle listed twice at a point: both cross terms land here.
+                    g[(c1, c1)] += 2.0 * x;
+                } else {
+                    g[(c1.max(c2), c1.min(c2))] += x;
                 }
             }
         }
     }
-    Ok(())
+    // Leave this thread's vector registers clean for the next triangle's basis evaluations
+    // (`crate::numeric::simd`).
+    crate::numeric::simd::clear_upper_state_here();
+    Ok((groups, g))
 }
 
 /// Chunks of faces between two progress reports of the fit's quadrature ([`fit_with_progress`]).

@@ -31,6 +31,7 @@
 //! centre: only C¹ there, and a starburst in the zebra stripes. This is not the paper's planar
 //! triangular B-spline fill; it is a single smooth patch.
 
+use std::collections::HashMap;
 use std::f64::consts::PI;
 
 /// Fourier modes of the seam data carried by the fill's polynomial part (at most `ns / 8` of
@@ -63,6 +64,17 @@ pub struct Located {
 /// angle of its centroid.
 type Candidate = (u32, [Point; 3], RigidMotion, f64);
 
+/// Where each face of the sectors' candidate lists first occurs: (sector, position).
+fn first_occurrences(sector_faces: &[Vec<Candidate>]) -> HashMap<u32, (usize, usize)> {
+    let mut first = HashMap::new();
+    for (k, list) in sector_faces.iter().enumerate() {
+        for (i, x) in list.iter().enumerate() {
+            first.entry(x.0).or_insert((k, i));
+        }
+    }
+    first
+}
+
 /// Seam data at one `ψ`: `C(ψ)`, `D(ψ)` and the spline's partials `(S_X, S_Y)`.
 pub type SeamData = ([f64; 3], [f64; 3], [[f64; 3]; 2]);
 
@@ -80,6 +92,9 @@ pub struct Hole {
     /// chart, and the unrolled angle `φ` of the centroid (tracked through the development, so
     /// it is not ambiguous by multiples of 2π where the cone angle exceeds 2π).
     sector_faces: Vec<Vec<Candidate>>,
+    /// Per face of `sector_faces`, where it first occurs (sector, position): the lookup of
+    /// [`Self::cone_polar`], once per tessellation vertex near the hole.
+    first_occurrence: HashMap<u32, (usize, usize)>,
     /// Seam radius: `ln R(ψ) = a₀ + Σ a_k cos kψ + b_k sin kψ + shift`.
     fourier: Vec<(f64, f64)>,
     shift: f64,
@@ -233,12 +248,14 @@ impl Hole {
             }
             sector_faces.push(list);
         }
+        let first_occurrence = first_occurrences(&sector_faces);
         let mut hole = Hole {
             vertex: s,
             cone_angle: theta,
             sector_start,
             link,
             sector_faces,
+            first_occurrence,
             fourier: Vec::new(),
             shift: 0.0,
             center: [0.0; 3],
@@ -430,9 +447,9 @@ impl Hole {
     /// Developed corners of active face `g` in the unrolled frame (from the first sector whose
     /// candidate list holds it), or `None` when `g` is not in the two-ring.
     fn developed(&self, g: u32) -> Option<([Point; 3], f64)> {
-        self.sector_faces
-            .iter()
-            .find_map(|list| list.iter().find(|x| x.0 == g).map(|x| (x.1, x.3)))
+        let &(k, i) = self.first_occurrence.get(&g)?;
+        let x = &self.sector_faces[k][i];
+        Some((x.1, x.3))
     }
 
     /// Cone polar coordinates `(ρ, φ)` of the point of face `g` with barycentric `bary`

@@ -468,12 +468,32 @@ impl SimplexFamily {
             work.resize(need, 0.0);
         }
         let nl = self.leaves.len();
+        // Which nodes are not identically zero near `x` (a bit per node, when they fit): a node
+        // whose children all vanish (under every variant) vanishes too and is skipped — most
+        // of a family's knot subsets do not contain a given point.
+        let mut live = [0u64; LIVE_WORDS];
+        let track = self.n_nodes() <= 64 * LIVE_WORDS;
+        let is_live =
+            |live: &[u64; LIVE_WORDS], id: u32| live[id as usize / 64] >> (id % 64) & 1 == 1;
         for (i, leaf) in self.leaves.iter().enumerate() {
             let inside = leaf.lines.iter().all(|l| l.admits(x, d, dp));
             let v = if inside { leaf.inv_det } else { 0.0 };
+            if inside && track {
+                live[i / 64] |= 1 << (i % 64);
+            }
             work[i * S..(i + 1) * S].copy_from_slice(&[v, 0.0, 0.0, 0.0, 0.0, 0.0]);
         }
         for (k, nd) in self.nodes.iter().enumerate() {
+            if track {
+                let any = |v: &Variant| v.child.iter().any(|&c| is_live(&live, c));
+                if !(any(&nd.var[0]) || (nd.two && any(&nd.var[1]))) {
+                    // All children are zero: so are the value and partials (the arithmetic
+                    // below would give ±0).
+                    work[(nl + k) * S..(nl + k + 1) * S].fill(0.0);
+                    continue;
+                }
+                live[(nl + k) / 64] |= 1 << ((nl + k) % 64);
+            }
             let (v, lam) = nd.variant_at(x);
             let (done, rest) = work.split_at_mut((nl + k) * S);
             let a = block(done, v.child[0] as usize * S);
@@ -605,6 +625,10 @@ impl SimplexFamily {
 }
 
 const INTERNAL: u32 = 1 << 31;
+
+/// Words of the live-node bitset of [`SimplexFamily::eval_offset_upto2`] (families of up to
+/// 1024 nodes skip their vanishing nodes; larger ones evaluate every node).
+const LIVE_WORDS: usize = 16;
 
 struct Builder<'a> {
     knots: &'a [Point],

@@ -126,29 +126,53 @@ pub fn star_frame(mesh: &Mesh, lengths: &[f64], v: u32) -> StarFrame {
 pub fn rotation_matrix(order: usize, rot: C) -> Vec<f64> {
     let np = n_partials(order);
     let mut t = vec![0.0; np * np];
+    rotation_matrix_into(order, rot, &mut t);
+    t
+}
+
+/// Largest order whose rotation [`rotate_partials`] builds on the stack.
+const STACK_ORDER: usize = 6;
+
+/// [`rotation_matrix`] into `t` (`n_partials(order)²` zeros on entry), with the polynomial of
+/// each row on the stack: the same operations in the same order, so the same numbers, without
+/// the small allocations per row (this runs once per basis triangle and point of the fit's
+/// quadrature).
+fn rotation_matrix_into(order: usize, rot: C, t: &mut [f64]) {
+    let np = n_partials(order);
     let (c, s) = (rot.re, rot.im);
+    let (mut poly_stack, mut next_stack) = ([0.0; 32], [0.0; 32]);
+    let (mut poly_heap, mut next_heap) = (Vec::new(), Vec::new());
+    let (poly, next): (&mut [f64], &mut [f64]) = if order + 2 <= 32 {
+        (&mut poly_stack, &mut next_stack)
+    } else {
+        poly_heap.resize(order + 2, 0.0);
+        next_heap.resize(order + 2, 0.0);
+        (&mut poly_heap, &mut next_heap)
+    };
     for k in 0..=order {
         for a in 0..=k {
             let b = k - a;
             // poly[p] = coefficient of ∂_1^p ∂_2^(deg − p)
-            let mut poly = vec![1.0];
+            poly[0] = 1.0;
+            let mut len = 1;
             for (times, (cx, cy)) in [(a, (c, s)), (b, (-s, c))] {
                 for _ in 0..times {
-                    let mut next = vec![0.0; poly.len() + 1];
-                    for (p, &w) in poly.iter().enumerate() {
+                    next[..=len].fill(0.0);
+                    for p in 0..len {
+                        let w = poly[p];
                         next[p + 1] += cx * w;
                         next[p] += cy * w;
                     }
-                    poly = next;
+                    len += 1;
+                    poly[..len].copy_from_slice(&next[..len]);
                 }
             }
             let row = partial_index(a, b);
-            for (p, &w) in poly.iter().enumerate() {
+            for (p, &w) in poly[..len].iter().enumerate() {
                 t[row * np + partial_index(p, k - p)] += w;
             }
         }
     }
-    t
 }
 
 /// Apply [`rotation_matrix`] to `n` functions' partials in place (`vals[i * np ..]`).
@@ -157,8 +181,57 @@ pub fn rotate_partials(order: usize, rot: C, vals: &mut [f64]) {
         return;
     }
     let np = n_partials(order);
-    let t = rotation_matrix(order, rot);
-    let mut tmp = vec![0.0; np];
+    if order > STACK_ORDER {
+        let t = rotation_matrix(order, rot);
+        apply_rotation(&t, np, vals);
+        return;
+    }
+    // Order ≤ 2 (the fit's quadrature, the tessellation): a 6 × 6 matrix, zeroed alone.
+    if order == 2 {
+        let mut t = [0.0; 36];
+        rotation_matrix_into(order, rot, &mut t);
+        apply_rotation_fixed::<6>(&t, vals);
+        return;
+    }
+    if order == 1 {
+        let mut t = [0.0; 9];
+        rotation_matrix_into(order, rot, &mut t);
+        apply_rotation_fixed::<3>(&t, vals);
+        return;
+    }
+    const NP: usize = n_partials(STACK_ORDER);
+    let mut t = [0.0; NP * NP];
+    rotation_matrix_into(order, rot, &mut t[..np * np]);
+    apply_rotation(&t[..np * np], np, vals);
+}
+
+/// [`apply_rotation`] for `N` partials known at compile time (orders 1 and 2): the same sums
+/// in the same order, unrolled.
+fn apply_rotation_fixed<const N: usize>(t: &[f64], vals: &mut [f64]) {
+    let t: &[f64] = &t[..N * N];
+    for chunk in vals.chunks_exact_mut(N) {
+        let mut x = [0.0; N];
+        x.copy_from_slice(chunk);
+        for i in 0..N {
+            let mut s = 0.0;
+            for j in 0..N {
+                s += t[i * N + j] * x[j];
+            }
+            chunk[i] = s;
+        }
+    }
+}
+
+/// `chunk ← t · chunk` for every chunk of `np` partials of `vals`.
+fn apply_rotation(t: &[f64], np: usize, vals: &mut [f64]) {
+    let mut stack = [0.0; n_partials(STACK_ORDER)];
+    let mut heap = Vec::new();
+    let tmp: &mut [f64] = if np <= stack.len() {
+        &mut stack[..np]
+    } else {
+        heap.resize(np, 0.0);
+        &mut heap
+    };
     for chunk in vals.chunks_exact_mut(np) {
         for i in 0..np {
             let mut s = 0.0;
@@ -167,7 +240,7 @@ pub fn rotate_partials(order: usize, rot: C, vals: &mut [f64]) {
             }
             tmp[i] = s;
         }
-        chunk.copy_from_slice(&tmp);
+        chunk.copy_from_slice(tmp);
     }
 }
 
