@@ -7,11 +7,12 @@
 //! `RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example diag_seahorse_subdivision [MESH]`
 
 use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
-use ricci::layout::deck::deck_group;
+use ricci::layout::deck::deck_group_ext;
 use ricci::layout::isometry::Complex;
 use ricci::layout::pipeline::{cut_disk_polished, polish_uniformization};
 use ricci::layout::place::layout_dd;
-use ricci::layout::subdivision_uv::common_subdivision_uvs;
+use ricci::layout::subdivision_uv::{common_subdivision_uvs, common_subdivision_uvs_ext, LaidOut};
+use ricci::metric::common_subdivision::disk_orientation;
 use ricci::metric::{Geometry, Hyperbolic, Scheme};
 use ricci::progress::NoProgress;
 
@@ -54,14 +55,18 @@ fn main() {
         let v = d.mesh.face(*f);
         let z = v.map(|i| lay.positions[i as usize]);
         println!(
-            "  degenerate cut face {f}: distance {:.2}, 1-|z| {:.2e}, lengths {:?}",
+            "  degenerate cut face {f}: distance {:.2}, 1-|z| {:.2e}, lengths {:?}, area {:.3e}",
             dist(z[0]),
             1.0 - z[0].norm(),
-            [0, 1, 2].map(|k| d.lengths[d.mesh.he_edge(3 * f + k) as usize])
+            [0, 1, 2].map(|k| d.lengths[d.mesh.he_edge(3 * f + k) as usize]),
+            {
+                let q = [0, 1, 2].map(|k| d.lengths[d.mesh.he_edge(3 * f + k) as usize]);
+                Geometry::Hyperbolic.area(q[0], q[1], q[2])
+            }
         );
     }
-    let group = deck_group::<Hyperbolic>(&lay, &d.polygon).unwrap();
-    let sub = common_subdivision_uvs::<Hyperbolic>(
+    let (group, frames) = deck_group_ext::<Hyperbolic>(&lay, &d.polygon).unwrap();
+    let f64_only = common_subdivision_uvs::<Hyperbolic>(
         &s.mesh,
         &s.positions,
         &l,
@@ -73,11 +78,64 @@ fn main() {
     )
     .unwrap();
     println!(
-        "subdivision: {} triangles, {} flipped, {} faces of T flipped, {} seam faces",
+        "subdivision from the f64 layout: {} triangles, {} flipped, {} faces of T flipped, {} seam faces",
+        f64_only.triangles.len(),
+        f64_only.flipped_faces,
+        f64_only.t_flipped_faces,
+        f64_only.seam_faces
+    );
+    {
+        // Which faces of T are flipped in the f64 layout, and are they seam faces?
+        let tri = &it.triangulation;
+        let faces: Vec<[u32; 3]> = (0..tri.n_faces() as u32).map(|f| tri.face(f)).collect();
+        let used = vec![true; tri.n_vertices];
+        let c = ricci::layout::input_uv::face_uvs::<Hyperbolic>(
+            &used,
+            &faces,
+            &lay.positions,
+            &d.vertex_origin,
+            Some(&group),
+        )
+        .unwrap();
+        for &f in c.flipped_faces.iter().take(30) {
+            let f = f as usize;
+            let src = [0, 1, 2].map(|i| c.source[3 * f + i]);
+            let z = c.corner[3 * f];
+            let lens = [0, 1, 2].map(|i| {
+                let e = tri.edge[3 * f + i] as usize;
+                ricci::metric::intrinsic::length_of_lambda(Geometry::Hyperbolic, tri.lambda[e])
+            });
+            println!(
+                "  T face {f} flipped (f64): maps {:?}, distance {:.2}, lengths {:?}",
+                src.map(|s| s.1),
+                dist(z),
+                lens
+            );
+        }
+    }
+    let laid = LaidOut {
+        positions: &lay.positions,
+        positions_lo: &lay.positions_lo,
+        origin: &d.vertex_origin,
+    };
+    let sub = common_subdivision_uvs_ext::<Hyperbolic>(
+        &s.mesh,
+        &s.positions,
+        &l,
+        &it.triangulation,
+        &r.u,
+        &laid,
+        Some(&group),
+        Some(&frames),
+    )
+    .unwrap();
+    println!(
+        "subdivision from the double-double layout: {} triangles, {} flipped, {} faces of T flipped, {} seam faces, {} recentred",
         sub.triangles.len(),
         sub.flipped_faces,
         sub.t_flipped_faces,
-        sub.seam_faces
+        sub.seam_faces,
+        sub.recentred_faces
     );
     let mut hist = [0usize; 8];
     for t in 0..sub.triangles.len() {
@@ -85,19 +143,18 @@ fn main() {
             let w = sub.corner_uv[3 * t + i];
             Complex::new(w[0], w[1])
         });
-        let q = z.map(|z| {
-            let k = 2.0 / (1.0 + z.norm_sqr());
-            [k * z.re, k * z.im]
-        });
-        let a =
-            (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]);
+        let a = disk_orientation(
+            sub.corner_uv[3 * t],
+            sub.corner_uv[3 * t + 1],
+            sub.corner_uv[3 * t + 2],
+        );
         if a.is_nan() || a <= 0.0 {
             let r = dist(z[0]);
             hist[((r / 5.0) as usize).min(7)] += 1;
             if hist.iter().sum::<usize>() <= 8 {
                 let size = (z[1] - z[0]).norm().max((z[2] - z[0]).norm());
                 println!(
-                    "  flipped {t} (input face {}): distance {r:.2}, 1-|z| {:.2e}, euclidean size {size:.2e}, klein area {a:.2e}",
+                    "  flipped {t} (input face {}): distance {r:.2}, 1-|z| {:.2e}, euclidean size {size:.2e}, orientation {a:.2e}",
                     sub.input_face[t],
                     1.0 - z[0].norm()
                 );

@@ -8,7 +8,7 @@
 //! before the layout (`ricci::flow::polish`; `--no-polish` turns it off): the report's
 //! `metric_polish` says what it did (`steps`, `residual_dd`, …, `applied: false` with a
 //! `reason` when it could not be applied, e.g. a metric with cone points). Without `--metric` the Ricci flow of the
-//! geometry is run (tolerance 1e-12 in H², 1e-11 otherwise). The seed face is a face id of the cut mesh (default:
+//! geometry is run (tolerance 1e-12 in H², 1e-10 otherwise). The seed face is a face id of the cut mesh (default:
 //! the face nearest the centre of the polygon). `--tiling N` draws the first N copies of the
 //! fundamental polygon (breadth first through the side pairings) instead of the polygon.
 //! UV.obj keeps the surface's own vertices (`v`) and gives every corner the layout coordinate
@@ -19,16 +19,18 @@ use crate::util::{print_json, write_atomic, UsageError};
 use indicatif::{ProgressBar, ProgressStyle};
 use ricci::flow::{FlowError, FlowResult};
 use ricci::layout::cover::{tiles_by_radius, word_string};
+use ricci::layout::deck::{deck_group_ext, DeckFrames};
 use ricci::layout::export::obj_with_corner_uv;
 use ricci::layout::input_uv::input_face_uvs;
 use ricci::layout::isometry::{Complex, Mobius, RigidMotion};
 use ricci::layout::pipeline::{cut_disk, cut_disk_polished, uniformization_geometry, CutDisk};
 use ricci::layout::place::{layout, layout_dd, minimax_centre, Space};
 use ricci::layout::subdivision_uv::{
-    common_subdivision_uvs, sphere_common_subdivision, sphere_flipped_faces, sphere_orientation,
+    common_subdivision_uvs_ext, sphere_common_subdivision, sphere_flipped_faces,
+    sphere_orientation, LaidOut,
 };
 use ricci::layout::svg::{fundamental_domain_svg, sphere_svg, tiling_svg};
-use ricci::layout::{deck_group, DeckGroup, Isometry, Layout, Polygon};
+use ricci::layout::{DeckGroup, Isometry, Layout, Polygon};
 use ricci::mesh::{topology, Mesh, Surface};
 use ricci::metric::file::MetricFile;
 use ricci::metric::{Euclidean, Geometry, Hyperbolic, Scheme, Spherical};
@@ -353,9 +355,12 @@ where
     out["max_length_error"] = json!(l.max_length_error);
     out["depth"] = json!(l.depth);
     let poly = disk.map(|d| &d.polygon);
-    let group = match poly {
-        Some(p) if p.sides.iter().any(|s| s.partner.is_some()) => Some(deck_group::<S>(&l, p)?),
-        _ => None,
+    let (group, frames) = match poly {
+        Some(p) if p.sides.iter().any(|s| s.partner.is_some()) => {
+            let (g, f) = deck_group_ext::<S>(&l, p)?;
+            (Some(g), Some(f))
+        }
+        _ => (None, None),
     };
     match (&group, poly) {
         (Some(g), Some(p)) => {
@@ -391,7 +396,20 @@ where
         Some(d) => d.vertex_origin.clone(),
         None => (0..mesh.n_vertices() as u32).collect(),
     };
-    planar_uv::<S>(a, surface, flow, &l.positions, &origin, group.as_ref(), out)?;
+    let laid = LaidOut {
+        positions: &l.positions,
+        positions_lo: &l.positions_lo,
+        origin: &origin,
+    };
+    planar_uv::<S>(
+        a,
+        surface,
+        flow,
+        &laid,
+        group.as_ref(),
+        frames.as_ref(),
+        out,
+    )?;
     if let Some(path) = &a.svg {
         let svg = match (a.tiling, &group, poly) {
             (Some(n), Some(g), Some(p)) => {
@@ -445,15 +463,15 @@ fn planar_uv<S: Space<Point = Complex>>(
     a: &Args,
     surface: &Surface,
     flow: Option<&FlowResult>,
-    positions: &[Complex],
-    origin: &[u32],
+    laid: &LaidOut<'_>,
     group: Option<&DeckGroup<S::Iso>>,
+    frames: Option<&DeckFrames<S::Frame>>,
     out: &mut Value,
 ) -> anyhow::Result<()>
 where
     S::Iso: JsonIso,
 {
-    let uvs = input_face_uvs::<S>(&surface.mesh, positions, origin, group)?;
+    let uvs = input_face_uvs::<S>(&surface.mesh, laid.positions, laid.origin, group)?;
     let n_flipped = uvs.flipped_faces.len();
     let mut uv = json!({
         "on": "input", "faces": "input", "flipped_faces": n_flipped,
@@ -463,15 +481,15 @@ where
     let mut sub = None;
     if n_flipped > 0 {
         match intrinsic {
-            Some((t, u)) => match common_subdivision_uvs::<S>(
+            Some((t, u)) => match common_subdivision_uvs_ext::<S>(
                 &surface.mesh,
                 &surface.positions,
                 &surface.edge_lengths(),
                 t,
                 u,
-                positions,
-                origin,
+                laid,
                 group,
+                frames,
             ) {
                 Ok(s) => sub = Some(s),
                 Err(e) => {
@@ -502,6 +520,7 @@ where
             uv["crossings"] = json!(s.crossings);
             uv["seam_faces"] = json!(s.seam_faces);
             uv["t_flipped_faces"] = json!(s.t_flipped_faces);
+            uv["recentred_faces"] = json!(s.recentred_faces);
             format!(
                 "the common subdivision of the input and the intrinsic triangulation ({} \
                  vertices on the input surface, {} faces, {} flipped; the input's own faces \
@@ -519,13 +538,21 @@ where
     };
     out["uv"] = uv;
     if let Some(path) = &a.out {
-        let comments = vec![
+        let mut comments = vec![
             format!("ricci layout of {} ({kind})", a.mesh.display()),
             format!("v, f: {what}"),
             "vt: layout coordinates per corner (Poincaré disk for hyperbolic); several vt per \
              vertex along the seams"
                 .to_string(),
         ];
+        if let Some(s) = sub.as_ref().filter(|s| s.recentred_faces > 0) {
+            comments.push(format!(
+                "vt: {} face(s) of the intrinsic triangulation lie too far out in the disk for \
+                 double precision and are written at their deck image nearest the centre (one \
+                 more seam around each)",
+                s.recentred_faces
+            ));
+        }
         let text = match &sub {
             Some(s) => obj_with_corner_uv(&s.positions, &s.triangles, &s.corner_uv, &comments),
             None => {

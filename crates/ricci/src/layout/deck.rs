@@ -267,6 +267,31 @@ pub fn deck_group<S: Space>(
     layout: &Layout<S::Point>,
     poly: &Polygon,
 ) -> Result<DeckGroup<S::Iso>> {
+    Ok(deck_group_ext::<S>(layout, poly)?.0)
+}
+
+/// The maps of a [`DeckGroup`] in the working precision of the space (double-double in H²),
+/// before [`deck_group`] rounds them: far out in the Poincaré disk a rounded map with entries
+/// ~e^{ℓ/2} moves points by ~1e-16·e^ℓ relative to the exact one.
+#[derive(Debug, Clone)]
+pub struct DeckFrames<F> {
+    /// Per entry of [`DeckGroup::pairings`]: its `map`.
+    pub pairings: Vec<F>,
+    /// Per corner: [`DeckGroup::corner_maps`].
+    pub corner_maps: Vec<Option<F>>,
+}
+
+/// A deck group with its maps in the working precision.
+pub type DeckGroupExt<S> = (
+    DeckGroup<<S as Space>::Iso>,
+    DeckFrames<<S as Space>::Frame>,
+);
+
+/// [`deck_group`] and its maps in the working precision ([`DeckFrames`]).
+pub fn deck_group_ext<S: Space>(
+    layout: &Layout<S::Point>,
+    poly: &Polygon,
+) -> Result<DeckGroupExt<S>> {
     poly.check()?;
     let pos = &layout.positions;
     if !layout.positions_lo.is_empty() && layout.positions_lo.len() != pos.len() {
@@ -334,7 +359,7 @@ pub fn deck_group<S: Space>(
         .iter()
         .map(|p| p.max_vertex_error)
         .fold(0.0, f64::max);
-    Ok(DeckGroup {
+    let group = DeckGroup {
         pairings,
         side_pairing,
         letters: poly.letters.clone(),
@@ -345,7 +370,12 @@ pub fn deck_group<S: Space>(
         max_edge_spread,
         max_edge_spread_matrix,
         max_vertex_error,
-    })
+    };
+    let frames = DeckFrames {
+        pairings: precise_maps,
+        corner_maps: q,
+    };
+    Ok((group, frames))
 }
 
 /// Working-precision isometries of the space `S`.

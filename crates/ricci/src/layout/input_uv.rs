@@ -14,9 +14,9 @@
 //! lists the faces that are not (`flipped_faces`): where a map exact inside the faces is
 //! needed, the common subdivision of the two triangulations is.
 
-use super::deck::DeckGroup;
+use super::deck::{DeckFrames, DeckGroup};
 use super::isometry::Isometry;
-use super::place::Space;
+use super::place::{Frame, Space};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 
@@ -29,6 +29,68 @@ pub struct InputUvs<P> {
     pub flipped_faces: Vec<u32>,
     /// Input faces that needed a deck transformation (they straddle a seam).
     pub seam_faces: usize,
+    /// Per corner: the laid-out vertex whose position it took and the index, in
+    /// [`candidate_maps`], of the deck transformation applied to it (0: the identity), so
+    /// that the corner can be recomputed in another precision.
+    pub source: Vec<(u32, u32)>,
+}
+
+/// The deck transformations [`face_uvs`] tries, in its order: the identity; the side
+/// pairings in both directions (a face straddling one seam); products of two of them and
+/// `Q_s Q_t⁻¹` for corner maps `Q` (faces at the polygon's corners, where several seams
+/// meet). The second value ends the three levels (identity; pairings; products).
+pub fn candidate_maps<I: Isometry>(group: Option<&DeckGroup<I>>) -> (Vec<I>, [usize; 3]) {
+    match group {
+        None => (vec![I::identity()], [1, 1, 1]),
+        Some(g) => {
+            let pairs: Vec<I> = g.pairings.iter().map(|p| p.map).collect();
+            let corners: Vec<I> = g.corner_maps.iter().flatten().copied().collect();
+            candidates(&pairs, &corners, I::identity(), I::compose, I::inverse)
+        }
+    }
+}
+
+/// [`candidate_maps`] (same order) in the working precision of the space, from the deck
+/// group's unrounded maps ([`DeckFrames`]).
+pub fn candidate_frames<F: Frame>(frames: &DeckFrames<F>) -> Vec<F> {
+    let corners: Vec<F> = frames.corner_maps.iter().flatten().copied().collect();
+    candidates(
+        &frames.pairings,
+        &corners,
+        F::identity(),
+        F::compose,
+        F::inverse,
+    )
+    .0
+}
+
+fn candidates<T: Copy>(
+    pairings: &[T],
+    corner_maps: &[T],
+    identity: T,
+    compose: impl Fn(&T, &T) -> T,
+    inverse: impl Fn(&T) -> T,
+) -> (Vec<T>, [usize; 3]) {
+    let mut cands = vec![identity];
+    let pairs: Vec<T> = pairings.iter().flat_map(|p| [*p, inverse(p)]).collect();
+    let mut prods = Vec::new();
+    for x in &pairs {
+        for y in &pairs {
+            prods.push(compose(x, y));
+        }
+    }
+    // Around the polygon's corners (copies of the base vertex) the sectors are related by
+    // Q_s Q_t⁻¹ (corner maps: P_0 ↦ P_s), which can be long products of pairings.
+    for qs in corner_maps {
+        for qt in corner_maps {
+            prods.push(compose(qs, &inverse(qt)));
+        }
+    }
+    cands.extend(pairs);
+    let l1 = cands.len();
+    cands.extend(prods);
+    let l2 = cands.len();
+    (cands, [1, l1, l2])
 }
 
 /// See the module docs. `positions` are the layout positions of the laid-out mesh's vertices,
@@ -62,6 +124,36 @@ pub fn face_uvs<S: Space>(
 where
     S::Iso: Isometry<Point = S::Point>,
 {
+    face_uvs_with_lengths::<S>(used, faces, None, positions, origin, group)
+}
+
+/// [`face_uvs`] for triangles whose side lengths in the laid-out metric are known
+/// (`side_lengths[f] = [l₀₁, l₁₂, l₂₀]`; the faces of the intrinsic triangulation the layout
+/// refines, which are congruent to their images): a face whose nearest images are flipped or
+/// do not have these side lengths — around the polygon's corners, where the sectors of many
+/// seams meet, the nearest image of a vertex can be the wrong one — takes the images, over all
+/// copies and candidate maps, whose distances match the side lengths best among the
+/// positively oriented ones.
+pub fn face_uvs_with_lengths<S: Space>(
+    used: &[bool],
+    faces: &[[u32; 3]],
+    side_lengths: Option<&[[f64; 3]]>,
+    positions: &[S::Point],
+    origin: &[u32],
+    group: Option<&DeckGroup<S::Iso>>,
+) -> Result<InputUvs<S::Point>>
+where
+    S::Iso: Isometry<Point = S::Point>,
+{
+    if let Some(l) = side_lengths {
+        if l.len() != faces.len() {
+            return Err(Error::input(format!(
+                "{} side-length triples for {} faces",
+                l.len(),
+                faces.len()
+            )));
+        }
+    }
     if positions.len() != origin.len() {
         return Err(Error::input(format!(
             "{} layout positions for {} vertex origins",
@@ -89,48 +181,19 @@ where
             "input vertex {v} has no position in the layout"
         )));
     }
-    // Candidate deck transformations: identity; the side pairings (each maps the partner
-    // side onto its side: a face straddling that seam) — both directions; products of two
-    // (faces at the polygon's corners, where several seams meet).
     // Searched in three levels (identity; pairings; products), the next only when the
     // previous leaves the face spread out or flipped.
-    let mut cands: Vec<S::Iso> = vec![S::Iso::identity()];
-    let mut level_end = [1usize, 1, 1];
-    if let Some(g) = group {
-        let pairs: Vec<S::Iso> = g
-            .pairings
-            .iter()
-            .flat_map(|p| [p.map, p.map.inverse()])
-            .collect();
-        let mut prods = Vec::new();
-        for x in &pairs {
-            for y in &pairs {
-                prods.push(x.compose(y));
-            }
-        }
-        // Around the polygon's corners (copies of the base vertex) the sectors are related
-        // by Q_s Q_t⁻¹ (corner maps: P_0 ↦ P_s), which can be long products of pairings.
-        let corners: Vec<S::Iso> = g.corner_maps.iter().flatten().copied().collect();
-        for qs in &corners {
-            for qt in &corners {
-                prods.push(qs.compose(&qt.inverse()));
-            }
-        }
-        cands.extend(pairs);
-        level_end[1] = cands.len();
-        cands.extend(prods);
-        level_end[2] = cands.len();
-    }
-    // Nearest image of vertex `w` to point `p`: (distance, point).
-    let nearest = |w: u32, p: S::Point, n: usize| -> (f64, S::Point) {
-        let mut best = (f64::INFINITY, p);
+    let (cands, level_end) = candidate_maps(group);
+    // Nearest image of vertex `w` to point `p`: (distance, point, (copy, map)).
+    let nearest = |w: u32, p: S::Point, n: usize| -> (f64, S::Point, (u32, u32)) {
+        let mut best = (f64::INFINITY, p, (u32::MAX, 0));
         for &c in &copies[w as usize] {
             let q = positions[c as usize];
-            for g in &cands[..n] {
+            for (k, g) in cands[..n].iter().enumerate() {
                 let gq = g.apply(q);
                 let d = S::distance(gq, p);
                 if d < best.0 {
-                    best = (d, gq);
+                    best = (d, gq, (c, k as u32));
                 }
             }
         }
@@ -139,12 +202,15 @@ where
     // First pass with the identity only: the typical size of a face in the layout.
     let mut spread = vec![0.0f64; faces.len()];
     let mut corner = Vec::with_capacity(3 * faces.len());
+    let mut source = Vec::with_capacity(3 * faces.len());
     for (f, t) in faces.iter().enumerate() {
-        let pa = positions[copies[t[0] as usize][0] as usize];
-        let (db, pb) = nearest(t[1], pa, 1);
-        let (dc, pc) = nearest(t[2], pa, 1);
+        let ca = copies[t[0] as usize][0];
+        let pa = positions[ca as usize];
+        let (db, pb, sb) = nearest(t[1], pa, 1);
+        let (dc, pc, sc) = nearest(t[2], pa, 1);
         spread[f] = db.max(dc).max(S::distance(pb, pc));
         corner.extend([pa, pb, pc]);
+        source.extend([(ca, 0), sb, sc]);
     }
     let mut sorted: Vec<f64> = spread.iter().copied().filter(|x| x.is_finite()).collect();
     sorted.sort_by(f64::total_cmp);
@@ -160,15 +226,16 @@ where
         let mut best = (
             f64::INFINITY,
             [corner[3 * f], corner[3 * f + 1], corner[3 * f + 2]],
+            [source[3 * f], source[3 * f + 1], source[3 * f + 2]],
         );
         for &n in &level_end[1..] {
             for &ca in &copies[t[0] as usize] {
                 let pa = positions[ca as usize];
-                let (db, pb) = nearest(t[1], pa, n);
-                let (dc, pc) = nearest(t[2], pa, n);
+                let (db, pb, sb) = nearest(t[1], pa, n);
+                let (dc, pc, sc) = nearest(t[2], pa, n);
                 let total = db.max(dc).max(S::distance(pb, pc));
                 if total < best.0 {
-                    best = (total, [pa, pb, pc]);
+                    best = (total, [pa, pb, pc], [(ca, 0), sb, sc]);
                 }
             }
             let [pa, pb, pc] = best.1;
@@ -179,7 +246,16 @@ where
         if best.0 < spread[f] {
             seam_faces += 1;
             corner[3 * f..3 * f + 3].copy_from_slice(&best.1);
+            source[3 * f..3 * f + 3].copy_from_slice(&best.2);
         }
+    }
+    if let (Some(l), Some(_)) = (side_lengths, group) {
+        let images = Images::<S> {
+            positions,
+            copies: &copies,
+            cands: &cands,
+        };
+        seam_faces += images.match_side_lengths(faces, l, &mut corner, &mut source);
     }
     let flipped_faces = (0..faces.len())
         .filter(|&f| S::orientation(corner[3 * f], corner[3 * f + 1], corner[3 * f + 2]) <= 0.0)
@@ -189,5 +265,94 @@ where
         corner,
         flipped_faces,
         seam_faces,
+        source,
     })
+}
+
+/// A face's corners with their mismatch and sources (copy, map).
+type Choice<P> = (f64, [P; 3], [(u32, u32); 3]);
+
+/// The images of the surface's vertices under the candidate deck maps.
+struct Images<'a, S: Space> {
+    positions: &'a [S::Point],
+    copies: &'a [Vec<u32>],
+    cands: &'a [S::Iso],
+}
+
+impl<S: Space> Images<'_, S>
+where
+    S::Iso: Isometry<Point = S::Point>,
+{
+    /// The `keep` images of vertex `w` whose distance from `p` is nearest to `want`:
+    /// (mismatch, point, (copy, map)).
+    fn matching(
+        &self,
+        w: u32,
+        p: S::Point,
+        want: f64,
+        keep: usize,
+    ) -> Vec<(f64, S::Point, (u32, u32))> {
+        let mut v = Vec::new();
+        for &c in &self.copies[w as usize] {
+            let q = self.positions[c as usize];
+            for (k, g) in self.cands.iter().enumerate() {
+                let gq = g.apply(q);
+                v.push(((S::distance(gq, p) - want).abs(), gq, (c, k as u32)));
+            }
+        }
+        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        v.truncate(keep);
+        v
+    }
+
+    /// See [`face_uvs_with_lengths`]; returns the number of faces changed.
+    fn match_side_lengths(
+        &self,
+        faces: &[[u32; 3]],
+        side_lengths: &[[f64; 3]],
+        corner: &mut [S::Point],
+        source: &mut [(u32, u32)],
+    ) -> usize {
+        let mismatch = |p: [S::Point; 3], l: [f64; 3]| {
+            (S::distance(p[0], p[1]) - l[0])
+                .abs()
+                .max((S::distance(p[1], p[2]) - l[1]).abs())
+                .max((S::distance(p[2], p[0]) - l[2]).abs())
+        };
+        let mut changed = 0;
+        for (f, t) in faces.iter().enumerate() {
+            let l = side_lengths[f];
+            let now = [corner[3 * f], corner[3 * f + 1], corner[3 * f + 2]];
+            let tol = 1e-6 * l[0].max(l[1]).max(l[2]);
+            let m0 = mismatch(now, l);
+            if S::orientation(now[0], now[1], now[2]) > 0.0 && m0 <= tol {
+                continue;
+            }
+            let mut best: Option<Choice<S::Point>> = None;
+            for &ca in &self.copies[t[0] as usize] {
+                let pa = self.positions[ca as usize];
+                let bs = self.matching(t[1], pa, l[0], 6);
+                let cs = self.matching(t[2], pa, l[2], 6);
+                for &(_, pb, sb) in &bs {
+                    for &(_, pc, sc) in &cs {
+                        if S::orientation(pa, pb, pc) <= 0.0 {
+                            continue;
+                        }
+                        let m = mismatch([pa, pb, pc], l);
+                        if best.as_ref().is_none_or(|b| m < b.0) {
+                            best = Some((m, [pa, pb, pc], [(ca, 0), sb, sc]));
+                        }
+                    }
+                }
+            }
+            if let Some((m, p, src)) = best {
+                if m < m0 || S::orientation(now[0], now[1], now[2]) <= 0.0 {
+                    corner[3 * f..3 * f + 3].copy_from_slice(&p);
+                    source[3 * f..3 * f + 3].copy_from_slice(&src);
+                    changed += 1;
+                }
+            }
+        }
+        changed
+    }
 }

@@ -26,15 +26,16 @@
 //! not through the Euclidean triangles of that Delaunay triangulation (CEPS's three-way
 //! overlay); see that function.
 
-use super::deck::DeckGroup;
-use super::input_uv::face_uvs;
+use super::deck::{DeckFrames, DeckGroup};
+use super::input_uv::{candidate_frames, candidate_maps, face_uvs_with_lengths};
 use super::isometry::Complex;
-use super::place::Space;
+use super::place::{ExtPoint, Frame, Space};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::metric::common_subdivision::CommonSubdivision;
-use crate::metric::intrinsic::IntrinsicTriangulation;
+use crate::metric::common_subdivision::{disk_orientation, CommonSubdivision};
+use crate::metric::intrinsic::{length_of_lambda, IntrinsicTriangulation};
 use crate::metric::Geometry;
+use crate::numeric::dd::Cdd;
 
 /// The common subdivision with its UVs (see the module docs).
 #[derive(Debug, Clone)]
@@ -62,6 +63,10 @@ pub struct SubdivisionUv {
     /// are not either: the layout, not the subdivision, is at fault — e.g. points too far out
     /// in the Poincaré disk for double precision).
     pub t_flipped_faces: usize,
+    /// Faces of `T` written at another image under the deck group than the layout's (nearer
+    /// the centre of the disk), because double precision could not resolve their pieces
+    /// where the polygon puts them (H² from a double-double layout only; 0 otherwise).
+    pub recentred_faces: usize,
     /// Crossings of input edges with edges of `T`, and faces of `T`.
     pub crossings: usize,
     pub t_faces: usize,
@@ -129,6 +134,65 @@ pub fn common_subdivision_uvs<S: Space<Point = Complex>>(
 where
     S::Iso: super::isometry::Isometry<Point = Complex>,
 {
+    let layout = LaidOut {
+        positions: layout_positions,
+        positions_lo: &[],
+        origin,
+    };
+    common_subdivision_uvs_ext::<S>(
+        input,
+        input_positions,
+        input_lengths,
+        intrinsic,
+        u,
+        &layout,
+        group,
+        None,
+    )
+}
+
+/// A layout of `T`'s (cut) simplicial mesh as [`common_subdivision_uvs_ext`] takes it.
+#[derive(Debug, Clone, Copy)]
+pub struct LaidOut<'a> {
+    /// Positions of the laid-out mesh's vertices (rounded to double precision).
+    pub positions: &'a [Complex],
+    /// Their low-order parts ([`super::place::Layout::positions_lo`]: H² layouts in
+    /// double-double), or empty.
+    pub positions_lo: &'a [Complex],
+    /// The surface vertex every laid-out vertex is a copy of (input ids first).
+    pub origin: &'a [u32],
+}
+
+/// [`common_subdivision_uvs`] from a layout given in the working precision of its space: in
+/// H² with `positions_lo` the corners of `T`'s faces are formed in double-double (copy
+/// positions and deck maps, [`super::input_uv::face_uvs`]'s choices) and the pieces are
+/// interpolated and rounded once ([`CommonSubdivision::uv_hyperbolic_dd`]); `t_flipped_faces`
+/// is then measured in double-double too. `frames` are the deck group's maps in double-double
+/// ([`super::deck::deck_group_ext`]; without them the rounded maps of `group` are used, which
+/// far out in the disk misplace the corners of faces that straddle a seam).
+#[allow(clippy::too_many_arguments)]
+pub fn common_subdivision_uvs_ext<S: Space<Point = Complex>>(
+    input: &Mesh,
+    input_positions: &[[f64; 3]],
+    input_lengths: &[f64],
+    intrinsic: &IntrinsicTriangulation,
+    u: &[f64],
+    layout: &LaidOut<'_>,
+    group: Option<&DeckGroup<S::Iso>>,
+    frames: Option<&DeckFrames<S::Frame>>,
+) -> Result<SubdivisionUv>
+where
+    S::Iso: super::isometry::Isometry<Point = Complex>,
+{
+    let (layout_positions, origin) = (layout.positions, layout.origin);
+    let lo = layout.positions_lo;
+    if !lo.is_empty() && lo.len() != layout_positions.len() {
+        return Err(Error::input(format!(
+            "{} low parts for {} layout positions",
+            lo.len(),
+            layout_positions.len()
+        )));
+    }
     if S::KIND == Geometry::Spherical {
         return Err(Error::input(
             "common_subdivision_uvs lays out E² and H²; use sphere_common_subdivision on S²",
@@ -143,9 +207,34 @@ where
             used[v as usize] = true;
         }
     }
-    let corners = face_uvs::<S>(&used, &faces, layout_positions, origin, group)?;
+    // T's faces are congruent to their images: their side lengths pick the right deck images.
+    let side_lengths: Vec<[f64; 3]> = (0..tri.n_faces())
+        .map(|f| {
+            [0, 1, 2].map(|i| {
+                let e = intrinsic.edge[3 * f + i] as usize;
+                length_of_lambda(S::KIND, intrinsic.lambda[e])
+            })
+        })
+        .collect();
+    let corners = face_uvs_with_lengths::<S>(
+        &used,
+        &faces,
+        Some(&side_lengths),
+        layout_positions,
+        origin,
+        group,
+    )?;
     let corner: Vec<[f64; 2]> = corners.corner.iter().map(|z| [z.re, z.im]).collect();
-    let uv = sub.uv(S::KIND, u, &corner)?;
+    let mut t_flipped_faces = corners.flipped_faces.len();
+    let mut recentred_faces = 0;
+    let uv = if S::KIND == Geometry::Hyperbolic && !lo.is_empty() {
+        let dd = hyperbolic_uv_dd::<S>(&sub, u, &corners.source, layout, group, frames)?;
+        t_flipped_faces = dd.t_flipped_faces;
+        recentred_faces = dd.recentred_faces;
+        dd.uv
+    } else {
+        sub.uv(S::KIND, u, &corner)?
+    };
     let flipped_faces = sub.flipped_triangles(S::KIND, &uv);
     Ok(SubdivisionUv {
         locations: loc,
@@ -156,9 +245,128 @@ where
         sphere_points: Vec::new(),
         flipped_faces,
         seam_faces: corners.seam_faces,
-        t_flipped_faces: corners.flipped_faces.len(),
+        t_flipped_faces,
+        recentred_faces,
         crossings: sub.crossings.len(),
         t_faces: tri.n_faces(),
+    })
+}
+
+/// What [`hyperbolic_uv_dd`] computed.
+struct DdUv {
+    uv: Vec<[f64; 2]>,
+    t_flipped_faces: usize,
+    recentred_faces: usize,
+}
+
+/// H² from a double-double layout (see [`common_subdivision_uvs_ext`]): the corners of `T`'s
+/// faces in double-double from `face_uvs`'s choices (`source`), the pieces interpolated and
+/// rounded once. A face of `T` that still has a piece whose rounded UV triangle is not
+/// positively oriented lies too far out in the disk for double precision to resolve it
+/// there (at distance r the written coordinates resolve ~1e-16·e^r); it is written at the
+/// image under the deck group nearest the centre instead (greedily over the candidate maps
+/// of [`candidate_maps`]), when all its pieces are positively oriented there: one more seam
+/// around that face, counted in `recentred_faces`.
+fn hyperbolic_uv_dd<S: Space<Point = Complex>>(
+    sub: &CommonSubdivision,
+    u: &[f64],
+    source: &[(u32, u32)],
+    layout: &LaidOut<'_>,
+    group: Option<&DeckGroup<S::Iso>>,
+    deck_frames: Option<&DeckFrames<S::Frame>>,
+) -> Result<DdUv>
+where
+    S::Iso: super::isometry::Isometry<Point = Complex>,
+{
+    let (maps, _) = candidate_maps(group);
+    let frames: Vec<S::Frame> = match deck_frames.map(candidate_frames) {
+        Some(f) if f.len() == maps.len() => f,
+        _ => maps.iter().map(S::Frame::from_iso).collect(),
+    };
+    let ext: Vec<ExtPoint<S>> = source
+        .iter()
+        .map(|&(c, k)| {
+            let c = c as usize;
+            let p = S::Frame::ext(layout.positions[c], Some(layout.positions_lo[c]));
+            frames[k as usize].apply(p)
+        })
+        .collect();
+    let cdd = |p: ExtPoint<S>| {
+        let (hi, lo) = S::Frame::split(p);
+        Cdd::from_parts(hi, lo.unwrap_or(Complex::new(0.0, 0.0)))
+    };
+    let nf = ext.len() / 3;
+    let t_flipped_faces = (0..nf)
+        .filter(|&f| {
+            let o = S::Frame::orientation(ext[3 * f], ext[3 * f + 1], ext[3 * f + 2]);
+            o.is_nan() || o <= 0.0
+        })
+        .count();
+    let (hi, lo): (Vec<[f64; 2]>, Vec<[f64; 2]>) = ext
+        .iter()
+        .map(|&p| {
+            let z = cdd(p);
+            ([z.re.hi, z.im.hi], [z.re.lo, z.im.lo])
+        })
+        .unzip();
+    let mut uv = sub.uv_hyperbolic_dd(u, &hi, &lo)?;
+    let piece_flipped = |uv: &[[f64; 2]], t: usize| {
+        let o = disk_orientation(uv[3 * t], uv[3 * t + 1], uv[3 * t + 2]);
+        o.is_nan() || o <= 0.0
+    };
+    let mut pieces: Vec<Vec<usize>> = vec![Vec::new(); nf];
+    let mut bad = vec![false; nf];
+    for (t, &f) in sub.t_face.iter().enumerate() {
+        pieces[f as usize].push(t);
+        if piece_flipped(&uv, t) {
+            bad[f as usize] = true;
+        }
+    }
+    let origin = S::Frame::ext(S::base_point(), None);
+    let radius = |p: &[ExtPoint<S>; 3]| {
+        p.iter()
+            .map(|&q| S::Frame::point_distance(q, origin))
+            .fold(0.0, f64::max)
+    };
+    let mut recentred_faces = 0;
+    for f in (0..nf).filter(|&f| bad[f]) {
+        // Greedy descent over the candidate maps towards the centre (at most 32 steps).
+        let start = [ext[3 * f], ext[3 * f + 1], ext[3 * f + 2]];
+        let (mut p, mut r) = (start, radius(&start));
+        for _ in 0..32 {
+            let best = frames[1..]
+                .iter()
+                .map(|h| {
+                    let q = p.map(|x| h.apply(x));
+                    (radius(&q), q)
+                })
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            match best {
+                Some((rq, q)) if rq < r - 1e-6 => (p, r) = (q, rq),
+                _ => break,
+            }
+        }
+        if r >= radius(&start) {
+            continue;
+        }
+        let p = p.map(cdd);
+        let mut moved = Vec::with_capacity(3 * pieces[f].len());
+        for &t in &pieces[f] {
+            for c in 0..3 {
+                moved.push(sub.piece_uv_hyperbolic_dd(t, c, u, &p)?);
+            }
+        }
+        if (0..pieces[f].len()).all(|k| !piece_flipped(&moved, k)) {
+            for (k, &t) in pieces[f].iter().enumerate() {
+                uv[3 * t..3 * t + 3].copy_from_slice(&moved[3 * k..3 * k + 3]);
+            }
+            recentred_faces += 1;
+        }
+    }
+    Ok(DdUv {
+        uv,
+        t_flipped_faces,
+        recentred_faces,
     })
 }
 
@@ -267,6 +475,7 @@ pub fn sphere_common_subdivision(
         sphere_points: sphere,
         flipped_faces,
         seam_faces: 0,
+        recentred_faces: 0,
         t_flipped_faces: sphere_flipped_faces(
             points,
             &(0..tri.n_faces() as u32)

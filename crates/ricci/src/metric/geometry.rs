@@ -216,6 +216,28 @@ impl Background for Euclidean {
     }
 }
 
+/// Area of a hyperbolic (`t = tanh`) or spherical (`t = tan`) triangle from its sides by
+/// L'Huilier's formula `tan(A/4) = √(t(s/2) t((s−a)/2) t((s−b)/2) t((s−c)/2))`, with the
+/// differences formed as in Kahan's Heron formula (sides sorted `a ≥ b ≥ c`:
+/// `2(s − a) = c − (a − b)`, …), so it keeps its relative accuracy for tiny and needle
+/// triangles, where the angle defect or excess cancels. Sides that violate the triangle
+/// inequality (and NaN) give 0.
+fn lhuilier(l: [f64; 3], t: fn(f64) -> f64) -> f64 {
+    let mut s = l;
+    s.sort_by(|a, b| b.total_cmp(a));
+    let [a, b, c] = s;
+    let (x0, x1, x2, x3) = (a + (b + c), c - (a - b), c + (a - b), a + (b - c));
+    if x1.is_nan() || x1 <= 0.0 {
+        return 0.0;
+    }
+    let p = t(0.25 * x0) * t(0.25 * x1) * t(0.25 * x2) * t(0.25 * x3);
+    if p > 0.0 {
+        4.0 * p.sqrt().atan()
+    } else {
+        0.0
+    }
+}
+
 impl Background for Hyperbolic {
     const KIND: Geometry = Geometry::Hyperbolic;
     #[inline]
@@ -238,7 +260,9 @@ impl Background for Hyperbolic {
         ch.max(1.0).acosh()
     }
     fn area(a: f64, b: f64, c: f64) -> f64 {
-        (PI - Self::angle(a, b, c) - Self::angle(b, c, a) - Self::angle(c, a, b)).max(0.0)
+        // L'Huilier: tan(A/4)² = Π tanh(x/2) over x = s, s − a, s − b, s − c (the angle
+        // defect π − Σθ cancels for small triangles: below ~1e-15 it rounded to ≤ 0).
+        lhuilier([a, b, c], f64::tanh)
     }
     fn radius_of_variable(u: f64) -> f64 {
         // γ = 2 atanh(e^u) = log((1 + e^u) / (1 − e^u)).
@@ -288,7 +312,8 @@ impl Background for Spherical {
         ca.clamp(-1.0, 1.0).acos()
     }
     fn area(a: f64, b: f64, c: f64) -> f64 {
-        (Self::angle(a, b, c) + Self::angle(b, c, a) + Self::angle(c, a, b) - PI).max(0.0)
+        // L'Huilier: tan(A/4)² = Π tan(x/2) over x = s, s − a, s − b, s − c.
+        lhuilier([a, b, c], f64::tan)
     }
     fn radius_of_variable(u: f64) -> f64 {
         2.0 * u.exp().atan()
@@ -363,6 +388,48 @@ mod tests {
         assert!((Spherical::angle(q, q, q) - q).abs() < 1e-12);
         assert!((Spherical::area(q, q, q) - q).abs() < 1e-12);
         assert!((Euclidean::area(3.0, 4.0, 5.0) - 6.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn lhuilier_areas_match_the_angle_defect_and_keep_tiny_triangles() {
+        // Moderate triangles: the angle defect / excess is accurate there.
+        for (a, b, c) in [(0.3, 0.4, 0.5), (1.0, 1.2, 0.7), (2.0, 1.5, 0.9)] {
+            let defect = PI
+                - Hyperbolic::angle(a, b, c)
+                - Hyperbolic::angle(b, c, a)
+                - Hyperbolic::angle(c, a, b);
+            assert!(
+                (Hyperbolic::area(a, b, c) - defect).abs() < 1e-14,
+                "{a} {b} {c}"
+            );
+            let excess =
+                Spherical::angle(a, b, c) + Spherical::angle(b, c, a) + Spherical::angle(c, a, b)
+                    - PI;
+            assert!(
+                (Spherical::area(a, b, c) - excess).abs() < 1e-14,
+                "{a} {b} {c}"
+            );
+        }
+        // Tiny triangles and needles: the area tends to the Euclidean one (relative
+        // correction ~ area), where π − Σθ rounds to 0 or below.
+        for l in [
+            [3e-8, 4e-8, 5e-8],
+            [1e-6, 1e-6, 1e-13],
+            [2e-9, 1.5e-9, 1e-9],
+        ] {
+            let e = Euclidean::area(l[0], l[1], l[2]);
+            for got in [
+                Hyperbolic::area(l[0], l[1], l[2]),
+                Spherical::area(l[0], l[1], l[2]),
+            ] {
+                assert!(
+                    got > 0.0 && ((got - e) / e).abs() < 1e-12,
+                    "{l:?}: {got} vs {e}"
+                );
+            }
+        }
+        assert_eq!(Hyperbolic::area(3.0, 1.0, 1.0), 0.0);
+        assert_eq!(Spherical::area(1.0, 0.2, 0.3), 0.0);
     }
 
     #[test]

@@ -67,6 +67,7 @@ use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::metric::intrinsic::IntrinsicTriangulation;
 use crate::metric::Geometry;
+use crate::numeric::dd::{Cdd, Dd};
 
 use normal::replay;
 use trace::build;
@@ -313,28 +314,90 @@ impl CommonSubdivision {
         }
         let mut out = Vec::with_capacity(3 * self.triangles.len());
         for (t, &f) in self.t_face.iter().enumerate() {
-            let verts = tri.face(f);
             let p = [0, 1, 2].map(|i| corner_uv[3 * f as usize + i]);
             for c in 0..3 {
-                let w = self.t_weights[3 * t + c];
-                // β_i = w_i e^{−u_i}, normalised in log space.
-                let mut logs = [f64::NEG_INFINITY; 3];
-                for i in 0..3 {
-                    if w[i] > 0.0 {
-                        let ui = if u.is_empty() {
-                            0.0
-                        } else {
-                            u[verts[i] as usize]
-                        };
-                        logs[i] = w[i].ln() - ui;
-                    }
-                }
-                let m = logs.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-                let beta = logs.map(|l| if l.is_finite() { (l - m).exp() } else { 0.0 });
+                let beta = self.beta(t, c, u);
                 out.push(interpolate(geometry, &p, &beta)?);
             }
         }
         Ok(out)
+    }
+
+    /// Projective weights `β_i = w_i e^{−u_i}` of corner `c` of triangle `t` on its face of
+    /// `T`, normalised in log space (largest 1).
+    fn beta(&self, t: usize, c: usize, u: &[f64]) -> [f64; 3] {
+        let verts = self.triangulation.face(self.t_face[t]);
+        let w = self.t_weights[3 * t + c];
+        let mut logs = [f64::NEG_INFINITY; 3];
+        for i in 0..3 {
+            if w[i] > 0.0 {
+                let ui = if u.is_empty() {
+                    0.0
+                } else {
+                    u[verts[i] as usize]
+                };
+                logs[i] = w[i].ln() - ui;
+            }
+        }
+        let m = logs.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        logs.map(|l| if l.is_finite() { (l - m).exp() } else { 0.0 })
+    }
+
+    /// [`CommonSubdivision::uv`] for a hyperbolic layout of `T` given to double-double
+    /// precision (`corner_hi[3f + i] + corner_lo[3f + i]`, Poincaré disk): the pieces are
+    /// interpolated in the frame centred at a corner as in `uv`, but the Möbius maps into and
+    /// out of that frame are evaluated in double-double, so every written point is the
+    /// correctly rounded image of the interpolated one (far out in the disk the
+    /// double-precision corners alone resolve only ~1e-16·e^r, and thin faces of `T` there
+    /// came out flipped: seahorse2_100K).
+    pub fn uv_hyperbolic_dd(
+        &self,
+        u: &[f64],
+        corner_hi: &[[f64; 2]],
+        corner_lo: &[[f64; 2]],
+    ) -> Result<Vec<[f64; 2]>> {
+        let tri = &self.triangulation;
+        if corner_hi.len() != 3 * tri.n_faces() || corner_lo.len() != corner_hi.len() {
+            return Err(Error::input(format!(
+                "layout has {} corners ({} low parts), the triangulation {}",
+                corner_hi.len(),
+                corner_lo.len(),
+                3 * tri.n_faces()
+            )));
+        }
+        if !u.is_empty() && u.len() != tri.n_vertices {
+            return Err(Error::input(format!(
+                "{} scale factors for {} vertices",
+                u.len(),
+                tri.n_vertices
+            )));
+        }
+        let mut out = Vec::with_capacity(3 * self.triangles.len());
+        for (t, &f) in self.t_face.iter().enumerate() {
+            let p = [0, 1, 2].map(|i| {
+                let (h, l) = (corner_hi[3 * f as usize + i], corner_lo[3 * f as usize + i]);
+                Cdd {
+                    re: Dd::new(h[0]) + Dd::new(l[0]),
+                    im: Dd::new(h[1]) + Dd::new(l[1]),
+                }
+            });
+            for c in 0..3 {
+                out.push(self.piece_uv_hyperbolic_dd(t, c, u, &p)?);
+            }
+        }
+        Ok(out)
+    }
+
+    /// UV of corner `c` of triangle `t` when the corners of its face of `T` are at `p`
+    /// (Poincaré disk, double-double; see [`CommonSubdivision::uv_hyperbolic_dd`]).
+    pub fn piece_uv_hyperbolic_dd(
+        &self,
+        t: usize,
+        c: usize,
+        u: &[f64],
+        p: &[Cdd; 3],
+    ) -> Result<[f64; 2]> {
+        interpolate_hyperbolic_dd(p, &self.beta(t, c, u))
     }
 
     /// Number of triangles whose UV triangle is not positively oriented: signed area in E²;
@@ -416,10 +479,20 @@ pub fn disk_orientation(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
 fn interpolate(geometry: Geometry, p: &[[f64; 2]; 3], beta: &[f64; 3]) -> Result<[f64; 2]> {
     let s: f64 = beta.iter().sum();
     match geometry {
-        Geometry::Euclidean => Ok([
-            (beta[0] * p[0][0] + beta[1] * p[1][0] + beta[2] * p[2][0]) / s,
-            (beta[0] * p[0][1] + beta[1] * p[1][1] + beta[2] * p[2][1]) / s,
-        ]),
+        Geometry::Euclidean => {
+            // As offsets from the corner of largest weight: exact at the corners, and the
+            // offsets of a thin piece keep their relative accuracy (camel.off had 2 pieces
+            // flipped by the rounding of Σ β_i P_i).
+            let j = (0..3)
+                .max_by(|&a, &b| beta[a].total_cmp(&beta[b]))
+                .unwrap_or(0);
+            let (mut x, mut y) = (0.0, 0.0);
+            for i in (0..3).filter(|&i| i != j) {
+                x += beta[i] * (p[i][0] - p[j][0]);
+                y += beta[i] * (p[i][1] - p[j][1]);
+            }
+            Ok([p[j][0] + x / s, p[j][1] + y / s])
+        }
         Geometry::Hyperbolic => {
             for z in p {
                 if !(z[0] * z[0] + z[1] * z[1] < 1.0) {
@@ -460,6 +533,51 @@ fn interpolate(geometry: Geometry, p: &[[f64; 2]; 3], beta: &[f64; 3]) -> Result
              through a puncture)",
         )),
     }
+}
+
+/// The hyperbolic branch of [`interpolate`] with double-double corners: `to_centre` and
+/// `from_centre` in double-double, the hyperboloid sum near the centre in double precision,
+/// one rounding at the end.
+fn interpolate_hyperbolic_dd(p: &[Cdd; 3], beta: &[f64; 3]) -> Result<[f64; 2]> {
+    for z in p {
+        let d = Dd::ONE - z.norm_sqr();
+        if d.hi.is_nan() || d.hi <= 0.0 {
+            return Err(Error::input(format!(
+                "layout point ({}, {}) is not inside the Poincaré disk",
+                z.re.hi, z.im.hi
+            )));
+        }
+    }
+    let j = (0..3)
+        .max_by(|&a, &b| beta[a].total_cmp(&beta[b]))
+        .unwrap_or(0);
+    let centre = p[j];
+    let mut x = [0.0f64; 3];
+    for i in 0..3 {
+        if beta[i] == 0.0 {
+            continue;
+        }
+        let w = if i == j {
+            [0.0, 0.0]
+        } else {
+            // (z − a)/(1 − ā z)
+            let q = (p[i] - centre) / (Cdd::ONE - centre.conj() * p[i]);
+            [q.re.hi, q.im.hi]
+        };
+        let r2 = w[0] * w[0] + w[1] * w[1];
+        let d = 1.0 - r2;
+        x[0] += beta[i] * (1.0 + r2) / d;
+        x[1] += beta[i] * 2.0 * w[0] / d;
+        x[2] += beta[i] * 2.0 * w[1] / d;
+    }
+    let q = (x[0] * x[0] - x[1] * x[1] - x[2] * x[2]).max(0.0).sqrt();
+    let w = Cdd {
+        re: Dd::new(x[1] / (x[0] + q)),
+        im: Dd::new(x[2] / (x[0] + q)),
+    };
+    // (w + a)/(1 + ā w)
+    let z = (w + centre) / (Cdd::ONE + centre.conj() * w);
+    Ok([z.re.hi, z.im.hi])
 }
 
 impl CommonSubdivision {
