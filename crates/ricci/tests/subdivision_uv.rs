@@ -433,7 +433,7 @@ fn geodesic_orientation(uv: &[[f64; 2]], t: usize) -> f64 {
 #[test]
 fn far_out_hyperbolic_layout_keeps_every_piece_positively_oriented() {
     use ricci::layout::dd::disk_distance_dd;
-    use ricci::layout::dd::{Cdd, Dd, MobiusDd};
+    use ricci::layout::dd::MobiusDd;
     use ricci::layout::deck::{deck_group_ext, DeckFrames};
     use ricci::layout::isometry::Complex;
     use ricci::layout::pipeline::{cut_disk_polished, polish_uniformization};
@@ -441,6 +441,7 @@ fn far_out_hyperbolic_layout_keeps_every_piece_positively_oriented() {
     use ricci::layout::subdivision_uv::{common_subdivision_uvs_ext, LaidOut};
     use ricci::layout::{DeckGroup, Mobius};
     use ricci::metric::Hyperbolic;
+    use ricci::numeric::dd::{Cdd, Dd};
     let Some(dir) = ricci_meshes::ricci_meshes().filter(|d| d.is_dir()) else {
         eprintln!("RICCI_MESHES unset: skipping eight");
         return;
