@@ -7,12 +7,12 @@
 //! in the mesh file itself); otherwise plain grey.
 
 mod field;
-mod uv;
 
 use crate::util::read_surface;
 use crate::util::{print_json, write_atomic, UsageError};
 use anyhow::bail;
 use field::{scalar_field, Field};
+use ricci::mesh::io::uv_match::{has_corner_uvs, uv_file_surface, uvs_from_file, MatchedUvs};
 use ricci::mesh::Surface;
 use ricci_render::render::Uvs;
 use ricci_render::{
@@ -22,7 +22,6 @@ use ricci_render::{
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use uv::{has_corner_uvs, uv_file_surface, uvs_from_file};
 
 /// Built-in scalar fields computed from the mesh.
 const BUILTIN: &[&str] = &[
@@ -150,6 +149,15 @@ enum Output {
 enum FoundUvs {
     PerVertex(Vec<[f64; 2]>),
     PerCorner(Vec<[f64; 2]>),
+}
+
+impl From<MatchedUvs> for FoundUvs {
+    fn from(m: MatchedUvs) -> FoundUvs {
+        match m {
+            MatchedUvs::PerVertex(v) => FoundUvs::PerVertex(v),
+            MatchedUvs::PerCorner(v) => FoundUvs::PerCorner(v),
+        }
+    }
 }
 
 impl FoundUvs {
@@ -301,11 +309,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let positions = &surface.positions;
     let triangles = surface.mesh.faces();
     let uvs: Option<FoundUvs> = match &a.uv {
-        Some(path) => Some(uvs_from_file(path, &surface)?),
+        Some(path) => Some(uvs_from_file(path, &surface)?.into()),
         // The mesh's own `vt`: per vertex, or per corner across seams (a layout's uv.obj).
         None => match &surface.uvs {
             Some(uv) => Some(FoundUvs::PerVertex(uv.clone())),
-            None if has_corner_uvs(&a.mesh) => Some(uvs_from_file(&a.mesh, &surface)?),
+            None if has_corner_uvs(&a.mesh) => Some(uvs_from_file(&a.mesh, &surface)?.into()),
             None => None,
         },
     };

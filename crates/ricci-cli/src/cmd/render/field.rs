@@ -1,8 +1,10 @@
 //! The scalar field of `ricci render --scalar`: a built-in field computed from the mesh
-//! (ricci-render's [`fields`]), or values read from a text file or a METRIC.json.
+//! (ricci-render's [`fields`]), or values read from a text file or a METRIC.json
+//! (`ricci::mesh::io::scalars`).
 
 use super::{usage, FoundUvs, BUILTIN};
-use anyhow::{bail, Context};
+use anyhow::bail;
+use ricci::mesh::io::scalars::{read_scalar_file, ScalarFile};
 use ricci::mesh::Surface;
 use ricci_render::{fields, ScalarLocation};
 use serde_json::json;
@@ -97,64 +99,7 @@ pub(super) fn scalar_field(
             BUILTIN.join(", ")
         )));
     }
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
-    let is_json = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-    let (values, name) = if is_json {
-        let v: serde_json::Value = serde_json::from_str(&text)
-            .map_err(|e| anyhow::anyhow!("{}: not valid JSON: {e}", path.display()))?;
-        let keys: Vec<&str> = match key {
-            Some(k) => vec![k],
-            None => vec!["u", "K"],
-        };
-        let (k, arr) = keys
-            .iter()
-            .find_map(|k| v.get(*k).and_then(|a| a.as_array()).map(|a| (*k, a)))
-            .ok_or_else(|| {
-                anyhow::anyhow!(
-                    "{}: no array under the key {}",
-                    path.display(),
-                    keys.join(" or ")
-                )
-            })?;
-        let vals = arr
-            .iter()
-            .enumerate()
-            .map(|(i, x)| {
-                x.as_f64()
-                    .or(if x.is_null() { Some(f64::NAN) } else { None })
-                    .ok_or_else(|| {
-                        anyhow::anyhow!("{}: entry {i} of \"{k}\" is not a number", path.display())
-                    })
-            })
-            .collect::<anyhow::Result<Vec<f64>>>()?;
-        (vals, k.to_string())
-    } else {
-        let mut vals = Vec::new();
-        for (ln, line) in text.lines().enumerate() {
-            let line = line.split('#').next().unwrap_or("");
-            for tok in line
-                .split(|c: char| c.is_whitespace() || c == ',')
-                .filter(|t| !t.is_empty())
-            {
-                let x: f64 = tok.parse().map_err(|_| {
-                    anyhow::anyhow!(
-                        "{}, line {}: '{tok}' is not a number",
-                        path.display(),
-                        ln + 1
-                    )
-                })?;
-                vals.push(x);
-            }
-        }
-        (
-            vals,
-            path.file_stem()
-                .map(|s| s.to_string_lossy().to_string())
-                .unwrap_or_default(),
-        )
-    };
+    let ScalarFile { values, name } = read_scalar_file(path, key)?;
     let (nv, nf) = (p.len(), t.len());
     let location = if values.len() == nv {
         ScalarLocation::Vertex

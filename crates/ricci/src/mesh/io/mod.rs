@@ -18,8 +18,10 @@ mod error;
 mod obj;
 mod off;
 mod ply;
+pub mod scalars;
 mod stl;
 pub(crate) mod text;
+pub mod uv_match;
 
 pub use error::{ReadError, ReadResult, Record};
 pub use obj::{parse_obj, write_obj};

@@ -1,18 +1,30 @@
-//! Texture coordinates for `ricci render`: from a UV file whose faces match the mesh face by
-//! face (a layout's uv.obj), or from the mesh's own per-corner `vt`.
+//! Texture coordinates of a mesh read from a UV file (an OBJ with `vt`, or a planar layout)
+//! whose faces match the mesh's face by face — what `ricci layout` and `ricci param` write
+//! (the input's faces with seams as extra `vt`), or a file with the mesh's own per-corner `vt`.
+//! Used by `ricci render --uv` and by anyone who wants a map back on the mesh it was made for.
 
-use super::FoundUvs;
-use anyhow::bail;
-use ricci::mesh::Surface;
+use super::read_soup;
+use crate::error::{Error, Result};
+use crate::mesh::{build_surface, Surface};
 use std::path::Path;
 
+/// Texture coordinates found for a mesh: one per vertex when every vertex has a single UV,
+/// else one per face corner (`3 f + i`), as a map with seams needs.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MatchedUvs {
+    /// One UV per vertex of the mesh.
+    PerVertex(Vec<[f64; 2]>),
+    /// One UV per face corner, `3 f + i`.
+    PerCorner(Vec<[f64; 2]>),
+}
+
 /// Whether `path` is an OBJ file whose every face corner has a `vt`.
-pub(super) fn has_corner_uvs(path: &Path) -> bool {
+pub fn has_corner_uvs(path: &Path) -> bool {
     let is_obj = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     is_obj
-        && ricci::mesh::io::read_soup(path)
+        && read_soup(path)
             .map(|s| s.corner_uvs.is_some())
             .unwrap_or(false)
 }
@@ -25,10 +37,10 @@ pub(super) fn has_corner_uvs(path: &Path) -> bool {
 /// the UVs on the triangulation it laid out (refined near the cut), with that triangulation's
 /// positions on the input surface. `None` when the file has the mesh's face count (the
 /// usual case) or is flat.
-pub(super) fn uv_file_surface(path: &Path, mesh: &Surface) -> anyhow::Result<Option<Surface>> {
-    let soup = ricci::mesh::io::read_soup(path)?;
+pub fn uv_file_surface(path: &Path, mesh: &Surface) -> Result<Option<Surface>> {
+    let soup = read_soup(path)?;
     let has_uv = soup.corner_uvs.is_some() || soup.uvs.is_some();
-    let (u, _) = ricci::mesh::build_surface(soup)?;
+    let (u, _) = build_surface(soup)?;
     if u.mesh.n_faces() == mesh.mesh.n_faces() || !has_uv {
         return Ok(None);
     }
@@ -60,16 +72,22 @@ fn embedded_area(s: &Surface) -> f64 {
         .sum()
 }
 
-pub(super) fn uvs_from_file(path: &Path, mesh: &Surface) -> anyhow::Result<FoundUvs> {
-    let soup = ricci::mesh::io::read_soup(path)?;
+/// Texture coordinates for `mesh` read from the UV file at `path`, whose faces must be the
+/// mesh's faces in the same order (a layout's or `ricci param`'s uv.obj): per vertex when every
+/// vertex of `mesh` gets one UV, else per corner (a map with seams). The UV file's `vt` are
+/// taken per vertex, else per corner, else a planar file's x and y; a corner of the UV file
+/// is matched to the mesh's corner with the same position (to 1e-9 of the diagonal), or to the
+/// same corner when no position matches (a layout written with planar positions).
+pub fn uvs_from_file(path: &Path, mesh: &Surface) -> Result<MatchedUvs> {
+    let soup = read_soup(path)?;
     let (in_polygons, in_corner_uvs) = (soup.polygons.clone(), soup.corner_uvs.clone());
-    let (u, report) = ricci::mesh::build_surface(soup)?;
+    let (u, report) = build_surface(soup)?;
     let (nf, unf) = (mesh.mesh.n_faces(), u.mesh.n_faces());
     if nf != unf {
-        bail!(
+        return Err(Error::input(format!(
             "{}: {unf} faces, but the mesh has {nf}; the UV file must have the same faces in the same order",
             path.display()
-        );
+        )));
     }
     let planar = {
         let d = u.diagonal().max(f64::MIN_POSITIVE);
@@ -102,10 +120,10 @@ pub(super) fn uvs_from_file(path: &Path, mesh: &Surface) -> anyhow::Result<Found
                         .iter()
                         .position(|&w| w == vin)
                         .ok_or_else(|| {
-                            anyhow::anyhow!(
+                            Error::input(format!(
                                 "{}: face {f} lost track of its corners",
                                 path.display()
-                            )
+                            ))
                         })?;
                     out.push(cuv[start[p] + k]);
                 }
@@ -116,10 +134,12 @@ pub(super) fn uvs_from_file(path: &Path, mesh: &Surface) -> anyhow::Result<Found
             let xy: Vec<[f64; 2]> = u.positions.iter().map(|p| [p[0], p[1]]).collect();
             per_vertex(&xy)
         }
-        (None, None, false) => bail!(
-            "{}: no texture coordinates (vt lines) and not a planar layout",
-            path.display()
-        ),
+        (None, None, false) => {
+            return Err(Error::input(format!(
+                "{}: no texture coordinates (vt lines) and not a planar layout",
+                path.display()
+            )))
+        }
     };
     let tol = 1e-9 * mesh.diagonal().max(f64::MIN_POSITIVE);
     let same = |a: [f64; 3], b: [f64; 3]| (0..3).all(|k| (a[k] - b[k]).abs() <= tol);
@@ -139,11 +159,11 @@ pub(super) fn uvs_from_file(path: &Path, mesh: &Surface) -> anyhow::Result<Found
         }
     }
     if matched_positions != 0 && matched_positions != 3 * nf {
-        bail!(
+        return Err(Error::input(format!(
             "{}: only {matched_positions} of {} corners have the position of the mesh's corner; the faces do not match",
             path.display(),
             3 * nf
-        );
+        )));
     }
     // Per vertex when every vertex has one UV.
     let mut per_vertex: Vec<Option<[f64; 2]>> = vec![None; mesh.positions.len()];
@@ -160,13 +180,13 @@ pub(super) fn uvs_from_file(path: &Path, mesh: &Surface) -> anyhow::Result<Found
         }
     }
     Ok(if consistent {
-        FoundUvs::PerVertex(
+        MatchedUvs::PerVertex(
             per_vertex
                 .into_iter()
                 .map(|x| x.unwrap_or([0.0; 2]))
                 .collect(),
         )
     } else {
-        FoundUvs::PerCorner(corner)
+        MatchedUvs::PerCorner(corner)
     })
 }
