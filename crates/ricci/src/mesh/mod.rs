@@ -63,6 +63,19 @@ impl Surface {
         let (lo, hi) = self.bounding_box();
         dist(lo, hi)
     }
+
+    /// Area of the embedded surface: Σ |(b − a) × (c − a)| / 2 over its faces.
+    pub fn area(&self) -> f64 {
+        use crate::numeric::vec3::{cross, norm, sub};
+        self.mesh
+            .faces()
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| self.positions[v as usize]);
+                0.5 * norm(cross(sub(b, a), sub(c, a)))
+            })
+            .sum()
+    }
 }
 
 pub(crate) use crate::numeric::vec3::dist;

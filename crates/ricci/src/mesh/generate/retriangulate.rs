@@ -185,22 +185,6 @@ mod tests {
     use crate::mesh::generate::torus;
     use crate::mesh::quality::face_angles;
 
-    /// Area from the positions (cross products).
-    fn area(s: &Surface) -> f64 {
-        (0..s.mesh.n_faces() as u32)
-            .map(|f| {
-                let [a, b, c] = s.mesh.face(f).map(|v| s.positions[v as usize]);
-                let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-                let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-                let x = [
-                    u[1] * w[2] - u[2] * w[1],
-                    u[2] * w[0] - u[0] * w[2],
-                    u[0] * w[1] - u[1] * w[0],
-                ];
-                0.5 * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt()
-            })
-            .sum()
-    }
     fn chi(s: &Surface) -> i64 {
         s.mesh.n_vertices() as i64 - s.mesh.n_edges() as i64 + s.mesh.n_faces() as i64
     }
@@ -211,18 +195,18 @@ mod tests {
     #[test]
     fn retriangulations_keep_the_surface() {
         let s = torus(1.0, 0.4, 12).unwrap();
-        let a0 = area(&s);
+        let a0 = s.area();
         let m = midpoint_subdivision(&s).unwrap();
         assert_eq!(m.mesh.n_faces(), 4 * s.mesh.n_faces());
         assert_eq!(chi(&m), chi(&s));
-        assert!((area(&m) - a0).abs() <= 1e-12 * a0);
+        assert!((m.area() - a0).abs() <= 1e-12 * a0);
         let r = random_face_splits(&s, 0.5, 7).unwrap();
         let split = (r.mesh.n_faces() - s.mesh.n_faces()) / 2;
         assert!(
             split > s.mesh.n_faces() / 4 && split < 3 * s.mesh.n_faces() / 4,
             "{split}"
         );
-        assert!((area(&r) - a0).abs() <= 1e-12 * a0);
+        assert!((r.area() - a0).abs() <= 1e-12 * a0);
         // Off-centre: the new vertices are not at the centroids.
         let nv = s.mesh.n_vertices();
         let mut worst = f64::INFINITY;
@@ -249,6 +233,6 @@ mod tests {
         assert!(min < 1f64.to_radians(), "min angle {}°", min.to_degrees());
         // Area close to the smooth torus's 4π² R r.
         let smooth = 4.0 * PI * PI * 0.3;
-        assert!((area(&s) - smooth).abs() < 0.01 * smooth, "{}", area(&s));
+        assert!((s.area() - smooth).abs() < 0.01 * smooth, "{}", s.area());
     }
 }

@@ -48,28 +48,9 @@ pub fn uv_file_surface(path: &Path, mesh: &Surface) -> Result<Option<Surface>> {
     let flat = u.positions.iter().all(|p| p[2].abs() <= 1e-9 * d);
     // The same surface: the same area (a refinement or common subdivision has the input's
     // area exactly; a piece of the surface or another surface does not).
-    let (a0, a1) = (embedded_area(mesh), embedded_area(&u));
+    let (a0, a1) = (mesh.area(), u.area());
     let same = (a1 - a0).abs() <= 1e-6 * a0.max(f64::MIN_POSITIVE);
     Ok((!flat && same).then_some(u))
-}
-
-/// Area of an embedded surface from its positions.
-fn embedded_area(s: &Surface) -> f64 {
-    s.mesh
-        .faces()
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|v| s.positions[v as usize]);
-            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-            let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-            let x = [
-                u[1] * w[2] - u[2] * w[1],
-                u[2] * w[0] - u[0] * w[2],
-                u[0] * w[1] - u[1] * w[0],
-            ];
-            0.5 * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt()
-        })
-        .sum()
 }
 
 /// Texture coordinates for `mesh` read from the UV file at `path`, whose faces must be the
