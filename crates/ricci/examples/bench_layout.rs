@@ -91,14 +91,7 @@ fn main() {
         let t_polish = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let disk = match &polished {
-            Some(p) => cut_disk_polished(
-                &s.mesh,
-                &p.lengths,
-                &p.lengths_lo,
-                None,
-                base,
-                &mut NoProgress,
-            ),
+            Some(p) => cut_disk_polished(&s.mesh, &p.metric, None, base, &mut NoProgress),
             None => cut_disk(
                 &s.mesh,
                 &flow.lengths,
@@ -130,8 +123,7 @@ fn main() {
             (None, _) => "off".to_string(),
         };
         let t = Instant::now();
-        let lo = (!disk.lengths_lo.is_empty()).then_some(&disk.lengths_lo[..]);
-        let l = layout_dd::<Hyperbolic>(&disk.mesh, &disk.lengths, lo, None).expect("layout");
+        let l = layout_dd::<Hyperbolic>(&disk.mesh, &disk.metric, None).expect("layout");
         let t_layout = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let g = deck_group::<Hyperbolic>(&l, &disk.polygon).expect("deck group");

@@ -33,7 +33,7 @@ fn main() {
     let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &f).unwrap();
     println!("flow+polish {:.2} s", t.elapsed().as_secs_f64());
     let t = Instant::now();
-    let sp = surface_spectrum(&work, &p.lengths, Some(&p.lengths_lo), None, count, maxt);
+    let sp = surface_spectrum(&work, &p.metric, None, count, maxt);
     println!("spectrum {:.2} s", t.elapsed().as_secs_f64());
     match sp {
         Ok((sp, d)) => println!(

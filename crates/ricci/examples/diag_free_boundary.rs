@@ -45,7 +45,7 @@ fn main() {
     )
     .unwrap();
     println!("polygon: {}", d.polygon.word());
-    let lay = layout::<Euclidean>(&d.mesh, &d.lengths, None).unwrap();
+    let lay = layout::<Euclidean>(&d.mesh, &d.metric, None).unwrap();
     println!(
         "layout: {} faces, {} flipped, {} degenerate",
         d.mesh.n_faces(),

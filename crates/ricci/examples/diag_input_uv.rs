@@ -27,7 +27,7 @@ fn main() {
         &mut NoProgress,
     )
     .unwrap();
-    let l = layout_dd::<Hyperbolic>(&d.mesh, &d.lengths, None, None).unwrap();
+    let l = layout_dd::<Hyperbolic>(&d.mesh, &d.metric, None).unwrap();
     let g = deck_group::<Hyperbolic>(&l, &d.polygon).unwrap();
     let u =
         input_face_uvs::<Hyperbolic>(&s.mesh, &l.positions, &d.vertex_origin, Some(&g)).unwrap();

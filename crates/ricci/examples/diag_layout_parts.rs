@@ -71,8 +71,7 @@ fn main() {
         ),
     );
     let pos = f.triangulation.is_none().then_some(&s.positions[..]);
-    let d =
-        cut_disk_polished(&work, &p.lengths, &p.lengths_lo, pos, None, &mut NoProgress).unwrap();
+    let d = cut_disk_polished(&work, &p.metric, pos, None, &mut NoProgress).unwrap();
     clock.lap(
         "cut",
         format!(
@@ -87,7 +86,7 @@ fn main() {
         "         cut report {}",
         serde_json::to_string(&d.cut.report).unwrap()
     );
-    let l = layout_dd::<Hyperbolic>(&d.mesh, &d.lengths, Some(&d.lengths_lo), None).unwrap();
+    let l = layout_dd::<Hyperbolic>(&d.mesh, &d.metric, None).unwrap();
     clock.lap(
         "layout",
         format!(

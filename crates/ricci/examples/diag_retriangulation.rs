@@ -39,7 +39,7 @@ fn spectrum(s: &Surface, scheme: Scheme) -> Result<Vec<f64>, String> {
         &mut NoProgress,
     )
     .map_err(|e| e.to_string())?;
-    let l = layout::<Euclidean>(&disk.mesh, &disk.lengths, None).map_err(|e| e.to_string())?;
+    let l = layout::<Euclidean>(&disk.mesh, &disk.metric, None).map_err(|e| e.to_string())?;
     let g = deck_group::<Euclidean>(&l, &disk.polygon).map_err(|e| e.to_string())?;
     let gens = g.named_generators();
     let sp = lattice_spectrum(gens[0].1.t, gens[1].1.t, 4).map_err(|e| e.to_string())?;

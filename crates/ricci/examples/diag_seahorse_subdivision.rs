@@ -38,9 +38,8 @@ fn main() {
     let it = r.triangulation.as_ref().unwrap();
     let p = polish_uniformization(&s.mesh, &l, &r).unwrap();
     let work = &it.simplicial.mesh;
-    let d =
-        cut_disk_polished(work, &p.lengths, &p.lengths_lo, None, None, &mut NoProgress).unwrap();
-    let lay = layout_dd::<Hyperbolic>(&d.mesh, &d.lengths, Some(&d.lengths_lo), None).unwrap();
+    let d = cut_disk_polished(work, &p.metric, None, None, &mut NoProgress).unwrap();
+    let lay = layout_dd::<Hyperbolic>(&d.mesh, &d.metric, None).unwrap();
     println!(
         "layout: {} faces, {} flipped, {} degenerate, depth {}",
         d.mesh.n_faces(),
@@ -58,9 +57,9 @@ fn main() {
             "  degenerate cut face {f}: distance {:.2}, 1-|z| {:.2e}, lengths {:?}, area {:.3e}",
             dist(z[0]),
             1.0 - z[0].norm(),
-            [0, 1, 2].map(|k| d.lengths[d.mesh.he_edge(3 * f + k) as usize]),
+            [0, 1, 2].map(|k| d.metric[d.mesh.he_edge(3 * f + k) as usize]),
             {
-                let q = [0, 1, 2].map(|k| d.lengths[d.mesh.he_edge(3 * f + k) as usize]);
+                let q = [0, 1, 2].map(|k| d.metric[d.mesh.he_edge(3 * f + k) as usize]);
                 Geometry::Hyperbolic.area(q[0], q[1], q[2])
             }
         );

@@ -518,7 +518,7 @@ fn lattice_normalized(r: &FlowResult, count: usize) -> Vec<f64> {
         &mut NoProgress,
     )
     .unwrap();
-    let l = layout::<Euclidean>(&disk.mesh, &disk.lengths, None).unwrap();
+    let l = layout::<Euclidean>(&disk.mesh, &disk.metric, None).unwrap();
     assert!(l.flipped_faces.is_empty());
     let g = deck_group::<Euclidean>(&l, &disk.polygon).unwrap();
     let gens = g.named_generators();
@@ -569,7 +569,7 @@ fn spectra_on_the_intrinsic_triangulation() {
     )
     .unwrap();
     let l =
-        ricci::layout::place::layout::<ricci::metric::Euclidean>(&disk.mesh, &disk.lengths, None)
+        ricci::layout::place::layout::<ricci::metric::Euclidean>(&disk.mesh, &disk.metric, None)
             .unwrap();
     let g = ricci::layout::deck_group::<ricci::metric::Euclidean>(&l, &disk.polygon).unwrap();
     let gens = g.named_generators();

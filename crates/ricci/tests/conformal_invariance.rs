@@ -43,7 +43,7 @@ fn spectrum(s: &Surface, geometry: Geometry, count: usize) -> Vec<f64> {
     let work = &f.triangulation.as_ref().unwrap().simplicial.mesh;
     if geometry == Geometry::Euclidean {
         let d = cut_disk(work, &f.lengths, geometry, None, None, &mut NoProgress).unwrap();
-        let l = layout::<Euclidean>(&d.mesh, &d.lengths, None).unwrap();
+        let l = layout::<Euclidean>(&d.mesh, &d.metric, None).unwrap();
         assert!(l.flipped_faces.is_empty());
         let g = deck_group::<Euclidean>(&l, &d.polygon).unwrap();
         let gens = g.named_generators();
@@ -51,9 +51,8 @@ fn spectrum(s: &Surface, geometry: Geometry, count: usize) -> Vec<f64> {
         sp.iter().map(|x| x / sp[0]).collect()
     } else {
         let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &f).unwrap();
-        let d = cut_disk_polished(work, &p.lengths, &p.lengths_lo, None, None, &mut NoProgress)
-            .unwrap();
-        let l = layout_dd::<Hyperbolic>(&d.mesh, &d.lengths, Some(&d.lengths_lo), None).unwrap();
+        let d = cut_disk_polished(work, &p.metric, None, None, &mut NoProgress).unwrap();
+        let l = layout_dd::<Hyperbolic>(&d.mesh, &d.metric, None).unwrap();
         assert!(l.flipped_faces.is_empty());
         let g = deck_group::<Hyperbolic>(&l, &d.polygon).unwrap();
         let sp = fuchsian_spectrum(&l, &d.polygon, &g, count, 2_000_000).unwrap();
@@ -109,7 +108,7 @@ fn irregular_tori_match_the_closed_form() {
             &mut NoProgress,
         )
         .unwrap();
-        let l = layout::<Euclidean>(&d.mesh, &d.lengths, None).unwrap();
+        let l = layout::<Euclidean>(&d.mesh, &d.metric, None).unwrap();
         let g = deck_group::<Euclidean>(&l, &d.polygon).unwrap();
         let gens = g.named_generators();
         let (re, im) = torus_modulus(gens[0].1.t, gens[1].1.t).unwrap();

@@ -38,7 +38,7 @@ fn deck_modulus(s: &Surface) -> (f64, f64) {
         &mut NoProgress,
     )
     .unwrap();
-    let l = layout::<Euclidean>(&d.mesh, &d.lengths, None).unwrap();
+    let l = layout::<Euclidean>(&d.mesh, &d.metric, None).unwrap();
     let g = deck_group::<Euclidean>(&l, &d.polygon).unwrap();
     let gens = g.named_generators();
     torus_modulus(gens[0].1.t, gens[1].1.t).unwrap()

@@ -55,7 +55,7 @@ where
     let work = &f.triangulation.as_ref().expect("intrinsic").simplicial.mesh;
     let bordered = s.mesh.has_boundary();
     let (positions, origin, group) = if bordered {
-        let l = layout_dd::<S>(work, &f.lengths, None, None).unwrap();
+        let l = layout_dd::<S>(work, &f.metric(), None).unwrap();
         assert!(l.flipped_faces.is_empty());
         (l.positions, (0..work.n_vertices() as u32).collect(), None)
     } else {
@@ -64,12 +64,11 @@ where
         // disagree by the flow's residual times sinh of the distance from the seed).
         let d = if geometry == Geometry::Hyperbolic {
             let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &f).unwrap();
-            cut_disk_polished(work, &p.lengths, &p.lengths_lo, None, None, &mut NoProgress).unwrap()
+            cut_disk_polished(work, &p.metric, None, None, &mut NoProgress).unwrap()
         } else {
             cut_disk(work, &f.lengths, geometry, None, None, &mut NoProgress).unwrap()
         };
-        let lo = (!d.lengths_lo.is_empty()).then_some(&d.lengths_lo[..]);
-        let l = layout_dd::<S>(&d.mesh, &d.lengths, lo, None).unwrap();
+        let l = layout_dd::<S>(&d.mesh, &d.metric, None).unwrap();
         assert!(l.flipped_faces.is_empty(), "{name}: intrinsic layout");
         let g = deck_group::<S>(&l, &d.polygon).unwrap();
         (l.positions, d.vertex_origin.clone(), Some(g))

@@ -52,7 +52,7 @@ fn accuracy(file: &str) -> Accuracy {
     let polished = polish_uniformization(&s.mesh, &s.edge_lengths(), &flow).unwrap();
     assert!(polished.converged, "{file}: polish {:?}", polished.history);
     let moved = polished
-        .lengths
+        .metric
         .iter()
         .zip(&flow.lengths)
         .map(|(a, b)| ((a - b) / b).abs())
@@ -60,8 +60,7 @@ fn accuracy(file: &str) -> Accuracy {
     assert!(moved < 1e-12, "{file}: polish moved a length by {moved:e}");
     let disk = cut_disk_polished(
         &s.mesh,
-        &polished.lengths,
-        &polished.lengths_lo,
+        &polished.metric,
         Some(&s.positions),
         None,
         &mut NoProgress,
@@ -75,8 +74,7 @@ fn accuracy(file: &str) -> Accuracy {
     let mut flipped = 0;
     let mut seed_dev: f64 = 0.0;
     for seed in [None, Some(nf / 3), Some(nf - 1)] {
-        let l = layout_dd::<Hyperbolic>(&disk.mesh, &disk.lengths, Some(&disk.lengths_lo), seed)
-            .unwrap();
+        let l = layout_dd::<Hyperbolic>(&disk.mesh, &disk.metric, seed).unwrap();
         flipped += l.flipped_faces.len();
         if let Some(first) = layouts.first() {
             let (_, d) = align_layouts::<Hyperbolic>(first, &l).unwrap();
@@ -240,11 +238,11 @@ fn no_flipped_faces_on_the_flow_list() {
                 }
             };
             match geometry {
-                Geometry::Hyperbolic => layout::<Hyperbolic>(&d.mesh, &d.lengths, None)
+                Geometry::Hyperbolic => layout::<Hyperbolic>(&d.mesh, &d.metric, None)
                     .unwrap()
                     .flipped_faces
                     .len(),
-                _ => layout::<Euclidean>(&d.mesh, &d.lengths, None)
+                _ => layout::<Euclidean>(&d.mesh, &d.metric, None)
                     .unwrap()
                     .flipped_faces
                     .len(),

@@ -9,7 +9,7 @@ use ricci::layout::pipeline::{
 };
 use ricci::layout::place::{layout, layout_dd};
 use ricci::mesh::generate;
-use ricci::metric::{ConformalStructure, Evaluator, Geometry, Hyperbolic, Scheme};
+use ricci::metric::{ConformalStructure, Evaluator, Geometry, Hyperbolic, IntrinsicMetric, Scheme};
 use ricci::progress::NoProgress;
 
 #[test]
@@ -71,12 +71,12 @@ fn double_double_curvature_agrees_with_the_flow_kernel_and_the_polish_converges(
     // Rounded to double precision, the polished u gives the flow kernel's lengths.
     let mut ev = Evaluator::new(&s.mesh, structure.clone());
     assert!(ev.evaluate(&p.u));
-    for (e, (&a, &b)) in ev.ws.lengths.iter().zip(&p.lengths).enumerate() {
+    for (e, (&a, &b)) in ev.ws.lengths.iter().zip(p.metric.lengths()).enumerate() {
         assert!((a - b).abs() <= 1e-15 * b, "edge {e}: {a} vs {b}");
     }
     // The vertex-scaling polish of the polished double-double lengths has nothing left to
     // do (its length law reproduces them through sinh/asinh).
-    let q = ricci::layout::pipeline::polish_lengths(&s.mesh, &p.lengths, &p.lengths_lo).unwrap();
+    let q = ricci::layout::pipeline::polish_lengths(&s.mesh, &p.metric).unwrap();
     assert!(q.residual_start <= 1e-26, "{:?}", q.history);
 }
 
@@ -105,23 +105,14 @@ fn polished_metric_makes_deck_maps_from_different_edges_agree() {
         &mut NoProgress,
     )
     .unwrap();
-    let lp = layout::<Hyperbolic>(&plain.mesh, &plain.lengths, None).unwrap();
+    let lp = layout::<Hyperbolic>(&plain.mesh, &plain.metric, None).unwrap();
     let gp = deck_group::<Hyperbolic>(&lp, &plain.polygon).unwrap();
     let p = polish_uniformization(&s.mesh, &input, &flow).unwrap();
-    let disk = cut_disk_polished(
-        &s.mesh,
-        &p.lengths,
-        &p.lengths_lo,
-        None,
-        None,
-        &mut NoProgress,
-    )
-    .unwrap();
+    let disk = cut_disk_polished(&s.mesh, &p.metric, None, None, &mut NoProgress).unwrap();
     if let Some(r) = disk.refined_polish {
         assert!(r.converged, "{r:?}");
     }
-    let l =
-        layout_dd::<Hyperbolic>(&disk.mesh, &disk.lengths, Some(&disk.lengths_lo), None).unwrap();
+    let l = layout_dd::<Hyperbolic>(&disk.mesh, &disk.metric, None).unwrap();
     let g = deck_group::<Hyperbolic>(&l, &disk.polygon).unwrap();
     eprintln!(
         "plain: relation {:e} spread {:e} / {:e}; polished: relation {:e} spread {:e} / {:e}",
@@ -137,13 +128,13 @@ fn polished_metric_makes_deck_maps_from_different_edges_agree() {
     assert!(g.max_edge_spread_matrix < 1e-20 && g.max_edge_spread < 1e-20);
     assert!(g.max_edge_spread_matrix < 1e-4 * gp.max_edge_spread_matrix);
     // With zero low parts the double-double entry point is the plain layout.
-    let z = layout_dd::<Hyperbolic>(
-        &plain.mesh,
-        &plain.lengths,
-        Some(&vec![0.0; plain.lengths.len()]),
-        None,
+    let zero_lo = IntrinsicMetric::with_low_parts(
+        Geometry::Hyperbolic,
+        plain.metric.to_vec(),
+        vec![0.0; plain.metric.len()],
     )
     .unwrap();
+    let z = layout_dd::<Hyperbolic>(&plain.mesh, &zero_lo, None).unwrap();
     assert_eq!(z.positions, lp.positions);
 }
 
@@ -204,7 +195,7 @@ fn vertex_scaling_metrics_are_polished_too() {
     let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &flow).unwrap();
     assert!(p.converged && p.residual_dd <= 1e-26, "{:?}", p.history);
     let moved = p
-        .lengths
+        .metric
         .iter()
         .zip(&flow.lengths)
         .map(|(a, b)| ((a - b) / b).abs())

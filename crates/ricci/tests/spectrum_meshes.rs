@@ -32,14 +32,14 @@ fn spectrum(s: &Surface, geometry: Geometry, scheme: Scheme, count: usize) -> Ve
     )
     .unwrap();
     if geometry == Geometry::Euclidean {
-        let l = layout::<Euclidean>(&disk.mesh, &disk.lengths, None).unwrap();
+        let l = layout::<Euclidean>(&disk.mesh, &disk.metric, None).unwrap();
         assert!(l.flipped_faces.is_empty());
         let g = deck_group::<Euclidean>(&l, &disk.polygon).unwrap();
         let gens = g.named_generators();
         let sp = lattice_spectrum(gens[0].1.t, gens[1].1.t, count).unwrap();
         sp.iter().map(|x| x / sp[0]).collect()
     } else {
-        let l = layout::<Hyperbolic>(&disk.mesh, &disk.lengths, None).unwrap();
+        let l = layout::<Hyperbolic>(&disk.mesh, &disk.metric, None).unwrap();
         assert!(l.flipped_faces.is_empty());
         let g = deck_group::<Hyperbolic>(&l, &disk.polygon).unwrap();
         let sp = fuchsian_spectrum(&l, &disk.polygon, &g, count, 2_000_000).unwrap();
@@ -127,7 +127,7 @@ fn compact_domain_spectrum_matches_the_canonical_polygon() {
         &mut NoProgress,
     )
     .unwrap();
-    let (sp, dom) = surface_spectrum(&s.mesh, &flow.lengths, None, None, 10, 2_000_000).unwrap();
+    let (sp, dom) = surface_spectrum(&s.mesh, &flow.metric(), None, 10, 2_000_000).unwrap();
     assert_eq!(sp.unmatched_links, 0);
     let got = sp.lengths();
     for (a, b) in got.iter().zip(&want) {
@@ -135,5 +135,5 @@ fn compact_domain_spectrum_matches_the_canonical_polygon() {
     }
     assert!(dom.radius > 0.0 && dom.generators >= 4, "{dom:?}");
     // A budget too small is an error, not a hang.
-    assert!(surface_spectrum(&s.mesh, &flow.lengths, None, None, 10, 50).is_err());
+    assert!(surface_spectrum(&s.mesh, &flow.metric(), None, 10, 50).is_err());
 }

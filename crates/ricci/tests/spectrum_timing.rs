@@ -33,8 +33,7 @@ fn time(name: &str) {
     let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &f).unwrap();
     let t1 = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let (sp, d) =
-        surface_spectrum(&work, &p.lengths, Some(&p.lengths_lo), None, 12, 2_000_000).unwrap();
+    let (sp, d) = surface_spectrum(&work, &p.metric, None, 12, 2_000_000).unwrap();
     let t2 = t.elapsed().as_secs_f64();
     let l = sp.lengths();
     eprintln!(

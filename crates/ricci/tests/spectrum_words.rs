@@ -106,7 +106,7 @@ fn generated_spectrum(base: Option<u32>, count: usize) -> (HyperbolicSpectrum, V
         &mut NoProgress,
     )
     .unwrap();
-    let l = layout::<Hyperbolic>(&disk.mesh, &disk.lengths, None).unwrap();
+    let l = layout::<Hyperbolic>(&disk.mesh, &disk.metric, None).unwrap();
     let g = deck_group::<Hyperbolic>(&l, &disk.polygon).unwrap();
     let sp = fuchsian_spectrum(&l, &disk.polygon, &g, count, 2_000_000).unwrap();
     (sp, g.named_generators().iter().map(|x| x.1).collect())
@@ -135,8 +135,7 @@ fn spectrum_does_not_depend_on_the_base_vertex() {
     )
     .unwrap();
     for centre in [None, Some(3), Some(n - 5)] {
-        let (sp, _) =
-            surface_spectrum(&s.mesh, &flow.lengths, None, centre, 12, 2_000_000).unwrap();
+        let (sp, _) = surface_spectrum(&s.mesh, &flow.metric(), centre, 12, 2_000_000).unwrap();
         let got = sp.lengths();
         for (a, b) in got.iter().zip(&want) {
             assert!(

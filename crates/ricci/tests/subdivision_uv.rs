@@ -367,16 +367,8 @@ fn beetle_common_subdivision_has_no_flipped_triangle() {
     assert!(it.initial_flips > 0);
     // As `ricci layout` does: the metric polished to double-double, cut, laid out.
     let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &r).unwrap();
-    let d = cut_disk_polished(
-        &it.simplicial.mesh,
-        &p.lengths,
-        &p.lengths_lo,
-        None,
-        None,
-        &mut NoProgress,
-    )
-    .unwrap();
-    let l = layout_dd::<Hyperbolic>(&d.mesh, &d.lengths, Some(&d.lengths_lo), None).unwrap();
+    let d = cut_disk_polished(&it.simplicial.mesh, &p.metric, None, None, &mut NoProgress).unwrap();
+    let l = layout_dd::<Hyperbolic>(&d.mesh, &d.metric, None).unwrap();
     let g = deck_group::<Hyperbolic>(&l, &d.polygon).unwrap();
     let own =
         input_face_uvs::<Hyperbolic>(&s.mesh, &l.positions, &d.vertex_origin, Some(&g)).unwrap();
@@ -458,16 +450,8 @@ fn far_out_hyperbolic_layout_keeps_every_piece_positively_oriented() {
     assert!(r.converged, "{:?}", r.notes);
     let it = r.triangulation.as_ref().unwrap();
     let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &r).unwrap();
-    let d = cut_disk_polished(
-        &it.simplicial.mesh,
-        &p.lengths,
-        &p.lengths_lo,
-        None,
-        None,
-        &mut NoProgress,
-    )
-    .unwrap();
-    let l = layout_dd::<Hyperbolic>(&d.mesh, &d.lengths, Some(&d.lengths_lo), None).unwrap();
+    let d = cut_disk_polished(&it.simplicial.mesh, &p.metric, None, None, &mut NoProgress).unwrap();
+    let l = layout_dd::<Hyperbolic>(&d.mesh, &d.metric, None).unwrap();
     let (g, frames) = deck_group_ext::<Hyperbolic>(&l, &d.polygon).unwrap();
     let sub =
         |laid: &LaidOut, g: Option<&DeckGroup<Mobius>>, frames: Option<&DeckFrames<MobiusDd>>| {
@@ -623,7 +607,7 @@ fn bunny_free_boundary_common_subdivision_has_no_flipped_triangle() {
         &mut NoProgress,
     )
     .unwrap();
-    let l = layout::<Euclidean>(&d.mesh, &d.lengths, None).unwrap();
+    let l = layout::<Euclidean>(&d.mesh, &d.metric, None).unwrap();
     let g = deck_group::<Euclidean>(&l, &d.polygon).unwrap();
     let sub = common_subdivision_uvs::<Euclidean>(
         &s.mesh,

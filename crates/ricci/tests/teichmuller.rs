@@ -40,15 +40,13 @@ fn marked_group(s: &Surface, base: Option<u32>) -> (MarkedGroup, Vec<f64>, f64) 
     assert!(f.converged);
     let work = &f.triangulation.as_ref().unwrap().simplicial.mesh;
     let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &f).unwrap();
-    let d =
-        cut_disk_polished(work, &p.lengths, &p.lengths_lo, None, base, &mut NoProgress).unwrap();
-    let l = layout_dd::<Hyperbolic>(&d.mesh, &d.lengths, Some(&d.lengths_lo), None).unwrap();
+    let d = cut_disk_polished(work, &p.metric, None, base, &mut NoProgress).unwrap();
+    let l = layout_dd::<Hyperbolic>(&d.mesh, &d.metric, None).unwrap();
     assert!(l.flipped_faces.is_empty());
     let g = deck_group::<Hyperbolic>(&l, &d.polygon).unwrap();
     let mut m = MarkedGroup::from_deck_group(&d.polygon, &g).unwrap();
     m.reduce_handles();
-    let (sp, _) =
-        surface_spectrum(work, &p.lengths, Some(&p.lengths_lo), None, 12, 2_000_000).unwrap();
+    let (sp, _) = surface_spectrum(work, &p.metric, None, 12, 2_000_000).unwrap();
     (m, sp.lengths(), sp.complete_up_to)
 }
 

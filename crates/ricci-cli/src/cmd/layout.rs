@@ -33,7 +33,7 @@ use ricci::layout::svg::{fundamental_domain_svg, sphere_svg, tiling_svg};
 use ricci::layout::{DeckGroup, Isometry, Layout, Polygon};
 use ricci::mesh::{topology, Mesh, Surface};
 use ricci::metric::file::MetricFile;
-use ricci::metric::{Euclidean, Geometry, Hyperbolic, Scheme, Spherical};
+use ricci::metric::{Euclidean, Geometry, Hyperbolic, IntrinsicMetric, Scheme, Spherical};
 use serde_json::{json, Value};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -164,16 +164,14 @@ pub fn spinner(json: bool) -> Bar {
     Bar(bar)
 }
 
-/// A metric with optional double-double low parts of its lengths.
+/// A metric with its reports.
 pub struct PolishedLengths {
-    pub geometry: Geometry,
+    /// The metric, with double-double low parts when it was polished.
+    pub metric: IntrinsicMetric,
     /// The triangulation the lengths belong to when it is not the input's: the intrinsic
     /// Delaunay triangulation of a conformal flow (or of a metric file that brings its own).
     /// Input vertices keep their ids in it.
     pub mesh: Option<Mesh>,
-    pub lengths: Vec<f64>,
-    /// `Some` when the metric was polished to double-double.
-    pub lengths_lo: Option<Vec<f64>>,
     /// The `metric` report.
     pub report: Value,
     /// The `metric_polish` report.
@@ -199,10 +197,8 @@ pub fn polished_metric(
     let (g, own, lengths, flow, report) =
         metric_and_flow(surface, geometry, target, scheme, metric_file, progress)?;
     let mut out = PolishedLengths {
-        geometry: g,
+        metric: IntrinsicMetric::new(g, lengths),
         mesh: own,
-        lengths,
-        lengths_lo: None,
         report,
         polish: json!({"applied": false, "reason": "not a hyperbolic metric"}),
         flow: None,
@@ -219,11 +215,7 @@ pub fn polished_metric(
     progress.report("polish", None, "polishing the metric to double-double");
     let res = match (&flow, &out.mesh) {
         (Some(f), _) => polish_uniformization(&surface.mesh, &surface.edge_lengths(), f),
-        (None, own) => polish_lengths(
-            own.as_ref().unwrap_or(&surface.mesh),
-            &out.lengths,
-            &vec![0.0; out.lengths.len()],
-        ),
+        (None, own) => polish_lengths(own.as_ref().unwrap_or(&surface.mesh), &out.metric),
     };
     match res {
         Ok(p) => {
@@ -232,8 +224,7 @@ pub fn polished_metric(
                 "steps": p.steps, "residual_start": p.residual_start,
                 "residual_dd": p.residual_dd, "converged": p.converged,
             });
-            out.lengths = p.lengths;
-            out.lengths_lo = Some(p.lengths_lo);
+            out.metric = p.metric;
         }
         Err(e) => out.polish = json!({"applied": false, "reason": e.to_string()}),
     }
@@ -332,23 +323,18 @@ fn planar<S: Space<Point = Complex>>(
     surface: &Surface,
     work: &Mesh,
     disk: Option<&CutDisk>,
-    lengths: &[f64],
-    lengths_lo: Option<&[f64]>,
+    metric: &IntrinsicMetric,
     flow: Option<&FlowResult>,
     out: &mut Value,
 ) -> anyhow::Result<()>
 where
     S::Iso: JsonIso,
 {
-    let (mesh, lens, lo) = match disk {
-        Some(d) => (
-            &d.mesh,
-            &d.lengths[..],
-            (!d.lengths_lo.is_empty()).then_some(&d.lengths_lo[..]),
-        ),
-        None => (work, lengths, lengths_lo),
+    let (mesh, metric) = match disk {
+        Some(d) => (&d.mesh, &d.metric),
+        None => (work, metric),
     };
-    let l: Layout<Complex> = layout_dd::<S>(mesh, lens, lo, a.seed_face)?;
+    let l: Layout<Complex> = layout_dd::<S>(mesh, metric, a.seed_face)?;
     out["flipped_faces"] = json!(l.flipped_faces.len());
     out["degenerate_faces"] = json!(l.degenerate_faces.len());
     out["seed_face"] = json!(l.seed_face);
@@ -752,10 +738,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let mut bar = spinner(a.json);
     let PolishedLengths {
-        geometry,
+        metric,
         mesh: own_mesh,
-        lengths,
-        lengths_lo,
         report: metric_report,
         polish: mut polish_report,
         flow,
@@ -769,6 +753,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         &mut bar,
     )
     .map_err(|e| anyhow::anyhow!("{}: {}", a.mesh.display(), crate::util::sentence(&e)))?;
+    let geometry = metric.geometry();
     // The triangulation the metric lives on, and the input's positions when it is the input.
     let work: &Mesh = own_mesh.as_ref().unwrap_or(&surface.mesh);
     let work_positions = own_mesh.is_none().then_some(&surface.positions[..]);
@@ -790,20 +775,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             anyhow::bail!("spherical layouts need a closed genus-0 surface");
         }
         bar.0.set_message("layout on the sphere");
-        sphere_layout(&a, &surface, work, &lengths, flow.as_ref(), &mut out)?;
+        sphere_layout(&a, &surface, work, &metric, flow.as_ref(), &mut out)?;
     } else {
         let disk = if simply_connected && comp.boundary_loops == 1 {
             None
         } else {
             bar.0.set_message("cutting along canonical loops");
-            let d = match &lengths_lo {
-                Some(lo) => {
-                    let d =
-                        cut_disk_polished(work, &lengths, lo, work_positions, a.base, &mut bar)?;
-                    polish_report["refined"] = json!(d.refined_polish);
-                    d
-                }
-                None => cut_disk(work, &lengths, geometry, work_positions, a.base, &mut bar)?,
+            let d = if metric.is_double_double() {
+                let d = cut_disk_polished(work, &metric, work_positions, a.base, &mut bar)?;
+                polish_report["refined"] = json!(d.refined_polish);
+                d
+            } else {
+                cut_disk(work, &metric, geometry, work_positions, a.base, &mut bar)?
             };
             out["boundary_word"] = json!(d.polygon.word());
             out["base_vertex"] = json!(d.cut.base);
@@ -823,8 +806,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 &surface,
                 work,
                 disk.as_ref(),
-                &lengths,
-                lengths_lo.as_deref(),
+                &metric,
                 flow.as_ref(),
                 &mut out,
             )?,
@@ -833,8 +815,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 &surface,
                 work,
                 disk.as_ref(),
-                &lengths,
-                None,
+                &metric,
                 flow.as_ref(),
                 &mut out,
             )?,

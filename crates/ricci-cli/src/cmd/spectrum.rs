@@ -88,10 +88,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     let mut bar = spinner(a.json);
     let PolishedLengths {
-        geometry,
+        metric,
         mesh: own_mesh,
-        lengths,
-        lengths_lo,
         report: metric_report,
         polish: polish_report,
         ..
@@ -106,11 +104,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     )
     .map_err(|e| anyhow::anyhow!("{}: {}", a.mesh.display(), crate::util::sentence(&e)))?;
     let work = own_mesh.as_ref().unwrap_or(&surface.mesh);
+    let geometry = metric.geometry();
     let (abs, extra, word) = if geometry == Geometry::Euclidean {
         bar.0.set_message("cutting along canonical loops");
-        let disk = cut_disk(work, &lengths, geometry, None, a.base, &mut bar)?;
+        let disk = cut_disk(work, &metric, geometry, None, a.base, &mut bar)?;
         bar.0.set_message("layout, deck group and spectrum");
-        let l = layout::<Euclidean>(&disk.mesh, &disk.lengths, None)?;
+        let l = layout::<Euclidean>(&disk.mesh, &disk.metric, None)?;
         let g = deck_group::<Euclidean>(&l, &disk.polygon)?;
         let gens = g.named_generators();
         if gens.len() != 2 {
@@ -127,15 +126,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         // A compact fundamental domain grown from a central vertex (no canonical cut needed;
         // `ricci::analysis::spectrum::surface_spectrum`), searched with a tile budget.
         bar.0.set_message("compact fundamental domain and spectrum");
-        let (sp, dom) = surface_spectrum(
-            work,
-            &lengths,
-            lengths_lo.as_deref(),
-            a.base,
-            a.count,
-            2_000_000,
-        )
-        .map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?;
+        let (sp, dom) = surface_spectrum(work, &metric, a.base, a.count, 2_000_000)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?;
         (
             sp.lengths(),
             json!({"method": "compact fundamental domain", "complete_up_to": sp.complete_up_to,

@@ -759,21 +759,9 @@ pub fn surface_teichmuller(
         .map(|t| &t.simplicial.mesh)
         .unwrap_or(mesh);
     progress.report("cut", None, "cutting along canonical loops");
-    let disk = cut_disk_polished(
-        work,
-        &polished.lengths,
-        &polished.lengths_lo,
-        None,
-        opts.base,
-        progress,
-    )?;
+    let disk = cut_disk_polished(work, &polished.metric, None, opts.base, progress)?;
     progress.report("layout", None, "layout and deck group");
-    let lay = crate::layout::place::layout_dd::<Hyperbolic>(
-        &disk.mesh,
-        &disk.lengths,
-        Some(&disk.lengths_lo),
-        None,
-    )?;
+    let lay = crate::layout::place::layout_dd::<Hyperbolic>(&disk.mesh, &disk.metric, None)?;
     let deck = crate::layout::deck::deck_group::<Hyperbolic>(&lay, &disk.polygon)?;
     let mut marked = MarkedGroup::from_deck_group(&disk.polygon, &deck)?;
     let handle_moves = marked.reduce_handles();

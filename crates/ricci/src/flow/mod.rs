@@ -235,6 +235,12 @@ pub struct IntrinsicResult {
 }
 
 impl FlowResult {
+    /// The metric the flow reached (geometry and lengths, double precision), on the mesh the
+    /// lengths belong to (the input's, or `triangulation.simplicial.mesh`).
+    pub fn metric(&self) -> crate::metric::IntrinsicMetric {
+        crate::metric::IntrinsicMetric::new(self.geometry, self.lengths.clone())
+    }
+
     /// The metric file of this result on `mesh` (the mesh the flow ran on): the format read
     /// by [`crate::metric::file::read_metric_file`] — geometry, what the flow reached
     /// (`converged`, `max_curvature_error`, `degenerate_faces`), per-vertex `u`, `curvature`

@@ -38,7 +38,7 @@
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::metric::{ConformalStructure, Evaluator, Geometry, HessianPattern};
+use crate::metric::{ConformalStructure, Evaluator, Geometry, HessianPattern, IntrinsicMetric};
 use crate::numeric::dd::{Cdd, Dd};
 use crate::numeric::sparse::SymmetricSolver;
 
@@ -66,9 +66,9 @@ pub struct PolishedMetric {
     /// Variables `u` (leading parts) and their low parts.
     pub u: Vec<f64>,
     pub u_lo: Vec<f64>,
-    /// Edge lengths by edge id: `lengths[e] + lengths_lo[e]` to ~32 digits.
-    pub lengths: Vec<f64>,
-    pub lengths_lo: Vec<f64>,
+    /// The polished metric (H²): edge `e` has length `lengths[e] + lengths_lo[e]` to ~32
+    /// digits (the low parts are always present).
+    pub metric: IntrinsicMetric,
     /// Refinement steps taken.
     pub steps: usize,
     /// Max |K − K̄| over the free vertices in double-double at the start.
@@ -329,8 +329,11 @@ pub fn polish_metric(
     Ok(PolishedMetric {
         u: ud.iter().map(|x| x.hi).collect(),
         u_lo: ud.iter().map(|x| x.lo).collect(),
-        lengths: lengths.iter().map(|x| x.hi).collect(),
-        lengths_lo: lengths.iter().map(|x| x.lo).collect(),
+        metric: IntrinsicMetric::with_low_parts(
+            Geometry::Hyperbolic,
+            lengths.iter().map(|x| x.hi).collect(),
+            lengths.iter().map(|x| x.lo).collect(),
+        )?,
         steps,
         residual_start,
         residual_dd: err,

@@ -14,7 +14,7 @@
 //! the lengths of split and new edges in double precision, so the refined metric is polished
 //! once more, in place, by vertex scaling (`sinh(l/2) = e^{(ui+uj)/2} sinh(l⁰/2)` from the
 //! double-double lengths, target 0 on every vertex — new vertices are flat). The cut mesh
-//! then carries `lengths_lo`, which [`super::place::layout_dd`] uses. The deck maps computed
+//! then carries an [`IntrinsicMetric`] with low parts, which [`super::place::layout_dd`] uses. The deck maps computed
 //! from different edges of a side then agree to the double-double layout's own accuracy
 //! instead of ~κ·sinh r with κ ≈ 5e-15 (BENCHMARKS.md, Layout).
 
@@ -24,7 +24,7 @@ use crate::error::{Error, Result};
 use crate::flow::polish::{polish_metric, PolishSettings, PolishedMetric};
 use crate::flow::{flow_with_fallback, FlowResult, UniformizationOptions};
 use crate::mesh::Mesh;
-use crate::metric::{ConformalStructure, Geometry, Scheme};
+use crate::metric::{ConformalStructure, Geometry, IntrinsicMetric, Scheme};
 use crate::progress::Progress;
 
 pub use crate::flow::uniformize::uniformization_geometry;
@@ -50,11 +50,9 @@ pub fn uniformization_metric(
 pub struct CutDisk {
     /// The cut mesh (faces keep the ids of the refined mesh).
     pub mesh: Mesh,
-    /// Edge lengths of the cut mesh.
-    pub lengths: Vec<f64>,
-    /// Low parts of the lengths (double-double metric, [`cut_disk_polished`]); empty
-    /// otherwise.
-    pub lengths_lo: Vec<f64>,
+    /// The metric on the cut mesh (edge lengths by cut-mesh edge id), with low parts
+    /// (double-double) after [`cut_disk_polished`], without after [`cut_disk`].
+    pub metric: IntrinsicMetric,
     /// What the polish of the refined metric did ([`cut_disk_polished`]).
     pub refined_polish: Option<PolishReport>,
     /// For every cut-mesh vertex, the vertex of the (refined) surface it is a copy of.
@@ -85,10 +83,8 @@ pub fn cut_disk(
     let cut = canonical_cut(mesh, lengths, geometry, positions, &opts, progress)?;
     let refined = &cut.refined;
     let cm = cut.cut_mesh.clone();
-    let mut cl = vec![0.0; cm.n_edges()];
-    for h in 0..cm.n_corners() as u32 {
-        cl[cm.he_edge(h) as usize] = refined.lengths[refined.mesh.he_edge(h) as usize];
-    }
+    let metric =
+        IntrinsicMetric::new(geometry, refined.lengths.clone()).carried_to(&refined.mesh, &cm);
     let polygon = Polygon::from_labelled(
         cut.polygon
             .iter()
@@ -97,8 +93,7 @@ pub fn cut_disk(
     )?;
     Ok(CutDisk {
         mesh: cm,
-        lengths: cl,
-        lengths_lo: Vec::new(),
+        metric,
         refined_polish: None,
         vertex_origin: cut.cut_vertex_origin.clone(),
         polygon,
@@ -160,7 +155,7 @@ pub fn polish_uniformization(
             ));
         }
         let m = &t.simplicial.mesh;
-        return polish_lengths(m, &flow.lengths, &vec![0.0; m.n_edges()]);
+        return polish_lengths(m, &flow.metric());
     }
     let structure =
         ConformalStructure::new(mesh, lengths, flow.geometry, flow.scheme, flow.input_scale)?;
@@ -175,22 +170,29 @@ pub fn polish_uniformization(
     )
 }
 
-/// Polish a double-double hyperbolic metric with zero target curvature in place by vertex
-/// scaling (see the module docs); returns the polished lengths.
-pub fn polish_lengths(mesh: &Mesh, lengths: &[f64], lengths_lo: &[f64]) -> Result<PolishedMetric> {
+/// Polish a hyperbolic metric with zero target curvature (to double-double, or double
+/// precision: missing low parts are 0) in place by vertex scaling (see the module docs);
+/// returns the polished metric.
+pub fn polish_lengths(mesh: &Mesh, metric: &IntrinsicMetric) -> Result<PolishedMetric> {
     use crate::numeric::dd::Dd;
+    if metric.geometry() != Geometry::Hyperbolic {
+        return Err(Error::input(format!(
+            "only hyperbolic metrics are polished, this one is {}",
+            metric.geometry()
+        )));
+    }
     let ne = mesh.n_edges();
-    if lengths.len() != ne || lengths_lo.len() != ne {
+    if metric.len() != ne {
         return Err(Error::input(format!(
             "{} lengths and {} low parts for a mesh with {ne} edges",
-            lengths.len(),
-            lengths_lo.len()
+            metric.len(),
+            metric.lengths_lo().map_or(0, <[f64]>::len)
         )));
     }
     let mut eta = Vec::with_capacity(ne);
     let mut eta_lo = Vec::with_capacity(ne);
     for e in 0..ne {
-        let x = ((Dd::new(lengths[e]) + Dd::new(lengths_lo[e])) * Dd::new(0.5)).sinh();
+        let x = (metric.length_dd(e) * Dd::new(0.5)).sinh();
         eta.push(x.hi);
         eta_lo.push(x.lo);
     }
@@ -215,28 +217,33 @@ pub fn polish_lengths(mesh: &Mesh, lengths: &[f64], lengths_lo: &[f64]) -> Resul
     )
 }
 
-/// [`cut_disk`] for a double-double H² metric with zero target curvature (`lengths` +
-/// `lengths_lo`, e.g. from [`polish_uniformization`]): the cut runs on the leading parts;
+/// [`cut_disk`] for a double-double H² metric with zero target curvature (e.g. the `metric`
+/// of [`polish_uniformization`]; missing low parts are 0): the cut runs on the leading parts;
 /// edges of the input keep their low parts, and when the cut refined the mesh, the refined
 /// metric is polished in place ([`polish_lengths`]) before it is carried to the cut mesh.
 pub fn cut_disk_polished(
     mesh: &Mesh,
-    lengths: &[f64],
-    lengths_lo: &[f64],
+    metric: &IntrinsicMetric,
     positions: Option<&[[f64; 3]]>,
     base: Option<u32>,
     progress: &mut dyn Progress,
 ) -> Result<CutDisk> {
-    if lengths_lo.len() != mesh.n_edges() {
+    if metric.geometry() != Geometry::Hyperbolic {
+        return Err(Error::input(format!(
+            "only hyperbolic metrics are cut in double-double, this one is {}",
+            metric.geometry()
+        )));
+    }
+    if metric.len() != mesh.n_edges() {
         return Err(Error::input(format!(
             "{} low parts of lengths for a mesh with {} edges",
-            lengths_lo.len(),
+            metric.len(),
             mesh.n_edges()
         )));
     }
     let mut disk = cut_disk(
         mesh,
-        lengths,
+        metric,
         Geometry::Hyperbolic,
         positions,
         base,
@@ -251,33 +258,26 @@ pub fn cut_disk_polished(
         if a < nv0 && b < nv0 {
             if let Some(h) = mesh.halfedge_between(a, b) {
                 let e0 = mesh.he_edge(h) as usize;
-                if lengths[e0] == refined.lengths[e] {
-                    *lo = lengths_lo[e0];
+                if metric[e0] == refined.lengths[e] {
+                    *lo = metric.low_part(e0);
                 }
             }
         }
     }
-    let (rl, rlo) = if refined.splits() > 0 {
+    let refined_metric =
+        IntrinsicMetric::with_low_parts(Geometry::Hyperbolic, refined.lengths.clone(), rlo)?;
+    let refined_metric = if refined.splits() > 0 {
         progress.report(
             "polish",
             None,
             "polishing the refined metric in double-double",
         );
-        let p = polish_lengths(rm, &refined.lengths, &rlo)?;
+        let p = polish_lengths(rm, &refined_metric)?;
         disk.refined_polish = Some(PolishReport::from(&p));
-        (p.lengths, p.lengths_lo)
+        p.metric
     } else {
-        (refined.lengths.clone(), rlo)
+        refined_metric
     };
-    let cm = &disk.mesh;
-    let mut cl = vec![0.0; cm.n_edges()];
-    let mut cl_lo = vec![0.0; cm.n_edges()];
-    for h in 0..cm.n_corners() as u32 {
-        let e = rm.he_edge(h) as usize;
-        cl[cm.he_edge(h) as usize] = rl[e];
-        cl_lo[cm.he_edge(h) as usize] = rlo[e];
-    }
-    disk.lengths = cl;
-    disk.lengths_lo = cl_lo;
+    disk.metric = refined_metric.carried_to(rm, &disk.mesh);
     Ok(disk)
 }

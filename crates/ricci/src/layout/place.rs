@@ -25,7 +25,7 @@
 //! come from the lengths in double-double ([`Space::seed_ext`]: `tanh(l/2)` and the half-angle
 //! tangent of the cosine law) and the relative placement maps the shared edge of two
 //! canonical triangles onto each other in double-double ([`Space::relative`]). Lengths can be
-//! given to double-double precision ([`layout_dd`], `lengths_lo`; the metric polished by
+//! given to double-double precision ([`layout_dd`], an [`IntrinsicMetric`]; the metric polished by
 //! [`crate::flow::polish`]); [`layout`] is `layout_dd` with zero low parts. Positions are kept
 //! in double-double ([`Layout::positions_lo`]), and the measurements (orientation, length
 //! error, radius) use them. With the flow's metric
@@ -49,7 +49,7 @@ use super::isometry::{
 };
 use crate::error::{Error, Result};
 use crate::mesh::{topology, Mesh, NONE};
-use crate::metric::geometry::{Background, Euclidean, Geometry, Hyperbolic, Spherical};
+use crate::metric::{Background, Euclidean, Geometry, Hyperbolic, IntrinsicMetric, Spherical};
 use crate::numeric::dd::Cdd;
 use std::collections::VecDeque;
 
@@ -559,16 +559,31 @@ pub fn layout<S: Space>(
     lengths: &[f64],
     seed_face: Option<u32>,
 ) -> Result<Layout<S::Point>> {
-    layout_dd::<S>(mesh, lengths, None, seed_face)
+    layout_parts::<S>(mesh, lengths, None, seed_face)
 }
 
-/// [`layout`] for a metric given to double-double precision: edge `e` has length
-/// `lengths[e] + lengths_lo[e]` (e.g. [`super::pipeline::cut_disk_polished`]). The low parts
-/// enter the canonical triangles of the faces in the working precision of the space
-/// ([`Space::seed_ext`]: double-double in H²; E² and S² ignore them). `None` is [`layout`].
+/// [`layout`] for an [`IntrinsicMetric`] of `S`'s geometry; its low parts, where present
+/// (e.g. [`super::pipeline::cut_disk_polished`]), enter the canonical triangles in the working
+/// precision of the space ([`Space::seed_ext`]: double-double in H²; E² and S² ignore them).
 ///
-/// Errors: as [`layout`], and low parts that are not finite or not one per edge.
+/// Errors: as [`layout`], a metric of another geometry, low parts that are not finite.
 pub fn layout_dd<S: Space>(
+    mesh: &Mesh,
+    metric: &IntrinsicMetric,
+    seed_face: Option<u32>,
+) -> Result<Layout<S::Point>> {
+    if metric.geometry() != S::KIND {
+        return Err(Error::input(format!(
+            "a {} metric cannot be laid out in the {} model space",
+            metric.geometry().name(),
+            S::KIND.name()
+        )));
+    }
+    layout_parts::<S>(mesh, metric, metric.lengths_lo(), seed_face)
+}
+
+/// [`layout`] with optional low parts (one per edge, as an [`IntrinsicMetric`] guarantees).
+fn layout_parts<S: Space>(
     mesh: &Mesh,
     lengths: &[f64],
     lengths_lo: Option<&[f64]>,
@@ -576,13 +591,6 @@ pub fn layout_dd<S: Space>(
 ) -> Result<Layout<S::Point>> {
     check_lengths(mesh, lengths, S::KIND)?;
     if let Some(lo) = lengths_lo {
-        if lo.len() != mesh.n_edges() {
-            return Err(Error::input(format!(
-                "{} low parts of edge lengths given for a mesh with {} edges",
-                lo.len(),
-                mesh.n_edges()
-            )));
-        }
         if let Some(e) = lo.iter().position(|x| !x.is_finite()) {
             let (edge, value) = (e as u32, lo[e]);
             return Err(LayoutError::InvalidLowPart { edge, value }.into());

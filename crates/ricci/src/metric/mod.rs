@@ -5,6 +5,8 @@
 //! * [`scheme`] — Thurston / tangential / inversive distance circle packings and vertex scaling;
 //! * [`conformal`] — the initial conformal structure built from a mesh's edge lengths;
 //! * [`kernel`] — the allocation-free evaluation of lengths, angles, curvature and Hessian;
+//! * [`lengths`] — [`IntrinsicMetric`]: geometry + edge lengths (+ their double-double tail),
+//!   the metric the flow produces and the cut, layout, atlas and spline consume;
 //! * [`file`] — the metric file (`METRIC.json`): one reader and writer for every command;
 //! * [`intrinsic`] — intrinsic (Δ-complex) triangulations with log Penner coordinates, Ptolemy
 //!   flips and the Penner Delaunay criterion (discrete conformal equivalence);
@@ -29,6 +31,7 @@ pub mod file;
 pub mod geometry;
 pub mod intrinsic;
 pub mod kernel;
+pub mod lengths;
 pub mod refine;
 pub mod scheme;
 
@@ -36,6 +39,7 @@ pub use conformal::ConformalStructure;
 pub use error::MetricError;
 pub use geometry::{Background, Euclidean, Geometry, Hyperbolic, Spherical};
 pub use kernel::{HessianPattern, MeshData, Workspace};
+pub use lengths::IntrinsicMetric;
 pub use scheme::{CirclePacking, Law, Scheme, VertexScaling};
 
 use crate::mesh::Mesh;

@@ -21,7 +21,7 @@ pub fn layout(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     let mut sec = Section::new("layout", "", "");
     let d = ctx.disk.as_ref().ok_or_else(|| anyhow::anyhow!("no cut"))?;
     env.bar.step("layout in the Poincaré disk");
-    let l = place::<Hyperbolic>(&d.mesh, &d.lengths, None)?;
+    let l = place::<Hyperbolic>(&d.mesh, &d.metric, None)?;
     env.bar.step("deck group");
     let g = deck_group::<Hyperbolic>(&l, &d.polygon)?;
     let relation_error = g

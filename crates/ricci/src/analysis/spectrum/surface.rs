@@ -135,7 +135,7 @@ impl BallCover {
 }
 
 /// Length spectrum of a closed hyperbolic surface given by a triangulation with a hyperbolic
-/// metric (`lengths` + optional double-double low parts `lengths_lo`, curvature 0 at every
+/// metric (`metric`, H², with or without double-double low parts, curvature 0 at every
 /// vertex; `centre`: the vertex the domain grows from, default a central one), through a **compact fundamental domain** instead of the canonical polygon.
 ///
 /// The domain `F` is the development of the surface along a spanning tree of the dual graph
@@ -175,14 +175,21 @@ impl BallCover {
 /// is an error that says so.
 pub fn surface_spectrum(
     mesh: &crate::mesh::Mesh,
-    lengths: &[f64],
-    lengths_lo: Option<&[f64]>,
+    metric: &crate::metric::IntrinsicMetric,
     centre: Option<u32>,
     count: usize,
     max_tiles: usize,
 ) -> Result<(HyperbolicSpectrum, CompactDomain)> {
     let ne = mesh.n_edges();
-    if lengths.len() != ne || lengths_lo.is_some_and(|l| l.len() != ne) {
+    let lengths = metric.lengths();
+    if metric.geometry() != crate::metric::Geometry::Hyperbolic {
+        return Err(Error::input(format!(
+            "the length spectrum of a surface is computed from a hyperbolic metric, this one is \
+             {}",
+            metric.geometry()
+        )));
+    }
+    if lengths.len() != ne {
         return Err(Error::input(format!(
             "{} edge lengths for a mesh with {ne} edges",
             lengths.len()
@@ -204,7 +211,7 @@ pub fn surface_spectrum(
         None => crate::cut::central_vertex(mesh, lengths)?,
     };
     let (seed, crossed) = grow_domain(mesh, lengths, o)?;
-    let dom = DomainPairings::new(mesh, lengths, lengths_lo, o, seed, &crossed)?;
+    let dom = DomainPairings::new(mesh, metric, o, seed, &crossed)?;
     let max_edge = lengths.iter().copied().fold(0.0, f64::max);
     let cover = BallCover::of_points(&dom.positions, dom.centre, 1.0, max_edge, 400);
     let radius = cover.radius;
@@ -349,8 +356,7 @@ impl DomainPairings {
     /// copy, reversed.
     fn new(
         mesh: &crate::mesh::Mesh,
-        lengths: &[f64],
-        lengths_lo: Option<&[f64]>,
+        metric: &crate::metric::IntrinsicMetric,
         o: u32,
         seed: u32,
         crossed: &[bool],
@@ -360,14 +366,7 @@ impl DomainPairings {
         use crate::numeric::dd::Cdd;
         let cut: Vec<bool> = crossed.iter().map(|&c| !c).collect();
         let (cm, origin) = crate::cut::slice(mesh, &cut)?;
-        let mut cl = vec![0.0; cm.n_edges()];
-        let mut cl_lo = vec![0.0; cm.n_edges()];
-        for h in 0..cm.n_corners() as u32 {
-            let e = mesh.he_edge(h) as usize;
-            cl[cm.he_edge(h) as usize] = lengths[e];
-            cl_lo[cm.he_edge(h) as usize] = lengths_lo.map_or(0.0, |l| l[e]);
-        }
-        let lay = layout_dd::<Hyperbolic>(&cm, &cl, Some(&cl_lo), Some(seed))?;
+        let lay = layout_dd::<Hyperbolic>(&cm, &metric.carried_to(mesh, &cm), Some(seed))?;
         if !lay.flipped_faces.is_empty() {
             return Err(Error::numerical(format!(
                 "the compact fundamental domain has {} flipped faces (face {}); is the metric \

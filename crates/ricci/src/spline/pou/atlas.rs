@@ -236,16 +236,8 @@ impl HyperbolicAtlas {
         progress.report("polish", None, "metric to double-double");
         let pol = polish_uniformization(mesh, &input, &flow)?;
         progress.report("cut", None, "canonical cut and fundamental domain");
-        let disk = cut_disk_polished(
-            mesh,
-            &pol.lengths,
-            &pol.lengths_lo,
-            Some(&surface.positions),
-            None,
-            progress,
-        )?;
-        let layout =
-            layout_dd::<Hyperbolic>(&disk.mesh, &disk.lengths, Some(&disk.lengths_lo), None)?;
+        let disk = cut_disk_polished(mesh, &pol.metric, Some(&surface.positions), None, progress)?;
+        let layout = layout_dd::<Hyperbolic>(&disk.mesh, &disk.metric, None)?;
         if !layout.flipped_faces.is_empty() {
             return Err(Error::numerical(format!(
                 "the layout of the fundamental domain flipped {} faces (first: face {})",
@@ -259,7 +251,7 @@ impl HyperbolicAtlas {
         let cm = disk.mesh.clone();
         let mut lengths = vec![0.0; rm.n_edges()];
         for h in 0..rm.n_corners() as u32 {
-            lengths[rm.he_edge(h) as usize] = disk.lengths[cm.he_edge(h) as usize];
+            lengths[rm.he_edge(h) as usize] = disk.metric[cm.he_edge(h) as usize];
         }
         let positions = refined
             .positions

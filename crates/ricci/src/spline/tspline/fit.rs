@@ -501,7 +501,7 @@ pub fn flat_torus_domain(
         .map(|t| t.simplicial.mesh.clone())
         .unwrap_or_else(|| surface.mesh.clone());
     let disk = cut_disk(&work, &r.lengths, Geometry::Euclidean, None, None, progress)?;
-    let l = layout::<Euclidean>(&disk.mesh, &disk.lengths, None)?;
+    let l = layout::<Euclidean>(&disk.mesh, &disk.metric, None)?;
     let g = deck_group::<Euclidean>(&l, &disk.polygon)?;
     let gens = g.named_generators();
     if gens.len() != 2 {
