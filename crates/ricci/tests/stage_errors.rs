@@ -177,3 +177,160 @@ fn layout_errors_name_the_edge_and_the_seed_face() {
     // A stage error is not mistaken for another stage's.
     assert!(e.stage_error::<FlowError>().is_none());
 }
+
+/// The atlas's cone checks (Step 1) name the vertex, and carry the sum and χ of a
+/// Gauss–Bonnet violation; every expected value comes from the list given or the mesh.
+#[test]
+fn atlas_errors_name_the_cone_vertex() {
+    use ricci::atlas::{AffineAtlas, AtlasError, AtlasOptions, Singularity};
+    let s = generate::genus(2, 16).unwrap();
+    let m = &s.mesh;
+    let n = m.n_vertices();
+    let chi = n as i64 - m.n_edges() as i64 + m.n_faces() as i64;
+    assert_eq!(chi, -2);
+    let kappa = 2.0 * PI * chi as f64;
+    let build = |cones: Vec<(u32, f64)>| {
+        let options = AtlasOptions {
+            cones: Some(cones),
+            ..AtlasOptions::default()
+        };
+        AffineAtlas::build(&s, &options, &mut NoProgress).unwrap_err()
+    };
+    // A vertex past the end.
+    let e = build(vec![(n as u32 + 3, kappa)]);
+    assert_eq!(
+        e.stage_error::<AtlasError>(),
+        Some(&AtlasError::VertexMissing {
+            role: "cone",
+            vertex: n as u32 + 3,
+            n_vertices: n
+        })
+    );
+    assert_eq!(e.kind(), Some(Kind::InvalidInput));
+    // A cone angle 2π − 7 < 0.
+    let e = build(vec![(4, 7.0), (5, kappa - 7.0)]);
+    assert_eq!(
+        e.stage_error::<AtlasError>(),
+        Some(&AtlasError::NoConeAngle {
+            vertex: 4,
+            curvature: 7.0
+        })
+    );
+    // Σ K̄ = 1 ≠ 2πχ.
+    let e = build(vec![(4, 1.0)]);
+    assert_eq!(
+        e.stage_error::<AtlasError>(),
+        Some(&AtlasError::GaussBonnet {
+            sum: 1.0,
+            euler_characteristic: chi
+        })
+    );
+    // The same vertex twice (the sum is right).
+    let e = build(vec![(9, kappa / 2.0), (9, kappa / 2.0)]);
+    assert_eq!(
+        e.stage_error::<AtlasError>(),
+        Some(&AtlasError::ConeListedTwice { vertex: 9 })
+    );
+    assert_eq!(e.stage_error::<AtlasError>().unwrap().vertex(), Some(9));
+    // A singular vertex on a torus, whose flat metric has none.
+    let t = generate::genus(1, 16).unwrap();
+    let options = AtlasOptions {
+        singularity: Singularity::Vertex(2),
+        ..AtlasOptions::default()
+    };
+    let e = AffineAtlas::build(&t, &options, &mut NoProgress).unwrap_err();
+    assert_eq!(
+        e.stage_error::<AtlasError>(),
+        Some(&AtlasError::SingularVertexNotNeeded {
+            vertex: 2,
+            genus_one: true
+        })
+    );
+    assert!(e.to_string().contains("genus-1"), "{e}");
+    // And on a disk (open surface).
+    let d = generate::disk(8).unwrap();
+    let e = AffineAtlas::build(&d, &options, &mut NoProgress).unwrap_err();
+    assert_eq!(
+        e.stage_error::<AtlasError>(),
+        Some(&AtlasError::SingularVertexNotNeeded {
+            vertex: 2,
+            genus_one: false
+        })
+    );
+    assert!(e.stage_error::<FlowError>().is_none());
+}
+
+/// The spline's parameter checks carry the parameter given: a degree above the largest
+/// supported one, a knot spread outside (0, 0.45], a fairness parameter r ≥ n.
+#[test]
+fn spline_errors_carry_the_parameter() {
+    use ricci::spline::dms::{DmsSpace, Domain, KnotClouds, KnotOptions, MAX_DEGREE};
+    use ricci::spline::fit::fairness_constraints;
+    use ricci::spline::SplineError;
+    let dom = Domain::new(
+        vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+    .unwrap();
+    let degree = MAX_DEGREE + 3;
+    let e = KnotClouds::place(&dom, degree, &KnotOptions::default()).unwrap_err();
+    assert_eq!(
+        e.stage_error::<SplineError>(),
+        Some(&SplineError::DegreeUnsupported {
+            spline: "DMS",
+            degree,
+            min: 1,
+            max: MAX_DEGREE
+        })
+    );
+    assert_eq!(e.kind(), Some(Kind::InvalidInput));
+    let spread = 0.9;
+    let opts = KnotOptions {
+        spread,
+        ..KnotOptions::default()
+    };
+    let e = KnotClouds::place(&dom, 3, &opts).unwrap_err();
+    assert_eq!(
+        e.stage_error::<SplineError>(),
+        Some(&SplineError::KnotSpread { spread })
+    );
+    let space = DmsSpace::with_placed_knots(dom, 3, &KnotOptions::default()).unwrap();
+    let e = fairness_constraints(&space, 3).unwrap_err();
+    assert_eq!(
+        e.stage_error::<SplineError>(),
+        Some(&SplineError::FairnessOutOfRange { r: 3, degree: 3 })
+    );
+    assert!(e.to_string().contains("n − 1 = 2"), "{e}");
+}
+
+/// A manifold spline is not defined on the faces around its extraordinary point: evaluating
+/// there names the face, which is read off the mesh (a face incident to the cone vertex).
+#[test]
+fn a_manifold_spline_names_a_face_of_its_hole() {
+    use ricci::atlas::FlatCharts;
+    use ricci::spline::dms::{KnotOptions, Workspace};
+    use ricci::spline::manifold::ManifoldSpace;
+    use ricci::spline::surface::{flat_domain, Singularity};
+    use ricci::spline::SplineError;
+    let s = generate::genus(2, 16).unwrap();
+    let m = &s.mesh;
+    let v = (0..m.n_vertices() as u32)
+        .max_by_key(|&v| (m.valence(v), std::cmp::Reverse(v)))
+        .unwrap();
+    let dom = flat_domain(&s, Singularity::Vertex(v), &mut NoProgress).unwrap();
+    assert_eq!(dom.singular, Some(v));
+    let space = ManifoldSpace::new(&dom.charts, 3, &KnotOptions::default()).unwrap();
+    let cm = dom.charts.mesh();
+    let face = (0..cm.n_faces() as u32)
+        .find(|&f| cm.face(f).contains(&v))
+        .unwrap();
+    let mut ws = Workspace::default();
+    let e = space
+        .basis_at_bary(face, [1.0 / 3.0; 3], 0, &mut ws)
+        .unwrap_err();
+    assert_eq!(
+        e.stage_error::<SplineError>(),
+        Some(&SplineError::FaceInHole { face })
+    );
+    assert_eq!(e.kind(), Some(Kind::InvalidInput));
+}

@@ -3,6 +3,7 @@
 //! canonical cut (Step 2, Step 4's cut), the flat metric (Step 3), the segmentation into a
 //! disk with its central chart (Step 4–5), then the cover ([`super::cover`]).
 
+use super::error::AtlasError;
 use super::valence::{flip_ring_valence, raise_ring_valence, rings_around, RingValenceWork};
 use super::{
     area_distortion, flat_flow, placement, AffineAtlas, AtlasOptions, AtlasReport, Chart,
@@ -10,7 +11,7 @@ use super::{
 };
 use crate::cut::{canonical_cut, CanonicalCut, CutOptions};
 use crate::error::{Error, Result};
-use crate::flow::{FlowResult, TargetSpec};
+use crate::flow::{FlowError, FlowResult, TargetSpec};
 use crate::layout::place::layout;
 use crate::mesh::{topology, Mesh, Surface, NONE};
 use crate::metric::refine::{Refined, Refiner};
@@ -190,17 +191,18 @@ fn choose_cones(
 ) -> Result<Cones> {
     let mesh = &surface.mesh;
     let chi = 2 - 2 * genus - nb as i64;
-    let check_vertex = |v: u32, what: &str| -> Result<()> {
-        if v as usize >= mesh.n_vertices() {
-            return Err(Error::input(format!(
-                "{what} vertex {v} does not exist (the mesh has {} vertices)",
-                mesh.n_vertices()
-            )));
+    let check_vertex = |vertex: u32, role: &'static str| -> Result<()> {
+        if vertex as usize >= mesh.n_vertices() {
+            let n_vertices = mesh.n_vertices();
+            return Err(AtlasError::VertexMissing {
+                role,
+                vertex,
+                n_vertices,
+            }
+            .into());
         }
-        if mesh.is_boundary_vertex(v) {
-            return Err(Error::input(format!(
-                "{what} vertex {v} lies on the boundary; cones must be interior vertices"
-            )));
+        if mesh.is_boundary_vertex(vertex) {
+            return Err(AtlasError::VertexOnBoundary { role, vertex }.into());
         }
         Ok(())
     };
@@ -215,43 +217,37 @@ fn choose_cones(
         for &(v, k) in list {
             check_vertex(v, "cone")?;
             if !(k.is_finite() && k < 2.0 * PI) {
-                return Err(Error::input(format!(
-                    "cone vertex {v} asks for curvature {k:.6}; a cone angle 2π − K̄ must be \
-                     positive, so K̄ < 2π"
-                )));
+                let (vertex, curvature) = (v, k);
+                return Err(AtlasError::NoConeAngle { vertex, curvature }.into());
             }
         }
         let sum: f64 = list.iter().map(|c| c.1).sum();
         if (sum - 2.0 * PI * chi as f64).abs() > 1e-9 {
-            return Err(Error::input(format!(
-                "the cone curvatures sum to {sum:.6} but Gauss–Bonnet needs 2πχ = {:.6} \
-                 (χ = {chi}); off by {:.3e}",
-                2.0 * PI * chi as f64,
-                sum - 2.0 * PI * chi as f64
-            )));
+            let euler_characteristic = chi;
+            return Err(AtlasError::GaussBonnet {
+                sum,
+                euler_characteristic,
+            }
+            .into());
         }
         let mut seen = HashSet::new();
         for &(v, _) in list {
             if !seen.insert(v) {
-                return Err(Error::input(format!("cone vertex {v} is listed twice")));
+                return Err(AtlasError::ConeListedTwice { vertex: v }.into());
             }
         }
         let l: Vec<(u32, f64)> = list.iter().copied().filter(|c| c.1 != 0.0).collect();
         (l, "cones")
     } else if nb > 0 {
-        if let Singularity::Vertex(v) = options.singularity {
-            return Err(Error::input(format!(
-                "an open surface needs no singular vertex (its curvature goes to the \
-                 boundary), but vertex {v} was given"
-            )));
+        if let Singularity::Vertex(vertex) = options.singularity {
+            let genus_one = false;
+            return Err(AtlasError::SingularVertexNotNeeded { vertex, genus_one }.into());
         }
         (Vec::new(), "free-boundary")
     } else if genus == 1 {
-        if let Singularity::Vertex(v) = options.singularity {
-            return Err(Error::input(format!(
-                "a closed genus-1 surface has a flat metric without singular points, but \
-                 vertex {v} was given"
-            )));
+        if let Singularity::Vertex(vertex) = options.singularity {
+            let genus_one = true;
+            return Err(AtlasError::SingularVertexNotNeeded { vertex, genus_one }.into());
         }
         (Vec::new(), "uniform")
     } else if genus == 0 {
@@ -417,9 +413,16 @@ fn flat_metric(
         // Thurston's Chow–Luo bound uses its clamped intersection angles φ ≤ π/2, so it
         // can refuse at a valence-4 vertex made by the refinement (all four φ = π/2, by
         // exactly 0) what the φ = 0 bound of inversive distance admits.
-        Err(Error::InvalidInput { message })
-            if message.contains("Chow–Luo") && options.scheme == Scheme::Thurston =>
+        // (The refusal is a `FlowError::ChowLuo` since the stage enums; matching the former
+        // `Error::InvalidInput` left this fallback dead.)
+        Err(e)
+            if options.scheme == Scheme::Thurston
+                && matches!(
+                    e.stage_error::<FlowError>(),
+                    Some(FlowError::ChowLuo { .. })
+                ) =>
         {
+            let message = e.to_string();
             let (f, s, mut n) =
                 flat_flow(rmesh, input, target, Scheme::Inversive, options.tolerance)?;
             n.insert(
@@ -544,9 +547,7 @@ fn add_slits(
             |_, v| on_cut[v as usize],
         );
         let Some(hit) = hit else {
-            return Err(Error::topology(format!(
-                "cone vertex {target} cannot be joined to the cut graph"
-            )));
+            return Err(AtlasError::ConeNotJoined { vertex: target }.into());
         };
         let mut v = hit;
         while v != target {

@@ -5,9 +5,10 @@
 //! towards a cone whose home chart is too large for them ([`super::LOCAL_CHART_CONDITIONING`]).
 //! Every chart is validated (lengths reproduced, no flipped face) when it is added.
 
+use super::error::AtlasError;
 use super::{develop, AffineAtlas, Chart, ChartId, ChartReport, FlatCharts};
 use super::{LOCAL_CHART_CONDITIONING, LOCAL_CHART_RINGS};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::mesh::NONE;
 use crate::progress::Progress;
 use std::collections::VecDeque;
@@ -152,10 +153,7 @@ impl AffineAtlas {
                 homed = self.try_chart(&[seed], seed, &remaining, tol);
             }
             if homed.is_empty() {
-                return Err(Error::numerical(format!(
-                    "face {seed}: its neighbourhood does not develop consistently into the \
-                     plane (is the metric flat there?)"
-                )));
+                return Err(AtlasError::ChartNotFlat { face: seed }.into());
             }
             for f in homed {
                 remaining[f as usize] = false;

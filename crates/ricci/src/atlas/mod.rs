@@ -54,13 +54,15 @@
 //! The stages live in their own files: [`AffineAtlas::build`] and the segmentation in
 //! `build.rs`, the flat metric with its scheme fallback in `flat.rs` ([`flat_flow`]), the
 //! valence surgery in `valence.rs` ([`raise_ring_valence`], [`flip_ring_valence`]), the cover
-//! by charts in `cover.rs`, the area distortion in `distortion.rs` ([`area_distortion`]).
+//! by charts in `cover.rs`, the area distortion in `distortion.rs` ([`area_distortion`]); the
+//! stage's errors that name a vertex or face in `error.rs` ([`AtlasError`]).
 
 mod build;
 pub mod charts;
 mod cover;
 pub mod develop;
 mod distortion;
+pub mod error;
 mod flat;
 mod overview;
 pub mod placement;
@@ -68,6 +70,7 @@ mod valence;
 
 pub use charts::{fit_rigid, ChartId, FlatCharts};
 pub use distortion::area_distortion;
+pub use error::AtlasError;
 pub use flat::{flat_flow, flat_flow_limited, FlatFlow};
 pub use placement::{Placement, PlacementOptions};
 pub use valence::{flip_ring_valence, raise_ring_valence, RingValenceWork};

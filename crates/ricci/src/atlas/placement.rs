@@ -29,6 +29,7 @@
 //!   candidates, Newton work in all; [`PlacementOptions`]), so a mesh where no candidate
 //!   converges is refused in bounded time with one sentence saying what was tried.
 
+use super::error::AtlasError;
 use super::AtlasOptions;
 use crate::error::{Error, Result};
 use crate::flow::TargetSpec;
@@ -523,10 +524,8 @@ pub fn measured_distortion(
     )
     .map(|c| c.distortion)
     .map_err(|e| {
-        Error::numerical(format!(
-            "the single-cone flow at vertex {v} did not converge ({})",
-            e.reason
-        ))
+        let (vertex, reason) = (v, e.reason);
+        AtlasError::SingleConeNotConverged { vertex, reason }.into()
     })
 }
 

@@ -84,6 +84,7 @@ use crate::error::{Error, Result};
 use crate::layout::RigidMotion;
 use crate::mesh::Mesh;
 use crate::numeric::dd::Dd;
+use crate::spline::error::SplineError;
 
 use super::dms::combine;
 use super::dms::{
@@ -213,9 +214,7 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
             )));
         }
         if !self.active[g as usize] {
-            return Err(Error::input(format!(
-                "manifold spline evaluation in face {g}: the face is incident to a singular vertex (the hole of the spline)"
-            )));
+            return Err(SplineError::FaceInHole { face: g }.into());
         }
         Ok(())
     }

@@ -20,11 +20,13 @@
 //!   extraordinary points;
 //! * [`surface`] — the whole construction (subdivision, fairing, fit, fill), tessellation,
 //!   errors against the input mesh and continuity measurements.
+//! * [`error`] — [`SplineError`], the errors that name a parameter, vertex or face.
 
 // Negated comparisons are deliberate: they also reject NaN. Index loops mirror the formulas.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
 pub mod dms;
+pub mod error;
 pub mod fit;
 pub mod hole;
 pub mod manifold;
@@ -35,3 +37,5 @@ pub mod simplex;
 pub mod space;
 pub mod surface;
 pub mod tspline;
+
+pub use error::SplineError;

@@ -3,6 +3,7 @@
 //! (general position, thin `Δ_β`, small `Ω_I`).
 
 use super::*;
+use crate::spline::error::SplineError;
 
 /// How [`KnotClouds::place`] puts the knots.
 #[derive(Debug, Clone, Copy)]
@@ -48,9 +49,13 @@ impl KnotClouds {
     /// must be the vertex itself (checked by [`DmsSpace::new`]).
     pub fn new(degree: usize, knots: Vec<Point>) -> Result<KnotClouds> {
         if !(1..=MAX_DEGREE).contains(&degree) {
-            return Err(Error::input(format!(
-                "DMS spline degree {degree} is not supported (1..={MAX_DEGREE})"
-            )));
+            return Err(SplineError::DegreeUnsupported {
+                spline: "DMS",
+                degree,
+                min: 1,
+                max: MAX_DEGREE,
+            }
+            .into());
         }
         if !knots.len().is_multiple_of(degree + 1) {
             return Err(Error::input(format!(
@@ -74,15 +79,19 @@ impl KnotClouds {
     /// are shrunk by 0.7 and re-optimised.
     pub fn place(domain: &Domain, degree: usize, opts: &KnotOptions) -> Result<KnotClouds> {
         if !(1..=MAX_DEGREE).contains(&degree) {
-            return Err(Error::input(format!(
-                "DMS spline degree {degree} is not supported (1..={MAX_DEGREE})"
-            )));
+            return Err(SplineError::DegreeUnsupported {
+                spline: "DMS",
+                degree,
+                min: 1,
+                max: MAX_DEGREE,
+            }
+            .into());
         }
         if !(opts.spread > 0.0 && opts.spread <= 0.45) {
-            return Err(Error::input(format!(
-                "knot spread {} is outside (0, 0.45]",
-                opts.spread
-            )));
+            return Err(SplineError::KnotSpread {
+                spread: opts.spread,
+            }
+            .into());
         }
         let mesh = domain.mesh();
         let nv = mesh.n_vertices();

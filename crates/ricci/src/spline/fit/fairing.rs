@@ -9,6 +9,7 @@ use faer::Mat;
 
 use crate::error::{Error, Result};
 use crate::numeric::sparse::Cholesky;
+use crate::spline::error::SplineError;
 
 use super::super::dms::multi_indices;
 use super::SplineSpace;
@@ -32,10 +33,7 @@ pub fn fairness_constraints<S: SplineSpace + ?Sized>(
 ) -> Result<Vec<Constraint>> {
     let n = space.degree();
     if r >= n {
-        return Err(Error::input(format!(
-            "fairness parameter r = {r} must be between 0 and n − 1 = {}",
-            n - 1
-        )));
+        return Err(SplineError::FairnessOutOfRange { r, degree: n }.into());
     }
     let nb = space.per_triangle();
     let mut out = Vec::new();

@@ -4,6 +4,7 @@
 //! triangles of every face.
 
 use super::*;
+use crate::spline::error::SplineError;
 
 /// Knot placement in vertex frames (module docs).
 struct Placement<'m> {
@@ -75,15 +76,19 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         let lengths = charts.lengths();
         let n = degree;
         if !(2..=MAX_DEGREE).contains(&n) {
-            return Err(Error::input(format!(
-                "manifold spline degree {n} is not supported (2..={MAX_DEGREE})"
-            )));
+            return Err(SplineError::DegreeUnsupported {
+                spline: "manifold",
+                degree: n,
+                min: 2,
+                max: MAX_DEGREE,
+            }
+            .into());
         }
         if !(opts.spread > 0.0 && opts.spread <= 0.45) {
-            return Err(Error::input(format!(
-                "knot spread {} is outside (0, 0.45]",
-                opts.spread
-            )));
+            return Err(SplineError::KnotSpread {
+                spread: opts.spread,
+            }
+            .into());
         }
         check_metric(mesh, lengths)?;
         let nf = mesh.n_faces();
@@ -164,9 +169,8 @@ fn active_faces<A: FlatCharts + Sync + ?Sized>(charts: &A) -> Result<(Vec<bool>,
     let mut is_sing = vec![false; nv];
     for &s in charts.singular_vertices() {
         if s as usize >= nv {
-            return Err(Error::input(format!(
-                "manifold spline: singular vertex {s} does not exist"
-            )));
+            let (vertex, n_vertices) = (s, nv);
+            return Err(SplineError::SingularVertexMissing { vertex, n_vertices }.into());
         }
         is_sing[s as usize] = true;
     }
@@ -295,9 +299,7 @@ fn cloud_shapes(
         let a1 = a0 + span;
         let half = 0.5 * span.min(2.0 * PI - span).max(0.0);
         if !(half > 1e-6) {
-            return Err(Error::input(format!(
-                "manifold spline: the boundary of the spline domain folds back on itself at vertex {v}"
-            )));
+            return Err(SplineError::BoundaryFolds { vertex: v }.into());
         }
         wedge[v as usize] = (0.5 * (a0 + a1) + PI, half);
     }

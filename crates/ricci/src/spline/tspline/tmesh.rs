@@ -23,6 +23,7 @@
 //! [`TMesh::make_analysis_suitable`] extends T-junctions face by face until that holds.
 
 use crate::error::{Error, Result};
+use crate::spline::error::SplineError;
 
 /// The lattice of the flat torus: `(u, v) ~ (u + W, v) ~ (u + s, v + H)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -657,10 +658,8 @@ impl TMesh {
                 return Ok(splits);
             }
             if splits >= budget {
-                return Err(Error::numerical(format!(
-                    "the T-mesh is not analysis-suitable after {budget} extensions ({} intersecting T-junction extensions remain)",
-                    bad.len()
-                )));
+                let remaining = bad.len();
+                return Err(SplineError::NotAnalysisSuitable { budget, remaining }.into());
             }
             let tj = self.t_junctions();
             let mut progressed = false;
