@@ -58,11 +58,11 @@
 //! stage's errors that name a vertex or face in `error.rs` ([`AtlasError`]).
 
 mod build;
-pub mod charts;
+pub(crate) mod charts;
 mod cover;
-pub mod develop;
+pub(crate) mod develop;
 mod distortion;
-pub mod error;
+pub(crate) mod error;
 mod flat;
 mod overview;
 pub mod placement;

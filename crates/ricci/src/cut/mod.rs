@@ -44,12 +44,12 @@
 //! already cut (word `d₁`); with `b ≥ 2` boundary loops, `b` paths join them to `x`.
 
 mod assemble;
-pub mod error;
-pub mod homology;
-pub mod paths;
-pub mod schema;
-pub mod slice;
-pub mod system;
+pub(crate) mod error;
+pub(crate) mod homology;
+pub(crate) mod paths;
+pub(crate) mod schema;
+pub(crate) mod slice;
+pub(crate) mod system;
 
 use crate::error::{Error, Result};
 use crate::mesh::{topology, Mesh, NONE};

@@ -34,8 +34,8 @@
 
 pub mod adaptive;
 pub mod conformal;
-pub mod error;
-pub mod newton;
+pub(crate) mod error;
+pub(crate) mod newton;
 pub mod polish;
 pub mod sphere;
 pub mod target;

@@ -22,7 +22,7 @@
 pub mod cover;
 pub mod dd;
 pub mod deck;
-pub mod error;
+pub(crate) mod error;
 pub mod export;
 pub mod input_uv;
 pub mod isometry;

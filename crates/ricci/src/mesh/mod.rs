@@ -5,7 +5,7 @@
 //! take a `&Mesh` and edge lengths and never look at positions (docs/DESIGN.md §2).
 
 pub mod build;
-pub mod connectivity;
+pub(crate) mod connectivity;
 pub mod generate;
 pub mod io;
 pub mod quality;

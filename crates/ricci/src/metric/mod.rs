@@ -25,13 +25,13 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod common_subdivision;
-pub mod conformal;
-pub mod error;
+pub(crate) mod conformal;
+pub(crate) mod error;
 pub mod file;
 pub mod geometry;
 pub mod intrinsic;
 pub mod kernel;
-pub mod lengths;
+pub(crate) mod lengths;
 pub mod refine;
 pub mod scheme;
 

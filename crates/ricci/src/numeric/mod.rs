@@ -15,8 +15,8 @@
 
 pub mod dd;
 pub mod dense;
-pub mod dijkstra;
-pub mod simd;
+pub(crate) mod dijkstra;
+pub(crate) mod simd;
 pub mod sparse;
 pub mod vec3;
 

@@ -45,11 +45,11 @@
 //! 6. **Packing**: each chart scaled to its surface area, rotated to its smallest bounding
 //!    box (not with `--seamless`), shelf-packed and scaled into `[margin, 1 − margin]²`.
 
-pub mod boundary;
+pub(crate) mod boundary;
 mod chart;
 pub mod cones;
 pub mod seamless;
-pub mod seams;
+pub(crate) mod seams;
 pub mod sphere;
 pub mod svg;
 mod transfer;

@@ -26,7 +26,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
 pub mod dms;
-pub mod error;
+pub(crate) mod error;
 pub mod fit;
 pub mod hole;
 pub mod manifold;

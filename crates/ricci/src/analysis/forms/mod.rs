@@ -19,15 +19,15 @@
 
 pub mod cochain;
 pub mod harmonic;
-pub mod hodge;
-pub mod net;
-pub mod period;
+pub(crate) mod hodge;
+pub(crate) mod net;
+pub(crate) mod period;
 pub mod placement;
 pub mod small;
 pub mod trajectories;
 pub mod uniform;
-pub mod working;
-pub mod zeros;
+pub(crate) mod working;
+pub(crate) mod zeros;
 
 use crate::analysis::spectrum::torus_modulus;
 use crate::cut::{canonical_cut, CanonicalCut, CutOptions};

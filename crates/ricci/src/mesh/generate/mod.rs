@@ -28,11 +28,11 @@
 //! * re-triangulations of a surface (midpoint subdivision, random off-centre face splits) and
 //!   an irregular torus — [`retriangulate`]: the test inputs of re-triangulation invariance.
 
-pub mod implicit;
-pub mod planar;
-pub mod remesh;
-pub mod retriangulate;
-pub mod sphere;
+pub(crate) mod implicit;
+pub(crate) mod planar;
+pub(crate) mod remesh;
+pub(crate) mod retriangulate;
+pub(crate) mod sphere;
 pub mod torus;
 
 mod geom;

@@ -24,7 +24,7 @@
 
 pub mod atlas;
 pub mod fit;
-pub mod jet;
+pub(crate) mod jet;
 pub mod local;
 pub mod measure;
 pub mod surface;

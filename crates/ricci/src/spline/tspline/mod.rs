@@ -24,16 +24,16 @@
 
 #![allow(clippy::needless_range_loop)]
 
-pub mod basis;
-pub mod bezier;
-pub mod charts;
-pub mod correction;
+pub(crate) mod basis;
+pub(crate) mod bezier;
+pub(crate) mod charts;
+pub(crate) mod correction;
 pub mod curves;
 pub mod cylinders;
 pub mod export;
 pub mod fit;
-pub mod surface;
-pub mod tmesh;
+pub(crate) mod surface;
+pub(crate) mod tmesh;
 
 pub use bezier::{continuity, extract, BezierPatch, Continuity};
 pub use charts::{chart_independence, ChartIndependence};
