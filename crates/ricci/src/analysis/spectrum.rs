@@ -28,6 +28,7 @@
 //! group is one class. L starts at the shortest generator length and grows until at least
 //! the requested number of classes have length ≤ L; every class shorter than L is then found.
 
+use crate::analysis::teichmuller::translation_length_dd;
 use crate::error::{Error, Result};
 use crate::layout::dd::MobiusDd;
 use crate::layout::deck::{DeckGroup, Polygon};
@@ -154,58 +155,127 @@ impl HyperbolicSpectrum {
 
 /// Orbit points of tiles, found again by position (hyperbolic distance below 1e-7). Points are
 /// filed in cells of width `BAND` in the distance `r` from the origin and about `BAND` in arc
-/// length (at the cell's inner radius) in the angle, so a lookup compares with the points of 9
-/// cells only. (Cells in `r` alone crowd at large `r`, where the tiles of a search are: with
-/// the rejected tiles of seahorse2_100K also filed, lookups made the search 10× slower.)
+/// length (at the cell's inner radius) in the angle. (Cells in `r` alone crowd at large `r`,
+/// where the tiles of a search are: with the rejected tiles of seahorse2_100K also filed,
+/// lookups made the search 10× slower.) A point within 1e-7 of `x` is at most `1e-4` of a
+/// cell away from `x` in `r` and (beyond the first `SMALL` bands) in the angle, so a lookup
+/// probes the cell of `x` and a neighbour only when `x` lies within `MARGIN` (a hundredth of
+/// a cell, 100× the need) of that side: one cell for almost every lookup. Cells hold the
+/// head of a chain through `next` (no allocation per cell) and are hashed with a multiply.
 struct TileIndex {
-    cells: HashMap<(i64, i64), Vec<usize>>,
+    cells: HashMap<(i64, i64), u32, std::hash::BuildHasherDefault<CellHasher>>,
+    /// Next point of the same cell (`u32::MAX`: none).
+    next: Vec<u32>,
     points: Vec<([f64; 3], Complex)>,
+}
+
+/// Multiplicative hashing of the two integers of a cell key (SipHash was a tenth of the
+/// search's time).
+#[derive(Default, Clone, Copy)]
+struct CellHasher(u64);
+
+impl std::hash::Hasher for CellHasher {
+    #[inline]
+    fn finish(&self) -> u64 {
+        self.0 ^ (self.0 >> 29)
+    }
+    #[inline]
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ b as u64).wrapping_mul(0x100000001b3);
+        }
+    }
+    #[inline]
+    fn write_i64(&mut self, x: i64) {
+        self.0 = (self.0.rotate_left(29) ^ x as u64).wrapping_mul(0x9e3779b97f4a7c15);
+    }
 }
 
 impl TileIndex {
     const BAND: f64 = 1e-3;
+    /// Bands (r < 0.064) where the angular cells are probed three at a time: near the
+    /// origin the arc of a cell's inner circle is much shorter than the outer one's.
+    const SMALL: i64 = 64;
+    const MARGIN: f64 = 1e-2;
+    /// `sinh(1e-7 / 2)²`: two entries are the same point when `|p − q|² (1 + X₀)(1 + Y₀)/4`
+    /// is below it (hyperbolic distance below 1e-7, without the `asinh`).
+    const SAME: f64 = 5e-8 * 5e-8;
     fn new() -> Self {
         TileIndex {
-            cells: HashMap::new(),
+            cells: HashMap::default(),
+            next: Vec::new(),
             points: Vec::new(),
         }
     }
-    fn band(x: &[f64; 3]) -> i64 {
-        (x[2].max(1.0).acosh() / Self::BAND).floor() as i64
+    /// `r / BAND` of a hyperboloid point.
+    fn band_coordinate(x: &[f64; 3]) -> f64 {
+        x[2].max(1.0).acosh() / Self::BAND
     }
     /// Number of angular cells of band `k`: its inner circle's length over `BAND`.
     fn sectors(k: i64) -> i64 {
         let r = k.max(0) as f64 * Self::BAND;
         ((2.0 * std::f64::consts::PI * r.sinh() / Self::BAND).ceil() as i64).clamp(1, 1 << 52)
     }
-    fn sector(x: &[f64; 3], n: i64) -> i64 {
-        let u = (x[1].atan2(x[0]) / (2.0 * std::f64::consts::PI)).rem_euclid(1.0);
-        ((u * n as f64).floor() as i64).rem_euclid(n)
+    /// The angle of a point as a fraction of the full turn, in [0, 1].
+    fn turn(x: &[f64; 3]) -> f64 {
+        (x[1].atan2(x[0]) / (2.0 * std::f64::consts::PI)).rem_euclid(1.0)
     }
-    /// Disk point with 1 − |p|² = 2/(1 + X₀) known exactly, and the accurate distance.
-    fn dist(a: &([f64; 3], Complex), b: &([f64; 3], Complex)) -> f64 {
-        let s = ((1.0 + a.0[2]) * (1.0 + b.0[2])).sqrt();
-        2.0 * ((a.1 - b.1).norm() * s * 0.5).asinh()
-    }
+    /// Disk point with 1 − |p|² = 2/(1 + X₀) known exactly.
     fn entry(x: [f64; 3]) -> ([f64; 3], Complex) {
         (x, Complex::new(x[0], x[1]) / (1.0 + x[2]))
     }
-    /// A point within 1e-7 of `x` differs by less than a cell in `r` and in the angle (the
-    /// angular cells of the bands `k ± 1` are wider than `1e-7 / sinh r` by far).
+    fn same(a: &([f64; 3], Complex), b: &([f64; 3], Complex)) -> bool {
+        (a.1 - b.1).norm_sqr() * ((1.0 + a.0[2]) * (1.0 + b.0[2])) * 0.25 < Self::SAME
+    }
+    fn probe(&self, cell: (i64, i64), e: &([f64; 3], Complex)) -> Option<usize> {
+        let mut i = *self.cells.get(&cell)?;
+        while i != u32::MAX {
+            if Self::same(&self.points[i as usize], e) {
+                return Some(i as usize);
+            }
+            i = self.next[i as usize];
+        }
+        None
+    }
     fn find(&self, x: [f64; 3]) -> Option<usize> {
         let e = Self::entry(x);
-        let k = Self::band(&x);
-        for kk in k - 1..=k + 1 {
+        let t = Self::band_coordinate(&x);
+        let k = t.floor() as i64;
+        let ft = t - k as f64;
+        let u = Self::turn(&x);
+        let first = if ft < Self::MARGIN || k < Self::SMALL {
+            k - 1
+        } else {
+            k
+        };
+        let last = if ft > 1.0 - Self::MARGIN || k < Self::SMALL {
+            k + 1
+        } else {
+            k
+        };
+        for kk in first..=last {
             let n = Self::sectors(kk);
-            let a = Self::sector(&x, n);
-            let span = if n <= 3 { 0..n } else { a - 1..a + 2 };
-            for aa in span {
-                if let Some(list) = self.cells.get(&(kk, aa.rem_euclid(n))) {
-                    for &i in list {
-                        if Self::dist(&self.points[i], &e) < 1e-7 {
-                            return Some(i);
-                        }
+            let s = u * n as f64;
+            let a = s.floor() as i64;
+            let fs = s - a as f64;
+            if n <= 3 {
+                for aa in 0..n {
+                    if let Some(i) = self.probe((kk, aa), &e) {
+                        return Some(i);
                     }
+                }
+                continue;
+            }
+            let wide = kk < Self::SMALL;
+            let lo = if wide || fs < Self::MARGIN { a - 1 } else { a };
+            let hi = if wide || fs > 1.0 - Self::MARGIN {
+                a + 1
+            } else {
+                a
+            };
+            for aa in lo..=hi {
+                if let Some(i) = self.probe((kk, aa.rem_euclid(n)), &e) {
+                    return Some(i);
                 }
             }
         }
@@ -214,10 +284,31 @@ impl TileIndex {
     fn insert(&mut self, x: [f64; 3]) -> usize {
         let i = self.points.len();
         self.points.push(Self::entry(x));
-        let k = Self::band(&x);
-        let cell = (k, Self::sector(&x, Self::sectors(k)));
-        self.cells.entry(cell).or_default().push(i);
+        let k = Self::band_coordinate(&x).floor() as i64;
+        let n = Self::sectors(k);
+        let cell = (
+            k,
+            ((Self::turn(&x) * n as f64).floor() as i64).rem_euclid(n),
+        );
+        let head = self.cells.entry(cell).or_insert(u32::MAX);
+        self.next.push(*head);
+        *head = i as u32;
         i
+    }
+}
+
+/// `g o` on the hyperboloid for the centre `o_h`. When the centre is the origin (the compact
+/// domain is laid out so), `g 0 = b/ā`, i.e. `(2ab, |a|² + |b|²)`, straight from the leading
+/// parts of the coefficients (`|a|² − |b|² = 1` to double-double precision for a product of
+/// normalized words), without rounding, normalizing or forming the Lorentz matrix.
+#[inline]
+fn orbit_point(g: &MobiusDd, o_h: [f64; 3]) -> [f64; 3] {
+    if o_h == [0.0, 0.0, 1.0] {
+        let (a, b) = (g.a.hi(), g.b.hi());
+        let ab = a * b;
+        [2.0 * ab.re, 2.0 * ab.im, a.norm_sqr() + b.norm_sqr()]
+    } else {
+        apply_h(&g.round().klein_matrix(), o_h)
     }
 }
 
@@ -231,13 +322,19 @@ fn apply_h(m: &[[f64; 3]; 3], x: [f64; 3]) -> [f64; 3] {
 
 /// The sides of a domain, given as its boundary points each tagged with the side that starts
 /// there, that the real diameter of the frame `fr` (an axis, see [`axis_frame`]) crosses or
-/// touches (within `tol`), each once.
-fn sides_crossed(fr: &Mobius, bnd: &[(Complex, usize)], tol: f64) -> Vec<usize> {
+/// touches (within `tol`), each once, in the order of the boundary; only the boundary edges
+/// `edges` (edge `e` joins points `e` and `e + 1`, increasing) are tested.
+fn sides_crossed(
+    fr: &Mobius,
+    bnd: &[(Complex, usize)],
+    edges: impl IntoIterator<Item = usize>,
+    tol: f64,
+) -> Vec<usize> {
     let nb = bnd.len();
-    let ims: Vec<f64> = bnd.iter().map(|b| fr.apply(b.0).im).collect();
+    let im = |e: usize| fr.apply(bnd[e % nb].0).im;
     let mut sides = Vec::new();
-    for e in 0..nb {
-        let (a, b) = (ims[e], ims[(e + 1) % nb]);
+    for e in edges {
+        let (a, b) = (im(e), im(e + 1));
         if a * b <= 0.0 || a.abs() < tol || b.abs() < tol {
             let s = bnd[e].1;
             if !sides.contains(&s) {
@@ -314,11 +411,11 @@ impl TileSearch {
                 // Normalized only when kept: the product of two normalized words is
                 // normalized to double-double precision, more than the lookup needs.
                 let gd = self.elems_dd[t].compose(sm);
-                let g = gd.round();
-                let go = apply_h(&g.klein_matrix(), o_h);
+                let go = orbit_point(&gd, o_h);
                 if self.index.find(go).is_some() {
                     continue;
                 }
+                let g = gd.round();
                 if keep(&g, go) {
                     self.index.insert(go);
                     self.elems.push(g);
@@ -349,18 +446,12 @@ impl TileSearch {
     /// `count`-th distinct length among the candidates up to `1.25 l` when there are that
     /// many (each distinct length is at least one class, so a search up to it is certain to
     /// find `count` classes), else `1.25 l`.
-    fn next_bound(
-        &self,
-        l: f64,
-        bnd: &[(Complex, usize)],
-        count: usize,
-        near: impl Fn(&Mobius) -> bool,
-    ) -> f64 {
+    fn next_bound(&self, l: f64, count: usize, cross: impl Fn(&Mobius) -> Vec<usize>) -> f64 {
         let cap = 1.25 * l;
-        let (cand, _) = self.candidates(cap, bnd, near);
+        let (cand, _) = self.candidates(cap, cross);
         let mut lens: Vec<f64> = cand
             .iter()
-            .map(|&i| self.elems[i].translation_length())
+            .map(|&i| translation_length_dd(&self.elems_dd[i]))
             .collect();
         lens.sort_by(f64::total_cmp);
         lens.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * b.abs());
@@ -370,28 +461,23 @@ impl TileSearch {
         }
     }
 
-    /// Candidates of the class search: the hyperbolic tiles with `ℓ ≤ l` whose axis passes
-    /// `near` (a conservative test) and crosses the boundary cycle `bnd`, with the sides it
-    /// crosses.
+    /// Candidates of the class search: the hyperbolic tiles with `ℓ ≤ l` (`ℓ` from the
+    /// double-double word) whose axis crosses the domain's boundary, with the sides it crosses
+    /// (`cross` of the axis' frame, see [`axis_frame`]; empty when the axis misses the domain).
     fn candidates(
         &self,
         l: f64,
-        bnd: &[(Complex, usize)],
-        near: impl Fn(&Mobius) -> bool,
+        cross: impl Fn(&Mobius) -> Vec<usize>,
     ) -> (Vec<usize>, Vec<Vec<usize>>) {
-        let tol = 1e-8;
         let mut cand: Vec<usize> = Vec::new();
         let mut crossings: Vec<Vec<usize>> = Vec::new();
         for (i, g) in self.elems.iter().enumerate().skip(1) {
-            let len = g.translation_length();
+            let len = translation_length_dd(&self.elems_dd[i]);
             if !(len > 0.0 && len <= l) {
                 continue;
             }
             let Some(fr) = axis_frame(g) else { continue };
-            if !near(&fr) {
-                continue;
-            }
-            let sides = sides_crossed(&fr, bnd, tol);
+            let sides = cross(&fr);
             if !sides.is_empty() {
                 cand.push(i);
                 crossings.push(sides);
@@ -404,13 +490,12 @@ impl TileSearch {
     fn spectrum(
         &self,
         l: f64,
-        bnd: &[(Complex, usize)],
         maps: &[MobiusDd],
         o_h: [f64; 3],
         count: usize,
-        near: impl Fn(&Mobius) -> bool,
+        cross: impl Fn(&Mobius) -> Vec<usize>,
     ) -> Option<HyperbolicSpectrum> {
-        let (cand, crossings) = self.candidates(l, bnd, near);
+        let (cand, crossings) = self.candidates(l, cross);
         let (mut classes, unmatched) =
             group_classes(&self.elems_dd, &cand, &crossings, maps, &self.index, o_h);
         classes.sort_by(|a, b| a.length.total_cmp(&b.length));
@@ -562,7 +647,8 @@ pub fn fuchsian_spectrum(
                  length bound {l:.3} (the fundamental polygon is very distorted)"
             )));
         };
-        if let Some(sp) = search.spectrum(l, &bnd, &maps_dd, o_h, count, |_| true) {
+        let cross = |fr: &Mobius| sides_crossed(fr, &bnd, 0..bnd.len(), 1e-8);
+        if let Some(sp) = search.spectrum(l, &maps_dd, o_h, count, cross) {
             return Ok(sp);
         }
         l *= 1.25;
@@ -614,7 +700,7 @@ fn group_classes(
             links.push(sm.inverse().compose(&g).compose(&sm).normalized());
         }
         for h in links {
-            match index.find(apply_h(&h.round().klein_matrix(), o_h)) {
+            match index.find(orbit_point(&h, o_h)) {
                 Some(i) => {
                     if let Some(&d) = pos_of.get(&i) {
                         let (a, b) = (find(&mut parent, c), find(&mut parent, d));
@@ -632,7 +718,7 @@ fn group_classes(
         let r = find(&mut parent, c);
         let g = elems[i].round();
         let e = classes.entry(r).or_insert(GeodesicClass {
-            length: g.translation_length(),
+            length: translation_length_dd(&elems[i]),
             representative: g,
             pieces: 0,
         });

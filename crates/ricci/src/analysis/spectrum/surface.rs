@@ -18,13 +18,30 @@ pub struct CompactDomain {
     pub generators: usize,
     /// Balls covering the domain (the tile test of the search).
     pub balls: usize,
+    /// Wall seconds of the two parts: the domain (growth, slicing, double-double layout, side
+    /// pairings, ball cover) and the search (tiles and classes, all rounds).
+    pub seconds_domain: f64,
+    pub seconds_search: f64,
 }
 
-/// A cover of a fundamental domain `F` by hyperbolic balls `B(c_j, r_j)` (hyperboloid
-/// centres), for the conservative test `d(F, gF) ≤ L ⇒ ∃ j, k: d(c_j, g c_k) ≤ L + r_j + r_k`.
+/// A two-level cover of a fundamental domain `F` by hyperbolic balls, for the conservative
+/// test `d(F, gF) ≤ L ⇒ ∃ a, b: d(c_a, g c_b) ≤ L + r_a + r_b`. Coarse balls `B(C_J, R_J)`
+/// (radius about 1) each hold a set of the domain's triangles, and fine balls (radius about
+/// [`BallCover::FINE`]) cover the triangles of their coarse ball: a pair of fine balls is
+/// tried only when its coarse pair passes. The fine pairs shrink the slack of the test from
+/// `R_J + R_K ≈ 2` to `r_a + r_b ≈ 0.7`, so far fewer tiles are kept (their number grows like
+/// `e^{L + slack}`); the coarse pairs keep the test cheap.
 struct BallCover {
-    /// (centre on the hyperboloid, centre in the disk, radius).
+    /// Coarse balls: (centre on the hyperboloid, centre in the disk, radius).
     balls: Vec<([f64; 3], Complex, f64)>,
+    /// `(cosh R_J, sinh R_J)` of the coarse balls.
+    coarse_cs: Vec<(f64, f64)>,
+    /// Fine balls of each coarse ball: (centre on the hyperboloid, radius).
+    fine: Vec<Vec<([f64; 3], f64)>>,
+    /// `(cosh r_a, sinh r_a)` of the fine balls.
+    fine_cs: Vec<Vec<(f64, f64)>>,
+    /// The coarse ball of each triangle.
+    face_ball: Vec<usize>,
     /// Largest distance from the domain's centre to one of its points.
     radius: f64,
     centre: [f64; 3],
@@ -32,60 +49,167 @@ struct BallCover {
 
 /// Thresholds of [`BallCover::may_be_within`] for one length bound, in cosh form.
 struct CoverLimits {
-    /// cosh(L + r_j + r_k), widened, row-major.
+    /// cosh(L + R_J + R_K), widened, row-major.
     pair: Vec<f64>,
-    /// cosh(L + r_j + radius), widened: a ball farther than this from g o cannot be near gF.
+    /// cosh(L + R_J + radius), widened: a ball farther than this from g o cannot be near gF.
     reach: Vec<f64>,
+    /// `(cosh(L + r_a), sinh(L + r_a))` of the fine balls: `cosh(L + r_a + r_b)` is
+    /// `cosh(L + r_a) cosh r_b + sinh(L + r_a) sinh r_b`.
+    fine_l: Vec<Vec<(f64, f64)>>,
+}
+
+/// cosh of the hyperbolic distance between two hyperboloid points (at least 1).
+fn cosh_dist(x: &[f64; 3], y: &[f64; 3]) -> f64 {
+    (x[2] * y[2] - x[0] * y[0] - x[1] * y[1]).max(1.0)
+}
+
+/// Greedy farthest-point centres for the points `pts` (hyperboloid), starting from `first`
+/// and adding the farthest point until every point is within `target` (cosh of the radius)
+/// of a centre or `max` centres are chosen; also each point's nearest centre (cosh of the
+/// distance, index).
+fn farthest_points(
+    pts: &[[f64; 3]],
+    first: [f64; 3],
+    target: f64,
+    max: usize,
+) -> (Vec<[f64; 3]>, Vec<(f64, usize)>) {
+    let mut near: Vec<(f64, usize)> = pts.iter().map(|x| (cosh_dist(x, &first), 0)).collect();
+    let mut centres = vec![first];
+    while centres.len() < max {
+        let (far, &(worst, _)) = near
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
+            .unwrap_or((0, &(1.0, 0)));
+        if worst <= target {
+            break;
+        }
+        let c = pts[far];
+        let k = centres.len();
+        centres.push(c);
+        for (x, n) in pts.iter().zip(near.iter_mut()) {
+            let d = cosh_dist(x, &c);
+            if d < n.0 {
+                *n = (d, k);
+            }
+        }
+    }
+    (centres, near)
+}
+
+/// Each triangle (corner indices into `pts`) given to the centre, among the nearest ones of
+/// its corners, that holds its three corners within the smallest distance; returns cosh of
+/// each centre's radius (at least each point's distance to its nearest centre). Hyperbolic
+/// balls are convex and a geodesic triangle is the convex hull of its corners, so each
+/// triangle lies in its centre's ball.
+fn ball_radii(
+    pts: &[[f64; 3]],
+    tris: &[[usize; 3]],
+    centres: &[[f64; 3]],
+    near: &[(f64, usize)],
+    owner: &mut Vec<usize>,
+) -> Vec<f64> {
+    let mut rad = vec![1.0f64; centres.len()];
+    for n in near {
+        rad[n.1] = rad[n.1].max(n.0);
+    }
+    owner.clear();
+    for t in tris {
+        let (k, need) = t
+            .iter()
+            .map(|&v| {
+                let k = near[v].1;
+                let need = t
+                    .iter()
+                    .map(|&w| cosh_dist(&pts[w], &centres[k]))
+                    .fold(1.0, f64::max);
+                (k, need)
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap_or((0, 1.0));
+        rad[k] = rad[k].max(need);
+        owner.push(k);
+    }
+    rad
 }
 
 impl BallCover {
-    /// Greedy farthest-point cover of the vertices `points` of a triangulated domain with
-    /// balls of radius about `r`, padded by `pad` (the longest edge: a point of a triangle is
-    /// within its longest side of each of its corners), at most `max_balls` balls (the
-    /// radius grows when the budget is reached).
-    fn of_points(points: &[Complex], centre: Complex, r: f64, pad: f64, max_balls: usize) -> Self {
+    /// Radius (about) of the fine balls.
+    const FINE: f64 = 0.35;
+
+    /// The cover of a triangulated domain (vertices `points`, geodesic triangles `faces`)
+    /// around `centre`: coarse balls of radius about `r` (at most `max_balls`; the radius
+    /// grows when the budget is reached), fine balls of radius about [`Self::FINE`] (at most
+    /// 64 per coarse ball). No radius is padded: triangles lie in their balls (see
+    /// [`ball_radii`]), and the domain in the ball of radius `radius` around `centre`.
+    fn of_domain(
+        points: &[Complex],
+        faces: &[[u32; 3]],
+        centre: Complex,
+        r: f64,
+        max_balls: usize,
+    ) -> Self {
         let h: Vec<[f64; 3]> = points.iter().map(|&p| poincare_to_hyperboloid(p)).collect();
         let c0 = poincare_to_hyperboloid(centre);
-        let cosh_d =
-            |x: &[f64; 3], y: &[f64; 3]| (x[2] * y[2] - x[0] * y[0] - x[1] * y[1]).max(1.0);
-        // Nearest chosen centre per point (cosh of the distance) and its index.
-        let mut near: Vec<(f64, usize)> = h.iter().map(|x| (cosh_d(x, &c0), 0)).collect();
-        let radius = near.iter().map(|n| n.0).fold(1.0, f64::max).acosh() + pad;
-        let mut centres = vec![c0];
-        let mut disk = vec![centre];
-        let target = r.cosh();
-        while centres.len() < max_balls {
-            let (far, &(worst, _)) = near
-                .iter()
-                .enumerate()
-                .max_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
-                .unwrap_or((0, &(1.0, 0)));
-            if worst <= target {
-                break;
-            }
-            let c = h[far];
-            let k = centres.len();
-            centres.push(c);
-            disk.push(points[far]);
-            for (x, n) in h.iter().zip(near.iter_mut()) {
-                let d = cosh_d(x, &c);
-                if d < n.0 {
-                    *n = (d, k);
-                }
-            }
+        let radius = h
+            .iter()
+            .map(|x| cosh_dist(x, &c0))
+            .fold(1.0, f64::max)
+            .acosh();
+        let tris: Vec<[usize; 3]> = faces.iter().map(|f| f.map(|v| v as usize)).collect();
+        let (centres, near) = farthest_points(&h, c0, r.cosh(), max_balls);
+        let mut owner = Vec::new();
+        let rad = ball_radii(&h, &tris, &centres, &near, &mut owner);
+        // Fine balls per coarse ball, over the corners of its triangles.
+        let mut local = vec![usize::MAX; h.len()];
+        let mut fine = Vec::with_capacity(centres.len());
+        let mut fine_owner = Vec::new();
+        let mut by_owner: Vec<Vec<usize>> = vec![Vec::new(); centres.len()];
+        for (t, &k) in owner.iter().enumerate() {
+            by_owner[k].push(t);
         }
-        let mut rad = vec![0.0f64; centres.len()];
-        for n in &near {
-            rad[n.1] = rad[n.1].max(n.0);
+        for (&ck, mine) in centres.iter().zip(&by_owner) {
+            let mut pts: Vec<[f64; 3]> = Vec::new();
+            let mut ids: Vec<usize> = Vec::new();
+            let mut own: Vec<[usize; 3]> = Vec::new();
+            for t in mine.iter().map(|&t| &tris[t]) {
+                own.push(t.map(|v| {
+                    if local[v] == usize::MAX {
+                        local[v] = pts.len();
+                        pts.push(h[v]);
+                        ids.push(v);
+                    }
+                    local[v]
+                }));
+            }
+            for &v in &ids {
+                local[v] = usize::MAX;
+            }
+            let (fc, fnear) = farthest_points(&pts, ck, Self::FINE.cosh(), 64);
+            let frad = ball_radii(&pts, &own, &fc, &fnear, &mut fine_owner);
+            fine.push(
+                fc.into_iter()
+                    .zip(frad)
+                    .map(|(c, rc)| (c, rc.acosh()))
+                    .collect::<Vec<_>>(),
+            );
         }
-        let balls = centres
-            .into_iter()
-            .zip(disk)
+        let disk = |x: &[f64; 3]| Complex::new(x[0], x[1]) / (1.0 + x[2]);
+        let balls: Vec<([f64; 3], Complex, f64)> = centres
+            .iter()
             .zip(rad)
-            .map(|((c, z), rc)| (c, z, rc.acosh() + pad))
+            .map(|(c, rc)| (*c, disk(c), rc.acosh()))
             .collect();
+        let cs = |r: f64| (r.cosh(), r.sinh());
         BallCover {
+            coarse_cs: balls.iter().map(|b| cs(b.2)).collect(),
+            fine_cs: fine
+                .iter()
+                .map(|f: &Vec<([f64; 3], f64)>| f.iter().map(|b| cs(b.1)).collect())
+                .collect(),
             balls,
+            fine,
+            face_ball: owner,
             radius,
             centre: c0,
         }
@@ -100,37 +224,82 @@ impl BallCover {
                 .map(|i| widen(l + self.balls[i / n].2 + self.balls[i % n].2))
                 .collect(),
             reach: self.balls.iter().map(|b| widen(l + b.2 + radius)).collect(),
+            fine_l: self
+                .fine
+                .iter()
+                .map(|f| {
+                    f.iter()
+                        .map(|b| ((l + b.1).cosh(), (l + b.1).sinh()))
+                        .collect()
+                })
+                .collect(),
         }
     }
 
-    /// False only if `d(F, gF) > L` is certain.
+    /// False only if `d(F, gF) > L` is certain: no pair of fine balls `a` (in coarse ball
+    /// `J`), `b` (in `K`) with `d(C_J, g o) ≤ L + R_J + radius`, `d(C_J, g C_K) ≤ L + R_J +
+    /// R_K`, `d(c_a, g C_K) ≤ L + r_a + R_K` and `d(c_a, g c_b) ≤ L + r_a + r_b` (each
+    /// necessary for a point of ball `a` within `L` of a point of `g` ball `b`).
     fn may_be_within(&self, g: &Mobius, go: [f64; 3], lim: &CoverLimits) -> bool {
-        let cosh_d = |x: &[f64; 3], y: &[f64; 3]| x[2] * y[2] - x[0] * y[0] - x[1] * y[1];
+        let widen = |x: f64| x * (1.0 + 1e-9) + 1e-9;
         let k = g.klein_matrix();
         let n = self.balls.len();
         let mut moved: Vec<Option<[f64; 3]>> = vec![None; n];
+        let mut moved_fine: Vec<Vec<[f64; 3]>> = vec![Vec::new(); n];
         for (j, bj) in self.balls.iter().enumerate() {
-            if cosh_d(&bj.0, &go) > lim.reach[j] {
+            if cosh_dist(&bj.0, &go) > lim.reach[j] {
                 continue;
             }
             let row = &lim.pair[j * n..(j + 1) * n];
             for (kk, bk) in self.balls.iter().enumerate() {
                 let gk = *moved[kk].get_or_insert_with(|| apply_h(&k, bk.0));
-                if cosh_d(&bj.0, &gk) <= row[kk] {
-                    return true;
+                if cosh_dist(&bj.0, &gk) > row[kk] {
+                    continue;
+                }
+                if moved_fine[kk].is_empty() {
+                    moved_fine[kk] = self.fine[kk].iter().map(|b| apply_h(&k, b.0)).collect();
+                }
+                let (ch, sh) = self.coarse_cs[kk];
+                for (fa, &(cl, sl)) in self.fine[j].iter().zip(&lim.fine_l[j]) {
+                    if cosh_dist(&fa.0, &gk) > widen(cl * ch + sl * sh) {
+                        continue;
+                    }
+                    for (gb, &(chb, shb)) in moved_fine[kk].iter().zip(&self.fine_cs[kk]) {
+                        if cosh_dist(&fa.0, gb) <= widen(cl * chb + sl * shb) {
+                            return true;
+                        }
+                    }
                 }
             }
         }
         false
     }
 
-    /// False only if the axis (the real diameter in the frame `fr`) certainly misses `F`.
-    fn meets_axis(&self, fr: &Mobius) -> bool {
-        self.balls.iter().any(|b| {
-            let w = fr.apply(b.1);
-            let sinh_d = 2.0 * w.im.abs() / (1.0 - w.norm_sqr()).max(1e-300);
-            sinh_d.asinh() <= b.2 * (1.0 + 1e-9) + 1e-9
-        })
+    /// The sides of the domain's boundary `bnd` that the axis (the real diameter in the
+    /// frame `fr`) crosses or touches, as [`super::sides_crossed`] over the whole boundary,
+    /// testing only the boundary edges (`edges`: per coarse ball, those of its triangles) of
+    /// the balls within 0.01 of the axis: an edge that crosses the axis has its crossing point
+    /// in its ball, and one that touches it within the tolerance `1e-8` (in the frame's disk,
+    /// hyperbolic ≤ 1e-3 for the points of candidates' frames) is within 0.01 of it.
+    fn sides_crossed(
+        &self,
+        fr: &Mobius,
+        bnd: &[(Complex, usize)],
+        edges: &[Vec<usize>],
+    ) -> Vec<usize> {
+        let mut near: Vec<usize> = self
+            .balls
+            .iter()
+            .zip(edges)
+            .filter(|(b, _)| {
+                let w = fr.apply(b.1);
+                let sinh_d = 2.0 * w.im.abs() / (1.0 - w.norm_sqr()).max(1e-300);
+                sinh_d.asinh() <= b.2 * (1.0 + 1e-9) + 0.01
+            })
+            .flat_map(|(_, es)| es.iter().copied())
+            .collect();
+        near.sort_unstable();
+        sides_crossed(fr, bnd, near, 1e-8)
     }
 }
 
@@ -210,18 +379,21 @@ pub fn surface_spectrum(
         }
         None => crate::cut::central_vertex(mesh, lengths)?,
     };
+    let clock = std::time::Instant::now();
     let (seed, crossed) = grow_domain(mesh, lengths, o)?;
     let dom = DomainPairings::new(mesh, metric, o, seed, &crossed)?;
-    let max_edge = lengths.iter().copied().fold(0.0, f64::max);
-    let cover = BallCover::of_points(&dom.positions, dom.centre, 1.0, max_edge, 400);
+    let cover = BallCover::of_domain(&dom.positions, &dom.faces, dom.centre, 1.0, 400);
     let radius = cover.radius;
-    let domain = CompactDomain {
+    let mut domain = CompactDomain {
         radius,
         faces: mesh.n_faces(),
         boundary_edges: dom.boundary.len(),
         generators: dom.generators.len(),
         balls: cover.balls.len(),
+        seconds_domain: clock.elapsed().as_secs_f64(),
+        seconds_search: 0.0,
     };
+    let clock = std::time::Instant::now();
     let mut l = dom
         .generators
         .iter()
@@ -234,6 +406,11 @@ pub fn surface_spectrum(
         ));
     }
     let o_h = cover.centre;
+    // The boundary edges of each coarse ball (edge e lies in its triangle, in the ball).
+    let mut ball_edges: Vec<Vec<usize>> = vec![Vec::new(); cover.balls.len()];
+    for (e, &f) in dom.boundary_faces.iter().enumerate() {
+        ball_edges[cover.face_ball[f as usize]].push(e);
+    }
     let mut search = TileSearch::new(o_h);
     for _round in 0..16 {
         let bound = ((l + 2.0 * radius) * (1.0 + 1e-9) + 1e-9).cosh();
@@ -250,11 +427,12 @@ pub fn surface_spectrum(
             )));
         }
         // The axis is the real diameter in the frame: skip it when it misses every ball.
-        let near = |fr: &Mobius| cover.meets_axis(fr);
-        if let Some(sp) = search.spectrum(l, &dom.boundary, &dom.generators, o_h, count, near) {
+        let cross = |fr: &Mobius| cover.sides_crossed(fr, &dom.boundary, &ball_edges);
+        if let Some(sp) = search.spectrum(l, &dom.generators, o_h, count, cross) {
+            domain.seconds_search = clock.elapsed().as_secs_f64();
             return Ok((sp, domain));
         }
-        l = search.next_bound(l, &dom.boundary, count, near);
+        l = search.next_bound(l, count, cross);
     }
     Err(Error::numerical(format!(
         "the spectrum search did not find {count} classes within its budget of 16 \
@@ -339,14 +517,18 @@ fn grow_domain(mesh: &crate::mesh::Mesh, lengths: &[f64], o: u32) -> Result<(u32
 
 /// The compact fundamental domain laid out in double-double and its side pairings.
 struct DomainPairings {
-    /// Layout of the sliced surface (double part).
+    /// Layout of the sliced surface (double part), centred: the centre vertex is at 0.
     positions: Vec<Complex>,
+    /// Faces of the sliced surface (geodesic triangles of the layout).
+    faces: Vec<[u32; 3]>,
     /// The copy of the centre vertex in the seed face.
     centre: Complex,
     /// Distinct side pairings (a generating set of the deck group).
     generators: Vec<MobiusDd>,
     /// Boundary cycle: (position, generator of the side starting there).
     boundary: Vec<(Complex, usize)>,
+    /// The face of each boundary edge (from point `e` to point `e + 1`).
+    boundary_faces: Vec<u32>,
 }
 
 impl DomainPairings {
@@ -361,6 +543,7 @@ impl DomainPairings {
         seed: u32,
         crossed: &[bool],
     ) -> Result<Self> {
+        use crate::layout::dd::disk_distance_dd;
         use crate::layout::place::layout_dd;
         use crate::metric::Hyperbolic;
         use crate::numeric::dd::Cdd;
@@ -375,7 +558,6 @@ impl DomainPairings {
                 lay.flipped_faces[0]
             )));
         }
-        let pos = |v: u32| Cdd::from_parts(lay.positions[v as usize], lay.positions_lo[v as usize]);
         let loops = cm.boundary_loop_halfedges();
         if loops.len() != 1 {
             return Err(Error::numerical(format!(
@@ -388,35 +570,63 @@ impl DomainPairings {
             .iter()
             .position(|&v| origin[v as usize] == o)
             .unwrap_or(0);
-        let centre = lay.positions[cm.face(seed)[i0] as usize];
-        let o_h = poincare_to_hyperboloid(centre);
+        // The domain is moved (in double-double) so that its centre is the origin: the orbit
+        // point of a word g is then `g 0 = b/ā` ([`super::orbit_point`]).
+        let c = cm.face(seed)[i0] as usize;
+        let to_centre = MobiusDd::to_origin(Cdd::from_parts(lay.positions[c], lay.positions_lo[c]));
+        let moved: Vec<Cdd> = (0..cm.n_vertices())
+            .map(|v| to_centre.apply(Cdd::from_parts(lay.positions[v], lay.positions_lo[v])))
+            .collect();
+        let pos = |v: u32| moved[v as usize];
+        let positions: Vec<Complex> = moved.iter().map(|p| p.hi()).collect();
+        let centre = Complex::new(0.0, 0.0);
+        let o_h = [0.0, 0.0, 1.0];
         let mut generators: Vec<MobiusDd> = Vec::new();
         let mut gen_index = TileIndex::new();
         let mut boundary: Vec<(Complex, usize)> = Vec::with_capacity(loops[0].len());
+        let mut boundary_faces: Vec<u32> = Vec::with_capacity(loops[0].len());
+        // The last few pairings found, most recent first: consecutive boundary edges mostly
+        // lie on one side (or on the two sides of a slit, paired by the identity).
+        let mut recent: Vec<usize> = Vec::with_capacity(5);
         for &h in &loops[0] {
             let t = mesh.he_twin(h);
-            let m = MobiusDd::from_pairs(
-                pos(cm.he_origin(t)),
-                pos(cm.he_tip(t)),
-                pos(cm.he_tip(h)),
-                pos(cm.he_origin(h)),
-            )
-            .normalized();
-            let go = apply_h(&m.round().klein_matrix(), o_h);
-            let k = match gen_index.find(go) {
+            let (p0, p1) = (pos(cm.he_origin(t)), pos(cm.he_tip(h)));
+            // A deck transformation that maps `p0` within 1e-9 of `p1` is this edge's pairing
+            // (two distinct ones differ by an element that moves `p1` by at least the
+            // systole), so `from_pairs` is needed only for a pairing not seen lately.
+            let seen = recent
+                .iter()
+                .copied()
+                .find(|&k| disk_distance_dd(generators[k].apply(p0), p1) < 1e-9);
+            let k = match seen {
                 Some(k) => k,
                 None => {
-                    generators.push(m);
-                    gen_index.insert(go)
+                    let m = MobiusDd::from_pairs(p0, pos(cm.he_tip(t)), p1, pos(cm.he_origin(h)))
+                        .normalized();
+                    let go = orbit_point(&m, o_h);
+                    match gen_index.find(go) {
+                        Some(k) => k,
+                        None => {
+                            generators.push(m);
+                            gen_index.insert(go)
+                        }
+                    }
                 }
             };
-            boundary.push((lay.positions[cm.he_origin(h) as usize], k));
+            recent.retain(|&x| x != k);
+            recent.insert(0, k);
+            recent.truncate(4);
+            boundary.push((positions[cm.he_origin(h) as usize], k));
+            boundary_faces.push(cm.he_face(h));
         }
+        let faces = (0..cm.n_faces() as u32).map(|f| cm.face(f)).collect();
         Ok(DomainPairings {
-            positions: lay.positions,
+            positions,
+            faces,
             centre,
             generators,
             boundary,
+            boundary_faces,
         })
     }
 }
