@@ -88,7 +88,7 @@ fn main() {
         let q = [0, 1, 2].map(|i| uv[3 * t + i]);
         let a =
             (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]);
-        if !(a > 0.0) {
+        if a.is_nan() || a <= 0.0 {
             let f = cs.t_face[t];
             let w = [0, 1, 2].map(|i| cs.t_weights[3 * t + i]);
             println!(
