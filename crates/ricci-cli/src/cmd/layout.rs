@@ -507,6 +507,7 @@ where
             uv["seam_faces"] = json!(s.seam_faces);
             uv["t_flipped_faces"] = json!(s.t_flipped_faces);
             uv["recentred_faces"] = json!(s.recentred_faces);
+            uv["nudged_uvs"] = json!(s.nudged_uvs);
             format!(
                 "the common subdivision of the input and the intrinsic triangulation ({} \
                  vertices on the input surface, {} faces, {} flipped; the input's own faces \
@@ -537,6 +538,13 @@ where
                  double precision and are written at their deck image nearest the centre (one \
                  more seam around each)",
                 s.recentred_faces
+            ));
+        }
+        if let Some(s) = sub.as_ref().filter(|s| s.nudged_uvs > 0) {
+            comments.push(format!(
+                "vt: {} UV(s) moved by at most 3 ulps so that pieces positively oriented in \
+                 exact arithmetic stay so after rounding",
+                s.nudged_uvs
             ));
         }
         let text = match &sub {

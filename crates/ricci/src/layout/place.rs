@@ -675,11 +675,15 @@ pub fn minimax_centre<S: Space>(points: &[S::Point]) -> S::Point {
     };
     let mut c = first;
     for it in 1..300 {
-        let far = points
-            .iter()
-            .copied()
-            .max_by(|p, q| S::distance(c, *p).total_cmp(&S::distance(c, *q)))
-            .unwrap_or(c);
+        // The farthest point (the last of equals, as `max_by`), one distance per point.
+        let mut far = first;
+        let mut d_far = S::distance(c, first);
+        for &p in &points[1..] {
+            let d = S::distance(c, p);
+            if d.total_cmp(&d_far) != std::cmp::Ordering::Less {
+                (far, d_far) = (p, d);
+            }
+        }
         c = S::toward(c, far, 1.0 / (it as f64 + 1.0));
     }
     c

@@ -32,7 +32,9 @@ use super::isometry::Complex;
 use super::place::{ExtPoint, Frame, Space};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::metric::common_subdivision::{disk_orientation, CommonSubdivision};
+use crate::metric::common_subdivision::{
+    disk_orientation, repair_rounded_pieces, CommonSubdivision,
+};
 use crate::metric::intrinsic::{length_of_lambda, IntrinsicTriangulation};
 use crate::metric::Geometry;
 use crate::numeric::dd::Cdd;
@@ -67,6 +69,10 @@ pub struct SubdivisionUv {
     /// the centre of the disk), because double precision could not resolve their pieces
     /// where the polygon puts them (H² from a double-double layout only; 0 otherwise).
     pub recentred_faces: usize,
+    /// UVs moved by a few ulps so that pieces that are positively oriented in exact
+    /// arithmetic but came out degenerate or flipped from rounding are positive
+    /// ([`crate::metric::common_subdivision::repair_rounded_pieces`]).
+    pub nudged_uvs: usize,
     /// Crossings of input edges with edges of `T`, and faces of `T`.
     pub crossings: usize,
     pub t_faces: usize,
@@ -235,8 +241,21 @@ where
     } else {
         sub.uv(S::KIND, u, &corner)?
     };
+    let mut uv = uv;
+    let t_flipped: std::collections::HashSet<u32> = corners.flipped_faces.iter().copied().collect();
+    let nudged_uvs = repair_rounded_pieces(
+        S::KIND,
+        &sub.triangles,
+        &mut uv,
+        sub.n_input_vertices as u32,
+        |t| {
+            !t_flipped.contains(&sub.t_face[t])
+                && sub.barycentric_orientation(t, u) > BARYCENTRIC_MARGIN
+        },
+    );
     let flipped_faces = sub.flipped_triangles(S::KIND, &uv);
     Ok(SubdivisionUv {
+        nudged_uvs,
         locations: loc,
         positions,
         triangles: sub.triangles.clone(),
@@ -251,6 +270,11 @@ where
         t_faces: tri.n_faces(),
     })
 }
+
+/// A piece whose barycentric orientation on its face of `T` exceeds this is positively
+/// oriented in exact arithmetic (the determinant of normalised weights is computed to a few
+/// ulps of 1); only such pieces have their rounded UVs repaired.
+const BARYCENTRIC_MARGIN: f64 = 1e-13;
 
 /// What [`hyperbolic_uv_dd`] computed.
 struct DdUv {
@@ -476,6 +500,7 @@ pub fn sphere_common_subdivision(
         flipped_faces,
         seam_faces: 0,
         recentred_faces: 0,
+        nudged_uvs: 0,
         t_flipped_faces: sphere_flipped_faces(
             points,
             &(0..tri.n_faces() as u32)

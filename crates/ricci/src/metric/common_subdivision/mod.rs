@@ -61,6 +61,7 @@
 mod develop;
 mod normal;
 mod polygons;
+mod rounding;
 mod trace;
 
 use crate::error::{Error, Result};
@@ -74,6 +75,7 @@ use trace::build;
 
 pub use develop::{layout_euclidean, layout_hyperbolic};
 pub use normal::{flipped_normal_coordinate, TriangleArcs};
+pub use rounding::repair_rounded_pieces;
 
 type Tri = IntrinsicTriangulation;
 
@@ -405,17 +407,23 @@ impl CommonSubdivision {
     /// to the centre of the Poincaré disk ([`disk_orientation`]).
     pub fn flipped_triangles(&self, geometry: Geometry, uv: &[[f64; 2]]) -> usize {
         (0..self.triangles.len())
-            .filter(|&t| {
-                let q = [0, 1, 2].map(|i| uv.get(3 * t + i).copied().unwrap_or([f64::NAN; 2]));
-                let a = if geometry == Geometry::Hyperbolic {
-                    disk_orientation(q[0], q[1], q[2])
-                } else {
-                    (q[1][0] - q[0][0]) * (q[2][1] - q[0][1])
-                        - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0])
-                };
-                a.is_nan() || a <= 0.0
-            })
+            .filter(|&t| !piece_positive(geometry, uv, t))
             .count()
+    }
+
+    /// Orientation of triangle `t` inside its face of `T` in exact terms: the determinant of
+    /// the barycentric coordinates (normalised projective weights, vertex scaling `u`) of its
+    /// three corners on that face. Positive when the piece has the face's orientation — then
+    /// its UV triangle is positively oriented whenever the face's is, up to rounding.
+    pub fn barycentric_orientation(&self, t: usize, u: &[f64]) -> f64 {
+        let b = [0, 1, 2].map(|c| {
+            let w = self.beta(t, c, u);
+            let s = w[0] + w[1] + w[2];
+            w.map(|x| x / s)
+        });
+        b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1])
+            - b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0])
+            + b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0])
     }
 
     /// Per-vertex UVs when the per-corner UVs agree within `tol` at every vertex (a layout
@@ -438,6 +446,18 @@ impl CommonSubdivision {
         }
         (if worst <= tol { Some(out) } else { None }, worst)
     }
+}
+
+/// Whether the UV triangle `t` (corners `3t..3t+3` of `uv`) is positively oriented: signed
+/// area in E², [`disk_orientation`] in H² (`false` for NaN).
+pub fn piece_positive(geometry: Geometry, uv: &[[f64; 2]], t: usize) -> bool {
+    let q = [0, 1, 2].map(|i| uv.get(3 * t + i).copied().unwrap_or([f64::NAN; 2]));
+    let a = if geometry == Geometry::Hyperbolic {
+        disk_orientation(q[0], q[1], q[2])
+    } else {
+        (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0])
+    };
+    a > 0.0
 }
 
 /// `(z − a)/(1 − ā z)`: the Möbius map of the Poincaré disk that moves `a` to the centre.
