@@ -29,9 +29,11 @@ pub mod bezier;
 pub mod charts;
 pub mod correction;
 pub mod curves;
+pub mod cylinder_fit;
 pub mod cylinders;
 pub mod export;
 pub mod fit;
+pub mod genus_domain;
 pub mod surface;
 pub mod tmesh;
 
