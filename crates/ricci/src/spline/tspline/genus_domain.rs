@@ -18,6 +18,7 @@ use super::cylinders::{cylinders, integral_form, CylinderDecomposition};
 use crate::analysis::forms::cochain::on_halfedge;
 use crate::analysis::forms::{HolomorphicForm, HolomorphicForms};
 use crate::error::{Error, Result};
+use crate::mesh::Mesh;
 use serde::Serialize;
 
 /// One cylinder of the domain with data.
@@ -177,35 +178,7 @@ fn develop(
             "vertex {x} has no copy in the cut mesh"
         )));
     }
-    // critical levels: the saddles of the piecewise-linear function v (sign changes of dv
-    // around the vertex ≥ 4), where its level sets change topology. They can sit at other
-    // vertices than the zeros of the decomposition (found from the index of Re ω's face
-    // vectors), and a level missed here would merge two cylinders of a band.
-    let mut saddles = Vec::new();
-    for x in 0..nv as u32 {
-        let signs: Vec<bool> = mesh
-            .outgoing(x)
-            .map(|hh| on_halfedge(mesh, &form.im, hh) >= 0.0)
-            .collect();
-        let k = signs.len();
-        let changes = (0..k).filter(|&i| signs[i] != signs[(i + 1) % k]).count();
-        if changes >= 4 {
-            saddles.push(x);
-        }
-    }
-    let mut levels: Vec<f64> = saddles.iter().map(|&x| vmod[x as usize]).collect();
-    levels.sort_by(f64::total_cmp);
-    levels.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
-    let bands: Vec<(f64, f64)> = if levels.is_empty() {
-        vec![(0.0, 1.0)]
-    } else {
-        (0..levels.len())
-            .map(|i| {
-                let hi = levels.get(i + 1).copied().unwrap_or(levels[0] + 1.0);
-                (levels[i], hi - levels[i])
-            })
-            .collect()
-    };
+    let (saddles, levels, bands) = critical_bands(mesh, form, &vmod);
     // band and height in the band (rel ∈ (0, H)) per vertex; None on a critical level
     let eps = 1e-9;
     let mut band: Vec<Option<(usize, f64)>> = vec![None; nv];
@@ -219,58 +192,7 @@ fn develop(
             }
         }
     }
-    // components of the in-band graph, developed by breadth-first search
-    let mut comp = vec![usize::MAX; nv];
-    let mut uv = vec![[0.0f64; 2]; nv];
-    let mut holonomy: Vec<Vec<f64>> = Vec::new();
-    let mut comp_band = Vec::new();
-    let step = |hh: u32| {
-        (
-            on_halfedge(mesh, &form.re, hh),
-            on_halfedge(mesh, &form.im, hh),
-        )
-    };
-    let in_band = |x: usize, y: usize, dv: f64| -> bool {
-        match (band[x], band[y]) {
-            (Some((a, rx)), Some((b, ry))) => a == b && (rx + dv - ry).abs() < 1e-7,
-            _ => false,
-        }
-    };
-    let mut out_edges: Vec<Vec<u32>> = vec![Vec::new(); nv];
-    for hh in 0..mesh.n_halfedges() as u32 {
-        if !mesh.is_boundary_halfedge(hh) {
-            out_edges[mesh.he_origin(hh) as usize].push(hh);
-        }
-    }
-    for root in 0..nv {
-        let Some((b, rel)) = band[root] else { continue };
-        if comp[root] != usize::MAX {
-            continue;
-        }
-        let id = holonomy.len();
-        holonomy.push(Vec::new());
-        comp_band.push(b);
-        comp[root] = id;
-        uv[root] = [0.0, rel];
-        let mut queue = std::collections::VecDeque::from([root]);
-        while let Some(x) = queue.pop_front() {
-            for &hh in &out_edges[x] {
-                let y = mesh.he_tip(hh) as usize;
-                let (du, dv) = step(hh);
-                if !in_band(x, y, dv) {
-                    continue;
-                }
-                let p = [uv[x][0] + du, uv[x][1] + dv];
-                if comp[y] == usize::MAX {
-                    comp[y] = id;
-                    uv[y] = p;
-                    queue.push_back(y);
-                } else {
-                    holonomy[id].push(p[0] - uv[y][0]);
-                }
-            }
-        }
-    }
+    let (comp, uv, holonomy, comp_band) = components(mesh, form, &band);
     // circumference per component: the smallest non-zero holonomy
     let scale = dec
         .cylinders
@@ -333,43 +255,11 @@ fn develop(
             });
         }
     }
-    // crossings of the critical levels: an edge from the top band of one cylinder into the
-    // next band, crossing exactly that level
-    let mut crossings = Vec::new();
-    let chart = |x: usize| {
-        if comp[x] == usize::MAX {
-            None
-        } else {
-            let c = chart_of[comp[x]];
-            (c != usize::MAX).then_some(c)
-        }
-    };
-    for hh in 0..mesh.n_halfedges() as u32 {
-        if mesh.is_boundary_halfedge(hh) {
-            continue;
-        }
-        let (x, y) = (mesh.he_origin(hh) as usize, mesh.he_tip(hh) as usize);
-        let (du, dv) = step(hh);
-        let (Some(a), Some(b)) = (chart(x), chart(y)) else {
-            continue;
-        };
-        if dv <= 0.0 {
-            continue;
-        }
-        let (ha, rx) = (charts[a].height, uv[x][1]);
-        let ry = uv[y][1];
-        let top = (charts[a].band + 1) % bands.len();
-        if charts[b].band != top || rx + dv <= ha || (rx + dv - ha - ry).abs() > 1e-7 {
-            continue;
-        }
-        let t = (ha - rx) / dv;
-        crossings.push(Crossing {
-            lower: a,
-            u_lower: (ucyl[x] + t * du).rem_euclid(charts[a].circumference),
-            upper: b,
-            u_upper: (ucyl[y] - (1.0 - t) * du).rem_euclid(charts[b].circumference),
-        });
-    }
+    let cyl: Vec<Option<usize>> = comp
+        .iter()
+        .map(|&k| (k != usize::MAX && chart_of[k] != usize::MAX).then(|| chart_of[k]))
+        .collect();
+    let crossings = crossings(mesh, form, &cyl, &uv, &ucyl, &charts, bands.len());
     Ok(GenusDomain {
         decomposition: dec,
         combination: Vec::new(),
@@ -381,4 +271,145 @@ fn develop(
         crossings,
         holonomy_defect: defect,
     })
+}
+
+/// The saddles of the piecewise-linear function `v` (sign changes of `dv` around the vertex
+/// ≥ 4), where its level sets change topology, their levels `v mod 1`, and the bands between
+/// consecutive levels `(bottom, height)`. The saddles can sit at other vertices than the zeros
+/// of the decomposition (found from the index of `Re ω`'s face vectors); a level missed here
+/// would merge two cylinders of a band.
+fn critical_bands(
+    mesh: &Mesh,
+    form: &HolomorphicForm,
+    vmod: &[f64],
+) -> (Vec<u32>, Vec<f64>, Vec<(f64, f64)>) {
+    let mut saddles = Vec::new();
+    for x in 0..mesh.n_vertices() as u32 {
+        let signs: Vec<bool> = mesh
+            .outgoing(x)
+            .map(|hh| on_halfedge(mesh, &form.im, hh) >= 0.0)
+            .collect();
+        let k = signs.len();
+        let changes = (0..k).filter(|&i| signs[i] != signs[(i + 1) % k]).count();
+        if changes >= 4 {
+            saddles.push(x);
+        }
+    }
+    let mut levels: Vec<f64> = saddles.iter().map(|&x| vmod[x as usize]).collect();
+    levels.sort_by(f64::total_cmp);
+    levels.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    let bands: Vec<(f64, f64)> = if levels.is_empty() {
+        vec![(0.0, 1.0)]
+    } else {
+        (0..levels.len())
+            .map(|i| {
+                let hi = levels.get(i + 1).copied().unwrap_or(levels[0] + 1.0);
+                (levels[i], hi - levels[i])
+            })
+            .collect()
+    };
+    (saddles, levels, bands)
+}
+
+/// `(re, im)` of the form on a half-edge.
+fn step(mesh: &Mesh, form: &HolomorphicForm, hh: u32) -> (f64, f64) {
+    (
+        on_halfedge(mesh, &form.re, hh),
+        on_halfedge(mesh, &form.im, hh),
+    )
+}
+
+type Components = (Vec<usize>, Vec<[f64; 2]>, Vec<Vec<f64>>, Vec<usize>);
+
+/// The components of the graph of edges inside one band (`band[x] = (band, height in it)`),
+/// developed by breadth-first search: per vertex its component (`usize::MAX`: none) and
+/// developed `(u, v)`, per component the `u` holonomies of its non-tree edges and its band.
+fn components(mesh: &Mesh, form: &HolomorphicForm, band: &[Option<(usize, f64)>]) -> Components {
+    let nv = mesh.n_vertices();
+    let mut comp = vec![usize::MAX; nv];
+    let mut uv = vec![[0.0f64; 2]; nv];
+    let mut holonomy: Vec<Vec<f64>> = Vec::new();
+    let mut comp_band = Vec::new();
+    let in_band = |x: usize, y: usize, dv: f64| -> bool {
+        match (band[x], band[y]) {
+            (Some((a, rx)), Some((b, ry))) => a == b && (rx + dv - ry).abs() < 1e-7,
+            _ => false,
+        }
+    };
+    let mut out_edges: Vec<Vec<u32>> = vec![Vec::new(); nv];
+    for hh in 0..mesh.n_halfedges() as u32 {
+        if !mesh.is_boundary_halfedge(hh) {
+            out_edges[mesh.he_origin(hh) as usize].push(hh);
+        }
+    }
+    for root in 0..nv {
+        let Some((b, rel)) = band[root] else { continue };
+        if comp[root] != usize::MAX {
+            continue;
+        }
+        let id = holonomy.len();
+        holonomy.push(Vec::new());
+        comp_band.push(b);
+        comp[root] = id;
+        uv[root] = [0.0, rel];
+        let mut queue = std::collections::VecDeque::from([root]);
+        while let Some(x) = queue.pop_front() {
+            for &hh in &out_edges[x] {
+                let y = mesh.he_tip(hh) as usize;
+                let (du, dv) = step(mesh, form, hh);
+                if !in_band(x, y, dv) {
+                    continue;
+                }
+                let p = [uv[x][0] + du, uv[x][1] + dv];
+                if comp[y] == usize::MAX {
+                    comp[y] = id;
+                    uv[y] = p;
+                    queue.push_back(y);
+                } else {
+                    holonomy[id].push(p[0] - uv[y][0]);
+                }
+            }
+        }
+    }
+    (comp, uv, holonomy, comp_band)
+}
+
+/// The crossings of the critical levels: edges from a cylinder (`cyl[x]`) into a cylinder of
+/// the next band that cross exactly that level, with the crossing point's `u` on both sides.
+fn crossings(
+    mesh: &Mesh,
+    form: &HolomorphicForm,
+    cyl: &[Option<usize>],
+    uv: &[[f64; 2]],
+    ucyl: &[f64],
+    charts: &[CylinderChart],
+    bands: usize,
+) -> Vec<Crossing> {
+    let mut out = Vec::new();
+    for hh in 0..mesh.n_halfedges() as u32 {
+        if mesh.is_boundary_halfedge(hh) {
+            continue;
+        }
+        let (x, y) = (mesh.he_origin(hh) as usize, mesh.he_tip(hh) as usize);
+        let (du, dv) = step(mesh, form, hh);
+        let (Some(a), Some(b)) = (cyl[x], cyl[y]) else {
+            continue;
+        };
+        if dv <= 0.0 {
+            continue;
+        }
+        let (ha, rx, ry) = (charts[a].height, uv[x][1], uv[y][1]);
+        let top = (charts[a].band + 1) % bands;
+        if charts[b].band != top || rx + dv <= ha || (rx + dv - ha - ry).abs() > 1e-7 {
+            continue;
+        }
+        let t = (ha - rx) / dv;
+        out.push(Crossing {
+            lower: a,
+            u_lower: (ucyl[x] + t * du).rem_euclid(charts[a].circumference),
+            upper: b,
+            u_upper: (ucyl[y] - (1.0 - t) * du).rem_euclid(charts[b].circumference),
+        });
+    }
+    out
 }
