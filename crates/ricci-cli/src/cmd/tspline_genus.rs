@@ -120,7 +120,7 @@ pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> an
                 "midpoints": midpoints,
                 "glue_weight": opts.glue,
                 "jumps": jumps_json(&glued, 2),
-                "note": "the cylinders are fitted separately; the zeros lie on these trajectories, so the same jumps hold at the extraordinary points"
+                "note": "separate splines per cylinder, pulled together by a least-squares penalty at the crossings (not C0); the zeros lie on these trajectories, so the same jumps hold at the extraordinary points"
             },
             "extraordinary_points": dec.zeros.len(),
         },

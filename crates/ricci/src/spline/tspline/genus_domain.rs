@@ -257,7 +257,10 @@ fn develop(
     }
     let cyl: Vec<Option<usize>> = comp
         .iter()
-        .map(|&k| (k != usize::MAX && chart_of[k] != usize::MAX).then(|| chart_of[k]))
+        .map(|&k| match chart_of.get(k) {
+            Some(&c) if c != usize::MAX => Some(c),
+            _ => None,
+        })
         .collect();
     let crossings = crossings(mesh, form, &cyl, &uv, &ucyl, &charts, bands.len());
     Ok(GenusDomain {
