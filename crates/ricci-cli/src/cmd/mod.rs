@@ -16,3 +16,4 @@ pub mod spectrum;
 pub mod spline;
 pub mod teichmuller;
 pub mod tspline;
+pub mod tspline_genus;

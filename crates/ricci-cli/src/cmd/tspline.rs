@@ -2,8 +2,9 @@
 //! mesh over its domain manifold (paper 003; `ricci::spline::tspline`), exported for CAD.
 //!
 //! Supported now: closed surfaces of genus 1, over the flat torus of the default conformal flow
-//! (for genus 1 the flat layout is the conformal net). Other topologies are refused with a
-//! sentence naming the missing domain (the holomorphic 1-forms' conformal net, issue 17).
+//! (for genus 1 the flat layout is the conformal net), and closed surfaces of genus ≥ 2 over
+//! the cylinders of a holomorphic 1-form (`tspline_genus`). Other topologies are refused with a
+//! sentence naming the missing domain.
 //!
 //! `--out DIR` writes `tspline.step` (AP214, one `B_SPLINE_SURFACE_WITH_KNOTS` face per Bézier
 //! patch), `tspline.igs` (entity 128 per patch), `surface.obj` (closed welded tessellation on a lattice grid), `tmesh.svg`
@@ -29,7 +30,7 @@ use std::time::Instant;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Mesh file (OBJ, OFF, PLY, STL); closed genus-1 surfaces for now.
+    /// Mesh file (OBJ, OFF, PLY, STL); closed surfaces of genus ≥ 1 for now.
     pub mesh: PathBuf,
     /// Fitting tolerance L∞, as a fraction of the longest bounding-box side ("0.5%" or 0.005).
     #[arg(long, default_value = "0.5%")]
@@ -270,9 +271,12 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         Some(c) => (topo.components.len(), c.genus, c.boundary_loops),
         None => (0, 0, 0),
     };
+    if comps == 1 && genus >= 2 && loops == 0 {
+        return crate::cmd::tspline_genus::run_genus(&a, &surface, tolerance, t0);
+    }
     if comps != 1 || genus != 1 || loops != 0 {
         anyhow::bail!(
-            "{}: ricci tspline supports closed genus-1 surfaces for now (domain: the flat torus); this mesh has {comps} component(s), genus {genus} and {loops} boundary loop(s), whose domain manifold needs the conformal net of holomorphic 1-forms (paper 003 §2, issue 17), not built yet",
+            "{}: ricci tspline supports closed surfaces of genus ≥ 1 for now (domains: the flat torus, the cylinders of a holomorphic 1-form); this mesh has {comps} component(s), genus {genus} and {loops} boundary loop(s), whose domain manifold (paper 003 §2: the sphere map for genus 0, the double cover for boundaries) is not built yet",
             a.mesh.display()
         );
     }

@@ -140,40 +140,50 @@ pub fn elements(basis: &TBasis) -> Vec<[f64; 4]> {
     out
 }
 
-/// Extract one bicubic Bézier patch per element.
-pub fn extract(ts: &TSpline) -> Vec<BezierPatch> {
+/// The bicubic Bézier patch over `[u0, u1] × [v0, v1]` interpolating `f` at the 4×4 nodes of
+/// the rectangle (exact when `f` is a bicubic polynomial there).
+pub fn interpolate_patch(
+    u0: f64,
+    u1: f64,
+    v0: f64,
+    v1: f64,
+    f: impl Fn(f64, f64) -> [f64; 3],
+) -> BezierPatch {
     let inv = collocation_inverse();
-    elements(&ts.basis)
-        .into_iter()
-        .map(|[u0, u1, v0, v1]| {
-            let mut f = [[[0.0; 3]; 4]; 4];
-            for (a, &x) in NODES.iter().enumerate() {
-                for (b, &y) in NODES.iter().enumerate() {
-                    f[a][b] = ts.point(u0 + x * (u1 - u0), v0 + y * (v1 - v0));
-                }
-            }
-            // C = inv · F · invᵀ
-            let mut control = [[[0.0; 3]; 4]; 4];
-            for i in 0..4 {
-                for j in 0..4 {
-                    for a in 0..4 {
-                        for b in 0..4 {
-                            let w = inv[i][a] * inv[j][b];
-                            for d in 0..3 {
-                                control[i][j][d] += w * f[a][b][d];
-                            }
-                        }
+    let mut values = [[[0.0; 3]; 4]; 4];
+    for (a, &x) in NODES.iter().enumerate() {
+        for (b, &y) in NODES.iter().enumerate() {
+            values[a][b] = f(u0 + x * (u1 - u0), v0 + y * (v1 - v0));
+        }
+    }
+    // C = inv · F · invᵀ
+    let mut control = [[[0.0; 3]; 4]; 4];
+    for i in 0..4 {
+        for j in 0..4 {
+            for a in 0..4 {
+                for b in 0..4 {
+                    let w = inv[i][a] * inv[j][b];
+                    for d in 0..3 {
+                        control[i][j][d] += w * values[a][b][d];
                     }
                 }
             }
-            BezierPatch {
-                u0,
-                u1,
-                v0,
-                v1,
-                control,
-            }
-        })
+        }
+    }
+    BezierPatch {
+        u0,
+        u1,
+        v0,
+        v1,
+        control,
+    }
+}
+
+/// Extract one bicubic Bézier patch per element.
+pub fn extract(ts: &TSpline) -> Vec<BezierPatch> {
+    elements(&ts.basis)
+        .into_iter()
+        .map(|[u0, u1, v0, v1]| interpolate_patch(u0, u1, v0, v1, |u, v| ts.point(u, v)))
         .collect()
 }
 

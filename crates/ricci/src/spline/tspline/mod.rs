@@ -29,9 +29,11 @@ pub(crate) mod bezier;
 pub(crate) mod charts;
 pub(crate) mod correction;
 pub mod curves;
+pub mod cylinder_fit;
 pub mod cylinders;
 pub mod export;
 pub mod fit;
+pub mod genus_domain;
 pub(crate) mod surface;
 pub(crate) mod tmesh;
 
