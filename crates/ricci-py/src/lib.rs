@@ -76,9 +76,9 @@ fn parse<A: clap::Args + clap::FromArgMatches>(name: &str, argv: &[String]) -> R
 }
 
 /// The subcommands the package runs, by name.
-const COMMANDS: [&str; 11] = [
+const COMMANDS: [&str; 12] = [
     "info", "flow", "layout", "spectrum", "cut", "atlas", "spline", "pou", "render", "generate",
-    "param",
+    "param", "tspline",
 ];
 
 fn dispatch(command: &str, argv: &[String]) -> Result<(), Failure> {
@@ -94,6 +94,7 @@ fn dispatch(command: &str, argv: &[String]) -> Result<(), Failure> {
         "render" => cmd::render::run(parse(command, argv)?),
         "generate" => cmd::generate::run(parse(command, argv)?),
         "param" => cmd::param::run(parse(command, argv)?),
+        "tspline" => cmd::tspline::run_cmd(parse(command, argv)?),
         _ => {
             return Err(Failure::Usage(format!(
                 "unknown command {command:?}; the package runs {}",

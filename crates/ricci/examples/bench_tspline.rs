@@ -3,10 +3,11 @@
 //!
 //! `cargo run --release -p ricci --example bench_tspline -- MESH TOLERANCE [mark_fraction …]`
 //! (TOLERANCE as a fraction, e.g. 0.0044; env SMOOTHING, INITIAL_FACES, MAX_POINTS_PER_FACE,
-//! PARAMETER_CORRECTION override the defaults). Prints, per strategy: control points, rms %, L∞ %,
+//! PARAMETER_CORRECTION, CORRECTION_STEPS, RMS_TOLERANCE, SMOOTHING_DECAY, MAX_CONTROL_POINTS
+//! override the defaults). Prints, per strategy: control points, rms %, L∞ %,
 //! iterations, converged, CPU seconds of the fit (the domain is computed once, timed apart).
 use ricci::progress::NoProgress;
-use ricci::spline::tspline::fit::{fit, flat_torus_domain, FitOptions};
+use ricci::spline::tspline::fit::{area_weighted_rms, fit, flat_torus_domain, FitOptions};
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -37,6 +38,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         t.elapsed().as_secs_f64()
     );
     println!("mark_fraction | control points | rms % | L∞ % | iterations | converged | fit s");
+    let d = FitOptions::default();
     for f in fractions {
         let opts = FitOptions {
             tolerance: tol,
@@ -54,10 +56,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .ok()
                 .and_then(|s| s.parse().ok())
                 .unwrap_or(FitOptions::default().initial_faces),
-            parameter_correction: std::env::var("PARAMETER_CORRECTION")
-                .ok()
-                .and_then(|s| s.parse().ok())
-                .unwrap_or(0),
+            parameter_correction: env("PARAMETER_CORRECTION", d.parameter_correction),
+            correction_steps: env("CORRECTION_STEPS", d.correction_steps),
+            rms_tolerance: env("RMS_TOLERANCE", d.rms_tolerance),
+            smoothing_decay: env("SMOOTHING_DECAY", d.smoothing_decay),
+            max_control_points: env("MAX_CONTROL_POINTS", d.max_control_points),
             ..FitOptions::default()
         };
         let t = Instant::now();
@@ -75,9 +78,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let trace: Vec<String> = r
             .steps
             .iter()
-            .map(|s| format!("{}→{:.2}", s.control_points, s.max_error_percent))
+            .map(|s| {
+                format!(
+                    "{}→{:.3}/{:.4}",
+                    s.control_points, s.max_error_percent, s.rms_error_percent
+                )
+            })
             .collect();
         println!("  {}", trace.join(", "));
+        if let Some(a) = area_weighted_rms(&surface, &r.errors) {
+            println!("  area-weighted rms {:.4} %", 100.0 * a / r.scale);
+        }
     }
     Ok(())
+}
+
+fn env<T: std::str::FromStr>(name: &str, default: T) -> T {
+    std::env::var(name)
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(default)
 }

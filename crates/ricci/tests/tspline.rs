@@ -540,5 +540,61 @@ fn kitten_fit_is_c2_across_every_patch_side_and_chart_independent() {
     );
 }
 
+/// Paper 003 Table 1, kitten (models scaled to the unit cube: errors in % of the longest
+/// bounding-box side): 765 control points, rms 0.05 %, L∞ 0.44 %. With two rounds of
+/// parameter correction per fit, ours must use at most the paper's control points and reach
+/// at most its L∞. The paper's rms is **not met** (session 6: 0.067 % over the vertices,
+/// 0.061 % area-weighted, at 660 control points); the test holds the rms to within 1.5× the
+/// paper's, so that a regression of the fit fails here. The errors are recomputed from the
+/// spline and the returned parameters: `|S(u_k) − p_k|` bounds the distance of `p_k` to the
+/// surface from above.
+#[test]
+fn kitten_with_parameter_correction_meets_paper_003_count_and_max_error() {
+    use ricci::spline::tspline::fit::{area_weighted_rms, fit, flat_torus_domain, FitOptions};
+    let Some(dir) = ricci_meshes() else {
+        eprintln!("RICCI_MESHES is not set: skipping kitten_with_parameter_correction_meets_paper_003_count_and_max_error");
+        return;
+    };
+    let (paper_points, paper_rms, paper_max) = (765, 0.05, 0.44);
+    let path = std::path::Path::new(&dir).join("kitten.nf20k.off");
+    let (s, _) = ricci::mesh::io::read_surface(&path).unwrap();
+    let mut quiet = ricci::progress::NoProgress;
+    let (uv, lat) = flat_torus_domain(&s, &mut quiet).unwrap();
+    let opts = FitOptions {
+        tolerance: paper_max / 100.0,
+        parameter_correction: 2,
+        ..Default::default()
+    };
+    let r = fit(&s.positions, &uv, lat, &opts, &mut quiet).unwrap();
+    // the scale: the longest side of the bounding box, from the mesh
+    let (lo, hi) = s.bounding_box();
+    let scale = (0..3).map(|d| hi[d] - lo[d]).fold(0.0, f64::max);
+    let errors: Vec<f64> = s
+        .positions
+        .iter()
+        .zip(&r.params)
+        .map(|(p, q)| {
+            let x = r.spline.point(q[0], q[1]);
+            ((x[0] - p[0]).powi(2) + (x[1] - p[1]).powi(2) + (x[2] - p[2]).powi(2)).sqrt()
+        })
+        .collect();
+    let max = 100.0 * errors.iter().cloned().fold(0.0, f64::max) / scale;
+    let rms =
+        100.0 * (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt() / scale;
+    let rms_area = 100.0 * area_weighted_rms(&s, &errors).unwrap() / scale;
+    eprintln!(
+        "kitten: {} control points, rms {rms:.4} % (area-weighted {rms_area:.4} %), L∞ {max:.4} %",
+        r.spline.control.len()
+    );
+    assert!(r.converged);
+    assert!(
+        r.spline.control.len() <= paper_points,
+        "{} control points",
+        r.spline.control.len()
+    );
+    assert!(max <= paper_max, "L∞ {max} %");
+    assert!(rms <= 1.5 * paper_rms, "rms {rms} %");
+}
+
 mod ricci_meshes;
 use ricci_meshes::ricci_meshes;

@@ -14,11 +14,12 @@
 //! `zebra.png` (reflection lines of the fitted surface) and `tspline.json` (the report).
 
 use crate::cmd::layout::spinner;
-use crate::util::{print_json, write_atomic, UsageError};
-use ricci::mesh::io::read_surface;
+use crate::util::{print_json, read_surface, write_atomic, write_json_atomic, UsageError};
 use ricci::spline::tspline::curves::{tmesh_on_surface, torus_tessellation};
 use ricci::spline::tspline::export::{iges, step, torus_obj};
-use ricci::spline::tspline::fit::{fit, flat_torus_domain, FitOptions};
+use ricci::spline::tspline::fit::{
+    area_weighted_rms, fit, flat_torus_domain, FitOptions, FitResult,
+};
 use ricci::spline::tspline::{
     chart_independence, continuity, extract, BezierPatch, ChartIndependence, Continuity, TSpline,
 };
@@ -53,6 +54,16 @@ pub struct Args {
     /// the foot of its perpendicular on the surface, then refit); 0 = the conformal parameters.
     #[arg(long, default_value_t = 0)]
     pub parameter_correction: usize,
+    /// Gauss–Newton steps per data point in each round of parameter correction.
+    #[arg(long, default_value_t = 3)]
+    pub correction_steps: usize,
+    /// Target rms error ("0.05%" or 0.0005; 0 = none): after L∞ is met, the faces with the
+    /// largest sums of squared errors are refined until the rms is at most this.
+    #[arg(long, default_value = "0")]
+    pub rms_tolerance: String,
+    /// Factor applied to the thin-plate weight after every refinement (1 = constant).
+    #[arg(long, default_value_t = 1.0)]
+    pub smoothing_decay: f64,
     /// Budget: refinement iterations.
     #[arg(long, default_value_t = 30)]
     pub max_iterations: usize,
@@ -65,12 +76,20 @@ pub struct Args {
     /// Output directory.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// With --out: leave out the two PNG pictures (tmesh-surface.png, zebra.png).
+    #[arg(long)]
+    pub no_pictures: bool,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
 }
 
 fn parse_tolerance(s: &str) -> Result<f64, UsageError> {
+    parse_fraction("--tolerance", s, false)
+}
+
+/// A fraction given as "0.5%" or 0.005, in (0, 1) (or [0, 1) with `zero`).
+fn parse_fraction(flag: &str, s: &str, zero: bool) -> Result<f64, UsageError> {
     let t = s.trim();
     let (num, pct) = match t.strip_suffix('%') {
         Some(n) => (n.trim(), true),
@@ -78,11 +97,11 @@ fn parse_tolerance(s: &str) -> Result<f64, UsageError> {
     };
     let x: f64 = num
         .parse()
-        .map_err(|_| UsageError(format!("--tolerance {s}: not a number (use 0.5% or 0.005)")))?;
+        .map_err(|_| UsageError(format!("{flag} {s}: not a number (use 0.5% or 0.005)")))?;
     let x = if pct { x / 100.0 } else { x };
-    if !(x > 0.0 && x < 1.0) {
+    if !((x > 0.0 || (zero && x == 0.0)) && x < 1.0) {
         return Err(UsageError(format!(
-            "--tolerance {s} must be between 0 and 100 %"
+            "{flag} {s} must be between 0 and 100 %"
         )));
     }
     Ok(x)
@@ -244,6 +263,20 @@ fn check_ranges(a: &Args) -> anyhow::Result<()> {
         ))
         .into());
     }
+    if !(a.smoothing_decay > 0.0 && a.smoothing_decay <= 1.0) {
+        return Err(UsageError(format!(
+            "--smoothing-decay {} is not in (0, 1]",
+            a.smoothing_decay
+        ))
+        .into());
+    }
+    if !(1..=20).contains(&a.correction_steps) {
+        return Err(UsageError(format!(
+            "--correction-steps {} is not in 1..=20",
+            a.correction_steps
+        ))
+        .into());
+    }
     if a.parameter_correction > 10 {
         return Err(UsageError(format!(
             "--parameter-correction {} is not in 0..=10",
@@ -264,6 +297,7 @@ fn check_ranges(a: &Args) -> anyhow::Result<()> {
 pub fn run_cmd(a: Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let tolerance = parse_tolerance(&a.tolerance)?;
+    let rms_tolerance = parse_fraction("--rms-tolerance", &a.rms_tolerance, true)?;
     check_ranges(&a)?;
     let (surface, _) = read_surface(&a.mesh)?;
     let topo = ricci::mesh::topology(&surface.mesh);
@@ -292,6 +326,9 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         mark_fraction: a.mark_fraction,
         max_points_per_face: a.max_points_per_face,
         parameter_correction: a.parameter_correction,
+        correction_steps: a.correction_steps,
+        rms_tolerance,
+        smoothing_decay: a.smoothing_decay,
         ..FitOptions::default()
     };
     bar.0.set_message("fitting");
@@ -323,6 +360,8 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         "analysis_suitable": r.spline.basis.mesh.is_analysis_suitable(),
         "bezier_patches": patches.len(),
         "rms_error_percent": rms,
+        "rms_error_percent_area_weighted": area_weighted_rms(&surface, &r.errors)
+            .map(|x| 100.0 * x / r.scale),
         "max_error_percent": max,
         "tolerance_percent": 100.0 * tolerance,
         "converged": r.converged,
@@ -331,6 +370,9 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         "continuity": continuity_json(&class, &jumps, &charts),
         "data_points": surface.positions.len(),
         "parameter_correction": opts.parameter_correction,
+        "correction_steps": opts.correction_steps,
+        "rms_tolerance_percent": 100.0 * rms_tolerance,
+        "smoothing_decay": opts.smoothing_decay,
         "scale": r.scale,
         "seconds_fit": fit_seconds,
         "seconds": t0.elapsed().as_secs_f64(),
@@ -346,36 +388,7 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         );
     }
     if let Some(dir) = &a.out {
-        write_atomic(
-            &dir.join("tspline.step"),
-            step(&patches, "tspline").as_bytes(),
-        )?;
-        write_atomic(
-            &dir.join("tspline.igs"),
-            iges(&patches, "tspline").as_bytes(),
-        )?;
-        // lattice grid with about `tessellation` segments per patch side
-        let per = (patches.len() as f64).sqrt() * a.tessellation as f64;
-        let ratio = (lattice.width / lattice.height).sqrt();
-        let (n, m) = ((per * ratio).ceil() as usize, (per / ratio).ceil() as usize);
-        write_atomic(
-            &dir.join("surface.obj"),
-            torus_obj(&r.spline, n, m).as_bytes(),
-        )?;
-        write_atomic(&dir.join("tmesh.svg"), tmesh_svg(&r.spline).as_bytes())?;
-        let (net, zebra) = pictures(
-            &r.spline,
-            patches.len(),
-            a.tessellation,
-            (1200, 900),
-            View::default(),
-        )?;
-        write_atomic(&dir.join("tmesh-surface.png"), &net.to_png()?)?;
-        write_atomic(&dir.join("zebra.png"), &zebra.to_png()?)?;
-        write_atomic(
-            &dir.join("samples.json"),
-            serde_json::to_string(&samples_json(&r.spline, &patches))?.as_bytes(),
-        )?;
+        write_outputs(dir, &a, &r, &patches)?;
         out["out"] = json!(dir.display().to_string());
         out["seconds"] = json!(t0.elapsed().as_secs_f64());
         write_atomic(
@@ -404,4 +417,69 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The files of `--out DIR` but the report (see the module docs).
+fn write_outputs(
+    dir: &std::path::Path,
+    a: &Args,
+    r: &FitResult,
+    patches: &[BezierPatch],
+) -> anyhow::Result<()> {
+    let lattice = r.spline.basis.mesh.lattice;
+    write_atomic(
+        &dir.join("tspline.step"),
+        step(patches, "tspline").as_bytes(),
+    )?;
+    write_atomic(
+        &dir.join("tspline.igs"),
+        iges(patches, "tspline").as_bytes(),
+    )?;
+    // lattice grid with about `tessellation` segments per patch side
+    let per = (patches.len() as f64).sqrt() * a.tessellation as f64;
+    let ratio = (lattice.width / lattice.height).sqrt();
+    let (n, m) = ((per * ratio).ceil() as usize, (per / ratio).ceil() as usize);
+    write_atomic(
+        &dir.join("surface.obj"),
+        torus_obj(&r.spline, n, m).as_bytes(),
+    )?;
+    write_atomic(&dir.join("tmesh.svg"), tmesh_svg(&r.spline).as_bytes())?;
+    if !a.no_pictures {
+        let (net, zebra) = pictures(
+            &r.spline,
+            patches.len(),
+            a.tessellation,
+            (1200, 900),
+            View::default(),
+        )?;
+        write_atomic(&dir.join("tmesh-surface.png"), &net.to_png()?)?;
+        write_atomic(&dir.join("zebra.png"), &zebra.to_png()?)?;
+    }
+    write_atomic(
+        &dir.join("samples.json"),
+        serde_json::to_string(&samples_json(&r.spline, patches))?.as_bytes(),
+    )?;
+    write_json_atomic(&dir.join("spline.json"), spline_json(r, patches))?;
+    Ok(())
+}
+
+/// `spline.json`: the fitted spline as arrays — anchors (parameters of the control points) and
+/// control points, the data points' parameters (corrected when asked) and errors, and the
+/// Bézier patches (`[u0, u1, v0, v1]` and 4×4 control points, `[i][j]` with `i` along `u`) that
+/// evaluate it anywhere after reducing `(u, v)` to the fundamental domain of the lattice.
+fn spline_json(r: &FitResult, patches: &[BezierPatch]) -> serde_json::Value {
+    let lattice = r.spline.basis.mesh.lattice;
+    let anchors: Vec<[f64; 2]> = r.spline.basis.anchors.iter().map(|a| [a.u, a.v]).collect();
+    let bounds: Vec<[f64; 4]> = patches.iter().map(|p| [p.u0, p.u1, p.v0, p.v1]).collect();
+    let control: Vec<_> = patches.iter().map(|p| p.control).collect();
+    json!({
+        "lattice": {"width": lattice.width, "height": lattice.height, "shift": lattice.shift},
+        "anchors": anchors,
+        "control": r.spline.control,
+        "params": r.params,
+        "errors": r.errors,
+        "scale": r.scale,
+        "patch_bounds": bounds,
+        "patch_control": control,
+    })
 }

@@ -45,6 +45,7 @@ __all__ = [
     "RicciError",
     "SpectrumResult",
     "SplineResult",
+    "TSplineResult",
     "UsageError",
     "atlas",
     "cut",
@@ -56,6 +57,7 @@ __all__ = [
     "run_cli",
     "spectrum",
     "spline",
+    "tspline",
     "validate",
     "write_mesh",
 ]
@@ -286,9 +288,101 @@ class SplineResult(Report):
             self.surface = Mesh(v, f)
 
 
+class TSplineResult(Report):
+    """``ricci tspline``: cubic T-spline over the flat torus fitted to a genus-1 mesh (paper
+    003). Without an ``out`` folder, its files are in ``files`` and as arrays:
+
+    ``anchors`` (n, 2) parameters of the control points and ``control`` (n, 3) the control
+    points; ``params`` (m, 2) the data points' parameters (corrected when
+    ``parameter_correction`` > 0) and ``errors`` (m,) their distances ``|S(u_k) − p_k|``;
+    ``patch_bounds`` (P, 4) ``[u0, u1, v0, v1]`` and ``patch_control`` (P, 4, 4, 3) the
+    Bézier patches (``[i][j]``, ``i`` along ``u``); ``lattice`` (width, height, shift);
+    ``surface`` (a :class:`Mesh`, the tessellation ``surface.obj``). ``evaluate(uv)`` gives
+    the surface at any parameters."""
+
+    command = "tspline"
+    control_points: int
+    rms_error_percent: float
+    max_error_percent: float
+    iterations: int
+    continuity: Any
+    seconds: float
+
+    def __init__(self, data, files=None, memory=None):
+        super().__init__(data, files)
+        self.anchors = self.control = self.params = self.errors = None
+        self.patch_bounds = self.patch_control = self.lattice = self.surface = None
+        if not memory:
+            return
+        spline = self.files.get(f"{memory}/spline.json")
+        if spline is not None:
+            d = json.loads(spline)
+            f64 = lambda x, *shape: np.array(x, dtype=np.float64).reshape(*shape)
+            self.anchors, self.control = f64(d["anchors"], -1, 2), f64(d["control"], -1, 3)
+            self.params, self.errors = f64(d["params"], -1, 2), f64(d["errors"], -1)
+            self.patch_bounds = f64(d["patch_bounds"], -1, 4)
+            self.patch_control = f64(d["patch_control"], -1, 4, 4, 3)
+            lat = d["lattice"]
+            self.lattice = (lat["width"], lat["height"], lat["shift"])
+        obj = self.files.get(f"{memory}/surface.obj")
+        if obj is not None:
+            v, f, _, _ = _parse_obj(obj)
+            self.surface = Mesh(v, f)
+
+    def canonical(self, uv: Any) -> np.ndarray:
+        """Representatives of parameters ``uv`` ((k, 2)) in ``[0, W) × [0, H)`` (the
+        lattice's fundamental rectangle, the top side glued to the bottom shifted by ``s``)."""
+        if self.lattice is None:
+            raise RicciError("the spline's arrays are only kept without an out folder")
+        w, h, s = self.lattice
+        uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
+        u, v = uv[:, 0].copy(), uv[:, 1].copy()
+        n = np.floor(v / h)
+        v -= n * h
+        u -= n * s
+        over = v >= h
+        v[over] -= h
+        u[over] -= s
+        v[v < 0.0] = 0.0
+        u -= np.floor(u / w) * w
+        u[u >= w] -= w
+        u[u < 0.0] = 0.0
+        return np.stack([u, v], axis=1)
+
+    def evaluate(self, uv: Any) -> np.ndarray:
+        """The surface ``S(u, v)`` at parameters ``uv`` ((k, 2), any representatives): (k, 3),
+        from the Bézier patches (NaN where no patch holds the point)."""
+        c = self.canonical(uv)
+        out = np.full((len(c), 3), np.nan)
+        for b, ctrl in zip(self.patch_bounds, self.patch_control):
+            u0, u1, v0, v1 = b
+            m = (c[:, 0] >= u0) & (c[:, 0] <= u1) & (c[:, 1] >= v0) & (c[:, 1] <= v1)
+            m &= np.isnan(out[:, 0])
+            if not m.any():
+                continue
+            bu = _bernstein((c[m, 0] - u0) / (u1 - u0))
+            bv = _bernstein((c[m, 1] - v0) / (v1 - v0))
+            out[m] = np.einsum("ki,kj,ijd->kd", bu, bv, ctrl)
+        return out
+
+
+def _bernstein(t: np.ndarray) -> np.ndarray:
+    s = 1.0 - t
+    return np.stack([s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t], axis=1)
+
+
 _RESULTS = {
     c.command: c
-    for c in (InfoResult, FlowResult, LayoutResult, SpectrumResult, CutResult, AtlasResult, SplineResult)
+    for c in (
+        InfoResult,
+        FlowResult,
+        LayoutResult,
+        SpectrumResult,
+        CutResult,
+        AtlasResult,
+        SplineResult,
+        TSplineResult,
+    )
 }
 
 # Output options kept in memory when no path is given: command → (option, memory name).
@@ -298,6 +392,7 @@ _MEMORY_OUT = {
     "cut": ("out", "cut.obj"),
     "atlas": ("out", "atlas"),
     "spline": ("out", "spline"),
+    "tspline": ("out", "tspline"),
 }
 
 
@@ -658,4 +753,53 @@ def spline(
         charts=charts,
         tessellation=tessellation,
         out=out,
+    )
+
+
+def tspline(
+    mesh: MeshLike,
+    faces: Any = None,
+    *,
+    tolerance: Optional[Union[str, float]] = None,
+    rms_tolerance: Optional[Union[str, float]] = None,
+    smoothing: Optional[float] = None,
+    smoothing_decay: Optional[float] = None,
+    initial_faces: Optional[int] = None,
+    mark_fraction: Optional[float] = None,
+    max_points_per_face: Optional[int] = None,
+    parameter_correction: Optional[int] = None,
+    correction_steps: Optional[int] = None,
+    max_iterations: Optional[int] = None,
+    max_control_points: Optional[int] = None,
+    tessellation: Optional[int] = None,
+    out: Optional[PathLike] = None,
+    pictures: bool = False,
+    name: Optional[str] = None,
+    arrays: bool = True,
+) -> TSplineResult:
+    """``ricci tspline``: cubic T-spline over the domain manifold (genus 1: the flat torus)
+    fitted with adaptive refinement until ``L∞ ≤ tolerance`` ("0.5%" or 0.005, of the longest
+    bounding-box side) and, if given, ``rms ≤ rms_tolerance``. out: folder for STEP, IGES,
+    OBJ, SVG, JSON (and with ``pictures`` the PNGs); without it the spline comes back as
+    arrays (see :class:`TSplineResult`). Other options are the CLI's."""
+    return run(  # type: ignore[return-value]
+        "tspline",
+        mesh,
+        faces,
+        name=name,
+        arrays=arrays,
+        tolerance=tolerance,
+        rms_tolerance=rms_tolerance,
+        smoothing=smoothing,
+        smoothing_decay=smoothing_decay,
+        initial_faces=initial_faces,
+        mark_fraction=mark_fraction,
+        max_points_per_face=max_points_per_face,
+        parameter_correction=parameter_correction,
+        correction_steps=correction_steps,
+        max_iterations=max_iterations,
+        max_control_points=max_control_points,
+        tessellation=tessellation,
+        out=out,
+        no_pictures=not pictures,
     )

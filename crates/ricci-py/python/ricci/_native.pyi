@@ -23,7 +23,13 @@ def run(
     vertices: Optional[bytes] = None,
     faces: Optional[bytes] = None,
 ) -> Tuple[str, Dict[str, Union[bytes, _Metric]]]:
-    """Run the CLI subcommand with `argv` (mesh path first); (JSON report, in-memory files)."""
+    """Run the CLI subcommand with `argv` (mesh path first); (JSON report, in-memory files).
+
+    `command` is one of COMMANDS: info, flow, layout, spectrum, cut, atlas, spline, pou,
+    render, generate, param, tspline. For tspline with `--out <memory>/tspline`, the files are
+    `<memory>/tspline/{tspline.step, tspline.igs, surface.obj, tmesh.svg, samples.json,
+    spline.json, tspline.json}` (bytes; spline.json holds anchors, control, params, errors,
+    scale, lattice, patch_bounds, patch_control)."""
 
 def read_mesh(
     path: Union[str, PathLike[str]],

@@ -62,6 +62,15 @@ pub struct FitOptions {
     /// (move each parameter to the foot of its perpendicular, refit). `0` keeps the
     /// parameters of the domain (paper 003 §3.3 as written).
     pub parameter_correction: usize,
+    /// Gauss–Newton steps per data point in each round of parameter correction.
+    pub correction_steps: usize,
+    /// Target rms error as a fraction of the longest bounding-box side (`0` = none). While the
+    /// rms is above it (and `L∞ ≤ ε`), the faces with the largest sums of squared errors (their
+    /// share of the rms) are refined: those above `mark_fraction ×` the largest sum.
+    pub rms_tolerance: f64,
+    /// The thin-plate weight is multiplied by this factor after every refinement (`1` =
+    /// constant): finer T-meshes need less fairing to stay well posed.
+    pub smoothing_decay: f64,
 }
 
 impl Default for FitOptions {
@@ -77,6 +86,9 @@ impl Default for FitOptions {
             cg_tolerance: 1e-10,
             cg_max_iterations: 5000,
             parameter_correction: 0,
+            correction_steps: 3,
+            rms_tolerance: 0.0,
+            smoothing_decay: 1.0,
         }
     }
 }
@@ -266,6 +278,30 @@ fn errors_of(ts: &TSpline, points: &[[f64; 3]], params: &[[f64; 2]]) -> Vec<f64>
         .collect()
 }
 
+/// The rms of per-vertex `errors` weighted by vertex area (a third of the incident faces'
+/// areas): the rms over points spread evenly on the surface, which a decimated mesh's vertices
+/// (dense where the detail is) are not. `None` when the sizes differ or the area is zero.
+pub fn area_weighted_rms(surface: &Surface, errors: &[f64]) -> Option<f64> {
+    use crate::numeric::vec3::{cross, norm, sub};
+    if errors.len() != surface.positions.len() {
+        return None;
+    }
+    let mut w = vec![0.0; errors.len()];
+    for t in surface.mesh.faces() {
+        let [a, b, c] = t.map(|v| surface.positions[v as usize]);
+        let third = norm(cross(sub(b, a), sub(c, a))) / 6.0;
+        for &v in t {
+            w[v as usize] += third;
+        }
+    }
+    let total: f64 = w.iter().sum();
+    if !(total > 0.0) {
+        return None;
+    }
+    let sse: f64 = w.iter().zip(errors).map(|(w, e)| w * e * e).sum();
+    Some((sse / total).sqrt())
+}
+
 /// Longest side of the bounding box.
 pub fn bbox_scale(points: &[[f64; 3]]) -> f64 {
     let mut lo = [f64::INFINITY; 3];
@@ -309,6 +345,18 @@ pub fn fit(
             opts.mark_fraction
         )));
     }
+    if !(opts.rms_tolerance >= 0.0 && opts.rms_tolerance < 1.0) {
+        return Err(Error::input(format!(
+            "the rms tolerance {} of the T-spline fit must be in [0, 1)",
+            opts.rms_tolerance
+        )));
+    }
+    if !(opts.smoothing_decay > 0.0 && opts.smoothing_decay <= 1.0) {
+        return Err(Error::input(format!(
+            "the smoothing decay {} of the T-spline fit must be in (0, 1]",
+            opts.smoothing_decay
+        )));
+    }
     let scale = bbox_scale(points);
     if !(scale > 0.0) {
         return Err(Error::input("the data points have an empty bounding box"));
@@ -350,6 +398,8 @@ pub fn fit(
     let mut steps = Vec::new();
     let mut prev: Option<TSpline> = None;
     let mut iteration = 0;
+    let rms_target = opts.rms_tolerance.max(0.0) * scale;
+    let mut smoothing = opts.smoothing;
     loop {
         iteration += 1;
         progress.report("tspline", None, &format!("T-spline fit {iteration}"));
@@ -359,7 +409,8 @@ pub fn fit(
         let guess: Option<Vec<[f64; 3]>> = prev
             .as_ref()
             .map(|p| basis.anchors.iter().map(|a| p.point(a.u, a.v)).collect());
-        let (ts, cg_it, cg_res) = fit_corrected(basis, points, &mut params, opts, guess)?;
+        let (ts, cg_it, cg_res) =
+            fit_corrected(basis, points, &mut params, opts, smoothing, guess)?;
         let errors = errors_of(&ts, points, &params);
         let max = errors.iter().cloned().fold(0.0, f64::max);
         let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
@@ -372,36 +423,15 @@ pub fn fit(
             cg_iterations: cg_it,
             cg_relative_residual: cg_res,
         });
-        let converged = max <= eps;
-        if converged
+        let converged = max <= eps && (rms_target == 0.0 || rms <= rms_target);
+        let marks = if converged
             || iteration >= opts.max_iterations
             || ts.control.len() >= opts.max_control_points
         {
-            return Ok(FitResult {
-                spline: ts,
-                steps,
-                scale,
-                errors,
-                params,
-                converged,
-            });
-        }
-        // per-face L∞
-        let mut face_err = vec![0.0f64; mesh.faces().len()];
-        for (k, uv) in params.iter().enumerate() {
-            if errors[k] > eps {
-                if let Some(f) = mesh.locate(uv[0], uv[1]) {
-                    face_err[f] = face_err[f].max(errors[k]);
-                }
-            }
-        }
-        let threshold = eps.max(opts.mark_fraction * max);
-        let marks: Vec<(usize, bool)> = face_err
-            .iter()
-            .enumerate()
-            .filter(|(_, &e)| e > threshold)
-            .map(|(f, &e)| (f, e > 2.0 * eps))
-            .collect();
+            Vec::new()
+        } else {
+            refinement_marks(&mesh, &params, &errors, eps, rms_target, opts.mark_fraction)
+        };
         if marks.is_empty() {
             return Ok(FitResult {
                 spline: ts,
@@ -414,8 +444,52 @@ pub fn fit(
         }
         mesh.refine_faces(&marks);
         mesh.make_analysis_suitable(50_000)?;
+        smoothing *= opts.smoothing_decay;
         prev = Some(ts);
     }
+}
+
+/// The faces to refine after a fit (`(face, split 1-to-4)`). While `L∞ > ε`: the faces with
+/// `L∞ᴵ > max(ε, θ L∞)`, 1-to-4 above `2ε`, else 1-to-2 (paper 003 §3.3 with the worst-face
+/// fraction `θ`). Then, while the rms is above `rms_target`: the faces whose sum of squared
+/// errors exceeds `θ ×` the largest, 1-to-2 across the longer side.
+fn refinement_marks(
+    mesh: &TMesh,
+    params: &[[f64; 2]],
+    errors: &[f64],
+    eps: f64,
+    rms_target: f64,
+    theta: f64,
+) -> Vec<(usize, bool)> {
+    let max = errors.iter().cloned().fold(0.0, f64::max);
+    let mut face_max = vec![0.0f64; mesh.faces().len()];
+    let mut face_sse = vec![0.0f64; mesh.faces().len()];
+    for (uv, &e) in params.iter().zip(errors) {
+        if let Some(f) = mesh.locate(uv[0], uv[1]) {
+            face_max[f] = face_max[f].max(e);
+            face_sse[f] += e * e;
+        }
+    }
+    if max > eps {
+        let threshold = eps.max(theta * max);
+        return face_max
+            .iter()
+            .enumerate()
+            .filter(|(_, &e)| e > threshold)
+            .map(|(f, &e)| (f, e > 2.0 * eps))
+            .collect();
+    }
+    let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len().max(1) as f64).sqrt();
+    if rms_target > 0.0 && rms > rms_target {
+        let top = face_sse.iter().cloned().fold(0.0, f64::max);
+        return face_sse
+            .iter()
+            .enumerate()
+            .filter(|(_, &e)| e > theta * top && e > 0.0)
+            .map(|(f, _)| (f, false))
+            .collect();
+    }
+    Vec::new()
 }
 
 /// [`fit_fixed`], then `opts.parameter_correction` rounds of parameter correction and refit.
@@ -424,19 +498,20 @@ fn fit_corrected(
     points: &[[f64; 3]],
     params: &mut Vec<[f64; 2]>,
     opts: &FitOptions,
+    smoothing: f64,
     guess: Option<Vec<[f64; 3]>>,
 ) -> Result<(TSpline, usize, f64)> {
     let (mut ts, mut cg_it, mut cg_res) = fit_fixed(
         basis,
         points,
         params,
-        opts.smoothing,
+        smoothing,
         guess.as_deref(),
         opts.cg_tolerance,
         opts.cg_max_iterations,
     )?;
     for _ in 0..opts.parameter_correction {
-        let (corrected, moved) = correct_parameters(&ts, points, params, 3);
+        let (corrected, moved) = correct_parameters(&ts, points, params, opts.correction_steps);
         if moved == 0 {
             break;
         }
@@ -445,7 +520,7 @@ fn fit_corrected(
             ts.basis.clone(),
             points,
             params,
-            opts.smoothing,
+            smoothing,
             Some(&ts.control),
             opts.cg_tolerance,
             opts.cg_max_iterations,
