@@ -20,7 +20,26 @@ use ricci::mesh::{BuildReport, Surface};
 /// The demo reports it per stage, so that stage costs can be compared on a busy machine, where
 /// wall times mostly measure the other processes.
 pub fn process_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    stat_cpu_seconds("/proc/self/stat")
+}
+
+/// CPU time (user + system) of one thread of this process, by its kernel thread id (see
+/// [`current_thread_id`]), from `/proc/self/task/ID/stat`; `None` elsewhere or when the thread
+/// has ended.
+pub fn thread_cpu_seconds(tid: u32) -> Option<f64> {
+    stat_cpu_seconds(&format!("/proc/self/task/{tid}/stat"))
+}
+
+/// The kernel's id of the calling thread (the first field of `/proc/thread-self/stat`);
+/// `None` where there is no such file.
+pub fn current_thread_id() -> Option<u32> {
+    let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
+    stat.split_whitespace().next()?.parse().ok()
+}
+
+/// utime + stime of a `stat` file of `/proc`, in seconds.
+fn stat_cpu_seconds(path: &str) -> Option<f64> {
+    let stat = std::fs::read_to_string(path).ok()?;
     // Fields after the command name (which is in parentheses and may contain spaces): state
     // is field 3, utime and stime are fields 14 and 15.
     let rest = &stat[stat.rfind(')')? + 1..];

@@ -162,6 +162,27 @@ fn every_link_of_the_page_is_a_local_non_empty_file() {
             "geodesics"
         ]
     );
+    // The file list is in the order of the stages, also for the stages that ran on a thread
+    // of their own beside the others (the spline): each stage's files come after those of
+    // the stages before it.
+    // (Inside a stage the order is the order of writing, which its file descriptions need
+    // not follow.)
+    let mut last = 0;
+    for id in &order {
+        let at: Vec<usize> = v["stages"][*id]["files"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| listed.iter().position(|x| Some(*x) == f.as_str()).unwrap())
+            .collect();
+        if let (Some(&lo), Some(&hi)) = (at.iter().min(), at.iter().max()) {
+            assert!(
+                lo >= last,
+                "a file of stage {id} is listed before one of an earlier stage"
+            );
+            last = hi;
+        }
+    }
     let mut at = 0;
     for id in order {
         let i = html[at..]
@@ -572,6 +593,46 @@ fn a_failed_stage_is_reported_in_the_page_and_the_exit_status() {
         }
     }
     assert!(!dir.join("loops.png").exists() && !dir.join("polygon.png").exists());
+}
+
+/// The spline runs on a thread of its own beside the other stages: its failure is reported
+/// like any other, its files are dropped, and the stages after it are not affected.
+#[test]
+fn a_failed_stage_that_ran_beside_the_others_is_reported_too() {
+    let dir = tmp().join("failing-beside");
+    let out = Command::new(bin())
+        .args(["demo", "--json", "--out"])
+        .arg(&dir)
+        .env("RICCI_DEMO_FAIL", "spline")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("spline") && err.contains("index.html"),
+        "{err}"
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).expect("the JSON is still printed");
+    let st = |id: &str| v["stages"][id]["status"].as_str().unwrap().to_string();
+    assert_eq!(st("spline"), "failed");
+    for id in ["surface", "atlas", "pou", "param", "forms", "geodesics"] {
+        assert_eq!(st(id), "ok", "{id}");
+    }
+    assert!(!dir.join("spline.obj").exists() && !dir.join("spline-zebra.png").exists());
+    assert!(dir.join("pou.obj").is_file());
+    let files: Vec<&str> = v["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_str().unwrap())
+        .collect();
+    assert!(!files.iter().any(|f| f.starts_with("spline")), "{files:?}");
+    // Nothing is left of the staging folder.
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let name = e.unwrap().file_name().to_string_lossy().to_string();
+        assert!(!name.starts_with('.'), "{name} left in the folder");
+    }
 }
 
 #[test]

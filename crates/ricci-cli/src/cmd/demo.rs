@@ -21,6 +21,7 @@
 
 // One file per stage (in the order of [`STAGES`]); `common` holds what several share.
 mod atlas;
+mod beside;
 mod common;
 mod cone;
 mod flow;
@@ -151,6 +152,13 @@ pub const STAGES: &[Stage] = &[
     Stage { id: "geodesics", title: "Shortest closed geodesics on the surface", reference: "axes of the deck transformations of the shortest classes, pulled back into the fundamental polygon (paper 002 §6.3.3)", needs: &["layout"], run: geodesics_stage::geodesics },
 ];
 
+/// Stages that run on a thread (and rayon pool) of their own, beside the stages after them,
+/// as soon as the stages they need have succeeded ([`beside`]): the manifold spline is more
+/// than half of the demo's CPU time and needs only the surface. Such a stage gets a copy of
+/// the surface ([`Ctx::beside`]) and leaves nothing in the [`Ctx`]; a stage that needs it
+/// waits for it. The page, the JSON and the pictures do not depend on this (only timings).
+pub const BESIDE: &[&str] = &["spline"];
+
 /// Stages announced in the page but not built yet (title, sentence).
 pub const PLACEHOLDERS: &[(&str, &str)] = &[];
 
@@ -160,6 +168,9 @@ pub struct Out {
     dir: PathBuf,
     staging: PathBuf,
     files: Vec<String>,
+    /// Whether this value removes the staging folder when dropped (a [`Out::sibling`] does
+    /// not).
+    owner: bool,
 }
 
 impl Out {
@@ -184,7 +195,18 @@ impl Out {
             dir: dir.to_path_buf(),
             staging,
             files: Vec::new(),
+            owner: true,
         })
+    }
+
+    /// The same staging folder with a file list of its own (for a stage on another thread).
+    fn sibling(&self) -> Out {
+        Out {
+            dir: self.dir.clone(),
+            staging: self.staging.clone(),
+            files: Vec::new(),
+            owner: false,
+        }
     }
 
     /// Write one file (atomically) into the staging folder.
@@ -220,7 +242,9 @@ impl Out {
 impl Drop for Out {
     fn drop(&mut self) {
         // After a commit the folder is empty; after an error nothing of it is kept.
-        let _ = std::fs::remove_dir_all(&self.staging);
+        if self.owner {
+            let _ = std::fs::remove_dir_all(&self.staging);
+        }
     }
 }
 
@@ -276,29 +300,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut out = Out::new(&a.out)?;
     let mut bar = StageBar::new(a.json);
     let mut ctx = Ctx::new(a.resolution as u32);
-    let mut sections: Vec<Section> = Vec::new();
-    let n = STAGES.len();
-    for (k, st) in STAGES.iter().enumerate() {
-        bar.stage(k + 1, n, st.title);
-        let section = run_stage(st, &sections, &mut ctx, &mut out, &mut bar);
-        bar.bar.println(format!(
-            "{} [{}/{n}] {} ({:.2} s){}",
-            match section.status {
-                Status::Ok => "✓",
-                Status::Warning(_) => "!",
-                _ => "✗",
-            },
-            k + 1,
-            st.title,
-            section.seconds,
-            section
-                .status
-                .message()
-                .map(|m| format!(": {m}"))
-                .unwrap_or_default()
-        ));
-        sections.push(section);
-    }
+    let sections = run_stages(&mut ctx, &mut out, &mut bar);
     bar.bar.finish_and_clear();
 
     let failed: Vec<&Section> = sections.iter().filter(|s| !s.status.usable()).collect();
@@ -355,23 +357,170 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Run one stage (or skip it when a stage it needs did not succeed) and time it; a failure
-/// drops the files the stage wrote and becomes the section's status.
+/// Run the stages: in order on this thread, except those of [`BESIDE`], which start on their
+/// own thread as soon as the stages they need are done. Returns the sections in the order of
+/// [`STAGES`], and leaves the files in `out` in that order too.
+fn run_stages(ctx: &mut Ctx, out: &mut Out, bar: &mut StageBar) -> Vec<Section> {
+    let n = STAGES.len();
+    let mut done: Vec<Option<Section>> = (0..n).map(|_| None).collect();
+    let mut files: Vec<Vec<String>> = vec![Vec::new(); n];
+    let mut started = vec![false; n];
+    let mut running: Vec<beside::Beside> = Vec::new();
+    for k in 0..n {
+        // Start the stages of BESIDE whose needs are done (or skip them, if one failed).
+        for (j, st) in STAGES.iter().enumerate().skip(k) {
+            if started[j]
+                || !BESIDE.contains(&st.id)
+                || st.needs.iter().any(|id| !is_done(&done, id))
+            {
+                continue;
+            }
+            started[j] = true;
+            let job = missing_needs(st, &done)
+                .is_empty()
+                .then(|| beside::Beside::start(j, st, ctx.beside(), out))
+                .flatten();
+            match job {
+                Some(job) => running.push(job),
+                None => {
+                    bar.stage(j + 1, n, st.title);
+                    let keep = out.files.len();
+                    let missing = missing_needs(st, &done);
+                    let s = run_stage(
+                        st,
+                        &missing,
+                        ctx,
+                        out,
+                        bar,
+                        &crate::util::process_cpu_seconds,
+                    );
+                    files[j] = out.files.split_off(keep);
+                    progress_line(bar, j, st, &s);
+                    done[j] = Some(s);
+                }
+            }
+        }
+        let st = &STAGES[k];
+        if started[k] {
+            continue;
+        }
+        // Wait for the stages running beside that this one needs.
+        for id in st.needs {
+            if let Some(i) = running.iter().position(|r| STAGES[r.k].id == *id) {
+                let job = running.swap_remove(i);
+                finish_beside(job, bar, &mut done, &mut files);
+            }
+        }
+        bar.stage(k + 1, n, st.title);
+        // The CPU time of this thread and the global pool: the process's minus the stages
+        // running beside.
+        let cpu_now = || {
+            let others: Option<f64> = running.iter().map(|r| r.cpu.seconds()).sum();
+            crate::util::process_cpu_seconds()
+                .zip(others)
+                .map(|(p, o)| p - o)
+        };
+        let keep = out.files.len();
+        let missing = missing_needs(st, &done);
+        let s = run_stage(st, &missing, ctx, out, bar, &cpu_now);
+        files[k] = out.files.split_off(keep);
+        progress_line(bar, k, st, &s);
+        done[k] = Some(s);
+        // Report the stages beside that have finished meanwhile.
+        while let Some(i) = running.iter().position(|r| r.is_finished()) {
+            finish_beside(running.swap_remove(i), bar, &mut done, &mut files);
+        }
+    }
+    running.sort_by_key(|r| r.k);
+    for job in running {
+        let st = &STAGES[job.k];
+        bar.stage(job.k + 1, n, st.title);
+        bar.step("finishing (it ran beside the stages after it)");
+        finish_beside(job, bar, &mut done, &mut files);
+    }
+    out.files = files.concat();
+    done.into_iter()
+        .zip(STAGES)
+        .map(|(s, st)| {
+            s.unwrap_or_else(|| {
+                let mut s = Section::new(st.id, st.title, st.reference);
+                s.status = Status::Failed("this stage failed: it was not run".into());
+                s
+            })
+        })
+        .collect()
+}
+
+/// Join a stage that ran beside, print its line and keep its section and files.
+fn finish_beside(
+    job: beside::Beside,
+    bar: &StageBar,
+    done: &mut [Option<Section>],
+    files: &mut [Vec<String>],
+) {
+    let k = job.k;
+    let (s, f) = job.join(&STAGES[k]);
+    progress_line(bar, k, &STAGES[k], &s);
+    files[k] = f;
+    done[k] = Some(s);
+}
+
+/// Whether stage `id` has finished (successfully or not).
+fn is_done(done: &[Option<Section>], id: &str) -> bool {
+    STAGES
+        .iter()
+        .position(|s| s.id == id)
+        .is_none_or(|i| done[i].is_some())
+}
+
+/// The stages `st` needs that did not succeed (or have not run).
+fn missing_needs<'a>(st: &'a Stage, done: &[Option<Section>]) -> Vec<&'a str> {
+    st.needs
+        .iter()
+        .copied()
+        .filter(|id| {
+            !done
+                .iter()
+                .flatten()
+                .any(|s| s.id == *id && s.status.usable())
+        })
+        .collect()
+}
+
+/// The line of a finished stage on stderr: `✓ [k/N] title (seconds)`.
+fn progress_line(bar: &StageBar, k: usize, st: &Stage, section: &Section) {
+    bar.bar.println(format!(
+        "{} [{}/{}] {} ({:.2} s){}",
+        match section.status {
+            Status::Ok => "✓",
+            Status::Warning(_) => "!",
+            _ => "✗",
+        },
+        k + 1,
+        STAGES.len(),
+        st.title,
+        section.seconds,
+        section
+            .status
+            .message()
+            .map(|m| format!(": {m}"))
+            .unwrap_or_default()
+    ));
+}
+
+/// Run one stage (or skip it when stages it needs, `missing`, did not succeed) and time it (CPU
+/// seconds by `cpu_now`); a failure drops the files the stage wrote and becomes the section's
+/// status.
 fn run_stage(
     st: &Stage,
-    done: &[Section],
+    missing: &[&str],
     ctx: &mut Ctx,
     out: &mut Out,
     bar: &mut StageBar,
+    cpu_now: &dyn Fn() -> Option<f64>,
 ) -> Section {
-    let missing: Vec<&str> = st
-        .needs
-        .iter()
-        .copied()
-        .filter(|id| !done.iter().any(|s| s.id == *id && s.status.usable()))
-        .collect();
     let ts = Instant::now();
-    let cpu0 = crate::util::process_cpu_seconds();
+    let cpu0 = cpu_now();
     let mut section = if missing.is_empty() {
         let keep = out.files.len();
         let mut env = Env { out, bar };
@@ -404,9 +553,7 @@ fn run_stage(
     section.title = st.title.to_string();
     section.reference = st.reference.to_string();
     section.seconds = ts.elapsed().as_secs_f64();
-    section.cpu_seconds = cpu0
-        .zip(crate::util::process_cpu_seconds())
-        .map(|(a, b)| b - a);
+    section.cpu_seconds = cpu0.zip(cpu_now()).map(|(a, b)| b - a);
     section
 }
 

@@ -57,6 +57,14 @@ impl Ctx {
             atlas: None,
         }
     }
+    /// What a stage running beside the others ([`super::BESIDE`]) may read: a copy of the
+    /// surface and its Euler characteristic.
+    pub(super) fn beside(&self) -> Ctx {
+        let mut c = Ctx::new(self.resolution);
+        c.surface = self.surface.clone();
+        c.chi = self.chi;
+        c
+    }
     pub(super) fn surface(&self) -> anyhow::Result<&Surface> {
         self.surface
             .as_ref()
