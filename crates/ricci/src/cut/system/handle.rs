@@ -4,9 +4,26 @@
 //! crosses `a_i` once, at `x` (paper 001 App. A, 002 §6.2.2.1). Every candidate is judged
 //! against the slot budget, so that the later handles still find room.
 
-use super::{is_simple_loop, Candidate, Gap, NoRoom, RawKind, RawPath, State, MAX_TRIES};
+use super::{is_simple_loop, Candidate, Gap, NoRoom, RawKind, RawPath, Search, State, MAX_TRIES};
 use crate::mesh::NONE;
 use std::collections::HashMap;
+
+/// The first search of one gap with its branches and parities (`State::s1`, `branch`,
+/// `parity`), parked while another gap's tree is in use. Within one handle nothing the trees
+/// depend on changes (blocked vertices, cuts near, slots: only `add_handle`, which ends the
+/// handle), so a parked tree is the tree that growing it again would give.
+struct Tree {
+    search: Search,
+    branch: Vec<u32>,
+    parity: Vec<u64>,
+}
+
+/// The trees of one handle's gaps, one current (in `State`), the others parked.
+struct Trees {
+    parked: Vec<Option<Tree>>,
+    /// Gap of the current tree (`usize::MAX` before the first).
+    current: usize,
+}
 
 /// Why a candidate for `a_i` was rejected (indices into `SearchStats::rejected`).
 const NO_LOOP: usize = 0;
@@ -75,10 +92,12 @@ impl<'a> State<'a> {
         }
         // Candidates from one tree per allowed gap.
         let mut best: HashMap<(usize, usize, usize, Vec<u64>), Candidate> = HashMap::new();
-        let mut tree_gap = usize::MAX;
+        let mut trees = Trees {
+            parked: (0..gaps.len()).map(|_| None).collect(),
+            current: usize::MAX,
+        };
         for &k in &allowed {
-            self.grow_tree(&gaps[k].slots);
-            tree_gap = k;
+            self.use_tree(&mut trees, k, &gaps[k].slots);
             self.collect_candidates(k, &gaps[k].slots, &mut best);
         }
         let mut cands: Vec<Candidate> = best.into_values().collect();
@@ -98,6 +117,9 @@ impl<'a> State<'a> {
             waste_max: 0,
         };
         let mut why = [0usize; 7];
+        // The loop `a` of every candidate tried: nothing it depends on changes between the
+        // budget rounds, so the second round reuses it (same loops, fewer searches).
+        let mut loops: Vec<Option<Option<Vec<u32>>>> = vec![None; cands.len().min(MAX_TRIES)];
         let fair = slack / h_rem;
         for (round, waste_max) in [fair, slack].into_iter().enumerate() {
             if round == 1 {
@@ -107,13 +129,14 @@ impl<'a> State<'a> {
                 self.stats.relaxed_budgets += 1;
             }
             budget.waste_max = waste_max;
-            for c in cands.iter().take(MAX_TRIES) {
-                if tree_gap != c.gap {
-                    self.grow_tree(&gaps[c.gap].slots);
-                    tree_gap = c.gap;
+            for (j, c) in cands.iter().take(MAX_TRIES).enumerate() {
+                if loops[j].is_none() {
+                    self.use_tree(&mut trees, c.gap, &gaps[c.gap].slots);
+                    loops[j] = Some(self.candidate_loop(c, &gaps[c.gap].slots));
                 }
                 self.stats.candidates_tried += 1;
-                match self.try_candidate(c, &budget) {
+                let a = loops[j].clone().flatten();
+                match self.try_candidate(c, a, &budget) {
                     Ok((a, b)) => {
                         self.count_rejections(&why);
                         self.add_handle(i, a, b);
@@ -134,6 +157,36 @@ impl<'a> State<'a> {
             i + 1,
             self.inp.genus
         )))
+    }
+
+    /// Make the tree of gap `k` (sources `slots`) current: the parked one if it was grown in
+    /// this handle, else a new one; the current tree is parked.
+    fn use_tree(&mut self, trees: &mut Trees, k: usize, slots: &[usize]) {
+        if trees.current == k {
+            return;
+        }
+        let cached = trees.parked[k].take();
+        let grow = cached.is_none();
+        if trees.current != usize::MAX || !grow {
+            let mut t = cached.unwrap_or_else(|| {
+                let nv = self.mesh().n_vertices();
+                Tree {
+                    search: Search::new(nv),
+                    branch: vec![NONE; nv],
+                    parity: vec![0; nv * self.inp.coh.words],
+                }
+            });
+            std::mem::swap(&mut self.s1, &mut t.search);
+            std::mem::swap(&mut self.branch, &mut t.branch);
+            std::mem::swap(&mut self.parity, &mut t.parity);
+            if trees.current != usize::MAX {
+                trees.parked[trees.current] = Some(t);
+            }
+        }
+        if grow {
+            self.grow_tree(slots);
+        }
+        trees.current = k;
     }
 
     fn count_rejections(&mut self, why: &[usize; 7]) {
@@ -163,15 +216,16 @@ impl<'a> State<'a> {
         });
     }
 
-    /// The loops `a` (from candidate `c`, whose gap's tree is grown) and `b` of a handle, or
+    /// The loops `a` (candidate `c`'s loop, `None` when it has none) and `b` of a handle, or
     /// why the candidate is rejected.
     fn try_candidate(
         &mut self,
         c: &Candidate,
+        a: Option<Vec<u32>>,
         budget: &Budget,
     ) -> Result<(Vec<u32>, Vec<u32>), usize> {
         let gap = &budget.gaps[c.gap];
-        let a = self.candidate_loop(c, &gap.slots).ok_or(NO_LOOP)?;
+        let a = a.ok_or(NO_LOOP)?;
         if !is_simple_loop(&a) || !self.loop_parity_nonzero(&a) {
             return Err(NOT_SIMPLE_OR_SEPARATING);
         }
