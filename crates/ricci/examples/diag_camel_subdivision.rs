@@ -46,7 +46,7 @@ fn main() {
     let it = r.triangulation.as_ref().unwrap();
     let work = &it.simplicial.mesh;
     let d = cut_disk(work, &r.lengths, g, None, None, &mut NoProgress).unwrap();
-    let lay = layout_dd::<Euclidean>(&d.mesh, &d.lengths, None, None).unwrap();
+    let lay = layout_dd::<Euclidean>(&d.mesh, &d.metric, None).unwrap();
     println!(
         "layout: {} faces, {} flipped, {} degenerate",
         d.mesh.n_faces(),

@@ -28,8 +28,7 @@ fn squares(name: &str) -> Option<(usize, f64)> {
     .unwrap();
     let work = f.triangulation.as_ref().unwrap().simplicial.mesh.clone();
     let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &f).unwrap();
-    let (sp, _) =
-        surface_spectrum(&work, &p.lengths, Some(&p.lengths_lo), None, 12, 2_000_000).unwrap();
+    let (sp, _) = surface_spectrum(&work, &p.metric, None, 12, 2_000_000).unwrap();
     let l = sp.lengths();
     let mut pairs = 0;
     let mut worst: f64 = 0.0;

@@ -667,7 +667,7 @@ fn camel_common_subdivision_has_no_flipped_piece() {
         &mut NoProgress,
     )
     .unwrap();
-    let l = layout_dd::<Euclidean>(&d.mesh, &d.lengths, None, None).unwrap();
+    let l = layout_dd::<Euclidean>(&d.mesh, &d.metric, None).unwrap();
     assert!(l.flipped_faces.is_empty() && l.degenerate_faces.is_empty());
     let (group, frames) = deck_group_ext::<Euclidean>(&l, &d.polygon).unwrap();
     let laid = LaidOut {

@@ -1,0 +1,191 @@
+//! Issue 15 item 3 diagnostic: the E² free-boundary conformal flow on a bumpy disk whose faces
+//! (boundary faces too) were split off-centre — once on the surface itself (boundary edges
+//! never flip) and once on its double (`mesh::double_cover`, boundary vertices held at
+//! `u = 0`, `K̄ = 0` elsewhere), where the boundary edges are ordinary edges.
+//!
+//! `cargo run --release -p ricci --example diag_double_flow [splits] [seed]`
+
+use ricci::flow::double::flow_on_double;
+use ricci::flow::target::resolve;
+use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
+use ricci::mesh::{generate, Surface};
+use ricci::metric::intrinsic::{length_of_lambda, IntrinsicTriangulation};
+use ricci::metric::{Geometry, Scheme};
+use ricci::progress::NoProgress;
+
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// As `tests/subdivision_uv.rs::split_off_centre_at` with `boundary = true`.
+fn split_off_centre(s: &Surface, count: usize, rng: &mut Lcg, near: f64) -> Surface {
+    let mut pos = s.positions.clone();
+    let mut faces = s.mesh.faces().to_vec();
+    for _ in 0..count {
+        let f = ((rng.next() * faces.len() as f64) as usize).min(faces.len() - 1);
+        let [a, b, c] = faces[f];
+        let w = [
+            near - 0.1 * rng.next(),
+            0.5 * (1.0 - near) * (1.0 + rng.next()),
+            0.0,
+        ];
+        let w = [w[0], w[1], 1.0 - w[0] - w[1]];
+        let (pa, pb, pc) = (pos[a as usize], pos[b as usize], pos[c as usize]);
+        let p = [0, 1, 2].map(|k| w[0] * pa[k] + w[1] * pb[k] + w[2] * pc[k]);
+        let v = pos.len() as u32;
+        pos.push(p);
+        faces[f] = [a, b, v];
+        faces.push([b, c, v]);
+        faces.push([c, a, v]);
+    }
+    Surface::new(pos, faces).unwrap()
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let count: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(120);
+    let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(7);
+    let d = generate::disk(16).unwrap();
+    let pos: Vec<[f64; 3]> = d
+        .positions
+        .iter()
+        .map(|p| {
+            let (x, y) = (p[0], p[1]);
+            [x, y, 0.5 * (3.0 * x).sin() * (2.0 * y).cos() + 0.7 * x * x]
+        })
+        .collect();
+    let s = Surface::new(pos, d.mesh.faces().to_vec()).unwrap();
+    let s = split_off_centre(&s, count, &mut Lcg(seed), 0.75);
+    let m = &s.mesh;
+    println!(
+        "surface: {} vertices, {} faces, {} boundary edges",
+        m.n_vertices(),
+        m.n_faces(),
+        (0..m.n_edges() as u32)
+            .filter(|&e| m.is_boundary_edge(e))
+            .count()
+    );
+    // 1. The flow on the surface itself.
+    let o = FlowOptions {
+        geometry: Geometry::Euclidean,
+        scheme: Scheme::Conformal,
+        target: TargetSpec::FreeBoundary,
+        tolerance: 1e-10,
+        ..FlowOptions::default()
+    };
+    let t = std::time::Instant::now();
+    match ricci_flow(m, &s.edge_lengths(), &o, &mut NoProgress) {
+        Ok(r) => {
+            println!(
+                "surface flow: converged {} in {} iterations, max |K − K̄| {:.3e}, {} degenerate \
+                 faces, {:.2} s",
+                r.converged,
+                r.iterations,
+                r.max_curvature_error,
+                r.degenerate_faces,
+                t.elapsed().as_secs_f64()
+            );
+            for h in r.history.iter().rev().take(4).rev() {
+                println!(
+                    "  it {}: err {:.3e} step {:.3e}",
+                    h.iteration, h.max_curvature_error, h.step
+                );
+            }
+            for n in &r.notes {
+                println!("  note: {n}");
+            }
+            // Where it stopped: the slack of the triangle inequality of the faces on a
+            // boundary edge ab (opposite vertex p), (l_ap + l_bp − l_ab) / l_ab.
+            if let Some(it) = &r.triangulation {
+                let t = &it.triangulation;
+                let mut slack: Vec<(f64, u32)> = Vec::new();
+                for e in 0..t.n_edges() as u32 {
+                    if !t.is_boundary_edge(e) {
+                        continue;
+                    }
+                    let h = t.edge_he[e as usize];
+                    let len = |x: u32| {
+                        length_of_lambda(Geometry::Euclidean, t.lambda[t.edge[x as usize] as usize])
+                    };
+                    let (ab, bp, pa) = (
+                        len(h),
+                        len(IntrinsicTriangulation::next(h)),
+                        len(IntrinsicTriangulation::prev(h)),
+                    );
+                    slack.push((
+                        (bp + pa - ab) / ab,
+                        t.origin[IntrinsicTriangulation::prev(h) as usize],
+                    ));
+                }
+                slack.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let bad = slack.iter().filter(|s| s.0 <= 1e-9).count();
+                println!(
+                    "  boundary triangles at the last iterate: {bad} with slack ≤ 1e-9 (of {}); \
+                     smallest {:?}",
+                    slack.len(),
+                    &slack[..slack.len().min(4)]
+                );
+                let interior_bad = r.degenerate_faces.saturating_sub(bad);
+                println!("  degenerate faces not on the boundary: {interior_bad}");
+            }
+        }
+        Err(e) => println!("surface flow: error {e}"),
+    }
+    // Boundary edges that are not Delaunay in the double at the input metric: the angle
+    // opposite them exceeds π/2.
+    let l = s.edge_lengths();
+    let mut obtuse = 0;
+    for e in 0..m.n_edges() as u32 {
+        if !m.is_boundary_edge(e) {
+            continue;
+        }
+        let h = m.edge_halfedge(e);
+        let (a, b) = (m.he_origin(h), m.he_tip(h));
+        let c = m.he_tip(m.he_next(h));
+        let len = |x: u32, y: u32| l[m.he_edge(m.halfedge_between(x, y).unwrap()) as usize];
+        let (ab, bc, ca) = (len(a, b), len(b, c), len(c, a));
+        if bc * bc + ca * ca < ab * ab {
+            obtuse += 1;
+        }
+    }
+    println!("boundary edges with an obtuse opposite angle (not Delaunay in the double): {obtuse}");
+    // 2. The flow on the double.
+    let target = resolve(m, Geometry::Euclidean, &TargetSpec::FreeBoundary).unwrap();
+    let t = std::time::Instant::now();
+    let r = flow_on_double(m, &l, Geometry::Euclidean, &target, 1e-10, &mut NoProgress).unwrap();
+    println!(
+        "double: {} vertices, {} faces; {} isometric flips",
+        r.double.n_vertices(),
+        r.double.n_faces(),
+        r.initial_flips
+    );
+    println!(
+        "double flow: converged {} in {} iterations, max |K − K̄| {:.3e}, {} degenerate faces, \
+         {} Ptolemy flips, max |u − u∘σ| {:.2e}, {:.2} s; boundary edges not in the final \
+         triangulation: {}",
+        r.converged,
+        r.iterations,
+        r.max_error,
+        r.degenerate_faces,
+        r.flips,
+        r.asymmetry,
+        t.elapsed().as_secs_f64(),
+        r.boundary_edges_flipped
+    );
+    for h in &r.history {
+        println!(
+            "  it {}: err {:.3e} step {:.3e}",
+            h.iteration, h.max_curvature_error, h.step
+        );
+    }
+    for n in &r.notes {
+        println!("  note: {n}");
+    }
+}
