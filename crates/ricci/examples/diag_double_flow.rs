@@ -3,7 +3,9 @@
 //! never flip) and once on its double (`mesh::double_cover`, boundary vertices held at
 //! `u = 0`, `K̄ = 0` elsewhere), where the boundary edges are ordinary edges.
 //!
-//! `cargo run --release -p ricci --example diag_double_flow [splits] [seed]`
+//! `cargo run --release -p ricci --example diag_double_flow [splits] [seed]`, or
+//! `… diag_double_flow MESH [euclidean|hyperbolic]`: a mesh file with boundary, free boundary in
+//! E², geodesic boundary in H², on the surface and on its double.
 
 use ricci::flow::double::flow_on_double;
 use ricci::flow::target::resolve;
@@ -50,6 +52,13 @@ fn split_off_centre(s: &Surface, count: usize, rng: &mut Lcg, near: f64) -> Surf
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
+    if let Some(path) = args.get(1).filter(|a| a.contains('.')) {
+        let geometry = match args.get(2).map(String::as_str) {
+            Some("hyperbolic") => Geometry::Hyperbolic,
+            _ => Geometry::Euclidean,
+        };
+        return mesh_file(path, geometry);
+    }
     let count: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(120);
     let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(7);
     let d = generate::disk(16).unwrap();
@@ -162,8 +171,8 @@ fn main() {
     let r = flow_on_double(m, &l, Geometry::Euclidean, &target, 1e-10, &mut NoProgress).unwrap();
     println!(
         "double: {} vertices, {} faces; {} isometric flips",
-        r.double.n_vertices(),
-        r.double.n_faces(),
+        r.sigma.len(),
+        2 * m.n_faces(),
         r.initial_flips
     );
     println!(
@@ -187,5 +196,62 @@ fn main() {
     }
     for n in &r.notes {
         println!("  note: {n}");
+    }
+}
+
+/// A mesh file: free boundary (E²) or geodesic boundary (H²), on the surface and the double.
+fn mesh_file(path: &str, geometry: Geometry) {
+    let (s, _) = ricci::mesh::io::read_surface(std::path::Path::new(path)).unwrap();
+    let spec = match geometry {
+        Geometry::Hyperbolic => TargetSpec::GeodesicBoundary,
+        _ => TargetSpec::FreeBoundary,
+    };
+    let o = FlowOptions {
+        geometry,
+        scheme: Scheme::Conformal,
+        target: spec.clone(),
+        tolerance: 1e-10,
+        ..FlowOptions::default()
+    };
+    let l = s.edge_lengths();
+    let t = std::time::Instant::now();
+    let f = ricci_flow(&s.mesh, &l, &o, &mut NoProgress).unwrap();
+    println!(
+        "{path} {geometry:?}: {} vertices; surface flow converged {} ({} iterations, {} \
+         isometric flips, max |K − K̄| {:.2e}), {:.2} s",
+        s.mesh.n_vertices(),
+        f.converged,
+        f.iterations,
+        f.triangulation.as_ref().map_or(0, |t| t.initial_flips),
+        f.max_curvature_error,
+        t.elapsed().as_secs_f64()
+    );
+    // H² reads the lengths scaled as the surface flow did.
+    let scaled: Vec<f64> = l.iter().map(|x| x * f.input_scale).collect();
+    let target = resolve(&s.mesh, geometry, &spec).unwrap();
+    let t = std::time::Instant::now();
+    match flow_on_double(&s.mesh, &scaled, geometry, &target, 1e-10, &mut NoProgress) {
+        Ok(r) => {
+            let du =
+                r.u.iter()
+                    .zip(&f.u)
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0f64, f64::max);
+            println!(
+                "double: {} vertices; converged {} ({} iterations, {} isometric + {} Ptolemy \
+                 flips, {} boundary edges flipped, max |K − K̄| {:.2e}, asymmetry {:.1e}), \
+                 {:.2} s; max |u_double − u_surface| on the surface {du:.2e}",
+                r.sigma.len(),
+                r.converged,
+                r.iterations,
+                r.initial_flips,
+                r.flips,
+                r.boundary_edges_flipped,
+                r.max_error,
+                r.asymmetry,
+                t.elapsed().as_secs_f64()
+            );
+        }
+        Err(e) => println!("double: {e}"),
     }
 }

@@ -6,10 +6,11 @@
 //! the surface's own flow where no boundary edge flips; `u = 0` for a surface that is already
 //! flat (the closed form).
 
+use ricci::flow::double::double_triangulation;
 use ricci::flow::double::flow_on_double;
 use ricci::flow::target::resolve;
 use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
-use ricci::mesh::{generate, Surface};
+use ricci::mesh::{double_cover, generate, topology, Surface};
 use ricci::metric::{Geometry, Scheme};
 use ricci::progress::NoProgress;
 use std::f64::consts::PI;
@@ -118,8 +119,12 @@ fn checked_double_flow(name: &str, s: &Surface) -> ricci::flow::double::DoubleFl
             assert!(k.abs() <= 1e-10, "{name}: K = {k} at interior vertex {v}");
         }
     }
-    // Gauss–Bonnet of the half: Σ K = 2π χ(M) = 2π (the boundary's turning angles).
-    assert!((total - 2.0 * PI).abs() <= 1e-9, "{name}: Σ K = {total}");
+    // Gauss–Bonnet of the half: Σ K = 2π χ(M) (interior K = 0: the boundary's turning angles).
+    let chi = topology(m).euler_characteristic() as f64;
+    assert!(
+        (total - 2.0 * PI * chi).abs() <= 1e-9,
+        "{name}: Σ K = {total}, χ = {chi}"
+    );
     r
 }
 
@@ -187,4 +192,55 @@ fn flat_disk_on_the_double_keeps_its_metric() {
     let r = checked_double_flow("flat disk", &s);
     let umax = r.u_double.iter().fold(0.0f64, |a, x| a.max(x.abs()));
     assert!(umax <= 1e-9, "max |u| = {umax}");
+}
+
+/// The double built as a Δ-complex (`double_triangulation`) is `mesh::double_cover`'s mesh
+/// face by face, with every edge's coordinate that of the surface edge it copies.
+#[test]
+fn double_triangulation_matches_the_double_cover() {
+    let s = bumpy_disk(false);
+    let l = s.edge_lengths();
+    let (tri, sigma, origin) = double_triangulation(&s.mesh, Geometry::Euclidean, &l).unwrap();
+    let (d, sigma2) = double_cover(&s.mesh).unwrap();
+    assert_eq!(sigma, sigma2);
+    assert_eq!(tri.n_faces(), d.n_faces());
+    assert_eq!(tri.n_edges(), d.n_edges());
+    for f in 0..d.n_faces() as u32 {
+        assert_eq!(tri.face(f), d.face(f), "face {f}");
+    }
+    for e in 0..tri.n_edges() as u32 {
+        let [a, b] = tri.edge_vertices(e);
+        let o = origin[e as usize];
+        let mut got = [a, b].map(|v| v.min(sigma[v as usize]));
+        let mut want = s.mesh.edge_vertices(o);
+        got.sort_unstable();
+        want.sort_unstable();
+        assert_eq!(got, want, "edge {e}");
+        assert_eq!(tri.lambda[e as usize], 2.0 * l[o as usize].ln(), "edge {e}");
+    }
+}
+
+/// A pair of pants whose interior edges join boundary vertices (the double is a Δ-complex
+/// with two edges between them; `double_cover` refuses it): the flow on the double converges.
+#[test]
+fn pants_with_chords_converge_on_the_double() {
+    let s = generate::pair_of_pants(24).unwrap();
+    assert!(double_cover(&s.mesh).is_err());
+    let r = checked_double_flow("pants", &s);
+    let o = FlowOptions {
+        geometry: Geometry::Euclidean,
+        scheme: Scheme::Conformal,
+        target: TargetSpec::FreeBoundary,
+        tolerance: 1e-12,
+        ..FlowOptions::default()
+    };
+    let f = ricci_flow(&s.mesh, &s.edge_lengths(), &o, &mut NoProgress).unwrap();
+    if r.boundary_edges_flipped == 0 && f.converged {
+        let d =
+            r.u.iter()
+                .zip(&f.u)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0f64, f64::max);
+        eprintln!("pants: max |u_double − u_surface| = {d:.2e}");
+    }
 }

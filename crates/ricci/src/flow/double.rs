@@ -12,6 +12,10 @@
 //! doubled since a boundary vertex's cone angle is twice its boundary angle) has a
 //! σ-symmetric solution (the energy is strictly convex once a vertex is held).
 //!
+//! The double is built here as an [`IntrinsicTriangulation`] ([`double_triangulation`]), a
+//! Δ-complex, so that an interior edge of the surface joining two boundary vertices (which
+//! [`crate::mesh::double_cover`] refuses: a [`Mesh`] has one edge per vertex pair) is allowed.
+//!
 //! The solution is a metric on the double's final Delaunay triangulation, whose edges may
 //! cross the fixed curve of σ (the surface's boundary): cutting that triangulation back to one
 //! half (for the layout and the common subdivision of the surface) is not done here.
@@ -20,8 +24,8 @@ use super::conformal::{solve, ConformalSettings};
 use super::newton::max_error;
 use super::{IterationRecord, Target};
 use crate::error::{Error, Result};
-use crate::mesh::double::double_edge_origin;
-use crate::mesh::{double_cover, Mesh};
+use crate::mesh::double::double_vertices;
+use crate::mesh::{Mesh, NONE};
 use crate::metric::intrinsic::IntrinsicTriangulation;
 use crate::metric::Geometry;
 use crate::progress::Progress;
@@ -29,8 +33,8 @@ use crate::progress::Progress;
 /// What [`flow_on_double`] produced.
 #[derive(Debug, Clone)]
 pub struct DoubleFlow {
-    /// The double (faces `0..F` are the surface's).
-    pub double: Mesh,
+    /// For every edge id of the double, the edge of the surface it is a copy of.
+    pub edge_origin: Vec<u32>,
     /// The involution on the double's vertices (fixes exactly the surface's boundary vertices).
     pub sigma: Vec<u32>,
     /// `u` per vertex of the double.
@@ -114,19 +118,16 @@ pub fn flow_on_double(
             mesh.n_vertices()
         )));
     }
-    let (double, sigma) = double_cover(mesh)?;
-    let origin = double_edge_origin(mesh, &double, &sigma)?;
-    let dl: Vec<f64> = origin.iter().map(|&e| lengths[e as usize]).collect();
+    let (mut tri, sigma, edge_origin) = double_triangulation(mesh, geometry, lengths)?;
     let mut dtarget = double_target(target, &sigma)?;
-    let mut tri = IntrinsicTriangulation::from_mesh(&double, geometry, &dl)?;
-    let flip_budget = 200 * double.n_edges() + 10_000;
+    let flip_budget = 200 * tri.n_edges() + 10_000;
     let init = tri.make_delaunay_isometric(geometry, flip_budget);
     if !init.delaunay {
         return Err(Error::numerical(format!(
             "the double's input metric did not become Delaunay within {flip_budget} flips"
         )));
     }
-    let nd = double.n_vertices();
+    let nd = sigma.len();
     let has_fixed = dtarget.fixed.iter().any(|&f| f);
     let pinned: Vec<u32> = if geometry == Geometry::Euclidean && !has_fixed {
         (0..nd as u32)
@@ -147,11 +148,12 @@ pub fn flow_on_double(
     let asymmetry = (0..nd)
         .map(|v| (out.u[v] - out.u[sigma[v] as usize]).abs())
         .fold(0.0f64, f64::max);
-    let boundary_edges_flipped = (0..double.n_edges() as u32)
-        .filter(|&e| mesh.is_boundary_edge(origin[e as usize]))
+    // Boundary edges keep their ids (< E) in the double.
+    let boundary_edges_flipped = (0..mesh.n_edges() as u32)
+        .filter(|&e| mesh.is_boundary_edge(e))
         .filter(|&e| {
             let mut a = tri.edge_vertices(e);
-            let mut b = double.edge_vertices(e);
+            let mut b = mesh.edge_vertices(e);
             a.sort_unstable();
             b.sort_unstable();
             a != b
@@ -185,7 +187,57 @@ pub fn flow_on_double(
         asymmetry,
         notes: out.notes,
         triangulation: tri,
-        double,
+        edge_origin,
         sigma,
     })
+}
+
+/// The double of `mesh` as a Δ-complex with the log Penner coordinates of `lengths`
+/// (module docs): faces `0..F` and edges `0..E` are the surface's (same ids), face `F + f` the
+/// mirror of face `f` (half-edge `3f + i` mirrored to `3(F + f) + 2 − i`), then one new edge
+/// per interior edge; a boundary edge's two sides are a half-edge and its mirror. Returns the
+/// triangulation, `σ` ([`double_vertices`]) and the surface edge of every edge.
+pub fn double_triangulation(
+    mesh: &Mesh,
+    geometry: Geometry,
+    lengths: &[f64],
+) -> Result<(IntrinsicTriangulation, Vec<u32>, Vec<u32>)> {
+    let half = IntrinsicTriangulation::from_mesh(mesh, geometry, lengths)?;
+    let sigma = double_vertices(mesh)?;
+    let nf = half.n_faces() as u32;
+    let nh = 3 * nf as usize;
+    let ne = half.n_edges();
+    let mirror = |h: u32| 3 * (nf + h / 3) + 2 - h % 3;
+    let mut tri = half.clone();
+    tri.n_vertices = sigma.len();
+    tri.origin.resize(2 * nh, NONE);
+    tri.twin.resize(2 * nh, NONE);
+    tri.edge.resize(2 * nh, NONE);
+    tri.boundary_vertex = vec![false; sigma.len()];
+    let mut edge_origin: Vec<u32> = (0..ne as u32).collect();
+    let mut mirror_edge = vec![NONE; ne];
+    for e in 0..ne as u32 {
+        if !half.is_boundary_edge(e) {
+            mirror_edge[e as usize] = edge_origin.len() as u32;
+            edge_origin.push(e);
+            tri.lambda.push(half.lambda[e as usize]);
+            tri.edge_he.push(mirror(half.edge_he[e as usize]));
+        }
+    }
+    for h in 0..nh as u32 {
+        // The mirror of h runs from σ(tip h) to σ(origin h).
+        let m = mirror(h) as usize;
+        tri.origin[m] = sigma[half.tip(h) as usize];
+        let (e, t) = (half.edge[h as usize], half.twin[h as usize]);
+        if t == NONE {
+            tri.twin[h as usize] = m as u32;
+            tri.twin[m] = h;
+            tri.edge[m] = e;
+        } else {
+            tri.twin[m] = mirror(t);
+            tri.edge[m] = mirror_edge[e as usize];
+        }
+    }
+    tri.check()?;
+    Ok((tri, sigma, edge_origin))
 }

@@ -25,7 +25,6 @@ pub fn double_cover(mesh: &Mesh) -> Result<(Mesh, Vec<u32>)> {
             "the mesh has no boundary: its double would be two disjoint copies",
         ));
     }
-    let nv = mesh.n_vertices();
     for e in 0..mesh.n_edges() as u32 {
         let [a, b] = mesh.edge_vertices(e);
         let (a, b) = (a.min(b), a.max(b));
@@ -36,22 +35,8 @@ pub fn double_cover(mesh: &Mesh) -> Result<(Mesh, Vec<u32>)> {
             )));
         }
     }
-    let mut sigma: Vec<u32> = (0..nv as u32).collect();
-    let mut next = nv as u32;
-    for v in 0..nv as u32 {
-        if !mesh.is_isolated(v) && !mesh.is_boundary_vertex(v) {
-            sigma[v as usize] = next;
-            next += 1;
-        }
-    }
-    let nd = next as usize;
-    sigma.resize(nd, NONE);
-    for v in 0..nv {
-        let s = sigma[v] as usize;
-        if s >= nv {
-            sigma[s] = v as u32;
-        }
-    }
+    let sigma = double_vertices(mesh)?;
+    let nd = sigma.len();
     let mut faces = mesh.faces().to_vec();
     faces.extend(
         mesh.faces()
@@ -60,6 +45,34 @@ pub fn double_cover(mesh: &Mesh) -> Result<(Mesh, Vec<u32>)> {
     );
     let double = Mesh::from_triangles(nd, faces)?;
     Ok((double, sigma))
+}
+
+/// The involution `σ` on the double's vertices (numbered as in the module docs), without
+/// building the double (whose connectivity may then be a Δ-complex: an interior edge of `M`
+/// between two boundary vertices appears twice). Errors when `mesh` has no boundary.
+pub fn double_vertices(mesh: &Mesh) -> Result<Vec<u32>> {
+    if !mesh.has_boundary() {
+        return Err(Error::input(
+            "the mesh has no boundary: its double would be two disjoint copies",
+        ));
+    }
+    let nv = mesh.n_vertices();
+    let mut sigma: Vec<u32> = (0..nv as u32).collect();
+    let mut next = nv as u32;
+    for v in 0..nv as u32 {
+        if !mesh.is_isolated(v) && !mesh.is_boundary_vertex(v) {
+            sigma[v as usize] = next;
+            next += 1;
+        }
+    }
+    sigma.resize(next as usize, NONE);
+    for v in 0..nv {
+        let s = sigma[v] as usize;
+        if s >= nv {
+            sigma[s] = v as u32;
+        }
+    }
+    Ok(sigma)
 }
 
 /// The vertex of `M` that vertex `v` of the double is a copy of (`v` itself or `σ(v)`).
