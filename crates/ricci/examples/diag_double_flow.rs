@@ -197,6 +197,77 @@ fn main() {
     for n in &r.notes {
         println!("  note: {n}");
     }
+    half_region(m, &r);
+}
+
+/// The next step's claim, measured: the faces of the double's final triangulation that meet
+/// the surface (a vertex in its interior; rung faces x, σx, y included) form a flat disk that
+/// lays out in the plane with no flipped face.
+fn half_region(m: &ricci::mesh::Mesh, r: &ricci::flow::double::DoubleFlow) {
+    let nv = m.n_vertices();
+    let s = r
+        .triangulation
+        .to_simplicial(Geometry::Euclidean, &r.u_double)
+        .unwrap();
+    let inside = |v: u32| (v as usize) < nv && r.sigma[v as usize] != v;
+    let mut id = vec![u32::MAX; s.mesh.n_vertices()];
+    let mut faces = Vec::new();
+    let mut all_fixed = 0;
+    let mut n = 0u32;
+    for f in 0..s.mesh.n_faces() as u32 {
+        let t = s.mesh.face(f);
+        let o = t.map(|v| s.vertex_origin[v as usize]);
+        if o.iter().all(|&v| v != u32::MAX && r.sigma[v as usize] == v) {
+            all_fixed += 1;
+        }
+        if !o.iter().any(|&v| v != u32::MAX && inside(v)) {
+            continue;
+        }
+        let mut nt = [0u32; 3];
+        for k in 0..3 {
+            let v = t[k] as usize;
+            if id[v] == u32::MAX {
+                id[v] = n;
+                n += 1;
+            }
+            nt[k] = id[v];
+        }
+        faces.push((f, nt));
+    }
+    let n = n as usize;
+    let region = ricci::mesh::Mesh::from_triangles(n, faces.iter().map(|x| x.1).collect()).unwrap();
+    let mut back = vec![0u32; n];
+    for (v, &i) in id.iter().enumerate() {
+        if i != u32::MAX {
+            back[i as usize] = v as u32;
+        }
+    }
+    let lengths: Vec<f64> = (0..region.n_edges() as u32)
+        .map(|e| {
+            let [a, b] = region.edge_vertices(e).map(|v| back[v as usize]);
+            let h = s.mesh.halfedge_between(a, b).unwrap();
+            s.lengths[s.mesh.he_edge(h) as usize]
+        })
+        .collect();
+    let t = ricci::mesh::topology(&region);
+    println!(
+        "half region: {} of {} faces, χ = {}, {} boundary loop(s), {} faces of the double with \
+         only boundary vertices (left out)",
+        region.n_faces(),
+        s.mesh.n_faces(),
+        t.euler_characteristic(),
+        t.boundary_loops(),
+        all_fixed
+    );
+    match ricci::layout::place::layout::<ricci::metric::Euclidean>(&region, &lengths, None) {
+        Ok(l) => println!(
+            "  layout: {} flipped, {} degenerate, max length error {:.2e}",
+            l.flipped_faces.len(),
+            l.degenerate_faces.len(),
+            l.max_length_error
+        ),
+        Err(e) => println!("  layout: {e}"),
+    }
 }
 
 /// A mesh file: free boundary (E²) or geodesic boundary (H²), on the surface and the double.
