@@ -244,3 +244,89 @@ fn pants_with_chords_converge_on_the_double() {
         eprintln!("pants: max |u_double − u_surface| = {d:.2e}");
     }
 }
+
+/// The next step's premise (docs/notes/wave2-s7-dbl7.md): the faces of the double's final
+/// Delaunay triangulation that meet the surface — a vertex in its interior, which includes the
+/// rung faces `(x, σx, y)` whose edge `x σx` crosses the boundary — form a topological disk
+/// (χ = 1, one boundary loop) whose metric is flat (the cones sit at the boundary vertices, on
+/// its boundary): laid out in the plane, every edge has its length and no face is flipped.
+#[test]
+fn faces_meeting_the_surface_form_a_flat_disk() {
+    use ricci::layout::place::layout;
+    use ricci::mesh::Mesh;
+    use ricci::metric::Euclidean;
+    for (count, seed) in [(120, 7), (200, 3), (300, 11)] {
+        let d = generate::disk(16).unwrap();
+        let pos: Vec<[f64; 3]> = d
+            .positions
+            .iter()
+            .map(|p| {
+                let (x, y) = (p[0], p[1]);
+                [x, y, 0.5 * (3.0 * x).sin() * (2.0 * y).cos() + 0.7 * x * x]
+            })
+            .collect();
+        let s = Surface::new(pos, d.mesh.faces().to_vec()).unwrap();
+        let s = split_off_centre(&s, count, &mut Lcg(seed), 0.75, false);
+        let name = format!("disk {count}/{seed}");
+        let r = checked_double_flow(&name, &s);
+        assert!(r.boundary_edges_flipped > 0, "{name}");
+        let nv = s.mesh.n_vertices();
+        let sm = r
+            .triangulation
+            .to_simplicial(Geometry::Euclidean, &r.u_double)
+            .unwrap();
+        let inside = |v: u32| v != u32::MAX && (v as usize) < nv && r.sigma[v as usize] != v;
+        let mut id = vec![u32::MAX; sm.mesh.n_vertices()];
+        let mut back = Vec::new();
+        let mut faces = Vec::new();
+        for f in 0..sm.mesh.n_faces() as u32 {
+            let t = sm.mesh.face(f);
+            if !t.iter().any(|&v| inside(sm.vertex_origin[v as usize])) {
+                continue;
+            }
+            faces.push(t.map(|v| {
+                if id[v as usize] == u32::MAX {
+                    id[v as usize] = back.len() as u32;
+                    back.push(v);
+                }
+                id[v as usize]
+            }));
+        }
+        let region = Mesh::from_triangles(back.len(), faces).unwrap();
+        let t = topology(&region);
+        assert_eq!(t.components.len(), 1, "{name}");
+        assert_eq!(t.euler_characteristic(), 1, "{name}");
+        assert_eq!(t.boundary_loops(), 1, "{name}");
+        // Some faces of the region are rung faces: two of their corners are x and σx.
+        let rungs = region
+            .faces()
+            .iter()
+            .filter(|t| {
+                let o = t.map(|v| sm.vertex_origin[back[v as usize] as usize]);
+                (0..3).any(|k| {
+                    let (a, b) = (o[k], o[(k + 1) % 3]);
+                    a != u32::MAX && b != u32::MAX && a != b && r.sigma[a as usize] == b
+                })
+            })
+            .count();
+        assert!(rungs > 0, "{name}: no rung face");
+        let lengths: Vec<f64> = (0..region.n_edges() as u32)
+            .map(|e| {
+                let [a, b] = region.edge_vertices(e).map(|v| back[v as usize]);
+                let h = sm.mesh.halfedge_between(a, b).unwrap();
+                sm.lengths[sm.mesh.he_edge(h) as usize]
+            })
+            .collect();
+        let l = layout::<Euclidean>(&region, &lengths, None).unwrap();
+        eprintln!(
+            "{name}: region {} faces ({rungs} rung faces), {} flipped, {} degenerate, length error {:.1e}",
+            region.n_faces(),
+            l.flipped_faces.len(),
+            l.degenerate_faces.len(),
+            l.max_length_error
+        );
+        assert!(l.flipped_faces.is_empty(), "{name}");
+        assert!(l.degenerate_faces.is_empty(), "{name}");
+        assert!(l.max_length_error <= 1e-12, "{name}");
+    }
+}
