@@ -34,6 +34,7 @@
 
 pub mod adaptive;
 pub mod conformal;
+pub mod double;
 pub(crate) mod error;
 pub(crate) mod newton;
 pub mod polish;

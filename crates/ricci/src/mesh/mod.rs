@@ -6,6 +6,7 @@
 
 pub mod build;
 pub(crate) mod connectivity;
+pub mod double;
 pub mod generate;
 pub mod io;
 pub mod quality;
@@ -13,6 +14,7 @@ pub mod topology;
 
 pub use build::{build_surface, BuildReport, PolygonSoup};
 pub use connectivity::{Mesh, NONE};
+pub use double::double_cover;
 pub use topology::{topology, Component, Topology};
 
 /// A mesh embedded in R³: connectivity plus one position per vertex (and optional UVs).
