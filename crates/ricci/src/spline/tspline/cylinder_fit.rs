@@ -119,8 +119,8 @@ impl CylinderSpline {
         out
     }
 
-    /// The (at most 4) `u` functions non-zero at `u' ∈ [0, L)`: column and value.
-    fn ubasis(&self, u: f64, out: &mut Vec<(usize, f64)>) {
+    /// The (at most 4) `u` functions non-zero at `u' ∈ [0, L)`: column, value, derivative.
+    fn ubasis(&self, u: f64, out: &mut Vec<(usize, [f64; 2])>) {
         out.clear();
         let l = self.circumference;
         if self.lines.is_empty() {
@@ -128,9 +128,9 @@ impl CylinderSpline {
             let su = ((u / hu).floor() as isize).clamp(0, nu - 1);
             for i in su - 1..su + 3 {
                 let tu: [f64; 5] = std::array::from_fn(|k| (i + k as isize - 2) as f64 * hu);
-                let b = cubic(&tu, u)[0];
-                if b != 0.0 {
-                    out.push((i.rem_euclid(nu) as usize, b));
+                let b = cubic(&tu, u);
+                if b[0] != 0.0 || b[1] != 0.0 {
+                    out.push((i.rem_euclid(nu) as usize, [b[0], b[1]]));
                 }
             }
             return;
@@ -144,15 +144,16 @@ impl CylinderSpline {
         let tau = |k: usize| a + (k.clamp(3, m + 3) - 3) as f64 * h;
         for k in q..q + 4 {
             let t: [f64; 5] = std::array::from_fn(|r| tau(k + r));
-            let b = cubic(&t, x)[0];
-            if b != 0.0 {
-                out.push(((start + k) % ncu, b));
+            let b = cubic(&t, x);
+            if b[0] != 0.0 || b[1] != 0.0 {
+                out.push(((start + k) % ncu, [b[0], b[1]]));
             }
         }
     }
 
-    /// The (at most 16) basis functions non-zero at `(u', v)`: control index and value.
-    fn basis(&self, u: f64, v: f64, out: &mut Vec<(usize, f64)>) {
+    /// The (at most 16) basis functions non-zero at `(u', v)`: control index and
+    /// `[N, ∂N/∂u', ∂N/∂v]`.
+    fn basis_d(&self, u: f64, v: f64, out: &mut Vec<(usize, [f64; 3])>) {
         let mut bu = Vec::with_capacity(4);
         self.ubasis(u.rem_euclid(self.circumference), &mut bu);
         out.clear();
@@ -163,14 +164,22 @@ impl CylinderSpline {
         for j in sv..sv + 4 {
             // clamped knots: function j uses tau[j..j + 5], tau[k] = vk(k − 3)
             let tv: [f64; 5] = std::array::from_fn(|k| vk(j as isize + k as isize - 3));
-            let bv = cubic(&tv, v)[0];
-            if bv == 0.0 {
+            let bv = cubic(&tv, v);
+            if bv[0] == 0.0 && bv[1] == 0.0 {
                 continue;
             }
             for &(i, b) in &bu {
-                out.push((j * ncu + i, b * bv));
+                out.push((j * ncu + i, [b[0] * bv[0], b[1] * bv[0], b[0] * bv[1]]));
             }
         }
+    }
+
+    /// The (at most 16) basis functions non-zero at `(u', v)`: control index and value.
+    fn basis(&self, u: f64, v: f64, out: &mut Vec<(usize, f64)>) {
+        let mut d = Vec::with_capacity(16);
+        self.basis_d(u, v, &mut d);
+        out.clear();
+        out.extend(d.iter().filter(|x| x.1[0] != 0.0).map(|&(k, x)| (k, x[0])));
     }
 
     /// The point at the spline's own parameters `(u', v)`.
@@ -230,6 +239,10 @@ pub struct GenusFitOptions {
     pub glue: f64,
     /// Share the glued boundary rows (exact C⁰); `false` forces the penalty.
     pub share: bool,
+    /// With shared rows: weight of the tangent penalty `w h² |∂_v S_lower − ∂_v S_upper|²`
+    /// (developed `v`, span width `h`) at three points per span of every glued strip, pulling
+    /// the two sides towards C¹ (0: off).
+    pub tangent: f64,
 }
 
 impl Default for GenusFitOptions {
@@ -242,6 +255,7 @@ impl Default for GenusFitOptions {
             max_control_points: 20_000,
             glue: 100.0,
             share: true,
+            tangent: 1.0,
         }
     }
 }
@@ -359,6 +373,7 @@ fn solve_all(
     smoothing: f64,
     glue: f64,
     gluing: Option<&Gluing>,
+    tangent: f64,
 ) -> Result<(Vec<CylinderSpline>, usize)> {
     let mut base = Vec::with_capacity(splines.len());
     let mut slots = 0;
@@ -388,6 +403,9 @@ fn solve_all(
                 }
             }
         }
+    }
+    if let Some(g) = gluing.filter(|_| tangent > 0.0) {
+        tangent_penalty(&splines, &base, g, tangent, &mut trip);
     }
     let (map, n) = shared_unknowns(&splines, &base, gluing);
     for t in trip.iter_mut() {
@@ -423,6 +441,42 @@ fn solve_all(
         }
     }
     Ok((splines, n))
+}
+
+/// `w h² |∂_v S_lower − ∂_v S_upper|²` at three points per span of every glued strip, with
+/// `∂_v` at fixed developed `u` (`∂_v − (shear / H) ∂_u'` in a spline's own parameters).
+fn tangent_penalty(
+    splines: &[CylinderSpline],
+    base: &[usize],
+    g: &Gluing,
+    w: f64,
+    trip: &mut Vec<Triplet<usize, usize, f64>>,
+) {
+    let (mut ba, mut bb) = (Vec::new(), Vec::new());
+    for x in &g.glues {
+        let (a, b) = (&splines[x.lower], &splines[x.upper]);
+        let m = a.spans[x.lower_strip];
+        let h = x.length / m as f64;
+        let (ka, kb) = (a.shear / a.height, b.shear / b.height);
+        for i in 0..3 * m {
+            let off = (i as f64 + 0.5) / 3.0 * h;
+            a.basis_d(a.lines[x.lower_strip] + off, a.height, &mut ba);
+            b.basis_d(b.lines[x.upper_strip] + off, 0.0, &mut bb);
+            let row: Vec<(usize, f64)> = ba
+                .iter()
+                .map(|&(k, d)| (base[x.lower] + k, d[2] - ka * d[1]))
+                .chain(
+                    bb.iter()
+                        .map(|&(k, d)| (base[x.upper] + k, kb * d[1] - d[2])),
+                )
+                .collect();
+            for &(r, p) in &row {
+                for &(c, q) in &row {
+                    trip.push(Triplet::new(r, c, w * h * h * p * q));
+                }
+            }
+        }
+    }
 }
 
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -583,7 +637,15 @@ pub fn fit_cylinders(
                 CylinderSpline::new(&domain.cylinders[c], layout(c), m, nv[c])
             })
             .collect();
-        (splines, unknowns) = solve_all(domain, fresh, &data, opts.smoothing, opts.glue, glued)?;
+        (splines, unknowns) = solve_all(
+            domain,
+            fresh,
+            &data,
+            opts.smoothing,
+            opts.glue,
+            glued,
+            opts.tangent,
+        )?;
         errors = splines
             .iter()
             .zip(&data)
