@@ -54,6 +54,7 @@ fn check_domain(name: &str, s: &Surface, d: &GenusDomain) {
         d.crossings.len(),
         d.holonomy_defect
     );
+    eprintln!("{name}: zero copies {:?}", d.zero_copies);
     // every cylinder is developed: Σ L·H over the charts is the net's signed uv area, computed
     // face by face by the decomposition (coarea formula, exact for piecewise-linear maps)
     let area: f64 = d.cylinders.iter().map(|c| c.circumference * c.height).sum();
@@ -134,7 +135,7 @@ fn genus_two_fit_meets_the_tolerance_and_is_c2_inside_the_cylinders() {
         // errors from the exported patches against the mesh vertices
         let (mut worst, mut sq) = (0.0f64, 0.0);
         for p in &d.points {
-            let u = p.u + fit.offsets[p.cylinder];
+            let u = fit.exported_u(p.cylinder, p.u, p.v);
             let q = patches
                 .iter()
                 .find(|q| {
@@ -197,11 +198,12 @@ fn genus_two_fit_meets_the_tolerance_and_is_c2_inside_the_cylinders() {
                 );
             }
         }
-        // C² inside the cylinders, and the third derivatives do jump (the check sees jumps)
-        let inside = fit.interior_jumps(&patches, 3);
+        // C² inside the cylinders away from the knot lines, and the third derivatives do jump
+        // (the check sees jumps); C⁰ on the knot lines
+        let (inside, lines) = fit.interior_jumps(&patches, 3);
         let rel = inside.relative();
         eprintln!(
-            "{name}: inside relative jumps {rel:?} over {} side points",
+            "{name}: inside relative jumps {rel:?} over {} side points; knot lines {lines:?}",
             inside.comparisons
         );
         let sides: usize = fit
@@ -209,26 +211,170 @@ fn genus_two_fit_meets_the_tolerance_and_is_c2_inside_the_cylinders() {
             .iter()
             .map(|s| 3 * (2 * s.nu * s.nv - s.nu))
             .sum();
-        assert_eq!(inside.comparisons, sides, "{name}");
+        let line_sides: usize = fit.splines.iter().map(|s| 3 * s.nv * s.lines.len()).sum();
+        assert_eq!(inside.comparisons, sides - line_sides, "{name}");
+        assert_eq!(lines.comparisons, line_sides, "{name}");
         assert!(
             rel[0] < 1e-12 && rel[1] < 1e-10 && rel[2] < 1e-8,
             "{name}: {rel:?}"
         );
         assert!(rel[3] > 1e-6, "{name}: {rel:?}");
-        // across the critical trajectories: both sides within the fit of the same surface
-        let (glued, mids) = fit.glued_jumps(&patches, &d);
-        eprintln!(
-            "{name}: across critical trajectories: jumps {:?} at {} crossings ({:.4} % of the side)",
-            glued.jumps,
-            glued.comparisons,
-            100.0 * glued.jumps[0] / side
-        );
-        assert_eq!(glued.comparisons, d.crossings.len() + mids);
-        assert!(mids > 0, "{name}");
-        assert!(
-            glued.jumps[0] <= 4.0 * tolerance * side,
-            "{name}: {:?}",
-            glued.jumps
-        );
+        assert!(lines.max_gap < 1e-9 * side, "{name}: {lines:?}");
+    }
+}
+
+/// The gap across the critical trajectories, from points found without the gluing: the mesh
+/// edges' crossings of the critical levels (both sides' developed coordinates), and seven
+/// points between consecutive crossings glued by the same translation; evaluated on the
+/// exported patches. Per point: gap, normal angle in degrees, and the distance (relative to
+/// the circumference) to the nearest copy of a zero on either side.
+fn gap_across(
+    fit: &ricci::spline::tspline::cylinder_fit::GenusFit,
+    d: &GenusDomain,
+) -> Vec<(f64, f64, f64)> {
+    let patches = fit.patches();
+    let at = |k: usize, u: f64, v: f64| {
+        let w = fit.exported_u(k, u, v);
+        let s = &fit.splines[k];
+        let v = v.clamp(0.0, s.height);
+        let q = patches
+            .iter()
+            .filter(|q| {
+                q.u0 >= fit.offsets[k] - 1e-12 && q.u1 <= fit.offsets[k] + s.circumference + 1e-12
+            })
+            .filter(|q| {
+                w >= q.u0 - 1e-12 && w <= q.u1 + 1e-12 && v >= q.v0 - 1e-12 && v <= q.v1 + 1e-12
+            })
+            .min_by(|a, b| {
+                (a.v0 - v)
+                    .abs()
+                    .min((a.v1 - v).abs())
+                    .total_cmp(&(b.v0 - v).abs().min((b.v1 - v).abs()))
+            })
+            .unwrap();
+        let n = {
+            let (a, b) = (q.partial(w, v, 1, 0), q.partial(w, v, 0, 1));
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        (q.point(w, v), n)
+    };
+    let mut pts: Vec<(usize, f64, usize, f64)> = d
+        .crossings
+        .iter()
+        .map(|x| (x.lower, x.u_lower, x.upper, x.u_upper))
+        .collect();
+    pts.sort_by(|a, b| (a.0, a.2).cmp(&(b.0, b.2)).then(a.1.total_cmp(&b.1)));
+    let mut probes = pts.clone();
+    for w in pts.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let lu = d.cylinders[a.2].circumference;
+        let t = |x: (usize, f64, usize, f64)| (x.3 - x.1).rem_euclid(lu);
+        let ds = (t(a) - t(b)).abs();
+        if a.0 == b.0 && a.2 == b.2 && ds.min(lu - ds) < 1e-9 * lu {
+            for k in 1..8 {
+                let u = a.1 + (b.1 - a.1) * k as f64 / 8.0;
+                probes.push((a.0, u, a.2, (u + t(a)).rem_euclid(lu)));
+            }
+        }
+    }
+    let zero = |k: usize, top: bool, u: f64| {
+        let l = d.cylinders[k].circumference;
+        d.zero_copies
+            .iter()
+            .filter(|z| z.cylinder == k && z.top == top)
+            .map(|z| {
+                let x = (z.u - u).rem_euclid(l);
+                x.min(l - x) / l
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut out = Vec::new();
+    for &(a, ul, b, uu) in &probes {
+        let (p, n) = at(a, ul, d.cylinders[a].height);
+        let (q, m) = at(b, uu, 0.0);
+        let g = ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();
+        let dot = n[0] * m[0] + n[1] * m[1] + n[2] * m[2];
+        let nn =
+            (n.iter().map(|x| x * x).sum::<f64>() * m.iter().map(|x| x * x).sum::<f64>()).sqrt();
+        let angle = (dot / nn).clamp(-1.0, 1.0).acos().to_degrees();
+        out.push((g, angle, zero(a, true, ul).min(zero(b, false, uu))));
+    }
+    out
+}
+
+#[test]
+fn genus_two_fit_is_continuous_across_every_critical_trajectory() {
+    let tolerance = 0.01;
+    for (name, s) in cases() {
+        let h = forms(&s);
+        let d = best_genus_domain(&h, s.positions.len()).unwrap();
+        let side = {
+            let mut lo = [f64::INFINITY; 3];
+            let mut hi = [f64::NEG_INFINITY; 3];
+            for p in &s.positions {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+            (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)
+        };
+        let mut gaps = Vec::new();
+        for share in [true, false] {
+            let opts = GenusFitOptions {
+                tolerance,
+                share,
+                ..GenusFitOptions::default()
+            };
+            let fit = fit_cylinders(&d, &s.positions, &opts).unwrap();
+            let probes = gap_across(&fit, &d);
+            let n = probes.len();
+            // points at least 0.2 % of the circumference from a zero, and the others (where a
+            // mesh edge passing by the cone point can be developed to the wrong side of it)
+            let far = |p: &&(f64, f64, f64)| p.2 >= 2e-3;
+            let max = |it: &mut dyn Iterator<Item = f64>| it.fold(0.0f64, f64::max);
+            let gap = max(&mut probes.iter().filter(far).map(|p| p.0));
+            let angle = max(&mut probes.iter().filter(far).map(|p| p.1));
+            let near: Vec<_> = probes.iter().filter(|p| p.2 < 2e-3).collect();
+            let near_open: Vec<_> = near.iter().filter(|p| p.0 > 1e-9 * side).collect();
+            let last = fit.steps.last().unwrap();
+            eprintln!(
+                "{name} (shared rows {share}): gluing {:?}; {} control points, rms {:.4} % max {:.4} %; across the critical trajectories: gap {:.3e} of the side at {n} points, normals up to {angle:.3}° apart; {} points near a zero, {} of them with a gap: {:?}",
+                fit.gluing.as_ref().map(|g| (g.glues.len(), g.mismatch, g.outliers, g.outlier_distance)),
+                fit.control_points(),
+                last.rms_error_percent,
+                last.max_error_percent,
+                gap / side,
+                near.len(),
+                near_open.len(),
+                near_open.iter().map(|p| (p.0 / side, p.1, p.2)).collect::<Vec<_>>()
+            );
+            assert!(fit.converged, "{name}");
+            assert!(n > d.crossings.len(), "{name}");
+            if share {
+                // the near ones with a gap are few: the outlier crossings of the gluing and
+                // the midpoints between two of them
+                let outliers = fit.gluing.as_ref().map_or(0, |g| g.outliers);
+                assert!(
+                    near_open.len() <= 8 * outliers,
+                    "{name}: {}",
+                    near_open.len()
+                );
+                assert!(
+                    fit.gluing.is_ok(),
+                    "{name}: {:?}",
+                    fit.gluing.as_ref().err()
+                );
+            }
+            gaps.push(gap / side);
+        }
+        // shared boundary rows: continuous to rounding; the penalty alone is not (the
+        // measurement sees gaps)
+        assert!(gaps[0] <= 1e-9, "{name}: gap {:e}", gaps[0]);
+        assert!(gaps[1] > 1e-6, "{name}: penalty gap {:e}", gaps[1]);
     }
 }

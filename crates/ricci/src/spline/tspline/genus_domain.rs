@@ -55,6 +55,17 @@ pub struct Crossing {
     pub u_upper: f64,
 }
 
+/// A saddle (zero) seen from one side of a cylinder: it lies on the cylinder's top (`v = H`)
+/// or bottom (`v = 0`) circle at `u`. A saddle can appear several times on one circle (the
+/// circle running through it twice); each appearance is one copy.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct ZeroCopy {
+    pub saddle: u32,
+    pub cylinder: usize,
+    pub top: bool,
+    pub u: f64,
+}
+
 /// The domain of a genus ≥ 2 surface: cylinders, data points in them, gluing samples.
 #[derive(Debug, Clone)]
 pub struct GenusDomain {
@@ -70,6 +81,8 @@ pub struct GenusDomain {
     /// Data points not assigned (on a critical level, or cut off near a zero).
     pub unassigned: Vec<u32>,
     pub crossings: Vec<Crossing>,
+    /// The saddles' copies on the cylinders' circles (from the edges into each cylinder).
+    pub zero_copies: Vec<ZeroCopy>,
     /// `max |holonomy − k L| / L` over the non-tree edges of every cylinder.
     pub holonomy_defect: f64,
 }
@@ -263,6 +276,7 @@ fn develop(
         })
         .collect();
     let crossings = crossings(mesh, form, &cyl, &uv, &ucyl, &charts, bands.len());
+    let zero_copies = zero_copies(mesh, form, &saddles, &cyl, &uv, &ucyl, &charts);
     Ok(GenusDomain {
         decomposition: dec,
         combination: Vec::new(),
@@ -272,6 +286,7 @@ fn develop(
         points,
         unassigned,
         crossings,
+        zero_copies,
         holonomy_defect: defect,
     })
 }
@@ -413,6 +428,51 @@ fn crossings(
             upper: b,
             u_upper: (ucyl[y] - (1.0 - t) * du).rem_euclid(charts[b].circumference),
         });
+    }
+    out
+}
+
+/// The copies of each saddle on the circles of the cylinders around it: every edge from the
+/// saddle to a vertex `y` of a cylinder gives the saddle's `u` there (`u_y − Re ω`), on the top
+/// or bottom circle (`v_y − Im ω` = `H` or 0); copies closer than `1e-6 L` are one.
+fn zero_copies(
+    mesh: &Mesh,
+    form: &HolomorphicForm,
+    saddles: &[u32],
+    cyl: &[Option<usize>],
+    uv: &[[f64; 2]],
+    ucyl: &[f64],
+    charts: &[CylinderChart],
+) -> Vec<ZeroCopy> {
+    let mut out: Vec<ZeroCopy> = Vec::new();
+    for &x in saddles {
+        for hh in mesh.outgoing(x) {
+            let y = mesh.he_tip(hh) as usize;
+            let Some(c) = cyl[y] else { continue };
+            let (du, dv) = step(mesh, form, hh);
+            let (l, h) = (charts[c].circumference, charts[c].height);
+            let v = uv[y][1] - dv;
+            let top = if v.abs() < 1e-7 {
+                false
+            } else if (v - h).abs() < 1e-7 {
+                true
+            } else {
+                continue;
+            };
+            let u = (ucyl[y] - du).rem_euclid(l);
+            let same = |z: &ZeroCopy| {
+                let d = (z.u - u).abs();
+                z.saddle == x && z.cylinder == c && z.top == top && d.min(l - d) < 1e-6 * l
+            };
+            if !out.iter().any(same) {
+                out.push(ZeroCopy {
+                    saddle: x,
+                    cylinder: c,
+                    top,
+                    u,
+                });
+            }
+        }
     }
     out
 }

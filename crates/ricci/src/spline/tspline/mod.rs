@@ -30,10 +30,12 @@ pub(crate) mod charts;
 pub(crate) mod correction;
 pub mod curves;
 pub mod cylinder_fit;
+pub mod cylinder_jumps;
 pub mod cylinders;
 pub mod export;
 pub mod fit;
 pub mod genus_domain;
+pub mod glue;
 pub(crate) mod surface;
 pub(crate) mod tmesh;
 
