@@ -176,7 +176,13 @@ struct GrowingPattern {
     solver: Option<SymmetricSolver>,
     /// Symbolic factorizations computed.
     symbolic_count: usize,
+    /// Nonzeros of the factor of the last analysis with a new AMD ordering.
+    amd_factor_nnz: usize,
 }
+
+/// Most growth of the factor's nonzeros, relative to the last AMD analysis, accepted with a
+/// reused ordering ([`GrowingPattern::cover`]).
+const REUSED_ORDERING_FILL: f64 = 1.1;
 
 impl GrowingPattern {
     fn new(held: &[bool]) -> GrowingPattern {
@@ -196,6 +202,7 @@ impl GrowingPattern {
             row_idx: (0..n as u32).collect(),
             solver: None,
             symbolic_count: 0,
+            amd_factor_nnz: 0,
         }
     }
     fn n(&self) -> usize {
@@ -252,15 +259,28 @@ impl GrowingPattern {
             diag_slot: Vec::new(),
             edge_slot: Vec::new(),
         };
-        // A grown pattern keeps the fill-reducing ordering of the first analysis: flips add
-        // pairs of vertices two apart, which that ordering still handles with little extra
-        // fill, and the AMD ordering is most of the cost of a symbolic analysis.
+        // A grown pattern keeps the fill-reducing ordering of the last AMD analysis while
+        // the factor stays within `REUSED_ORDERING_FILL` of that analysis' factor: flips add
+        // pairs of vertices two apart, which the old ordering usually absorbs with little
+        // extra fill, and the AMD ordering is most of the cost of a symbolic analysis. Many
+        // flips far from where the ordering expected them (the punctured sphere's flat
+        // picture) make the fill grow instead; then AMD runs again.
         let ordering = self.solver.as_ref().and_then(|s| s.ordering());
-        self.solver = Some(match ordering {
+        let reused = match ordering {
             Some((forward, inverse)) => {
-                SymmetricSolver::with_ordering(&pattern, &forward, &inverse)?
+                let s = SymmetricSolver::with_ordering(&pattern, &forward, &inverse)?;
+                let limit = REUSED_ORDERING_FILL * self.amd_factor_nnz as f64;
+                (s.factor_nnz as f64 <= limit).then_some(s)
             }
-            None => SymmetricSolver::new(&pattern)?,
+            None => None,
+        };
+        self.solver = Some(match reused {
+            Some(s) => s,
+            None => {
+                let s = SymmetricSolver::new(&pattern)?;
+                self.amd_factor_nnz = s.factor_nnz;
+                s
+            }
         });
         self.symbolic_count += 1;
         Ok(())

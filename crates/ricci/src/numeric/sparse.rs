@@ -387,6 +387,47 @@ mod tests {
     }
 
     #[test]
+    fn a_given_ordering_is_used_and_bad_orderings_are_refused() {
+        let n = 40;
+        let d = |i: usize| 2.2 + (i % 3) as f64 * 0.1;
+        let want: Vec<f64> = (0..n).map(|i| (i as f64 * 0.61).cos()).collect();
+        let (col_ptr, row_idx, values) = tridiagonal(n, d);
+        let pattern = LowerCsc {
+            n,
+            col_ptr: &col_ptr,
+            row_idx: &row_idx,
+        };
+        // A scrambled ordering (i ↦ 7i mod 40 is a bijection): the solve must still be exact,
+        // and the solver must report the ordering it was given.
+        let forward: Vec<u32> = (0..n as u32).map(|i| (7 * i) % n as u32).collect();
+        let mut inverse = vec![0u32; n];
+        for (i, &p) in forward.iter().enumerate() {
+            inverse[p as usize] = i as u32;
+        }
+        let mut s = SymmetricSolver::with_ordering(pattern, &forward, &inverse).unwrap();
+        assert_eq!(s.ordering(), Some((forward.clone(), inverse.clone())));
+        assert!(s.factor_llt(&values));
+        let mut x = apply(d, &want);
+        s.solve(&mut x);
+        let err = max_error(&x, &want);
+        assert!(err < 1e-12, "scrambled ordering: error {err}");
+        // The ordering of an AMD analysis, reused, gives the same solve.
+        let amd = SymmetricSolver::new(pattern).unwrap();
+        let (f, i) = amd.ordering().unwrap();
+        let mut s = SymmetricSolver::with_ordering(pattern, &f, &i).unwrap();
+        assert!(s.factor_llt(&values));
+        let mut x = apply(d, &want);
+        s.solve(&mut x);
+        assert!(max_error(&x, &want) < 1e-12);
+        // Not a permutation, or not its inverse, or the wrong length: errors, not panics.
+        let mut twice = forward.clone();
+        twice[1] = twice[0];
+        assert!(SymmetricSolver::with_ordering(pattern, &twice, &inverse).is_err());
+        assert!(SymmetricSolver::with_ordering(pattern, &forward, &forward).is_err());
+        assert!(SymmetricSolver::with_ordering(pattern, &forward[1..], &inverse).is_err());
+    }
+
+    #[test]
     fn sparse_lu_and_cholesky_solve_their_systems() {
         // Non-symmetric 3×3: A = [[4, 1, 0], [2, 5, 1], [0, 3, 6]], x = (1, −2, 3).
         let a = [[4.0, 1.0, 0.0], [2.0, 5.0, 1.0], [0.0, 3.0, 6.0]];
