@@ -651,7 +651,9 @@ fn flip_log_replays_to_the_final_triangulation() {
     );
     check_result("genus-2 cones", &r);
     let fin = &r.triangulation.as_ref().unwrap().triangulation;
-    assert!(fin.flip_log.len() > 100);
+    // A long log (92 flips since the line search stopped re-evaluating trial points, which
+    // flipped edges back and forth; 100+ before).
+    assert!(fin.flip_log.len() > 50, "flip log {}", fin.flip_log.len());
     let mut t =
         IntrinsicTriangulation::from_mesh(&s.mesh, Geometry::Euclidean, &s.edge_lengths()).unwrap();
     for &e in &fin.flip_log {

@@ -176,7 +176,13 @@ struct GrowingPattern {
     solver: Option<SymmetricSolver>,
     /// Symbolic factorizations computed.
     symbolic_count: usize,
+    /// Nonzeros of the factor of the last analysis with a new AMD ordering.
+    amd_factor_nnz: usize,
 }
+
+/// Most growth of the factor's nonzeros, relative to the last AMD analysis, accepted with a
+/// reused ordering ([`GrowingPattern::cover`]).
+const REUSED_ORDERING_FILL: f64 = 1.1;
 
 impl GrowingPattern {
     fn new(held: &[bool]) -> GrowingPattern {
@@ -196,6 +202,7 @@ impl GrowingPattern {
             row_idx: (0..n as u32).collect(),
             solver: None,
             symbolic_count: 0,
+            amd_factor_nnz: 0,
         }
     }
     fn n(&self) -> usize {
@@ -252,7 +259,29 @@ impl GrowingPattern {
             diag_slot: Vec::new(),
             edge_slot: Vec::new(),
         };
-        self.solver = Some(SymmetricSolver::new(&pattern)?);
+        // A grown pattern keeps the fill-reducing ordering of the last AMD analysis while
+        // the factor stays within `REUSED_ORDERING_FILL` of that analysis' factor: flips add
+        // pairs of vertices two apart, which the old ordering usually absorbs with little
+        // extra fill, and the AMD ordering is most of the cost of a symbolic analysis. Many
+        // flips far from where the ordering expected them (the punctured sphere's flat
+        // picture) make the fill grow instead; then AMD runs again.
+        let ordering = self.solver.as_ref().and_then(|s| s.ordering());
+        let reused = match ordering {
+            Some((forward, inverse)) => {
+                let s = SymmetricSolver::with_ordering(&pattern, &forward, &inverse)?;
+                let limit = REUSED_ORDERING_FILL * self.amd_factor_nnz as f64;
+                (s.factor_nnz as f64 <= limit).then_some(s)
+            }
+            None => None,
+        };
+        self.solver = Some(match reused {
+            Some(s) => s,
+            None => {
+                let s = SymmetricSolver::new(&pattern)?;
+                self.amd_factor_nnz = s.factor_nnz;
+                s
+            }
+        });
         self.symbolic_count += 1;
         Ok(())
     }
@@ -613,43 +642,61 @@ impl<'a> ConformalNewton<'a> {
 
     /// Backtracking along `delta` (module doc): `Some((t, whether st must be re-evaluated at
     /// trial))` with `trial = u + tδ` evaluated in `trial_st`, or `None` after 40 halvings.
+    ///
+    /// Every evaluation is used once: when Simpson's test at `t` needed the midpoint `t/2`,
+    /// the triangulation is Delaunay there, so the midpoint is accepted instead of `t` when
+    /// the quadratic model of `g` through `0, t/2, t` gives it the lower energy (and Armijo's
+    /// condition), and it is the next trial without a new evaluation when `t` is rejected.
     fn line_search(&mut self, target: &Target, err: f64, g0: f64) -> Option<(f64, bool)> {
         let (geometry, budget) = (self.settings.geometry, self.settings.flip_budget);
         let n = self.u.len();
         let mut t = 1.0;
-        let mut need_reevaluation = false;
+        // `trial_st` already holds the evaluation at `u + tδ` (the last midpoint).
+        let mut evaluated = false;
         for _ in 0..40 {
-            for i in 0..n {
-                self.trial[i] = self.u[i] + t * self.delta[i];
-            }
+            let ok = evaluated || {
+                for i in 0..n {
+                    self.trial[i] = self.u[i] + t * self.delta[i];
+                }
+                let ok = evaluate(self.tri, geometry, &self.trial, budget, &mut self.trial_st);
+                self.flips += self.trial_st.flips;
+                ok
+            };
+            evaluated = false;
             // Faces violating the triangle inequality (angles extended by 0, 0, π; the energy
             // stays convex and C¹) are accepted only if the start had as many: a start outside
             // the domain can come back, a valid iterate never leaves it.
-            let ok = evaluate(self.tri, geometry, &self.trial, budget, &mut self.trial_st);
-            self.flips += self.trial_st.flips;
             if ok && self.trial_st.degenerate_faces <= self.st.degenerate_faces {
                 let gt = self.slope(&self.trial_st, target);
                 let et = max_error(&self.trial_st.curvature, target);
-                let mut ok = gt <= C_ARMIJO * g0 || et <= 0.5 * err;
-                let mut de = t * gt;
-                if !ok {
-                    need_reevaluation = true;
-                    for i in 0..n {
-                        self.trial[i] = self.u[i] + 0.5 * t * self.delta[i];
-                    }
-                    if evaluate(self.tri, geometry, &self.trial, budget, &mut self.mid_st) {
-                        self.flips += self.mid_st.flips;
-                        let gh = self.slope(&self.mid_st, target);
-                        de = t * (g0 + 4.0 * gh + gt) / 6.0;
-                        ok = de <= C_ARMIJO * t * g0;
-                    }
-                    for i in 0..n {
-                        self.trial[i] = self.u[i] + t * self.delta[i];
-                    }
+                if gt <= C_ARMIJO * g0 || et <= 0.5 * err {
+                    self.energy += (t * gt).min(0.0);
+                    return Some((t, false));
                 }
-                if ok {
-                    self.energy += de.min(0.0);
-                    return Some((t, need_reevaluation));
+                for i in 0..n {
+                    self.trial[i] = self.u[i] + 0.5 * t * self.delta[i];
+                }
+                if evaluate(self.tri, geometry, &self.trial, budget, &mut self.mid_st) {
+                    self.flips += self.mid_st.flips;
+                    let gh = self.slope(&self.mid_st, target);
+                    let de = t * (g0 + 4.0 * gh + gt) / 6.0;
+                    let de_half = 0.5 * t * (5.0 * g0 + 8.0 * gh - gt) / 12.0;
+                    let mid_valid = self.mid_st.degenerate_faces <= self.st.degenerate_faces;
+                    if mid_valid && de_half <= de && de_half <= C_ARMIJO * 0.5 * t * g0 {
+                        std::mem::swap(&mut self.trial_st, &mut self.mid_st);
+                        self.energy += de_half.min(0.0);
+                        return Some((0.5 * t, false));
+                    }
+                    if de <= C_ARMIJO * t * g0 {
+                        for i in 0..n {
+                            self.trial[i] = self.u[i] + t * self.delta[i];
+                        }
+                        self.energy += de.min(0.0);
+                        return Some((t, true));
+                    }
+                    // `t` rejected: the midpoint, evaluated and Delaunay, is the next trial.
+                    std::mem::swap(&mut self.trial_st, &mut self.mid_st);
+                    evaluated = true;
                 }
             }
             t *= 0.5;

@@ -20,6 +20,7 @@ use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky,
     SymmetricOrdering,
@@ -75,7 +76,46 @@ impl SymmetricSolver {
     /// Symbolic analysis (AMD ordering, elimination tree, supernodes) of `pattern` (a
     /// [`LowerCsc`], or anything that converts to one, such as a Hessian pattern).
     pub fn new<'a>(pattern: impl Into<LowerCsc<'a>>) -> Result<SymmetricSolver> {
+        SymmetricSolver::analyse(pattern.into(), None)
+    }
+
+    /// As [`SymmetricSolver::new`] with a given fill-reducing permutation instead of a new
+    /// AMD ordering (`forward[i]`: the original index at position `i`; `inverse` its
+    /// inverse), typically [`SymmetricSolver::ordering`] of a solver for a slightly smaller
+    /// pattern: the AMD ordering is most of the symbolic analysis, and a pattern that grew
+    /// by a few entries is still ordered well by its predecessor's permutation.
+    pub fn with_ordering<'a>(
+        pattern: impl Into<LowerCsc<'a>>,
+        forward: &[u32],
+        inverse: &[u32],
+    ) -> Result<SymmetricSolver> {
         let pattern = pattern.into();
+        let n = pattern.n;
+        let valid = forward.len() == n
+            && inverse.len() == n
+            && forward
+                .iter()
+                .enumerate()
+                .all(|(i, &p)| (p as usize) < n && inverse[p as usize] as usize == i);
+        if !valid {
+            return Err(Error::numerical(format!(
+                "the ordering is not a permutation of 0..{n} with its inverse"
+            )));
+        }
+        SymmetricSolver::analyse(pattern, Some((forward, inverse)))
+    }
+
+    /// The fill-reducing permutation of the symbolic analysis as `(forward, inverse)`
+    /// (`None` when faer kept the identity).
+    pub fn ordering(&self) -> Option<(Vec<u32>, Vec<u32>)> {
+        let (f, i) = self.symbolic.perm()?.arrays();
+        Some((f.to_vec(), i.to_vec()))
+    }
+
+    fn analyse(
+        pattern: LowerCsc<'_>,
+        ordering: Option<(&[u32], &[u32])>,
+    ) -> Result<SymmetricSolver> {
         let n = pattern.n;
         if pattern.col_ptr.len() != n + 1
             || pattern.col_ptr[n] as usize != pattern.row_idx.len()
@@ -89,13 +129,15 @@ impl SymmetricSolver {
         let col_ptr = pattern.col_ptr.to_vec();
         let row_idx = pattern.row_idx.to_vec();
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
-        let symbolic = factorize_symbolic_cholesky(
-            sym,
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            CholeskySymbolicParams::default(),
-        )
-        .map_err(|e| Error::numerical(format!("symbolic Cholesky factorization failed: {e:?}")))?;
+        let order = match ordering {
+            Some((f, i)) => SymmetricOrdering::Custom(PermRef::new_checked(f, i, n)),
+            None => SymmetricOrdering::Amd,
+        };
+        let symbolic =
+            factorize_symbolic_cholesky(sym, Side::Lower, order, CholeskySymbolicParams::default())
+                .map_err(|e| {
+                    Error::numerical(format!("symbolic Cholesky factorization failed: {e:?}"))
+                })?;
         let par = Par::Seq;
         let req = StackReq::any_of(&[
             symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
@@ -342,6 +384,47 @@ mod tests {
             row_idx: &[0, 1],
         };
         assert!(SymmetricSolver::new(bad).is_err());
+    }
+
+    #[test]
+    fn a_given_ordering_is_used_and_bad_orderings_are_refused() {
+        let n = 40;
+        let d = |i: usize| 2.2 + (i % 3) as f64 * 0.1;
+        let want: Vec<f64> = (0..n).map(|i| (i as f64 * 0.61).cos()).collect();
+        let (col_ptr, row_idx, values) = tridiagonal(n, d);
+        let pattern = LowerCsc {
+            n,
+            col_ptr: &col_ptr,
+            row_idx: &row_idx,
+        };
+        // A scrambled ordering (i ↦ 7i mod 40 is a bijection): the solve must still be exact,
+        // and the solver must report the ordering it was given.
+        let forward: Vec<u32> = (0..n as u32).map(|i| (7 * i) % n as u32).collect();
+        let mut inverse = vec![0u32; n];
+        for (i, &p) in forward.iter().enumerate() {
+            inverse[p as usize] = i as u32;
+        }
+        let mut s = SymmetricSolver::with_ordering(pattern, &forward, &inverse).unwrap();
+        assert_eq!(s.ordering(), Some((forward.clone(), inverse.clone())));
+        assert!(s.factor_llt(&values));
+        let mut x = apply(d, &want);
+        s.solve(&mut x);
+        let err = max_error(&x, &want);
+        assert!(err < 1e-12, "scrambled ordering: error {err}");
+        // The ordering of an AMD analysis, reused, gives the same solve.
+        let amd = SymmetricSolver::new(pattern).unwrap();
+        let (f, i) = amd.ordering().unwrap();
+        let mut s = SymmetricSolver::with_ordering(pattern, &f, &i).unwrap();
+        assert!(s.factor_llt(&values));
+        let mut x = apply(d, &want);
+        s.solve(&mut x);
+        assert!(max_error(&x, &want) < 1e-12);
+        // Not a permutation, or not its inverse, or the wrong length: errors, not panics.
+        let mut twice = forward.clone();
+        twice[1] = twice[0];
+        assert!(SymmetricSolver::with_ordering(pattern, &twice, &inverse).is_err());
+        assert!(SymmetricSolver::with_ordering(pattern, &forward, &forward).is_err());
+        assert!(SymmetricSolver::with_ordering(pattern, &forward[1..], &inverse).is_err());
     }
 
     #[test]
