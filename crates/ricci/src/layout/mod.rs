@@ -24,6 +24,7 @@ pub mod dd;
 pub mod deck;
 pub(crate) mod error;
 pub mod export;
+pub mod frame;
 pub mod input_uv;
 pub mod isometry;
 pub mod pipeline;
