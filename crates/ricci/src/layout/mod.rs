@@ -14,6 +14,9 @@
 //! * [`pipeline`] — surface with metric → canonical cut → layout → deck group (with the
 //!   uniformization flow when no metric is given; H² metrics polished to double-double).
 //! * [`svg`], [`export`] — pictures of the fundamental domain and tilings; OBJ with UVs.
+//! * [`double_half`] — the map of a surface with boundary from the conformal flow on its double:
+//!   the common subdivision of the surface's faces with the double's final triangulation, and
+//!   its UVs.
 //! * [`input_uv`] — UVs on the input's own faces from a layout of another triangulation of
 //!   the surface (refined or intrinsic), mapped across the seams by the deck group.
 //! * [`synthetic`] — closed surfaces with exact flat / hyperbolic metrics and known polygons
@@ -22,6 +25,7 @@
 pub mod cover;
 pub mod dd;
 pub mod deck;
+pub mod double_half;
 pub(crate) mod error;
 pub mod export;
 pub mod frame;

@@ -70,7 +70,7 @@ use crate::metric::intrinsic::IntrinsicTriangulation;
 use crate::metric::Geometry;
 use crate::numeric::dd::{Cdd, Dd};
 
-use normal::replay;
+use normal::{replay, replay_on};
 use trace::build;
 
 pub use develop::{layout_euclidean, layout_hyperbolic};
@@ -179,7 +179,36 @@ impl CommonSubdivision {
         t: &IntrinsicTriangulation,
         u: &[f64],
     ) -> Result<CommonSubdivision> {
-        let (mut tri, normal) = replay(mesh, geometry, lengths, &t.flip_log)?;
+        let (tri, normal) = replay(mesh, geometry, lengths, &t.flip_log)?;
+        Self::from_replayed(mesh, tri, normal, t, u)
+    }
+
+    /// [`CommonSubdivision::from_triangulation`] with the input triangulation given: `start`
+    /// is `mesh`'s triangulation (its half-edges and edge ids, e.g. from
+    /// [`IntrinsicTriangulation::from_mesh`]) with the half-edge `edge_he` of every edge that
+    /// the flips of `t.flip_log` were made from (a flip's result depends on that choice).
+    pub fn from_triangulation_on(
+        mesh: &Mesh,
+        start: IntrinsicTriangulation,
+        t: &IntrinsicTriangulation,
+        u: &[f64],
+    ) -> Result<CommonSubdivision> {
+        if start.origin.len() != mesh.n_corners() || start.n_edges() != mesh.n_edges() {
+            return Err(Error::input(
+                "the start triangulation is not a triangulation of the input mesh",
+            ));
+        }
+        let (tri, normal) = replay_on(start, &t.flip_log)?;
+        Self::from_replayed(mesh, tri, normal, t, u)
+    }
+
+    fn from_replayed(
+        mesh: &Mesh,
+        mut tri: IntrinsicTriangulation,
+        normal: Vec<i32>,
+        t: &IntrinsicTriangulation,
+        u: &[f64],
+    ) -> Result<CommonSubdivision> {
         if tri.origin != t.origin || tri.twin != t.twin || tri.edge != t.edge {
             return Err(Error::input(
                 "replaying the flip log on the input does not reproduce the given triangulation",

@@ -127,7 +127,13 @@ pub(super) fn replay(
     lengths: &[f64],
     flip_log: &[u32],
 ) -> Result<(Tri, Vec<i32>)> {
-    let mut tri = IntrinsicTriangulation::from_mesh(mesh, geometry, lengths)?;
+    let tri = IntrinsicTriangulation::from_mesh(mesh, geometry, lengths)?;
+    replay_on(tri, flip_log)
+}
+
+/// [`replay`] from a given start: `tri` must be the input triangulation (the input mesh's
+/// half-edges and edge ids), whose `edge_he` choices the flips follow.
+pub(super) fn replay_on(mut tri: Tri, flip_log: &[u32]) -> Result<(Tri, Vec<i32>)> {
     let mut normal = vec![-1i32; tri.n_edges()];
     for (step, &e) in flip_log.iter().enumerate() {
         if e as usize >= tri.n_edges() {
