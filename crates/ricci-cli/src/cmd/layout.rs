@@ -13,6 +13,8 @@
 //! fundamental polygon (breadth first through the side pairings) instead of the polygon.
 //! UV.obj keeps the surface's own vertices (`v`) and gives every corner the layout coordinate
 //! of its cut-mesh vertex (`vt`; for the sphere, `v` are the points on the unit sphere).
+//! The JSON's `timings` gives the CPU seconds of the process per stage (`input`, `flow`,
+//! `polish`, `cut`, `layout`, `deck`, `output` — UVs and files), `timings_wall` the wall seconds.
 
 use crate::util::read_surface;
 use crate::util::{print_json, write_atomic, UsageError};
@@ -196,6 +198,7 @@ pub fn polished_metric(
     use ricci::layout::pipeline::{polish_lengths, polish_uniformization};
     let (g, own, lengths, flow, report) =
         metric_and_flow(surface, geometry, target, scheme, metric_file, progress)?;
+    crate::util::stage_done("flow");
     let mut out = PolishedLengths {
         metric: IntrinsicMetric::new(g, lengths),
         mesh: own,
@@ -228,6 +231,7 @@ pub fn polished_metric(
         }
         Err(e) => out.polish = json!({"applied": false, "reason": e.to_string()}),
     }
+    crate::util::stage_done("polish");
     out.flow = flow;
     Ok(out)
 }
@@ -335,6 +339,7 @@ where
         None => (work, metric),
     };
     let l: Layout<Complex> = layout_dd::<S>(mesh, metric, a.seed_face)?;
+    crate::util::stage_done("layout");
     out["flipped_faces"] = json!(l.flipped_faces.len());
     out["degenerate_faces"] = json!(l.degenerate_faces.len());
     out["seed_face"] = json!(l.seed_face);
@@ -348,6 +353,7 @@ where
         }
         _ => (None, None),
     };
+    crate::util::stage_done("deck");
     match (&group, poly) {
         (Some(g), Some(p)) => {
             let dj = deck_json(g, p);
@@ -733,6 +739,7 @@ fn sphere_from_lengths(
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
+    crate::util::stages_start();
     let geometry: Option<Geometry> = match &a.geometry {
         Some(g) => Some(g.parse().map_err(UsageError)?),
         None => None,
@@ -741,6 +748,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         return Err(UsageError("--tiling needs at least one copy".into()).into());
     }
     let (surface, _) = read_surface(&a.mesh)?;
+    crate::util::stage_done("input");
     if let Some(b) = a.base {
         crate::util::check_vertex("--base", b, surface.mesh.n_vertices())?;
     }
@@ -799,12 +807,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             out["boundary_word"] = json!(d.polygon.word());
             out["base_vertex"] = json!(d.cut.base);
             out["refinement_splits"] = json!(d.cut.report.refinement_splits);
+            out["cut_attempts"] = json!(d.cut.report.attempts);
+            out["cut_failed_attempts"] = json!(d.cut.report.failed_attempts);
             out["loop_lengths"] = json!(d
                 .cut
                 .loops
                 .iter()
                 .map(|l| json!({"label": l.label, "length": l.length}))
                 .collect::<Vec<_>>());
+            crate::util::stage_done("cut");
             Some(d)
         };
         bar.0.set_message("layout and deck group");
@@ -830,6 +841,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
     }
     bar.0.finish_and_clear();
+    crate::util::stage_done("output");
+    let (cpu, wall) = crate::util::stages_take();
+    out["timings"] = cpu;
+    out["timings_wall"] = wall;
     out["metric_polish"] = polish_report;
     out["seconds"] = json!(t0.elapsed().as_secs_f64());
     if a.json {
