@@ -182,7 +182,21 @@ pub struct PolishedLengths {
     pub flow: Option<ricci::flow::FlowResult>,
 }
 
-/// [`metric`], then for hyperbolic metrics (when `polish`) the double-double polish
+/// When the hyperbolic metric is polished to double-double.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Polish {
+    /// Not at all (`--no-polish`).
+    Off,
+    /// At once, on the metric's own triangulation.
+    Now,
+    /// After the cut, on its refined mesh, when the metric is a conformal flow's uniform one
+    /// (`cut_disk_polished` polishes the refined metric in place anyway, and one Newton step
+    /// there reaches double-double from the flow's double precision as from a polished
+    /// metric: polishing before the cut too would be done twice). Otherwise as `Now`.
+    AfterCut,
+}
+
+/// [`metric`], then for hyperbolic metrics (unless `polish` is `Off`) the double-double polish
 /// (`ricci::layout::pipeline::polish_uniformization` for the flow's metric,
 /// `polish_lengths` — vertex scaling in place — for a metric file). A polish that cannot be
 /// applied (a target other than 0, a metric with cone points) is reported, not an error.
@@ -192,7 +206,7 @@ pub fn polished_metric(
     target: Option<&str>,
     scheme: Option<Scheme>,
     metric_file: Option<&PathBuf>,
-    polish: bool,
+    polish: Polish,
     progress: &mut dyn ricci::progress::Progress,
 ) -> anyhow::Result<PolishedLengths> {
     use ricci::layout::pipeline::{polish_lengths, polish_uniformization};
@@ -210,8 +224,21 @@ pub fn polished_metric(
         out.flow = flow;
         return Ok(out);
     }
-    if !polish {
+    if polish == Polish::Off {
         out.polish = json!({"applied": false, "reason": "--no-polish"});
+        out.flow = flow;
+        return Ok(out);
+    }
+    let uniform = |f: &FlowResult| {
+        f.triangulation.is_some()
+            && !f.fixed.iter().any(|&x| x)
+            && f.target.iter().all(|&k| k == 0.0)
+    };
+    if polish == Polish::AfterCut && flow.as_ref().is_some_and(uniform) {
+        out.polish = json!({
+            "applied": true, "method": "vertex scaling in place on the cut's refined mesh",
+            "deferred": true,
+        });
         out.flow = flow;
         return Ok(out);
     }
@@ -752,6 +779,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if let Some(b) = a.base {
         crate::util::check_vertex("--base", b, surface.mesh.n_vertices())?;
     }
+    // A disk is laid out as it is; everything else is cut first.
+    let disk_as_is = topology(&surface.mesh)
+        .components
+        .first()
+        .is_some_and(|c| c.genus == 0 && c.boundary_loops == 1);
     let mut bar = spinner(a.json);
     let PolishedLengths {
         metric,
@@ -765,7 +797,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.target.as_deref(),
         a.scheme,
         a.metric.as_ref(),
-        !a.no_polish,
+        match (a.no_polish, disk_as_is) {
+            (true, _) => Polish::Off,
+            (false, true) => Polish::Now,
+            (false, false) => Polish::AfterCut,
+        },
         &mut bar,
     )
     .map_err(|e| anyhow::anyhow!("{}: {}", a.mesh.display(), crate::util::sentence(&e)))?;
@@ -797,9 +833,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             None
         } else {
             bar.0.set_message("cutting along canonical loops");
-            let d = if metric.is_double_double() {
+            let deferred = polish_report["deferred"] == json!(true);
+            let d = if metric.is_double_double() || deferred {
                 let d = cut_disk_polished(work, &metric, work_positions, a.base, &mut bar)?;
                 polish_report["refined"] = json!(d.refined_polish);
+                if let (true, Some(p)) = (deferred, &d.refined_polish) {
+                    polish_report["steps"] = json!(p.steps);
+                    polish_report["residual_start"] = json!(p.residual_start);
+                    polish_report["residual_dd"] = json!(p.residual_dd);
+                    polish_report["converged"] = json!(p.converged);
+                }
                 d
             } else {
                 cut_disk(work, &metric, geometry, work_positions, a.base, &mut bar)?
