@@ -24,7 +24,7 @@ use ricci::layout::cover::{tiles_by_radius, word_string};
 use ricci::layout::deck::{deck_group_ext, DeckFrames};
 use ricci::layout::export::obj_with_corner_uv;
 use ricci::layout::input_uv::input_face_uvs;
-use ricci::layout::isometry::{Complex, Mobius, RigidMotion};
+use ricci::layout::isometry::Complex;
 use ricci::layout::pipeline::{cut_disk, cut_disk_polished, uniformization_geometry, CutDisk};
 use ricci::layout::place::{layout, layout_dd, minimax_centre, Space};
 use ricci::layout::subdivision_uv::{
@@ -32,13 +32,17 @@ use ricci::layout::subdivision_uv::{
     sphere_orientation, LaidOut,
 };
 use ricci::layout::svg::{fundamental_domain_svg, sphere_svg, tiling_svg};
-use ricci::layout::{DeckGroup, Isometry, Layout, Polygon};
+use ricci::layout::{DeckGroup, Isometry, Layout};
 use ricci::mesh::{topology, Mesh, Surface};
 use ricci::metric::file::MetricFile;
 use ricci::metric::{Euclidean, Geometry, Hyperbolic, IntrinsicMetric, Scheme, Spherical};
 use serde_json::{json, Value};
 use std::path::PathBuf;
 use std::time::Instant;
+
+mod json;
+use json::deck_json;
+pub use json::JsonIso;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -89,60 +93,6 @@ pub fn read_metric(path: &std::path::Path, surface: &Surface) -> anyhow::Result<
     let m = ricci::metric::file::read_metric_file(path, &surface.mesh)?;
     m.check_usable(&path.display().to_string())?;
     Ok(m)
-}
-
-fn c2(z: Complex) -> Value {
-    json!([z.re, z.im])
-}
-
-/// JSON of a generator (or side pairing) per isometry type.
-pub trait JsonIso {
-    fn to_json(&self) -> Value;
-}
-impl JsonIso for RigidMotion {
-    fn to_json(&self) -> Value {
-        json!({"kind": "rigid_motion", "angle": self.angle(), "translation": c2(self.t)})
-    }
-}
-impl JsonIso for Mobius {
-    fn to_json(&self) -> Value {
-        let (theta, z0) = self.theta_center();
-        json!({
-            "kind": "mobius", "a": c2(self.a), "b": c2(self.b), "theta": theta, "center": c2(z0),
-            "trace": self.trace(), "translation_length": self.translation_length(),
-            "klein_matrix": self.klein_matrix(),
-        })
-    }
-}
-impl JsonIso for ricci::layout::Rotation {
-    fn to_json(&self) -> Value {
-        json!({"kind": "rotation", "matrix": self.m})
-    }
-}
-
-fn deck_json<I: Isometry + JsonIso>(g: &DeckGroup<I>, poly: &Polygon) -> Value {
-    let gens: Vec<Value> = g
-        .named_generators()
-        .iter()
-        .map(|(l, d)| {
-            let mut v = d.to_json();
-            v["letter"] = json!(l);
-            v
-        })
-        .collect();
-    let pairings: Vec<Value> = g
-        .pairings
-        .iter()
-        .map(|p| {
-            json!({
-                "side": poly.sides[p.side].label, "partner": poly.sides[p.partner].label,
-                "edge_spread": p.edge_spread, "edge_spread_matrix": p.edge_spread_matrix,
-                "max_vertex_error": p.max_vertex_error,
-                "map": p.map.to_json(),
-            })
-        })
-        .collect();
-    json!({"generators": gens, "side_pairings": pairings})
 }
 
 pub struct Bar(pub ProgressBar);
@@ -239,6 +189,7 @@ pub fn polished_metric(
             "applied": true, "method": "vertex scaling in place on the cut's refined mesh",
             "deferred": true,
         });
+        crate::util::stage_done("polish");
         out.flow = flow;
         return Ok(out);
     }
