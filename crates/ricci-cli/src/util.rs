@@ -423,3 +423,67 @@ pub fn ring_marker(
         closed: true,
     }
 }
+
+/// Per-stage timings of one command run (`ricci layout`'s `timings`): CPU seconds of the
+/// process (all threads, [`process_cpu_seconds`]) and wall seconds per stage, in the order the
+/// stages ended.
+#[derive(Default)]
+struct Stages {
+    last: Option<(std::time::Instant, f64)>,
+    cpu: serde_json::Map<String, serde_json::Value>,
+    wall: serde_json::Map<String, serde_json::Value>,
+}
+
+thread_local! {
+    static STAGES: RefCell<Stages> = RefCell::new(Stages::default());
+}
+
+/// Start timing the stages of a command run (forgets earlier ones).
+pub fn stages_start() {
+    STAGES.with(|s| {
+        *s.borrow_mut() = Stages {
+            last: Some((
+                std::time::Instant::now(),
+                process_cpu_seconds().unwrap_or(f64::NAN),
+            )),
+            ..Stages::default()
+        }
+    });
+}
+
+/// End the stage `name` here (its time runs from the previous mark); a stage ended twice adds
+/// up. Does nothing before [`stages_start`].
+pub fn stage_done(name: &str) {
+    STAGES.with(|s| {
+        let mut s = s.borrow_mut();
+        let Some((t, c)) = s.last else { return };
+        let now_c = process_cpu_seconds().unwrap_or(f64::NAN);
+        let add = |m: &mut serde_json::Map<String, serde_json::Value>, x: f64| {
+            let prev = m.get(name).and_then(|v| v.as_f64()).unwrap_or(0.0);
+            let v = prev + x;
+            m.insert(
+                name.to_string(),
+                if v.is_finite() {
+                    serde_json::json!((v * 1000.0).round() / 1000.0)
+                } else {
+                    serde_json::Value::Null
+                },
+            );
+        };
+        add(&mut s.cpu, now_c - c);
+        add(&mut s.wall, t.elapsed().as_secs_f64());
+        s.last = Some((std::time::Instant::now(), now_c));
+    });
+}
+
+/// The stages timed since [`stages_start`]: (`timings`: CPU seconds per stage, null where the
+/// CPU clock is not available; `timings_wall`: wall seconds per stage).
+pub fn stages_take() -> (serde_json::Value, serde_json::Value) {
+    STAGES.with(|s| {
+        let s = std::mem::take(&mut *s.borrow_mut());
+        (
+            serde_json::Value::Object(s.cpu),
+            serde_json::Value::Object(s.wall),
+        )
+    })
+}

@@ -66,6 +66,25 @@ fn layout_json_and_files() {
     assert_eq!(p["applied"], true, "{p}");
     assert!(p["residual_dd"].as_f64().unwrap() <= 1e-26, "{p}");
     assert!(p["residual_start"].as_f64().unwrap() > p["residual_dd"].as_f64().unwrap());
+    // Polished once, on the cut's refined mesh: at least one Newton step there.
+    assert!(p["steps"].as_u64().unwrap() >= 1, "{p}");
+    // Per-stage timings: every stage of a cut surface, none negative, and the stages' wall
+    // seconds add up to no more than the whole run's.
+    let (cpu, wall) = (&v["timings"], &v["timings_wall"]);
+    let mut total = 0.0;
+    for k in ["input", "flow", "polish", "cut", "layout", "deck", "output"] {
+        let w = wall[k]
+            .as_f64()
+            .unwrap_or_else(|| panic!("timings_wall.{k}: {wall}"));
+        assert!(w >= 0.0, "{wall}");
+        total += w;
+        assert!(cpu[k].is_null() || cpu[k].as_f64().unwrap() >= 0.0, "{cpu}");
+    }
+    assert!(
+        total <= v["seconds"].as_f64().unwrap() + 1e-2,
+        "{wall} vs {}",
+        v["seconds"]
+    );
     let polished_spread = v["max_edge_spread_matrix"].as_f64().unwrap();
     let out = Command::new(bin())
         .arg("layout")

@@ -202,3 +202,56 @@ fn vertex_scaling_metrics_are_polished_too() {
         .fold(0.0, f64::max);
     assert!(moved < 1e-12, "{moved:e}");
 }
+
+#[test]
+fn a_double_precision_uniform_metric_is_polished_once_on_the_refined_mesh() {
+    // `ricci layout` passes the conformal flow's double-precision metric straight to
+    // `cut_disk_polished` (one polish, on the cut's refined mesh, instead of one before and
+    // one after the cut): the refined metric must reach double-double there, lay out with a
+    // relation error at double-double level, and be the same hyperbolic metric as the one
+    // polished first (on the edges both refined meshes keep from the flow's triangulation).
+    let s = generate::genus(2, 16).unwrap();
+    let input = s.edge_lengths();
+    let flow = uniformization_metric(
+        &s.mesh,
+        &input,
+        Geometry::Hyperbolic,
+        Scheme::Conformal,
+        1e-12,
+        &mut NoProgress,
+    )
+    .unwrap();
+    let work = &flow.triangulation.as_ref().unwrap().simplicial.mesh;
+    let once = cut_disk_polished(work, &flow.metric(), None, None, &mut NoProgress).unwrap();
+    let r = once.refined_polish.expect("a double metric is polished");
+    assert!(r.converged && r.residual_dd <= 1e-26, "{r:?}");
+    assert!(r.residual_start > 1e-17, "{r:?}");
+    let l = layout_dd::<Hyperbolic>(&once.mesh, &once.metric, None).unwrap();
+    let g = deck_group::<Hyperbolic>(&l, &once.polygon).unwrap();
+    assert!(l.flipped_faces.is_empty());
+    assert!(g.relation_error.unwrap() < 1e-20, "{:?}", g.relation_error);
+    assert!(g.max_edge_spread < 1e-20, "{}", g.max_edge_spread);
+    let p = polish_uniformization(&s.mesh, &input, &flow).unwrap();
+    let twice = cut_disk_polished(work, &p.metric, None, None, &mut NoProgress).unwrap();
+    // The polished metrics, by the refined-mesh vertices of their cut-mesh edges.
+    let by_pair = |d: &ricci::layout::pipeline::CutDisk| {
+        let mut m = std::collections::HashMap::new();
+        for e in 0..d.mesh.n_edges() as u32 {
+            let [a, b] = d.mesh.edge_vertices(e).map(|v| d.vertex_origin[v as usize]);
+            m.insert((a.min(b), a.max(b)), d.metric[e as usize]);
+        }
+        m
+    };
+    let (ma, mb) = (by_pair(&once), by_pair(&twice));
+    let nv0 = once.cut.refined.original_vertices as u32;
+    let mut compared = 0;
+    for (&(a, b), &x) in &ma {
+        let Some(&y) = mb.get(&(a, b)) else { continue };
+        if b >= nv0 {
+            continue;
+        }
+        assert!((x - y).abs() <= 1e-13 * y, "edge {a}–{b}: {x} vs {y}");
+        compared += 1;
+    }
+    assert!(compared > work.n_edges() / 2, "{compared} edges compared");
+}

@@ -13,6 +13,8 @@
 //! fundamental polygon (breadth first through the side pairings) instead of the polygon.
 //! UV.obj keeps the surface's own vertices (`v`) and gives every corner the layout coordinate
 //! of its cut-mesh vertex (`vt`; for the sphere, `v` are the points on the unit sphere).
+//! The JSON's `timings` gives the CPU seconds of the process per stage (`input`, `flow`,
+//! `polish`, `cut`, `layout`, `deck`, `output` — UVs and files), `timings_wall` the wall seconds.
 
 use crate::util::read_surface;
 use crate::util::{print_json, write_atomic, UsageError};
@@ -22,7 +24,7 @@ use ricci::layout::cover::{tiles_by_radius, word_string};
 use ricci::layout::deck::{deck_group_ext, DeckFrames};
 use ricci::layout::export::obj_with_corner_uv;
 use ricci::layout::input_uv::input_face_uvs;
-use ricci::layout::isometry::{Complex, Mobius, RigidMotion};
+use ricci::layout::isometry::Complex;
 use ricci::layout::pipeline::{cut_disk, cut_disk_polished, uniformization_geometry, CutDisk};
 use ricci::layout::place::{layout, layout_dd, minimax_centre, Space};
 use ricci::layout::subdivision_uv::{
@@ -30,13 +32,17 @@ use ricci::layout::subdivision_uv::{
     sphere_orientation, LaidOut,
 };
 use ricci::layout::svg::{fundamental_domain_svg, sphere_svg, tiling_svg};
-use ricci::layout::{DeckGroup, Isometry, Layout, Polygon};
+use ricci::layout::{DeckGroup, Isometry, Layout};
 use ricci::mesh::{topology, Mesh, Surface};
 use ricci::metric::file::MetricFile;
 use ricci::metric::{Euclidean, Geometry, Hyperbolic, IntrinsicMetric, Scheme, Spherical};
 use serde_json::{json, Value};
 use std::path::PathBuf;
 use std::time::Instant;
+
+mod json;
+use json::deck_json;
+pub use json::JsonIso;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -89,60 +95,6 @@ pub fn read_metric(path: &std::path::Path, surface: &Surface) -> anyhow::Result<
     Ok(m)
 }
 
-fn c2(z: Complex) -> Value {
-    json!([z.re, z.im])
-}
-
-/// JSON of a generator (or side pairing) per isometry type.
-pub trait JsonIso {
-    fn to_json(&self) -> Value;
-}
-impl JsonIso for RigidMotion {
-    fn to_json(&self) -> Value {
-        json!({"kind": "rigid_motion", "angle": self.angle(), "translation": c2(self.t)})
-    }
-}
-impl JsonIso for Mobius {
-    fn to_json(&self) -> Value {
-        let (theta, z0) = self.theta_center();
-        json!({
-            "kind": "mobius", "a": c2(self.a), "b": c2(self.b), "theta": theta, "center": c2(z0),
-            "trace": self.trace(), "translation_length": self.translation_length(),
-            "klein_matrix": self.klein_matrix(),
-        })
-    }
-}
-impl JsonIso for ricci::layout::Rotation {
-    fn to_json(&self) -> Value {
-        json!({"kind": "rotation", "matrix": self.m})
-    }
-}
-
-fn deck_json<I: Isometry + JsonIso>(g: &DeckGroup<I>, poly: &Polygon) -> Value {
-    let gens: Vec<Value> = g
-        .named_generators()
-        .iter()
-        .map(|(l, d)| {
-            let mut v = d.to_json();
-            v["letter"] = json!(l);
-            v
-        })
-        .collect();
-    let pairings: Vec<Value> = g
-        .pairings
-        .iter()
-        .map(|p| {
-            json!({
-                "side": poly.sides[p.side].label, "partner": poly.sides[p.partner].label,
-                "edge_spread": p.edge_spread, "edge_spread_matrix": p.edge_spread_matrix,
-                "max_vertex_error": p.max_vertex_error,
-                "map": p.map.to_json(),
-            })
-        })
-        .collect();
-    json!({"generators": gens, "side_pairings": pairings})
-}
-
 pub struct Bar(pub ProgressBar);
 impl ricci::progress::Progress for Bar {
     fn report(&mut self, stage: &str, _f: Option<f64>, message: &str) {
@@ -180,7 +132,21 @@ pub struct PolishedLengths {
     pub flow: Option<ricci::flow::FlowResult>,
 }
 
-/// [`metric`], then for hyperbolic metrics (when `polish`) the double-double polish
+/// When the hyperbolic metric is polished to double-double.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Polish {
+    /// Not at all (`--no-polish`).
+    Off,
+    /// At once, on the metric's own triangulation.
+    Now,
+    /// After the cut, on its refined mesh, when the metric is a conformal flow's uniform one
+    /// (`cut_disk_polished` polishes the refined metric in place anyway, and one Newton step
+    /// there reaches double-double from the flow's double precision as from a polished
+    /// metric: polishing before the cut too would be done twice). Otherwise as `Now`.
+    AfterCut,
+}
+
+/// [`metric`], then for hyperbolic metrics (unless `polish` is `Off`) the double-double polish
 /// (`ricci::layout::pipeline::polish_uniformization` for the flow's metric,
 /// `polish_lengths` — vertex scaling in place — for a metric file). A polish that cannot be
 /// applied (a target other than 0, a metric with cone points) is reported, not an error.
@@ -190,12 +156,13 @@ pub fn polished_metric(
     target: Option<&str>,
     scheme: Option<Scheme>,
     metric_file: Option<&PathBuf>,
-    polish: bool,
+    polish: Polish,
     progress: &mut dyn ricci::progress::Progress,
 ) -> anyhow::Result<PolishedLengths> {
     use ricci::layout::pipeline::{polish_lengths, polish_uniformization};
     let (g, own, lengths, flow, report) =
         metric_and_flow(surface, geometry, target, scheme, metric_file, progress)?;
+    crate::util::stage_done("flow");
     let mut out = PolishedLengths {
         metric: IntrinsicMetric::new(g, lengths),
         mesh: own,
@@ -207,8 +174,22 @@ pub fn polished_metric(
         out.flow = flow;
         return Ok(out);
     }
-    if !polish {
+    if polish == Polish::Off {
         out.polish = json!({"applied": false, "reason": "--no-polish"});
+        out.flow = flow;
+        return Ok(out);
+    }
+    let uniform = |f: &FlowResult| {
+        f.triangulation.is_some()
+            && !f.fixed.iter().any(|&x| x)
+            && f.target.iter().all(|&k| k == 0.0)
+    };
+    if polish == Polish::AfterCut && flow.as_ref().is_some_and(uniform) {
+        out.polish = json!({
+            "applied": true, "method": "vertex scaling in place on the cut's refined mesh",
+            "deferred": true,
+        });
+        crate::util::stage_done("polish");
         out.flow = flow;
         return Ok(out);
     }
@@ -228,6 +209,7 @@ pub fn polished_metric(
         }
         Err(e) => out.polish = json!({"applied": false, "reason": e.to_string()}),
     }
+    crate::util::stage_done("polish");
     out.flow = flow;
     Ok(out)
 }
@@ -335,6 +317,7 @@ where
         None => (work, metric),
     };
     let l: Layout<Complex> = layout_dd::<S>(mesh, metric, a.seed_face)?;
+    crate::util::stage_done("layout");
     out["flipped_faces"] = json!(l.flipped_faces.len());
     out["degenerate_faces"] = json!(l.degenerate_faces.len());
     out["seed_face"] = json!(l.seed_face);
@@ -348,6 +331,7 @@ where
         }
         _ => (None, None),
     };
+    crate::util::stage_done("deck");
     match (&group, poly) {
         (Some(g), Some(p)) => {
             let dj = deck_json(g, p);
@@ -733,6 +717,7 @@ fn sphere_from_lengths(
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
+    crate::util::stages_start();
     let geometry: Option<Geometry> = match &a.geometry {
         Some(g) => Some(g.parse().map_err(UsageError)?),
         None => None,
@@ -741,9 +726,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         return Err(UsageError("--tiling needs at least one copy".into()).into());
     }
     let (surface, _) = read_surface(&a.mesh)?;
+    crate::util::stage_done("input");
     if let Some(b) = a.base {
         crate::util::check_vertex("--base", b, surface.mesh.n_vertices())?;
     }
+    // A disk is laid out as it is; everything else is cut first.
+    let disk_as_is = topology(&surface.mesh)
+        .components
+        .first()
+        .is_some_and(|c| c.genus == 0 && c.boundary_loops == 1);
     let mut bar = spinner(a.json);
     let PolishedLengths {
         metric,
@@ -757,7 +748,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.target.as_deref(),
         a.scheme,
         a.metric.as_ref(),
-        !a.no_polish,
+        match (a.no_polish, disk_as_is) {
+            (true, _) => Polish::Off,
+            (false, true) => Polish::Now,
+            (false, false) => Polish::AfterCut,
+        },
         &mut bar,
     )
     .map_err(|e| anyhow::anyhow!("{}: {}", a.mesh.display(), crate::util::sentence(&e)))?;
@@ -789,9 +784,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             None
         } else {
             bar.0.set_message("cutting along canonical loops");
-            let d = if metric.is_double_double() {
+            let deferred = polish_report["deferred"] == json!(true);
+            let d = if metric.is_double_double() || deferred {
                 let d = cut_disk_polished(work, &metric, work_positions, a.base, &mut bar)?;
                 polish_report["refined"] = json!(d.refined_polish);
+                if let (true, Some(p)) = (deferred, &d.refined_polish) {
+                    polish_report["steps"] = json!(p.steps);
+                    polish_report["residual_start"] = json!(p.residual_start);
+                    polish_report["residual_dd"] = json!(p.residual_dd);
+                    polish_report["converged"] = json!(p.converged);
+                }
                 d
             } else {
                 cut_disk(work, &metric, geometry, work_positions, a.base, &mut bar)?
@@ -799,12 +801,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             out["boundary_word"] = json!(d.polygon.word());
             out["base_vertex"] = json!(d.cut.base);
             out["refinement_splits"] = json!(d.cut.report.refinement_splits);
+            out["cut_attempts"] = json!(d.cut.report.attempts);
+            out["cut_failed_attempts"] = json!(d.cut.report.failed_attempts);
             out["loop_lengths"] = json!(d
                 .cut
                 .loops
                 .iter()
                 .map(|l| json!({"label": l.label, "length": l.length}))
                 .collect::<Vec<_>>());
+            crate::util::stage_done("cut");
             Some(d)
         };
         bar.0.set_message("layout and deck group");
@@ -830,6 +835,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
     }
     bar.0.finish_and_clear();
+    crate::util::stage_done("output");
+    let (cpu, wall) = crate::util::stages_take();
+    out["timings"] = cpu;
+    out["timings_wall"] = wall;
     out["metric_polish"] = polish_report;
     out["seconds"] = json!(t0.elapsed().as_secs_f64());
     if a.json {

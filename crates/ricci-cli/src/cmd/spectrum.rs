@@ -10,7 +10,7 @@
 //! absolute (curvature −1, Tables 3–4) and also given normalized. A metric that did not
 //! converge is refused.
 
-use super::layout::{polished_metric, spinner, PolishedLengths};
+use super::layout::{polished_metric, spinner, Polish, PolishedLengths};
 use crate::util::read_surface;
 use crate::util::{print_json, UsageError};
 use ricci::analysis::spectrum::{lattice_spectrum, surface_spectrum};
@@ -99,7 +99,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         None,
         a.scheme,
         a.metric.as_ref(),
-        true,
+        Polish::Now,
         &mut bar,
     )
     .map_err(|e| anyhow::anyhow!("{}: {}", a.mesh.display(), crate::util::sentence(&e)))?;

@@ -219,8 +219,10 @@ pub fn polish_lengths(mesh: &Mesh, metric: &IntrinsicMetric) -> Result<PolishedM
 
 /// [`cut_disk`] for a double-double H² metric with zero target curvature (e.g. the `metric`
 /// of [`polish_uniformization`]; missing low parts are 0): the cut runs on the leading parts;
-/// edges of the input keep their low parts, and when the cut refined the mesh, the refined
-/// metric is polished in place ([`polish_lengths`]) before it is carried to the cut mesh.
+/// edges of the input keep their low parts, and when the cut refined the mesh (or the metric
+/// has no low parts: a double-precision uniform metric, polished here once instead of before
+/// and after the cut), the refined metric is polished in place ([`polish_lengths`]) before it
+/// is carried to the cut mesh.
 pub fn cut_disk_polished(
     mesh: &Mesh,
     metric: &IntrinsicMetric,
@@ -266,7 +268,7 @@ pub fn cut_disk_polished(
     }
     let refined_metric =
         IntrinsicMetric::with_low_parts(Geometry::Hyperbolic, refined.lengths.clone(), rlo)?;
-    let refined_metric = if refined.splits() > 0 {
+    let refined_metric = if refined.splits() > 0 || !metric.is_double_double() {
         progress.report(
             "polish",
             None,
