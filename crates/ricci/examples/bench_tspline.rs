@@ -3,11 +3,14 @@
 //!
 //! `cargo run --release -p ricci --example bench_tspline -- MESH TOLERANCE [mark_fraction …]`
 //! (TOLERANCE as a fraction, e.g. 0.0044; env SMOOTHING, INITIAL_FACES, MAX_POINTS_PER_FACE,
-//! PARAMETER_CORRECTION, CORRECTION_STEPS, RMS_TOLERANCE, SMOOTHING_DECAY, MAX_CONTROL_POINTS
+//! PARAMETER_CORRECTION, CORRECTION_STEPS, RMS_TOLERANCE, SMOOTHING_DECAY, MAX_CONTROL_POINTS,
+//! RMS_MARKS, CORRECTION_GAIN, AREA_WEIGHTS=1 (vertex-area weights; the trace's rms is then weighted)
 //! override the defaults). Prints, per strategy: control points, rms %, L∞ %,
 //! iterations, converged, CPU seconds of the fit (the domain is computed once, timed apart).
 use ricci::progress::NoProgress;
-use ricci::spline::tspline::fit::{area_weighted_rms, fit, flat_torus_domain, FitOptions};
+use ricci::spline::tspline::fit::{
+    area_weighted_rms, fit, flat_torus_domain, vertex_areas, FitOptions,
+};
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -58,9 +61,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .unwrap_or(FitOptions::default().initial_faces),
             parameter_correction: env("PARAMETER_CORRECTION", d.parameter_correction),
             correction_steps: env("CORRECTION_STEPS", d.correction_steps),
+            correction_gain: env("CORRECTION_GAIN", d.correction_gain),
             rms_tolerance: env("RMS_TOLERANCE", d.rms_tolerance),
             smoothing_decay: env("SMOOTHING_DECAY", d.smoothing_decay),
             max_control_points: env("MAX_CONTROL_POINTS", d.max_control_points),
+            rms_marks: env("RMS_MARKS", d.rms_marks),
+            weights: if env("AREA_WEIGHTS", 0) == 1 {
+                vertex_areas(&surface)
+            } else {
+                Vec::new()
+            },
             ..FitOptions::default()
         };
         let t = Instant::now();
@@ -87,7 +97,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .collect();
         println!("  {}", trace.join(", "));
         if let Some(a) = area_weighted_rms(&surface, &r.errors) {
-            println!("  area-weighted rms {:.4} %", 100.0 * a / r.scale);
+            let n = r.errors.len() as f64;
+            let v = (r.errors.iter().map(|e| e * e).sum::<f64>() / n).sqrt();
+            println!(
+                "  vertex rms {:.4} %, area-weighted rms {:.4} %",
+                100.0 * v / r.scale,
+                100.0 * a / r.scale
+            );
         }
     }
     Ok(())

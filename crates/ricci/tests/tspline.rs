@@ -342,6 +342,94 @@ fn adaptive_fit_reaches_the_tolerance_with_t_junctions() {
     }
 }
 
+/// Data weights: a point of weight 0 is no data (the fit equals the fit of the other points
+/// alone), and a common factor changes nothing (the fairness weight follows `tr(AᵀA)`).
+#[test]
+fn data_weights_zero_drop_points_and_a_common_factor_changes_nothing() {
+    use ricci::spline::tspline::fit::fit_fixed;
+    let lat = Lattice {
+        width: 4.0,
+        height: 1.5,
+        shift: 0.9,
+    };
+    let (pts, uv) = torus_samples(60, 24, lat);
+    let basis = || TBasis::new(TMesh::uniform(lat, 10, 5).unwrap()).unwrap();
+    let solve = |p: &[[f64; 3]], q: &[[f64; 2]], w: &[f64]| {
+        fit_fixed(basis(), p, q, w, 1e-4, None, 1e-13, 20_000)
+            .unwrap()
+            .0
+            .control
+    };
+    let half: Vec<f64> = (0..pts.len()).map(|k| (k % 2) as f64).collect();
+    let odd_p: Vec<[f64; 3]> = pts.iter().skip(1).step_by(2).cloned().collect();
+    let odd_q: Vec<[f64; 2]> = uv.iter().skip(1).step_by(2).cloned().collect();
+    let a = solve(&pts, &uv, &half);
+    let b = solve(&odd_p, &odd_q, &[]);
+    let full = solve(&pts, &uv, &[]);
+    let twice = solve(&pts, &uv, &vec![2.0; pts.len()]);
+    let diff = |x: &[[f64; 3]], y: &[[f64; 3]]| {
+        x.iter()
+            .zip(y)
+            .flat_map(|(p, q)| (0..3).map(move |d| (p[d] - q[d]).abs()))
+            .fold(0.0, f64::max)
+    };
+    assert!(diff(&a, &b) < 1e-8, "weight 0 ≠ dropped: {}", diff(&a, &b));
+    assert!(
+        diff(&full, &twice) < 1e-8,
+        "factor 2: {}",
+        diff(&full, &twice)
+    );
+    // and the weights do act: the half-weighted fit is not the full one
+    assert!(
+        diff(&a, &full) > 1e-6,
+        "weights ignored: {}",
+        diff(&a, &full)
+    );
+}
+
+/// The control-point budget is never exceeded by a refinement (the marks are halved until the
+/// refined, analysis-suitable T-mesh fits), and greedy rms marking spends it.
+#[test]
+fn rms_refinement_stays_within_the_control_point_budget() {
+    use ricci::spline::tspline::fit::{fit, FitOptions};
+    let lat = Lattice {
+        width: 4.0,
+        height: 1.5,
+        shift: 0.9,
+    };
+    let (pts, uv) = torus_samples(90, 40, lat);
+    for (budget, rms_marks) in [(150, 0), (150, 3), (233, 5)] {
+        let opts = FitOptions {
+            tolerance: 0.01,
+            rms_tolerance: 1e-7,
+            max_control_points: budget,
+            rms_marks,
+            initial_faces: 24,
+            max_points_per_face: 0,
+            max_iterations: 200,
+            ..Default::default()
+        };
+        let r = fit(&pts, &uv, lat, &opts, &mut ricci::progress::NoProgress).unwrap();
+        assert!(!r.converged);
+        let n = r.spline.control.len();
+        assert!(n <= budget, "{n} control points > {budget}: {:?}", r.steps);
+        assert!(r.steps.iter().all(|s| s.control_points <= budget));
+        // the rms phase refined (L∞ ≤ 1 % is reached first) and the rms went down
+        let first = r
+            .steps
+            .iter()
+            .position(|s| s.max_error_percent <= 1.0)
+            .unwrap();
+        assert!(r.steps.len() > first + 1, "{:?}", r.steps);
+        assert!(r.steps.last().unwrap().rms_error_percent < r.steps[first].rms_error_percent);
+        if rms_marks > 0 {
+            // greedy steps of at most `rms_marks` 1-to-2 splits (plus closure) stop close to
+            // the budget
+            assert!(n + 12 >= budget, "{n} of {budget}: {:?}", r.steps);
+        }
+    }
+}
+
 #[test]
 fn density_adaptive_start_bounds_the_points_per_face() {
     // The start splits faces 1-to-4 until none holds more than `max_points_per_face` samples;
@@ -594,6 +682,58 @@ fn kitten_with_parameter_correction_meets_paper_003_count_and_max_error() {
     );
     assert!(max <= paper_max, "L∞ {max} %");
     assert!(rms <= 1.5 * paper_rms, "rms {rms} %");
+}
+
+/// Paper 003 Table 1, kitten, all three numbers: at most 765 control points, rms ≤ 0.05 % and
+/// L∞ ≤ 0.44 % of the longest bounding-box side (the paper's unit cube), no slack factor. The
+/// rms is over the mesh vertices (the paper: distances at the mesh points), recomputed here from
+/// the spline at the returned parameters. The fit: eight rounds of parameter correction (Newton
+/// closest points) per refit, then rms-driven 1-to-2 splits of the faces with the largest sums
+/// of squared errors, never past the 765 control points.
+#[test]
+#[ignore = "≈ 50–65 CPU-seconds (8 correction rounds per refit); BENCHMARKS.md session 8 (tfit8) records the run; cargo test --release -p ricci --test tspline -- --ignored"]
+fn kitten_meets_paper_003_table_1_count_rms_and_max_error() {
+    use ricci::spline::tspline::fit::{area_weighted_rms, fit, flat_torus_domain, FitOptions};
+    let Some(dir) = ricci_meshes() else {
+        eprintln!("RICCI_MESHES is not set: skipping kitten_meets_paper_003_table_1_count_rms_and_max_error");
+        return;
+    };
+    let (paper_points, paper_rms, paper_max) = (765, 0.05, 0.44);
+    let path = std::path::Path::new(&dir).join("kitten.nf20k.off");
+    let (s, _) = ricci::mesh::io::read_surface(&path).unwrap();
+    let mut quiet = ricci::progress::NoProgress;
+    let (uv, lat) = flat_torus_domain(&s, &mut quiet).unwrap();
+    let opts = FitOptions {
+        tolerance: paper_max / 100.0,
+        rms_tolerance: paper_rms / 100.0,
+        max_control_points: paper_points,
+        parameter_correction: 8,
+        ..Default::default()
+    };
+    let r = fit(&s.positions, &uv, lat, &opts, &mut quiet).unwrap();
+    let (lo, hi) = s.bounding_box();
+    let scale = (0..3).map(|d| hi[d] - lo[d]).fold(0.0, f64::max);
+    let errors: Vec<f64> = s
+        .positions
+        .iter()
+        .zip(&r.params)
+        .map(|(p, q)| {
+            let x = r.spline.point(q[0], q[1]);
+            ((x[0] - p[0]).powi(2) + (x[1] - p[1]).powi(2) + (x[2] - p[2]).powi(2)).sqrt()
+        })
+        .collect();
+    let max = 100.0 * errors.iter().cloned().fold(0.0, f64::max) / scale;
+    let rms =
+        100.0 * (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt() / scale;
+    let rms_area = 100.0 * area_weighted_rms(&s, &errors).unwrap() / scale;
+    eprintln!(
+        "kitten: {} control points, rms {rms:.4} % (area-weighted {rms_area:.4} %), L∞ {max:.4} %",
+        r.spline.control.len()
+    );
+    assert!(r.converged, "{:?}", r.steps);
+    assert!(r.spline.control.len() <= paper_points);
+    assert!(max <= paper_max, "L∞ {max} %");
+    assert!(rms <= paper_rms, "rms {rms} %");
 }
 
 mod ricci_meshes;

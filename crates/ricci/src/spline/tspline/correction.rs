@@ -5,7 +5,9 @@
 //! slip of the fixed conformal parameters (paper 003 §3.3 fits at the parameters `u_k ∈ M`
 //! without saying how they are chosen; the conformal net gives the start).
 //!
-//! Gauss–Newton on `|S(u) − p|²`: `δ = −(JᵀJ)⁻¹ Jᵀ r` with `J = [S_u S_v]`, `r = S(u) − p`;
+//! Newton on `|S(u) − p|²/2`: `δ = −H⁻¹ Jᵀ r` with `J = [S_u S_v]`, `r = S(u) − p` and
+//! `H = JᵀJ + [r·S_uu r·S_uv; r·S_uv r·S_vv]` (the closest point, not its linearisation), or
+//! the Gauss–Newton `H = JᵀJ` where that `H` is not positive definite;
 //! a step is at most half the smaller side of the T-mesh face holding `u` and is halved (at
 //! most `HALVINGS` times) until the distance decreases; otherwise the parameter stays.
 
@@ -13,7 +15,7 @@ use super::surface::TSpline;
 
 const HALVINGS: usize = 4;
 
-/// `steps` Gauss–Newton steps per point; returns the corrected parameters (canonical
+/// `steps` Newton steps per point; returns the corrected parameters (canonical
 /// representatives) and how many of them moved.
 pub fn correct_parameters(
     ts: &TSpline,
@@ -40,7 +42,16 @@ pub fn correct_parameters(
                 let jet = ts.jet(uv[0], uv[1]);
                 let r = sub(&jet[0], p);
                 let (su, sv) = (jet[1], jet[2]);
-                let (a, b, c) = (dot(&su, &su), dot(&su, &sv), dot(&sv, &sv));
+                let (a0, b0, c0) = (dot(&su, &su), dot(&su, &sv), dot(&sv, &sv));
+                // Newton: the Hessian of |S − p|²/2 adds r·S_uu, r·S_uv, r·S_vv to JᵀJ; kept
+                // when it stays positive definite, else the Gauss–Newton matrix JᵀJ
+                let (a1, b1, c1) = (
+                    a0 + dot(&r, &jet[3]),
+                    b0 + dot(&r, &jet[4]),
+                    c0 + dot(&r, &jet[5]),
+                );
+                let newton = a1 > 0.0 && a1 * c1 - b1 * b1 > 1e-3 * (a0 * c0 - b0 * b0);
+                let (a, b, c) = if newton { (a1, b1, c1) } else { (a0, b0, c0) };
                 let det = a * c - b * b;
                 if !(det > 1e-300) {
                     break;

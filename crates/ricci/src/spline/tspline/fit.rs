@@ -62,15 +62,29 @@ pub struct FitOptions {
     /// (move each parameter to the foot of its perpendicular, refit). `0` keeps the
     /// parameters of the domain (paper 003 §3.3 as written).
     pub parameter_correction: usize,
-    /// Gauss–Newton steps per data point in each round of parameter correction.
+    /// Newton steps per data point in each round of parameter correction.
     pub correction_steps: usize,
+    /// The correction rounds of a fit stop early once a round lowers the (weighted) rms by
+    /// less than this fraction of it (`0` = always all [`FitOptions::parameter_correction`]
+    /// rounds).
+    pub correction_gain: f64,
     /// Target rms error as a fraction of the longest bounding-box side (`0` = none). While the
     /// rms is above it (and `L∞ ≤ ε`), the faces with the largest sums of squared errors (their
-    /// share of the rms) are refined: those above `mark_fraction ×` the largest sum.
+    /// share of the rms) are refined: those above `mark_fraction ×` the largest sum. The rms is
+    /// weighted by [`FitOptions::weights`] when they are given.
     pub rms_tolerance: f64,
     /// The thin-plate weight is multiplied by this factor after every refinement (`1` =
     /// constant): finer T-meshes need less fairing to stay well posed.
     pub smoothing_decay: f64,
+    /// Refinement steps of the rms phase (`L∞ ≤ ε`, rms above [`FitOptions::rms_tolerance`]):
+    /// `0` splits every face whose sum of squared errors exceeds `mark_fraction ×` the largest;
+    /// `k > 0` splits the `k` faces with the largest sums (greedy spending of the control-point
+    /// budget, at the cost of more refits).
+    pub rms_marks: usize,
+    /// Weight of each data point in the data term, the rms and the marking (empty = 1 each).
+    /// [`vertex_areas`] makes `Σ_k w_k |S(u_k) − p_k|²` the integral of the squared error over
+    /// the surface rather than a sum dominated by where the mesh is dense.
+    pub weights: Vec<f64>,
 }
 
 impl Default for FitOptions {
@@ -87,8 +101,11 @@ impl Default for FitOptions {
             cg_max_iterations: 5000,
             parameter_correction: 0,
             correction_steps: 3,
+            correction_gain: 0.0,
             rms_tolerance: 0.0,
             smoothing_decay: 1.0,
+            rms_marks: 0,
+            weights: Vec::new(),
         }
     }
 }
@@ -99,6 +116,7 @@ pub struct FitStep {
     pub control_points: usize,
     pub faces: usize,
     pub t_junctions: usize,
+    /// The rms of the errors, weighted by [`FitOptions::weights`] when they are given.
     pub rms_error_percent: f64,
     pub max_error_percent: f64,
     pub cg_iterations: usize,
@@ -128,11 +146,14 @@ const GAUSS: [(f64, f64); 4] = [
 ];
 
 /// Least squares with thin-plate fairness over a fixed T-mesh (one step of §3.3).
-/// `guess`: initial control points for the conjugate gradients.
+/// `guess`: initial control points for the conjugate gradients; `weights`: per data point
+/// (empty = 1 each).
+#[allow(clippy::too_many_arguments)]
 pub fn fit_fixed(
     basis: TBasis,
     points: &[[f64; 3]],
     params: &[[f64; 2]],
+    weights: &[f64],
     smoothing: f64,
     guess: Option<&[[f64; 3]]>,
     cg_tolerance: f64,
@@ -146,14 +167,15 @@ pub fn fit_fixed(
     let mut fair = Vec::new();
     let mut rhs = Mat::<f64>::zeros(n, 3);
     let mut buf = Vec::new();
-    for (p, uv) in points.iter().zip(params) {
+    for (k, (p, uv)) in points.iter().zip(params).enumerate() {
+        let w = weights.get(k).copied().unwrap_or(1.0);
         basis.eval(uv[0], uv[1], &mut buf);
         for &(i, ji) in &buf {
             for d in 0..3 {
-                rhs[(i, d)] += ji[0] * p[d];
+                rhs[(i, d)] += w * ji[0] * p[d];
             }
             for &(j, jj) in &buf {
-                data.push(Triplet::new(i, j, ji[0] * jj[0]));
+                data.push(Triplet::new(i, j, w * ji[0] * jj[0]));
             }
         }
     }
@@ -282,11 +304,22 @@ fn errors_of(ts: &TSpline, points: &[[f64; 3]], params: &[[f64; 2]]) -> Vec<f64>
 /// areas): the rms over points spread evenly on the surface, which a decimated mesh's vertices
 /// (dense where the detail is) are not. `None` when the sizes differ or the area is zero.
 pub fn area_weighted_rms(surface: &Surface, errors: &[f64]) -> Option<f64> {
-    use crate::numeric::vec3::{cross, norm, sub};
     if errors.len() != surface.positions.len() {
         return None;
     }
-    let mut w = vec![0.0; errors.len()];
+    let w = vertex_areas(surface);
+    let total: f64 = w.iter().sum();
+    if !(total > 0.0) {
+        return None;
+    }
+    Some(weighted_rms(errors, &w))
+}
+
+/// Per vertex a third of the incident faces' areas, scaled to mean 1 (all zero when the
+/// surface has no area): the weights of [`FitOptions::weights`] for an area-weighted fit.
+pub fn vertex_areas(surface: &Surface) -> Vec<f64> {
+    use crate::numeric::vec3::{cross, norm, sub};
+    let mut w = vec![0.0; surface.positions.len()];
     for t in surface.mesh.faces() {
         let [a, b, c] = t.map(|v| surface.positions[v as usize]);
         let third = norm(cross(sub(b, a), sub(c, a))) / 6.0;
@@ -294,12 +327,26 @@ pub fn area_weighted_rms(surface: &Surface, errors: &[f64]) -> Option<f64> {
             w[v as usize] += third;
         }
     }
-    let total: f64 = w.iter().sum();
-    if !(total > 0.0) {
-        return None;
+    let mean = w.iter().sum::<f64>() / w.len().max(1) as f64;
+    if mean > 0.0 {
+        w.iter_mut().for_each(|x| *x /= mean);
     }
-    let sse: f64 = w.iter().zip(errors).map(|(w, e)| w * e * e).sum();
-    Some((sse / total).sqrt())
+    w
+}
+
+/// `sqrt(Σ w_k e_k² / Σ w_k)` (`w` empty: the plain rms).
+fn weighted_rms(errors: &[f64], w: &[f64]) -> f64 {
+    let (mut sse, mut total) = (0.0, 0.0);
+    for (k, e) in errors.iter().enumerate() {
+        let w = w.get(k).copied().unwrap_or(1.0);
+        sse += w * e * e;
+        total += w;
+    }
+    if total > 0.0 {
+        (sse / total).sqrt()
+    } else {
+        0.0
+    }
 }
 
 /// Longest side of the bounding box.
@@ -351,12 +398,14 @@ pub fn fit(
             opts.rms_tolerance
         )));
     }
-    if !(opts.smoothing_decay > 0.0 && opts.smoothing_decay <= 1.0) {
+    let decay_ok = opts.smoothing_decay > 0.0 && opts.smoothing_decay <= 1.0;
+    if !(decay_ok && (0.0..1.0).contains(&opts.correction_gain)) {
         return Err(Error::input(format!(
-            "the smoothing decay {} of the T-spline fit must be in (0, 1]",
-            opts.smoothing_decay
+            "the smoothing decay {} and the correction gain {} of the T-spline fit must be in (0, 1] and [0, 1)",
+            opts.smoothing_decay, opts.correction_gain
         )));
     }
+    check_weights(&opts.weights, points.len())?;
     let scale = bbox_scale(points);
     if !(scale > 0.0) {
         return Err(Error::input("the data points have an empty bounding box"));
@@ -413,7 +462,7 @@ pub fn fit(
             fit_corrected(basis, points, &mut params, opts, smoothing, guess)?;
         let errors = errors_of(&ts, points, &params);
         let max = errors.iter().cloned().fold(0.0, f64::max);
-        let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+        let rms = weighted_rms(&errors, &opts.weights);
         steps.push(FitStep {
             control_points: ts.control.len(),
             faces,
@@ -430,9 +479,21 @@ pub fn fit(
         {
             Vec::new()
         } else {
-            refinement_marks(&mesh, &params, &errors, eps, rms_target, opts.mark_fraction)
+            let m = Marking {
+                eps,
+                rms_target,
+                theta: opts.mark_fraction,
+                rms_marks: opts.rms_marks,
+                weights: &opts.weights,
+            };
+            refinement_marks(&mesh, &params, &errors, &m)
         };
-        if marks.is_empty() {
+        let refined = if marks.is_empty() {
+            None
+        } else {
+            refine_within_budget(&mesh, &marks, opts.max_control_points)?
+        };
+        let Some(refined) = refined else {
             return Ok(FitResult {
                 spline: ts,
                 steps,
@@ -441,53 +502,112 @@ pub fn fit(
                 params,
                 converged,
             });
-        }
-        mesh.refine_faces(&marks);
-        mesh.make_analysis_suitable(50_000)?;
+        };
+        mesh = refined;
         smoothing *= opts.smoothing_decay;
         prev = Some(ts);
     }
 }
 
-/// The faces to refine after a fit (`(face, split 1-to-4)`). While `L∞ > ε`: the faces with
-/// `L∞ᴵ > max(ε, θ L∞)`, 1-to-4 above `2ε`, else 1-to-2 (paper 003 §3.3 with the worst-face
-/// fraction `θ`). Then, while the rms is above `rms_target`: the faces whose sum of squared
-/// errors exceeds `θ ×` the largest, 1-to-2 across the longer side.
+/// `weights` empty, or one finite non-negative weight per point with a positive sum.
+fn check_weights(weights: &[f64], n: usize) -> Result<()> {
+    if weights.is_empty() {
+        return Ok(());
+    }
+    if weights.len() != n {
+        return Err(Error::input(format!(
+            "the fit has {n} data points but {} weights",
+            weights.len()
+        )));
+    }
+    if let Some(k) = weights.iter().position(|w| !(w.is_finite() && *w >= 0.0)) {
+        return Err(Error::input(format!(
+            "the weight {} of data point {k} is not a finite non-negative number",
+            weights[k]
+        )));
+    }
+    if !(weights.iter().sum::<f64>() > 0.0) {
+        return Err(Error::input("the weights of the data points are all zero"));
+    }
+    Ok(())
+}
+
+/// The refinement rule's parameters (see [`refinement_marks`]).
+struct Marking<'a> {
+    eps: f64,
+    rms_target: f64,
+    theta: f64,
+    rms_marks: usize,
+    weights: &'a [f64],
+}
+
+/// The T-mesh refined by `marks` (most important first) and made analysis-suitable, with at
+/// most `budget` control points: when all marks exceed it, the first half of them is tried,
+/// and so on; `None` when even the first mark alone exceeds it.
+fn refine_within_budget(
+    mesh: &TMesh,
+    marks: &[(usize, bool)],
+    budget: usize,
+) -> Result<Option<TMesh>> {
+    let mut k = marks.len();
+    while k > 0 {
+        let mut m = mesh.clone();
+        m.refine_faces(&marks[..k]);
+        m.make_analysis_suitable(50_000)?;
+        if m.vertices().len() <= budget {
+            return Ok(Some(m));
+        }
+        k /= 2;
+    }
+    Ok(None)
+}
+
+/// The faces to refine after a fit (`(face, split 1-to-4)`, the worst first). While `L∞ > ε`:
+/// the faces with `L∞ᴵ > max(ε, θ L∞)`, 1-to-4 above `2ε`, else 1-to-2 (paper 003 §3.3 with
+/// the worst-face fraction `θ`). Then, while the rms is above `rms_target`: the faces whose sum
+/// of squared errors exceeds `θ ×` the largest (or the `rms_marks` largest), 1-to-2 across the
+/// longer side.
 fn refinement_marks(
     mesh: &TMesh,
     params: &[[f64; 2]],
     errors: &[f64],
-    eps: f64,
-    rms_target: f64,
-    theta: f64,
+    m: &Marking<'_>,
 ) -> Vec<(usize, bool)> {
+    let (eps, rms_target, theta) = (m.eps, m.rms_target, m.theta);
     let max = errors.iter().cloned().fold(0.0, f64::max);
     let mut face_max = vec![0.0f64; mesh.faces().len()];
     let mut face_sse = vec![0.0f64; mesh.faces().len()];
-    for (uv, &e) in params.iter().zip(errors) {
+    for (k, (uv, &e)) in params.iter().zip(errors).enumerate() {
         if let Some(f) = mesh.locate(uv[0], uv[1]) {
             face_max[f] = face_max[f].max(e);
-            face_sse[f] += e * e;
+            face_sse[f] += m.weights.get(k).copied().unwrap_or(1.0) * e * e;
         }
     }
     if max > eps {
         let threshold = eps.max(theta * max);
-        return face_max
+        let mut marks: Vec<(usize, f64)> = face_max
             .iter()
             .enumerate()
             .filter(|(_, &e)| e > threshold)
-            .map(|(f, &e)| (f, e > 2.0 * eps))
+            .map(|(f, &e)| (f, e))
             .collect();
+        marks.sort_by(|a, b| b.1.total_cmp(&a.1));
+        return marks.into_iter().map(|(f, e)| (f, e > 2.0 * eps)).collect();
     }
-    let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len().max(1) as f64).sqrt();
+    let rms = weighted_rms(errors, m.weights);
     if rms_target > 0.0 && rms > rms_target {
         let top = face_sse.iter().cloned().fold(0.0, f64::max);
-        return face_sse
+        let mut marks: Vec<(usize, f64)> = face_sse
             .iter()
             .enumerate()
-            .filter(|(_, &e)| e > theta * top && e > 0.0)
-            .map(|(f, _)| (f, false))
+            .filter(|(_, &e)| e > 0.0 && (m.rms_marks > 0 || e > theta * top))
+            .map(|(f, &e)| (f, e))
             .collect();
+        marks.sort_by(|a, b| b.1.total_cmp(&a.1));
+        if m.rms_marks > 0 {
+            marks.truncate(m.rms_marks);
+        }
+        return marks.into_iter().map(|(f, _)| (f, false)).collect();
     }
     Vec::new()
 }
@@ -505,11 +625,20 @@ fn fit_corrected(
         basis,
         points,
         params,
+        &opts.weights,
         smoothing,
         guess.as_deref(),
         opts.cg_tolerance,
         opts.cg_max_iterations,
     )?;
+    let rms_of = |ts: &TSpline, params: &[[f64; 2]]| {
+        weighted_rms(&errors_of(ts, points, params), &opts.weights)
+    };
+    let mut rms = if opts.correction_gain > 0.0 {
+        rms_of(&ts, params)
+    } else {
+        0.0
+    };
     for _ in 0..opts.parameter_correction {
         let (corrected, moved) = correct_parameters(&ts, points, params, opts.correction_steps);
         if moved == 0 {
@@ -520,11 +649,19 @@ fn fit_corrected(
             ts.basis.clone(),
             points,
             params,
+            &opts.weights,
             smoothing,
             Some(&ts.control),
             opts.cg_tolerance,
             opts.cg_max_iterations,
         )?;
+        if opts.correction_gain > 0.0 {
+            let now = rms_of(&ts, params);
+            if now > (1.0 - opts.correction_gain) * rms {
+                break;
+            }
+            rms = now;
+        }
     }
     Ok((ts, cg_it, cg_res))
 }
