@@ -39,7 +39,7 @@ use crate::numeric::sparse::Cholesky;
 use crate::progress::{NoProgress, Progress};
 
 use super::dms::{Precision, Workspace};
-use super::simplex::{n_partials, Point, LANES};
+use super::simplex::{n_partials, Point};
 
 // The spline-space interface and the quadrature rules live in their own modules (so that
 // [`super::dms`] and this one do not import each other).
@@ -334,40 +334,27 @@ fn face_gram<S: SplineSpace + ?Sized>(
     sc.point_vals.clear();
     sc.point_groups.push(0);
     sc.point_vals.push(0);
-    // The points in batches of nearby points of one face ([`SplineSpace::basis_at_many`]).
-    let mut params = [[0.0; 2]; LANES];
-    let mut start = 0;
-    while start < quad.len() {
-        let f = quad[start].0;
-        let mut end = start;
-        while end < quad.len() && end - start < LANES && quad[end].0 == f {
-            params[end - start] = quad[end].1;
-            end += 1;
-        }
-        space.basis_at_many(f, &params[..end - start], 2, &mut sc.ws)?;
-        for (l, &(_, _, w)) in quad[start..end].iter().enumerate() {
-            // Scaled second partials √w·(∂xx, √2 ∂xy, ∂yy): VᵀV sums w(∂xx² + 2∂xy² + ∂yy²).
-            let sw = [w.sqrt(), (2.0 * w).sqrt(), w.sqrt()];
-            let (indices, values) = (&sc.ws.lane_indices[l], &sc.ws.lane_values[l]);
-            for (gi, g) in indices.chunks(nb).enumerate() {
-                let t = g[0] / nb as u32;
-                let lg = match groups.iter().position(|&x| x == t) {
-                    Some(i) => i,
-                    None => {
-                        groups.push(t);
-                        groups.len() - 1
-                    }
-                };
-                sc.keys.push(lg as u32);
-                for p in 0..g.len() {
-                    let v = &values[(gi * nb + p) * np2..];
-                    sc.vals.push([sw[0] * v[3], sw[1] * v[4], sw[2] * v[5]]);
+    for &(f, u, w) in quad {
+        let m = space.basis_at(f, u, 2, &mut sc.ws)?;
+        // Scaled second partials √w·(∂xx, √2 ∂xy, ∂yy): VᵀV sums w(∂xx² + 2∂xy² + ∂yy²).
+        let sw = [w.sqrt(), (2.0 * w).sqrt(), w.sqrt()];
+        for (gi, g) in sc.ws.indices[..m].chunks(nb).enumerate() {
+            let t = g[0] / nb as u32;
+            let lg = match groups.iter().position(|&x| x == t) {
+                Some(i) => i,
+                None => {
+                    groups.push(t);
+                    groups.len() - 1
                 }
+            };
+            sc.keys.push(lg as u32);
+            for p in 0..g.len() {
+                let v = &sc.ws.values[(gi * nb + p) * np2..];
+                sc.vals.push([sw[0] * v[3], sw[1] * v[4], sw[2] * v[5]]);
             }
-            sc.point_groups.push(sc.keys.len());
-            sc.point_vals.push(sc.vals.len());
         }
-        start = end;
+        sc.point_groups.push(sc.keys.len());
+        sc.point_vals.push(sc.vals.len());
     }
     // Group the points by their key lists (first appearance order: deterministic).
     sc.sets.clear();
