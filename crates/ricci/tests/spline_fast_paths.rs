@@ -188,3 +188,162 @@ fn fit_progress_reports_fractions_and_changes_nothing() {
     assert_eq!(*fractions.last().unwrap(), 1.0);
     assert!(space.n_triangles() > 0);
 }
+
+/// A DMS-like family of degree `n`: three clouds of `n + 1` knots near the corners of a
+/// triangle, all knot sets of `n + 3` knots taking at least one knot from each cloud in order.
+fn dms_like_family(n: usize, st: &mut u64) -> (SimplexFamily, Vec<[f64; 2]>) {
+    let corners = [[0.0, 0.0], [1.0, 0.1], [0.3, 0.9]];
+    let m = n + 1;
+    let mut knots = Vec::new();
+    let mut groups = Vec::new();
+    for (g, c) in corners.iter().enumerate() {
+        for _ in 0..m {
+            knots.push([c[0] + 0.08 * lcg(st), c[1] + 0.08 * lcg(st)]);
+            groups.push(g as u8);
+        }
+    }
+    let mut sets = Vec::new();
+    for a in 1..=m {
+        for b in 1..=m {
+            let Some(c) = (n + 3).checked_sub(a + b) else {
+                continue;
+            };
+            if !(1..=m).contains(&c) {
+                continue;
+            }
+            let mask =
+                ((1u64 << a) - 1) | (((1u64 << b) - 1) << m) | (((1u64 << c) - 1) << (2 * m));
+            sets.push(mask);
+        }
+    }
+    (SimplexFamily::new(&knots, &groups, &sets).unwrap(), knots)
+}
+
+#[test]
+fn batched_family_evaluation_equals_the_scalar_one_bitwise() {
+    // `eval_offset_many` (issue 22, session 8) against `eval_offset` point by point: degrees 3
+    // and 4, orders 0..=2, batches of 1..=LANES points — nearby points (as the fit's quadrature
+    // gives), points scattered over and around the support (different live nodes and
+    // recurrence variants per lane), points on knot lines.
+    use ricci::spline::simplex::LANES;
+    let mut st = 11u64;
+    for n in [3usize, 4] {
+        let (fam, knots) = dms_like_family(n, &mut st);
+        let o = fam.origin();
+        let nf = fam.len();
+        let (mut w1, mut wm) = (Vec::new(), Vec::new());
+        let (mut checked, mut nonzero) = (0usize, 0usize);
+        for k in 0..1500 {
+            let lanes = 1 + k % LANES;
+            let near = k % 3 != 0;
+            let centre = [-0.2 + 1.5 * lcg(&mut st), -0.2 + 1.4 * lcg(&mut st)];
+            let mut xs = Vec::new();
+            let mut dirs = Vec::new();
+            for l in 0..lanes {
+                let u = if k % 7 == 0 && l % 2 == 0 {
+                    let (i, j) = ((k + l) % knots.len(), (k / 7 + l + 1) % knots.len());
+                    let t = lcg(&mut st);
+                    [
+                        knots[i][0] + t * (knots[j][0] - knots[i][0]),
+                        knots[i][1] + t * (knots[j][1] - knots[i][1]),
+                    ]
+                } else if near {
+                    [
+                        centre[0] + 0.02 * lcg(&mut st),
+                        centre[1] + 0.02 * lcg(&mut st),
+                    ]
+                } else {
+                    [-0.2 + 1.5 * lcg(&mut st), -0.2 + 1.4 * lcg(&mut st)]
+                };
+                xs.push([u[0] - o[0], u[1] - o[1]]);
+                dirs.push([lcg(&mut st) - 0.5, lcg(&mut st) - 0.5]);
+            }
+            for order in 0..=2 {
+                let np = n_partials(order);
+                let stride = nf * np + 3;
+                let mut many = vec![f64::NAN; LANES * stride];
+                fam.eval_offset_many(&xs, &dirs, order, &mut wm, &mut many, stride);
+                let mut one = vec![f64::NAN; nf * np];
+                for l in 0..lanes {
+                    fam.eval_offset(xs[l], dirs[l], order, &mut w1, &mut one);
+                    for (i, &b) in one.iter().enumerate() {
+                        let a = many[l * stride + i];
+                        assert!(
+                            a.to_bits() == b.to_bits(),
+                            "degree {n}, lane {l} of {lanes}, order {order}, entry {i}: {a:e} vs {b:e}"
+                        );
+                        checked += 1;
+                        nonzero += usize::from(a != 0.0);
+                    }
+                }
+            }
+        }
+        assert!(nonzero > checked / 10, "{nonzero} of {checked} non-zero");
+    }
+}
+
+#[test]
+fn manifold_basis_at_many_equals_basis_at() {
+    // `SplineSpace::basis_at_many` of the manifold space (the fit's quadrature path) against
+    // `basis_at` at every point: same functions in the same order, bitwise the same values and
+    // partials (degrees 3 and 4, random points of random faces of eight.off, batches of
+    // 1..=LANES points of one face).
+    use ricci::spline::dms::{Precision, Workspace};
+    use ricci::spline::simplex::LANES;
+    let Some(dir) = ricci_meshes() else {
+        eprintln!("note: RICCI_MESHES is not set; skipping the batched manifold basis test");
+        return;
+    };
+    let s = read_surface(&dir.join("eight.off")).expect("eight.off").0;
+    let dom = flat_domain(&s, Singularity::Auto, &mut NoProgress).unwrap();
+    let mut st = 5u64;
+    for n in [3usize, 4] {
+        let space = ManifoldSpace::new(&dom.charts, n, &KnotOptions::default()).unwrap();
+        let nf = space.n_triangles() as u32;
+        let mut ws = Workspace::with_precision(Precision::Double);
+        let mut ws1 = Workspace::with_precision(Precision::Double);
+        let (mut checked, mut nonzero) = (0usize, 0usize);
+        for k in 0..600 {
+            let f = (lcg(&mut st) * nf as f64) as u32 % nf;
+            if !space.is_active(f) {
+                continue;
+            }
+            let c = space.canonical_coords(f);
+            let lanes = 1 + k % LANES;
+            let params: Vec<[f64; 2]> = (0..lanes)
+                .map(|l| {
+                    // A corner now and then (exact barycentric coordinates), else inside.
+                    let (mut b1, mut b2) = (lcg(&mut st), lcg(&mut st));
+                    if b1 + b2 > 1.0 {
+                        (b1, b2) = (1.0 - b1, 1.0 - b2);
+                    }
+                    if k % 11 == 0 && l == 0 {
+                        (b1, b2) = (0.0, 1.0);
+                    }
+                    let b0 = 1.0 - b1 - b2;
+                    std::array::from_fn(|d| b0 * c[0][d] + b1 * c[1][d] + b2 * c[2][d])
+                })
+                .collect();
+            for order in 0..=2 {
+                space.basis_at_many(f, &params, order, &mut ws).unwrap();
+                for (l, &u) in params.iter().enumerate() {
+                    let m = space.basis_at(f, u, order, &mut ws1).unwrap();
+                    assert_eq!(ws.lane_indices[l], ws1.indices[..m], "degree {n} face {f}");
+                    assert_eq!(ws.lane_values[l].len(), ws1.values.len());
+                    for (i, (a, b)) in ws.lane_values[l].iter().zip(&ws1.values).enumerate() {
+                        assert!(
+                            a.to_bits() == b.to_bits(),
+                            "degree {n} face {f} lane {l} order {order} entry {i}: {a:e} vs {b:e}"
+                        );
+                        checked += 1;
+                        nonzero += usize::from(*a != 0.0);
+                    }
+                }
+            }
+        }
+        assert!(
+            checked > 10_000 && nonzero > checked / 4,
+            "{nonzero} of {checked}"
+        );
+    }
+}
