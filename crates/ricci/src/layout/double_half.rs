@@ -7,7 +7,10 @@
 //! alone cannot carry that metric. The surface's own map is built from the double instead:
 //!
 //! 1. The common subdivision of the double's *input* (the mesh [`double_cover`] builds, with
-//!    the mirrored lengths) and `T_D` ([`CommonSubdivision::from_triangulation`], unchanged),
+//!    the mirrored lengths) and `T_D`, its crossings placed through the input metric's
+//!    Delaunay triangulation ([`CommonSubdivision::from_triangulation_three_way`]: the
+//!    ideal-triangle map of [`CommonSubdivision::from_triangulation`] crowds crossings of the
+//!    boundary edges that the isometric flips removed into a boundary vertex),
 //!    restricted to its pieces in the input faces `0..F` — the faces of `M`. Its vertices are
 //!    `M`'s vertices (same ids) and the crossings of `T_D`'s edges with `M`'s edges, the
 //!    boundary edges included (there the rungs `x – σx` of `T_D` cross `∂M`).
@@ -27,7 +30,7 @@ use crate::error::{Error, Result};
 use crate::flow::double::{double_triangulation, DoubleFlow};
 use crate::mesh::double::{double_edge_origin, double_vertex_origin};
 use crate::mesh::{double_cover, Mesh, NONE};
-use crate::metric::common_subdivision::CommonSubdivision;
+use crate::metric::common_subdivision::{CommonSubdivision, ThreeWayReport};
 use crate::metric::intrinsic::{length_of_lambda, IntrinsicTriangulation};
 use crate::metric::Geometry;
 use std::collections::VecDeque;
@@ -44,6 +47,9 @@ pub struct HalfMap {
     /// Largest distance between the two placements of a corner across an edge of the region
     /// outside the unfolding's tree (0 up to rounding when the region is a flat disk).
     pub layout_gap: f64,
+    /// The three-way overlay's report (crossings placed through the input metric's Delaunay
+    /// triangulation).
+    pub three_way: ThreeWayReport,
 }
 
 /// The map of `mesh` (positions, Euclidean edge `lengths`: those the flow started from) from
@@ -77,7 +83,8 @@ pub fn half_subdivision(
         .collect();
     let u = &flow.u_double;
     let (start, t) = renumbered(&double, mesh, lengths, &d_lengths, &flow.triangulation, u)?;
-    let full = CommonSubdivision::from_triangulation_on(&double, start, &t, u)?;
+    let (full, three_way) =
+        CommonSubdivision::from_triangulation_three_way(&double, start, &t, u, flow.initial_flips)?;
     let all_positions = full.positions(&double, &d_positions)?;
     let nf = mesh.n_faces() as u32;
     let n_tf = full.triangulation.n_faces();
@@ -175,6 +182,7 @@ pub fn half_subdivision(
         region_faces,
         crossing_faces,
         layout_gap,
+        three_way,
     })
 }
 

@@ -62,6 +62,7 @@ mod develop;
 mod normal;
 mod polygons;
 mod rounding;
+mod three_way;
 mod trace;
 
 use crate::error::{Error, Result};
@@ -76,6 +77,7 @@ use trace::build;
 pub use develop::{layout_euclidean, layout_hyperbolic};
 pub use normal::{flipped_normal_coordinate, TriangleArcs};
 pub use rounding::repair_rounded_pieces;
+pub use three_way::ThreeWayReport;
 
 type Tri = IntrinsicTriangulation;
 

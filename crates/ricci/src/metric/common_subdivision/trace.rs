@@ -21,7 +21,7 @@ type Step = (u32, u32);
 
 /// Follow an input edge that crosses `h` at position `p` into `face(h)` until it ends at a
 /// corner; returns the further steps and the corner (`3f + i`) where it ends.
-fn walk(
+pub(super) fn walk(
     tri: &Tri,
     normal: &[i32],
     arcs: &[TriangleArcs],
