@@ -432,6 +432,17 @@ fn through_the_double(name: &str, s: &Surface, full: bool) -> (DoubleFlow, HalfM
         check_subdivision(name, s, sub, &|t| planar_orientation(&uv, t, false));
     } else {
         check_area_and_topology(name, s, sub);
+        let uv = &sub.corner_uv;
+        let mut faces: Vec<[u32; 3]> = (0..sub.triangles.len())
+            .filter(|&t| {
+                planar_orientation(uv, t, false)
+                    .partial_cmp(&0.0)
+                    .is_none_or(|o| o.is_le())
+            })
+            .map(|t| s.mesh.face(sub.input_face[t]))
+            .collect();
+        faces.dedup();
+        eprintln!("{name}: input faces of the flipped pieces: {faces:?}");
     }
     (r, h)
 }
