@@ -194,6 +194,32 @@ fn every_link_of_the_page_is_a_local_non_empty_file() {
     assert_eq!(v["ok"], true);
 }
 
+/// Item 9: every link below a picture says which file it opens — no two links of one caption
+/// read the same (the atlas chart's caption read "· SVG · SVG" for two different drawings).
+#[test]
+fn links_below_a_picture_have_distinct_labels() {
+    let (dir, _) = demo();
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    let mut captions = 0;
+    for cap in html.split("<figcaption>").skip(1) {
+        let cap = cap.split("</figcaption>").next().unwrap_or("");
+        captions += 1;
+        let labels: Vec<&str> = cap
+            .split("</a>")
+            .filter_map(|x| x.rsplit_once('>').map(|(_, t)| t))
+            .filter(|t| !t.is_empty())
+            .collect();
+        let mut seen = std::collections::BTreeSet::new();
+        for l in &labels {
+            assert!(
+                seen.insert(*l),
+                "two links labelled {l:?} below one picture: {cap}"
+            );
+        }
+    }
+    assert!(captions >= 20, "only {captions} captions");
+}
+
 #[test]
 fn pictures_decode_with_the_advertised_sizes() {
     let (dir, _) = demo();

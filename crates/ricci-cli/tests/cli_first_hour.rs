@@ -347,3 +347,79 @@ fn json_failures_print_one_error_object() {
         "nothing written"
     );
 }
+
+/// Item 4: `ricci spectrum --count 10000` (> 120 s in the issue) says up front, on stderr and
+/// before any work, that it will take long and roughly how long — whether or not stderr is a
+/// terminal (here a pipe). The command is stopped as soon as the line has arrived.
+#[test]
+fn spectrum_with_a_large_count_estimates_its_time_up_front() {
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    use std::time::{Duration, Instant};
+    let d = tmp("spectrum-count");
+    let g = generate(&d, "genus2", "12");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ricci"))
+        .args(["spectrum", g.to_str().unwrap(), "--count", "10000"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("ricci runs");
+    let stderr = child.stderr.take().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let t0 = Instant::now();
+    let mut estimate = None;
+    while t0.elapsed() < Duration::from_secs(60) {
+        match rx.recv_timeout(Duration::from_millis(200)) {
+            Ok(l) if l.contains("--count 10000") => {
+                estimate = Some(l);
+                break;
+            }
+            Ok(_) => {}
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+            Err(_) => break, // stderr closed: the command ended without the line
+        }
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    let l = estimate.expect("no estimate on stderr within 60 s of `spectrum --count 10000`");
+    // "… expect roughly N s": more than the 120 s the issue measured.
+    let secs: f64 = l
+        .rsplit("roughly ")
+        .next()
+        .and_then(|t| t.split_whitespace().next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("no number of seconds in: {l}"));
+    assert!(secs > 120.0, "estimate {secs} s: {l}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Item 7: `layout` says what it wrote (file, and that it holds the input's vertices and faces,
+/// which the README's `render --uv` needs) — one line, on stderr, naming the file.
+#[test]
+fn layout_says_what_it_wrote() {
+    let d = tmp("layout-wrote");
+    let t = generate(&d, "torus", "16");
+    let uv = d.join("uv.obj");
+    let o = ricci(&["layout", t.to_str().unwrap(), "--out", uv.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", err(&o));
+    assert!(uv.exists());
+    let said = format!("{}{}", String::from_utf8_lossy(&o.stdout), err(&o));
+    let line = said
+        .lines()
+        .find(|l| l.contains("wrote") && l.contains(uv.to_str().unwrap()))
+        .unwrap_or_else(|| panic!("no line saying it wrote {}: {said}", uv.display()));
+    // The counts it states are the file's.
+    let text = std::fs::read_to_string(&uv).unwrap();
+    let nv = text.lines().filter(|l| l.starts_with("v ")).count();
+    let nf = text.lines().filter(|l| l.starts_with("f ")).count();
+    assert!(line.contains(&format!("{nv} vertices")), "{line} ({nv} v)");
+    assert!(line.contains(&format!("{nf} faces")), "{line} ({nf} f)");
+    let _ = std::fs::remove_dir_all(&d);
+}

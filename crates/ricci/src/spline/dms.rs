@@ -300,6 +300,9 @@ pub struct Workspace {
     /// `values` that [`DmsSpace::basis_at`] would give at it.
     pub lane_indices: Vec<Vec<u32>>,
     pub lane_values: Vec<Vec<f64>>,
+    /// Order-2 rotations of the manifold spline's candidate bases, one slot per candidate of
+    /// the face last evaluated (`crate::spline::manifold::charts::rotate_partials2_cached`).
+    pub(crate) rot2: Vec<Option<([f64; 2], [f64; 36])>>,
 }
 
 impl Workspace {

@@ -97,7 +97,7 @@ use super::space::SplineSpace;
 mod build;
 mod charts;
 
-pub(crate) use charts::{apply, check_metric, cz, pt, rotate};
+pub(crate) use charts::{apply, check_metric, cz, pt, rotate, rotate_partials2_cached};
 pub use charts::{
     develop_face, face_side_lengths, rotate_partials, rotation_matrix, star_frame, LocalCharts,
     StarFrame,
@@ -233,6 +233,7 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         dir: Point,
         back: C,
         order: usize,
+        slot: usize,
         ws: &mut Workspace,
     ) {
         let n = self.degree;
@@ -268,7 +269,14 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
             }
             _ => basis.eval_offset(off, dir, order, &mut ws.simplex, &mut ws.local),
         }
-        rotate_partials(order, back, &mut ws.local[..nb * np]);
+        if order == 2 {
+            if ws.rot2.len() <= slot {
+                ws.rot2.resize(slot + 1, None);
+            }
+            rotate_partials2_cached(back, &mut ws.rot2[slot], &mut ws.local[..nb * np]);
+        } else {
+            rotate_partials(order, back, &mut ws.local[..nb * np]);
+        }
         for b in 0..nb {
             ws.indices.push((i as usize * nb + b) as u32);
         }
@@ -311,7 +319,7 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         );
         for k in a..b {
             let (i, m, x) = self.cand[k];
-            self.push_basis(i, &x, bary, rotate(m.rot, dir), m.rot, order, ws);
+            self.push_basis(i, &x, bary, rotate(m.rot, dir), m.rot, order, k - a, ws);
         }
         Ok(ws.indices.len())
     }
@@ -427,7 +435,7 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
                     "manifold spline: face {g} is not in the home chart {hi} of face {i}"
                 ))
             })?;
-            self.push_basis(i, &x, bary, rotate(m.rot, dir), m.rot, order, ws);
+            self.push_basis(i, &x, bary, rotate(m.rot, dir), m.rot, order, k - a, ws);
         }
         Ok(ws.indices.len())
     }

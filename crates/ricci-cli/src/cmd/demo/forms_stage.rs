@@ -47,8 +47,9 @@ pub fn forms(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         file: "forms-net.png".into(),
         caption: format!(
             "Conformal net of ω₁ (its integral as a checkerboard, {FORMS_CHECKS} checks per \
-             a₁-period): squares everywhere except at the {} zeros (red circles), where 2(m + 1) \
-             critical horizontal trajectories (blue) meet.",
+             a₁-period): squares everywhere except at the {} zeros (red circles; a zero on the far \
+             side of the surface is not in this view), where 2(m + 1) critical horizontal \
+             trajectories (blue) meet.",
             zeros.zeros.len()
         ),
         width: size.0,

@@ -54,7 +54,9 @@ pub fn param(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     sec.pictures.push(Picture {
         file: "param-checker.png".into(),
         caption: "Checkerboard of the UV map on the surface: conformal, so the checks are \
-                  squares; their size changes only slowly (the cones take the curvature)."
+                  squares; their size changes only slowly (the cones take the curvature). \
+                  Across the seams (the cut through the cones) the checks do not line up: the \
+                  UVs of the two sides differ by a rotation and a translation."
             .into(),
         width: img.image.width,
         height: img.image.height,

@@ -355,9 +355,15 @@ pub fn index_html(p: &Page) -> String {
                     f.height,
                     esc(&f.caption)
                 );
+                // One alternative: its format ("SVG"); several: their file names, so that two
+                // links never read the same ("SVG · SVG" said nothing of which is which).
                 for alt in &f.alternatives {
-                    let ext = alt.rsplit('.').next().unwrap_or("file").to_uppercase();
-                    let _ = write!(h, " · <a href=\"{}\">{}</a>", esc(alt), esc(&ext));
+                    let label = if f.alternatives.len() == 1 {
+                        alt.rsplit('.').next().unwrap_or("file").to_uppercase()
+                    } else {
+                        alt.clone()
+                    };
+                    let _ = write!(h, " · <a href=\"{}\">{}</a>", esc(alt), esc(&label));
                 }
                 h.push_str("</figcaption></figure>\n");
             }

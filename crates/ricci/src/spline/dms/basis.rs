@@ -18,6 +18,10 @@ pub struct TriangleBasis {
     pub(super) bbox: [Point; 2],
     /// Convex hull of all knots, counter-clockwise (contains every support).
     pub(super) hull: Vec<Point>,
+    /// Per hull edge `i → i + 1`: the tolerance of [`Self::may_contain`]'s side test,
+    /// `−1e-9 · |edge| · diameter`, computed once (it was computed at every call, two `hypot`s
+    /// per hull edge and evaluation; the same expression, so the same numbers).
+    pub(super) hull_tol: Vec<f64>,
     /// Affine barycentric maps of `Δ_γ`, `|γ| < n`, for the blossom: per γ (ordered by `|γ|`,
     /// then [`multi_indices`]) `[a, bx, by]` for each of the three coordinates.
     pub(super) patch: Vec<[[f64; 3]; 3]>,
@@ -27,6 +31,19 @@ pub struct TriangleBasis {
     pub(super) omega_ratio: f64,
     /// [`general_position`] of the knot array.
     pub(super) general_position: f64,
+}
+
+/// The side-test tolerances of [`TriangleBasis::may_contain`], one per hull edge.
+fn hull_tolerances(hull: &[Point], bbox: [Point; 2]) -> Vec<f64> {
+    let k = hull.len();
+    let diam = (bbox[1][0] - bbox[0][0]).max(bbox[1][1] - bbox[0][1]);
+    (0..k)
+        .map(|i| {
+            let (a, b) = (hull[i], hull[(i + 1) % k]);
+            let len = norm(sub(b, a));
+            -1e-9 * len * diam
+        })
+        .collect()
 }
 
 impl TriangleBasis {
@@ -105,10 +122,12 @@ impl TriangleBasis {
             }
         }
         let hull = convex_hull(&knots);
+        let hull_tol = hull_tolerances(&hull, [lo, hi]);
         Ok(TriangleBasis {
             degree: n,
             general_position: gp,
             hull,
+            hull_tol,
             knots,
             family,
             scale,
@@ -149,11 +168,9 @@ impl TriangleBasis {
             return false;
         }
         let k = self.hull.len();
-        let diam = (self.bbox[1][0] - self.bbox[0][0]).max(self.bbox[1][1] - self.bbox[0][1]);
         for i in 0..k {
             let (a, b) = (self.hull[i], self.hull[(i + 1) % k]);
-            let len = norm(sub(b, a));
-            if det3(a, b, u) < -1e-9 * len * diam {
+            if det3(a, b, u) < self.hull_tol[i] {
                 return false;
             }
         }

@@ -205,8 +205,34 @@ pub fn rotate_partials(order: usize, rot: C, vals: &mut [f64]) {
     apply_rotation(&t[..np * np], np, vals);
 }
 
+/// An order-2 rotation kept for reuse: the rotation `(re, im)` and its 6 × 6 matrix.
+pub type CachedRotation2 = Option<([f64; 2], [f64; 36])>;
+
+/// [`rotate_partials`] at order 2 with the matrix kept in `cache`: rebuilt only when `rot`
+/// differs (bitwise) from the cached rotation. The same matrix and the same products as
+/// [`rotate_partials`], so the same numbers; the fit's quadrature evaluates one face's
+/// candidate bases at 315 points, each with the same transition per candidate.
+pub(crate) fn rotate_partials2_cached(rot: C, cache: &mut CachedRotation2, vals: &mut [f64]) {
+    if rot.re == 1.0 && rot.im == 0.0 {
+        return;
+    }
+    let key = [rot.re, rot.im];
+    let hit = matches!(cache, Some((k, _))
+        if k[0].to_bits() == key[0].to_bits() && k[1].to_bits() == key[1].to_bits());
+    if !hit {
+        let mut t = [0.0; 36];
+        rotation_matrix_into(2, rot, &mut t);
+        *cache = Some((key, t));
+    }
+    if let Some((_, t)) = cache {
+        apply_rotation_fixed::<6>(t, vals);
+    }
+}
+
 /// [`apply_rotation`] for `N` partials known at compile time (orders 1 and 2): the same sums
-/// in the same order, unrolled.
+/// in the same order, unrolled (inlined: called out of line from the cached path it cost more
+/// than the matrix it saved).
+#[inline(always)]
 fn apply_rotation_fixed<const N: usize>(t: &[f64], vals: &mut [f64]) {
     let t: &[f64] = &t[..N * N];
     for chunk in vals.chunks_exact_mut(N) {
