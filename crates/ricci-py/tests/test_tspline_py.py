@@ -69,6 +69,26 @@ def test_tspline_equals_cli_on_generated_torus(generated, tmp_path):
     assert mem.surface is not None and mem.surface.faces.shape[1] == 3
 
 
+def test_tspline_fit_flags_equal_cli_on_generated_torus(generated, tmp_path):
+    # --area-weights, --correction-gain, --rms-marks (session 9): the same report as the CLI,
+    # echoed, and the reported rms is the vertex rms of the returned errors (checked inside)
+    argv = ["--tolerance", "1%", "--parameter-correction", "2", "--area-weights"]
+    argv += ["--correction-gain", "0.02", "--rms-marks", "2", "--rms-tolerance", "0.1%"]
+    _, want = check_against_cli(
+        generated["torus"],
+        tmp_path,
+        *argv,
+        tolerance="1%",
+        parameter_correction=2,
+        area_weights=True,
+        correction_gain=0.02,
+        rms_marks=2,
+        rms_tolerance="0.1%",
+    )
+    assert want["area_weights"] is True
+    assert want["correction_gain"] == 0.02 and want["rms_marks"] == 2
+
+
 def test_tspline_equals_cli_on_kitten_with_parameter_correction(tmp_path):
     path = shared("kitten.nf20k.off")
     check_against_cli(

@@ -4,7 +4,7 @@
 //! `cargo run --release -p ricci --example bench_tspline -- MESH TOLERANCE [mark_fraction …]`
 //! (TOLERANCE as a fraction, e.g. 0.0044; env SMOOTHING, INITIAL_FACES, MAX_POINTS_PER_FACE,
 //! PARAMETER_CORRECTION, CORRECTION_STEPS, RMS_TOLERANCE, SMOOTHING_DECAY, MAX_CONTROL_POINTS,
-//! RMS_MARKS, CORRECTION_GAIN, AREA_WEIGHTS=1 (vertex-area weights; the trace's rms is then weighted)
+//! RMS_MARKS, CORRECTION_GAIN, CG_TOLERANCE, AREA_WEIGHTS=1 (vertex-area weights; the trace's rms is then weighted)
 //! override the defaults). Prints, per strategy: control points, rms %, L∞ %,
 //! iterations, converged, CPU seconds of the fit (the domain is computed once, timed apart).
 use ricci::progress::NoProgress;
@@ -66,6 +66,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             smoothing_decay: env("SMOOTHING_DECAY", d.smoothing_decay),
             max_control_points: env("MAX_CONTROL_POINTS", d.max_control_points),
             rms_marks: env("RMS_MARKS", d.rms_marks),
+            cg_tolerance: env("CG_TOLERANCE", d.cg_tolerance),
             weights: if env("AREA_WEIGHTS", 0) == 1 {
                 vertex_areas(&surface)
             } else {
@@ -90,8 +91,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .iter()
             .map(|s| {
                 format!(
-                    "{}→{:.3}/{:.4}",
-                    s.control_points, s.max_error_percent, s.rms_error_percent
+                    "{}→{:.3}/{:.4} ({} cg)",
+                    s.control_points, s.max_error_percent, s.rms_error_percent, s.cg_iterations
                 )
             })
             .collect();

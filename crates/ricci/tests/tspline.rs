@@ -689,9 +689,11 @@ fn kitten_with_parameter_correction_meets_paper_003_count_and_max_error() {
 /// rms is over the mesh vertices (the paper: distances at the mesh points), recomputed here from
 /// the spline at the returned parameters. The fit: eight rounds of parameter correction (Newton
 /// closest points) per refit, then rms-driven 1-to-2 splits of the faces with the largest sums
-/// of squared errors, never past the 765 control points.
+/// of squared errors, never past the 765 control points. Issue 18 also asks for ≤ 30 s: ~15
+/// CPU-s since session 9 (the fairness matrix once per T-mesh, the data term refilled on its
+/// pattern; BENCHMARKS.md "Session 9 (tfit9)"), so it runs in CI; the time is a benchmark, not
+/// asserted here.
 #[test]
-#[ignore = "≈ 50–65 CPU-seconds (8 correction rounds per refit); BENCHMARKS.md session 8 (tfit8) records the run; cargo test --release -p ricci --test tspline -- --ignored"]
 fn kitten_meets_paper_003_table_1_count_rms_and_max_error() {
     use ricci::spline::tspline::fit::{area_weighted_rms, fit, flat_torus_domain, FitOptions};
     let Some(dir) = ricci_meshes() else {

@@ -18,7 +18,7 @@ use crate::util::{print_json, read_surface, write_atomic, write_json_atomic, Usa
 use ricci::spline::tspline::curves::{tmesh_on_surface, torus_tessellation};
 use ricci::spline::tspline::export::{iges, step, torus_obj};
 use ricci::spline::tspline::fit::{
-    area_weighted_rms, fit, flat_torus_domain, FitOptions, FitResult,
+    area_weighted_rms, fit, flat_torus_domain, vertex_areas, FitOptions, FitResult,
 };
 use ricci::spline::tspline::{
     chart_independence, continuity, extract, BezierPatch, ChartIndependence, Continuity, TSpline,
@@ -61,6 +61,19 @@ pub struct Args {
     /// largest sums of squared errors are refined until the rms is at most this.
     #[arg(long, default_value = "0")]
     pub rms_tolerance: String,
+    /// Stop the correction rounds of a refit once a round lowers the rms by less than this
+    /// fraction of it (0 = always all --parameter-correction rounds; e.g. 0.02). Genus 1.
+    #[arg(long, default_value_t = 0.0)]
+    pub correction_gain: f64,
+    /// Refinements for the rms (after L∞ is met): split the K faces with the largest sums of
+    /// squared errors per refit (0 = every face above --mark-fraction of the largest). Genus 1.
+    #[arg(long, default_value_t = 0)]
+    pub rms_marks: usize,
+    /// Weight every mesh vertex by its area (a third of the incident triangles) in the fit,
+    /// the rms target and the marking: the squared error integrated over the surface rather
+    /// than summed over vertices. The reported rms_error_percent stays the vertex rms. Genus 1.
+    #[arg(long)]
+    pub area_weights: bool,
     /// Factor applied to the thin-plate weight after every refinement (1 = constant).
     #[arg(long, default_value_t = 1.0)]
     pub smoothing_decay: f64,
@@ -277,6 +290,16 @@ fn check_ranges(a: &Args) -> anyhow::Result<()> {
         ))
         .into());
     }
+    if !(0.0..1.0).contains(&a.correction_gain) {
+        return Err(UsageError(format!(
+            "--correction-gain {} is not in [0, 1)",
+            a.correction_gain
+        ))
+        .into());
+    }
+    if a.rms_marks > 100_000 {
+        return Err(UsageError(format!("--rms-marks {} is not in 0..=100000", a.rms_marks)).into());
+    }
     if a.parameter_correction > 10 {
         return Err(UsageError(format!(
             "--parameter-correction {} is not in 0..=10",
@@ -329,6 +352,13 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         correction_steps: a.correction_steps,
         rms_tolerance,
         smoothing_decay: a.smoothing_decay,
+        correction_gain: a.correction_gain,
+        rms_marks: a.rms_marks,
+        weights: if a.area_weights {
+            vertex_areas(&surface)
+        } else {
+            Vec::new()
+        },
         ..FitOptions::default()
     };
     bar.0.set_message("fitting");
@@ -347,9 +377,10 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         None => "discontinuous".to_string(),
     };
     let last = r.steps.last().cloned();
-    let (rms, max) = last.as_ref().map_or((f64::NAN, f64::NAN), |s| {
-        (s.rms_error_percent, s.max_error_percent)
-    });
+    let max = last.as_ref().map_or(f64::NAN, |s| s.max_error_percent);
+    // the vertex rms (with --area-weights the steps' rms is the weighted one)
+    let n = r.errors.len().max(1) as f64;
+    let rms = 100.0 * (r.errors.iter().map(|e| e * e).sum::<f64>() / n).sqrt() / r.scale;
     let mut out = json!({
         "file": a.mesh.display().to_string(),
         "domain": "flat torus (genus 1)",
@@ -373,6 +404,9 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         "correction_steps": opts.correction_steps,
         "rms_tolerance_percent": 100.0 * rms_tolerance,
         "smoothing_decay": opts.smoothing_decay,
+        "correction_gain": opts.correction_gain,
+        "rms_marks": opts.rms_marks,
+        "area_weights": a.area_weights,
         "scale": r.scale,
         "seconds_fit": fit_seconds,
         "seconds": t0.elapsed().as_secs_f64(),

@@ -12,6 +12,7 @@
 //! most `HALVINGS` times) until the distance decreases; otherwise the parameter stays.
 
 use super::surface::TSpline;
+use rayon::prelude::*;
 
 const HALVINGS: usize = 4;
 
@@ -26,15 +27,16 @@ pub fn correct_parameters(
     let mesh = &ts.basis.mesh;
     let lattice = mesh.lattice;
     let faces = mesh.faces();
-    let mut moved = 0;
-    let out = points
-        .iter()
+    let grid = mesh.face_grid();
+    // every point on its own: in parallel, collected in order (the same for any thread count)
+    let out: Vec<([f64; 2], bool)> = points
+        .par_iter()
         .zip(params)
         .map(|(p, &uv)| {
             let mut uv = uv;
             let mut changed = false;
             for _ in 0..steps {
-                let Some(f) = mesh.locate(uv[0], uv[1]) else {
+                let Some(f) = grid.locate(uv[0], uv[1]) else {
                     break;
                 };
                 let face = &faces[f];
@@ -82,13 +84,11 @@ pub fn correct_parameters(
                 }
                 changed = true;
             }
-            if changed {
-                moved += 1;
-            }
-            uv
+            (uv, changed)
         })
         .collect();
-    (out, moved)
+    let moved = out.iter().filter(|x| x.1).count();
+    (out.into_iter().map(|x| x.0).collect(), moved)
 }
 
 fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {

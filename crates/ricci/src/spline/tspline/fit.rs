@@ -8,7 +8,9 @@
 //! exactly by 4×4 Gauss points on every Bézier element (the integrand is a polynomial of
 //! degree ≤ 6 per variable there). `λ = smoothing · tr(AᵀA)/tr(F)` keeps the parameter
 //! free of the scale of the domain. The system is solved by conjugate gradients (faer),
-//! symmetrically Jacobi-scaled, warm-started from the previous surface.
+//! symmetrically Jacobi-scaled, warm-started from the previous surface; `F` and the sparsity
+//! pattern are built once per T-mesh and the rounds of parameter correction refill only `AᵀA`
+//! ([`super::system`]).
 //!
 //! **Start**: a uniform tensor grid whose faces holding more than
 //! [`FitOptions::max_points_per_face`] data points are split 1-to-4 (repeatedly): for an evenly
@@ -22,20 +24,14 @@
 //! the T-mesh is analysis-suitable, and the fit is repeated, until `L∞ ≤ ε` or the budget of
 //! iterations / control points is spent (reported, not hidden).
 
-use super::bezier::elements;
 use super::correction::correct_parameters;
 use super::surface::{TBasis, TSpline};
+use super::system::FitSystem;
 use super::tmesh::{Lattice, TMesh};
 use crate::error::{Error, Result};
 use crate::mesh::Surface;
 use crate::progress::Progress;
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::matrix_free::conjugate_gradient::{
-    conjugate_gradient, conjugate_gradient_scratch, CgParams,
-};
-use faer::matrix_free::IdentityPrecond;
-use faer::sparse::{SparseColMat, Triplet};
-use faer::{Mat, Par};
+use rayon::prelude::*;
 
 /// Options of [`fit`].
 #[derive(Debug, Clone)]
@@ -138,13 +134,6 @@ pub struct FitResult {
     pub converged: bool,
 }
 
-const GAUSS: [(f64, f64); 4] = [
-    (0.069_431_844_202_973_71, 0.173_927_422_568_726_93),
-    (0.330_009_478_207_571_87, 0.326_072_577_431_273_07),
-    (0.669_990_521_792_428_1, 0.326_072_577_431_273_07),
-    (0.930_568_155_797_026_3, 0.173_927_422_568_726_93),
-];
-
 /// Least squares with thin-plate fairness over a fixed T-mesh (one step of §3.3).
 /// `guess`: initial control points for the conjugate gradients; `weights`: per data point
 /// (empty = 1 each).
@@ -159,139 +148,23 @@ pub fn fit_fixed(
     cg_tolerance: f64,
     cg_max_iterations: usize,
 ) -> Result<(TSpline, usize, f64)> {
-    let n = basis.len();
-    if n == 0 {
-        return Err(Error::input("the T-mesh has no anchors"));
-    }
-    let mut data = Vec::new();
-    let mut fair = Vec::new();
-    let mut rhs = Mat::<f64>::zeros(n, 3);
-    let mut buf = Vec::new();
-    for (k, (p, uv)) in points.iter().zip(params).enumerate() {
-        let w = weights.get(k).copied().unwrap_or(1.0);
-        basis.eval(uv[0], uv[1], &mut buf);
-        for &(i, ji) in &buf {
-            for d in 0..3 {
-                rhs[(i, d)] += w * ji[0] * p[d];
-            }
-            for &(j, jj) in &buf {
-                data.push(Triplet::new(i, j, w * ji[0] * jj[0]));
-            }
-        }
-    }
-    for [u0, u1, v0, v1] in elements(&basis) {
-        let area = (u1 - u0) * (v1 - v0);
-        for &(x, wx) in &GAUSS {
-            for &(y, wy) in &GAUSS {
-                basis.eval(u0 + x * (u1 - u0), v0 + y * (v1 - v0), &mut buf);
-                let w = wx * wy * area;
-                for &(i, ji) in &buf {
-                    for &(j, jj) in &buf {
-                        let e = ji[3] * jj[3] + 2.0 * ji[4] * jj[4] + ji[5] * jj[5];
-                        fair.push(Triplet::new(i, j, w * e));
-                    }
-                }
-            }
-        }
-    }
-    let mut tr_a = 0.0;
-    let mut tr_f = 0.0;
-    for t in &data {
-        if t.row == t.col {
-            tr_a += t.val;
-        }
-    }
-    for t in &fair {
-        if t.row == t.col {
-            tr_f += t.val;
-        }
-    }
-    let lambda = if tr_f > 0.0 {
-        smoothing * tr_a / tr_f
-    } else {
-        0.0
-    };
-    let mut diag = vec![0.0; n];
-    for t in &data {
-        if t.row == t.col {
-            diag[t.row] += t.val;
-        }
-    }
-    for t in &fair {
-        if t.row == t.col {
-            diag[t.row] += lambda * t.val;
-        }
-    }
-    if let Some(i) = diag.iter().position(|&d| !(d > 0.0)) {
-        return Err(Error::numerical(format!(
-            "the fitting system has an empty row for control point {i} (no data and no fairness)"
-        )));
-    }
-    let s: Vec<f64> = diag.iter().map(|d| 1.0 / d.sqrt()).collect();
-    let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(data.len() + fair.len());
-    trip.extend(
-        data.iter()
-            .map(|t| Triplet::new(t.row, t.col, t.val * s[t.row] * s[t.col])),
-    );
-    trip.extend(
-        fair.iter()
-            .map(|t| Triplet::new(t.row, t.col, lambda * t.val * s[t.row] * s[t.col])),
-    );
-    let k = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip)
-        .map_err(|e| Error::numerical(format!("could not assemble the fitting system: {e:?}")))?;
-    for i in 0..n {
-        for d in 0..3 {
-            rhs[(i, d)] *= s[i];
-        }
-    }
-    // unknowns y = D^{1/2} x
-    let mut x = Mat::<f64>::zeros(n, 3);
-    if let Some(g) = guess {
-        for i in 0..n.min(g.len()) {
-            for d in 0..3 {
-                x[(i, d)] = g[i][d] / s[i];
-            }
-        }
-    }
-    let precond = IdentityPrecond { dim: n };
-    let params_cg = CgParams {
-        rel_tolerance: cg_tolerance,
-        max_iters: cg_max_iterations,
-        ..Default::default()
-    };
-    let mut mem = MemBuffer::new(conjugate_gradient_scratch(precond, k.as_ref(), 3, Par::Seq));
-    let info = conjugate_gradient(
-        x.as_mut(),
-        precond,
-        k.as_ref(),
-        rhs.as_ref(),
-        params_cg,
-        |_| {},
-        Par::Seq,
-        MemStack::new(&mut mem),
-    );
-    let (iters, resid) = match info {
-        Ok(i) => (i.iter_count, i.rel_residual),
-        Err(e) => {
-            return Err(Error::numerical(format!(
-                "the conjugate gradients of the T-spline fit broke down: {e:?}"
-            )))
-        }
-    };
-    let control: Vec<[f64; 3]> = (0..n)
-        .map(|i| [x[(i, 0)] * s[i], x[(i, 1)] * s[i], x[(i, 2)] * s[i]])
-        .collect();
-    if control.iter().any(|c| c.iter().any(|x| !x.is_finite())) {
-        return Err(Error::numerical(
-            "the T-spline fit produced non-finite control points",
-        ));
-    }
+    let mut system = FitSystem::new(basis)?;
+    let (control, iters, resid) = system.solve(
+        points,
+        params,
+        weights,
+        smoothing,
+        guess,
+        cg_tolerance,
+        cg_max_iterations,
+    )?;
+    let basis = system.basis;
     Ok((TSpline { basis, control }, iters, resid))
 }
 
 fn errors_of(ts: &TSpline, points: &[[f64; 3]], params: &[[f64; 2]]) -> Vec<f64> {
     points
-        .iter()
+        .par_iter()
         .zip(params)
         .map(|(p, uv)| {
             let q = ts.point(uv[0], uv[1]);
@@ -426,8 +299,9 @@ pub fn fit(
     if opts.max_points_per_face > 0 {
         for _ in 0..16 {
             let mut count = vec![0usize; mesh.faces().len()];
+            let grid = mesh.face_grid();
             for uv in &params {
-                if let Some(f) = mesh.locate(uv[0], uv[1]) {
+                if let Some(f) = grid.locate(uv[0], uv[1]) {
                     count[f] += 1;
                 }
             }
@@ -577,8 +451,9 @@ fn refinement_marks(
     let max = errors.iter().cloned().fold(0.0, f64::max);
     let mut face_max = vec![0.0f64; mesh.faces().len()];
     let mut face_sse = vec![0.0f64; mesh.faces().len()];
+    let grid = mesh.face_grid();
     for (k, (uv, &e)) in params.iter().zip(errors).enumerate() {
-        if let Some(f) = mesh.locate(uv[0], uv[1]) {
+        if let Some(f) = grid.locate(uv[0], uv[1]) {
             face_max[f] = face_max[f].max(e);
             face_sse[f] += m.weights.get(k).copied().unwrap_or(1.0) * e * e;
         }
@@ -621,16 +496,24 @@ fn fit_corrected(
     smoothing: f64,
     guess: Option<Vec<[f64; 3]>>,
 ) -> Result<(TSpline, usize, f64)> {
-    let (mut ts, mut cg_it, mut cg_res) = fit_fixed(
-        basis,
-        points,
-        params,
-        &opts.weights,
-        smoothing,
-        guess.as_deref(),
-        opts.cg_tolerance,
-        opts.cg_max_iterations,
-    )?;
+    // the fairness matrix and the pattern once per T-mesh; the rounds refill the data term
+    let mut system = FitSystem::new(basis)?;
+    let solve = |system: &mut FitSystem, params: &[[f64; 2]], guess: Option<&[[f64; 3]]>| {
+        system.solve(
+            points,
+            params,
+            &opts.weights,
+            smoothing,
+            guess,
+            opts.cg_tolerance,
+            opts.cg_max_iterations,
+        )
+    };
+    let (control, mut cg_it, mut cg_res) = solve(&mut system, params, guess.as_deref())?;
+    let mut ts = TSpline {
+        basis: system.basis.clone(),
+        control,
+    };
     let rms_of = |ts: &TSpline, params: &[[f64; 2]]| {
         weighted_rms(&errors_of(ts, points, params), &opts.weights)
     };
@@ -645,16 +528,9 @@ fn fit_corrected(
             break;
         }
         *params = corrected;
-        (ts, cg_it, cg_res) = fit_fixed(
-            ts.basis.clone(),
-            points,
-            params,
-            &opts.weights,
-            smoothing,
-            Some(&ts.control),
-            opts.cg_tolerance,
-            opts.cg_max_iterations,
-        )?;
+        let control;
+        (control, cg_it, cg_res) = solve(&mut system, params, Some(&ts.control))?;
+        ts.control = control;
         if opts.correction_gain > 0.0 {
             let now = rms_of(&ts, params);
             if now > (1.0 - opts.correction_gain) * rms {

@@ -37,6 +37,7 @@ pub mod fit;
 pub mod genus_domain;
 pub mod glue;
 pub(crate) mod surface;
+pub(crate) mod system;
 pub(crate) mod tmesh;
 
 pub use bezier::{continuity, extract, BezierPatch, Continuity};

@@ -109,6 +109,30 @@ pub struct Anchor {
     pub knots_v: [f64; 5],
 }
 
+/// Faces by cells of a uniform grid over `[0, W) × [0, H)` (see [`TMesh::face_grid`]).
+pub struct FaceGrid<'a> {
+    mesh: &'a TMesh,
+    nx: usize,
+    ny: usize,
+    /// Per cell, the faces meeting it, in increasing order.
+    cells: Vec<Vec<u32>>,
+}
+
+impl FaceGrid<'_> {
+    /// The face containing the point: the first of the faces in increasing order, as
+    /// [`TMesh::locate`].
+    pub fn locate(&self, u: f64, v: f64) -> Option<usize> {
+        let lat = self.mesh.lattice;
+        let (cu, cv) = lat.canonical(u, v);
+        let ix = ((cu / lat.width * self.nx as f64).floor().max(0.0) as usize).min(self.nx - 1);
+        let iy = ((cv / lat.height * self.ny as f64).floor().max(0.0) as usize).min(self.ny - 1);
+        self.cells[iy * self.nx + ix]
+            .iter()
+            .map(|&k| k as usize)
+            .find(|&k| self.mesh.faces[k].contains(cu, cv))
+    }
+}
+
 /// A T-mesh over the flat torus.
 #[derive(Debug, Clone)]
 pub struct TMesh {
@@ -561,6 +585,32 @@ impl TMesh {
     /// Index of the face containing the point (half-open faces).
     pub fn locate(&self, u: f64, v: f64) -> Option<usize> {
         self.face_at(u, v)
+    }
+
+    /// A bucket grid over the faces: [`FaceGrid::locate`] answers what [`TMesh::locate`] does
+    /// without scanning every face.
+    pub fn face_grid(&self) -> FaceGrid<'_> {
+        let (w, h) = (self.lattice.width, self.lattice.height);
+        let side = (w * h / self.faces.len().max(1) as f64).sqrt().max(1e-300);
+        let nx = ((w / side).ceil() as usize).clamp(1, 1024);
+        let ny = ((h / side).ceil() as usize).clamp(1, 1024);
+        let cell = |x: f64, len: f64, n: usize| {
+            ((x / len * n as f64).floor().max(0.0) as usize).min(n - 1)
+        };
+        let mut cells = vec![Vec::new(); nx * ny];
+        for (k, f) in self.faces.iter().enumerate() {
+            for iy in cell(f.v0, h, ny)..=cell(f.v1, h, ny) {
+                for ix in cell(f.u0, w, nx)..=cell(f.u1, w, nx) {
+                    cells[iy * nx + ix].push(k as u32);
+                }
+            }
+        }
+        FaceGrid {
+            mesh: self,
+            nx,
+            ny,
+            cells,
+        }
     }
 
     fn split_vertical(&mut self, f: usize, c: f64) -> bool {
