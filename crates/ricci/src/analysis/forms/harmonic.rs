@@ -21,7 +21,7 @@ use faer::Mat;
 /// The cotangent weight `(cot α + cot β)/2` of every edge (α, β the angles opposite it; one
 /// term on boundary edges), from the Euclidean edge lengths. Errors on a face whose lengths
 /// violate the triangle inequality.
-pub fn cotan_weights(mesh: &Mesh, lengths: &[f64]) -> Result<Vec<f64>> {
+pub(crate) fn cotan_weights(mesh: &Mesh, lengths: &[f64]) -> Result<Vec<f64>> {
     if lengths.len() != mesh.n_edges() {
         return Err(Error::input(format!(
             "{} edge lengths given for a mesh with {} edges",
