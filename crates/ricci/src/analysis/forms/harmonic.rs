@@ -119,11 +119,6 @@ impl HarmonicProjector {
         })
     }
 
-    /// The cotangent weights the projector was built with.
-    pub fn weights(&self) -> &[f64] {
-        &self.weights
-    }
-
     /// The harmonic representatives `ω_k + du_k` of the closed forms `forms` (one solve with
     /// several right-hand sides).
     pub fn project(&self, mesh: &Mesh, forms: &[Vec<f64>]) -> Vec<Vec<f64>> {

@@ -18,12 +18,12 @@
 //!    [`uniform`]: the combination of least area distortion (§4.2.1).
 
 pub mod cochain;
-pub mod harmonic;
+pub(crate) mod harmonic;
 pub(crate) mod hodge;
 pub(crate) mod net;
 pub(crate) mod period;
 pub mod placement;
-pub mod small;
+pub(crate) mod small;
 pub mod trajectories;
 pub mod uniform;
 pub(crate) mod working;
