@@ -106,7 +106,7 @@ fn main() {
     println!("fair converged {}", fr.converged);
     let local = LocalCharts::new(
         atlas.mesh().clone(),
-        atlas.lengths().to_vec(),
+        ricci::metric::IntrinsicMetric::euclidean(atlas.lengths().to_vec()),
         atlas.positions().to_vec(),
         atlas.singular_vertices().to_vec(),
         None,

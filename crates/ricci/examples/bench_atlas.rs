@@ -8,6 +8,7 @@
 use ricci::atlas::placement::{brute_force, place};
 use ricci::atlas::{AffineAtlas, AtlasOptions, FlatCharts};
 use ricci::mesh::io::read_surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::Scheme;
 use ricci::progress::NoProgress;
 use std::path::PathBuf;
@@ -42,7 +43,12 @@ fn main() {
         let lengths = s.edge_lengths();
         let opts = AtlasOptions::default();
         let t = Instant::now();
-        let p = match place(&s, &lengths, &opts, &mut NoProgress) {
+        let p = match place(
+            &s,
+            &IntrinsicMetric::euclidean(lengths.to_vec()),
+            &opts,
+            &mut NoProgress,
+        ) {
             Ok(p) => p,
             Err(e) => {
                 eprintln!("{f}: {e}");
@@ -61,7 +67,13 @@ fn main() {
             cand.push(p.chosen);
         }
         let t = Instant::now();
-        let bf = brute_force(&s.mesh, &lengths, &cand, Scheme::Thurston, &mut NoProgress);
+        let bf = brute_force(
+            &s.mesh,
+            &IntrinsicMetric::euclidean(lengths.to_vec()),
+            &cand,
+            Scheme::Thurston,
+            &mut NoProgress,
+        );
         let t_bf = t.elapsed().as_secs_f64();
         let mut d: Vec<f64> = bf.iter().filter_map(|x| x.1).collect();
         d.sort_by(|a, b| a.total_cmp(b));

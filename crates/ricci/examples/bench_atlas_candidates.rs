@@ -11,6 +11,7 @@
 use ricci::atlas::placement::place;
 use ricci::atlas::{AffineAtlas, AtlasOptions, FlatCharts, Singularity};
 use ricci::mesh::io::read_surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::progress::NoProgress;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -62,7 +63,12 @@ fn main() {
         let lengths = s.edge_lengths();
         let c0 = cpu_seconds();
         let t = Instant::now();
-        let p = place(&s, &lengths, &opts, &mut NoProgress);
+        let p = place(
+            &s,
+            &IntrinsicMetric::euclidean(lengths.to_vec()),
+            &opts,
+            &mut NoProgress,
+        );
         let c_place = cpu_seconds() - c0;
         let w_place = t.elapsed().as_secs_f64();
         let p = match p {

@@ -15,6 +15,7 @@
 use ricci::cut::{canonical_cut, Construction, CutOptions};
 use ricci::mesh::io::read_surface;
 use ricci::metric::Geometry;
+use ricci::metric::IntrinsicMetric;
 use ricci::progress::NoProgress;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -58,8 +59,7 @@ fn main() {
             let t = Instant::now();
             let c = canonical_cut(
                 &s.mesh,
-                &lengths,
-                Geometry::Euclidean,
+                &IntrinsicMetric::new(Geometry::Euclidean, lengths.to_vec()),
                 Some(&s.positions),
                 &CutOptions {
                     base,

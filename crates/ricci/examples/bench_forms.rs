@@ -6,6 +6,7 @@
 
 use ricci::analysis::forms::uniform::uniform_combination;
 use ricci::analysis::forms::{holomorphic_forms, FormsOptions};
+use ricci::metric::IntrinsicMetric;
 use ricci::progress::NoProgress;
 use std::time::Instant;
 
@@ -42,7 +43,7 @@ fn main() {
         let t0 = Instant::now();
         let h = match holomorphic_forms(
             &s.mesh,
-            &s.edge_lengths(),
+            &IntrinsicMetric::euclidean(s.edge_lengths()),
             Some(&s.positions),
             &FormsOptions::default(),
             &mut NoProgress,

@@ -14,6 +14,7 @@ use ricci::layout::pipeline::{
 };
 use ricci::layout::place::layout_dd;
 use ricci::mesh::io::read_surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Geometry, Hyperbolic, Scheme};
 use ricci::progress::NoProgress;
 use std::path::PathBuf;
@@ -47,7 +48,7 @@ fn main() {
         let run = |scheme| {
             uniformization_metric(
                 &s.mesh,
-                &s.edge_lengths(),
+                &IntrinsicMetric::euclidean(s.edge_lengths()),
                 Geometry::Hyperbolic,
                 scheme,
                 1e-12,
@@ -80,7 +81,11 @@ fn main() {
         let polished = if no_polish {
             None
         } else {
-            match polish_uniformization(&s.mesh, &s.edge_lengths(), &flow) {
+            match polish_uniformization(
+                &s.mesh,
+                &IntrinsicMetric::euclidean(s.edge_lengths()),
+                &flow,
+            ) {
                 Ok(p) => Some(p),
                 Err(e) => {
                     eprintln!("{f}: polish: {e}");
@@ -94,8 +99,7 @@ fn main() {
             Some(p) => cut_disk_polished(&s.mesh, &p.metric, None, base, &mut NoProgress),
             None => cut_disk(
                 &s.mesh,
-                &flow.lengths,
-                Geometry::Hyperbolic,
+                &IntrinsicMetric::new(Geometry::Hyperbolic, flow.lengths.to_vec()),
                 None,
                 base,
                 &mut NoProgress,

@@ -4,6 +4,7 @@
 //! `cargo run --release -p ricci --example bench_spectrum -- MESH [COUNT] [MAX_TILES]`
 use ricci::analysis::spectrum::surface_spectrum;
 use ricci::layout::pipeline::{polish_uniformization, uniformization_metric};
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Geometry, Scheme};
 use ricci::progress::NoProgress;
 use std::time::Instant;
@@ -22,7 +23,7 @@ fn main() {
     let t = Instant::now();
     let f = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Geometry::Hyperbolic,
         Scheme::Conformal,
         1e-12,
@@ -30,7 +31,8 @@ fn main() {
     )
     .unwrap();
     let work = f.triangulation.as_ref().unwrap().simplicial.mesh.clone();
-    let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &f).unwrap();
+    let p =
+        polish_uniformization(&s.mesh, &IntrinsicMetric::euclidean(s.edge_lengths()), &f).unwrap();
     println!("flow+polish {:.2} s", t.elapsed().as_secs_f64());
     let t = Instant::now();
     let sp = surface_spectrum(&work, &p.metric, None, count, maxt);

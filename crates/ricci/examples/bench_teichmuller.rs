@@ -9,6 +9,7 @@ use ricci::analysis::teichmuller::{surface_teichmuller, TeichmullerOptions};
 use ricci::mesh::generate::{midpoint_subdivision, random_face_splits};
 use ricci::mesh::io::read_surface;
 use ricci::mesh::Surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::progress::NoProgress;
 use std::path::PathBuf;
 
@@ -17,7 +18,12 @@ fn run(name: &str, s: &Surface, base: Option<u32>) {
         base,
         ..Default::default()
     };
-    match surface_teichmuller(&s.mesh, &s.edge_lengths(), &opts, &mut NoProgress) {
+    match surface_teichmuller(
+        &s.mesh,
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
+        &opts,
+        &mut NoProgress,
+    ) {
         Ok(r) => {
             let c = &r.coordinates;
             let fmt = |v: &[f64]| {

@@ -14,6 +14,7 @@ use ricci::layout::pipeline::cut_disk;
 use ricci::layout::place::layout_dd;
 use ricci::layout::subdivision_uv::{common_subdivision_uvs_ext, LaidOut};
 use ricci::metric::common_subdivision::CommonSubdivision;
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Euclidean, Geometry};
 use ricci::progress::NoProgress;
 
@@ -45,7 +46,14 @@ fn main() {
     );
     let it = r.triangulation.as_ref().unwrap();
     let work = &it.simplicial.mesh;
-    let d = cut_disk(work, &r.lengths, g, None, None, &mut NoProgress).unwrap();
+    let d = cut_disk(
+        work,
+        &IntrinsicMetric::new(g, r.lengths.to_vec()),
+        None,
+        None,
+        &mut NoProgress,
+    )
+    .unwrap();
     let lay = layout_dd::<Euclidean>(&d.mesh, &d.metric, None).unwrap();
     println!(
         "layout: {} faces, {} flipped, {} degenerate",

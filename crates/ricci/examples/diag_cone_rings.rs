@@ -13,6 +13,7 @@
 use ricci::atlas::placement::{candidate_mesh, estimate, PlacementOptions};
 use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
 use ricci::mesh::io::read_surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{euler_characteristic, Geometry, Scheme};
 use ricci::progress::NoProgress;
 use std::collections::VecDeque;
@@ -45,7 +46,7 @@ fn main() {
     let t = Instant::now();
     let (est, method) = match estimate(
         mesh,
-        &lengths,
+        &IntrinsicMetric::euclidean(lengths.to_vec()),
         Scheme::Thurston,
         &PlacementOptions::default(),
     ) {
@@ -61,7 +62,13 @@ fn main() {
         .collect();
     order.sort_by(|&a, &b| est[a as usize].total_cmp(&est[b as usize]).then(a.cmp(&b)));
     for &v in order.iter().take(count) {
-        let refined = match candidate_mesh(mesh, &lengths, v, kappa, graded) {
+        let refined = match candidate_mesh(
+            mesh,
+            &IntrinsicMetric::euclidean(lengths.to_vec()),
+            v,
+            kappa,
+            graded,
+        ) {
             Ok(r) => r,
             Err(e) => {
                 println!("vertex {v}: {e}");

@@ -10,45 +10,11 @@
 use ricci::flow::double::flow_on_double;
 use ricci::flow::target::resolve;
 use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
-use ricci::mesh::{generate, Surface};
+use ricci::mesh::generate;
 use ricci::metric::intrinsic::{length_of_lambda, IntrinsicTriangulation};
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Geometry, Scheme};
 use ricci::progress::NoProgress;
-
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
-/// As `tests/subdivision_uv.rs::split_off_centre_at` with `boundary = true`.
-fn split_off_centre(s: &Surface, count: usize, rng: &mut Lcg, near: f64) -> Surface {
-    let mut pos = s.positions.clone();
-    let mut faces = s.mesh.faces().to_vec();
-    for _ in 0..count {
-        let f = ((rng.next() * faces.len() as f64) as usize).min(faces.len() - 1);
-        let [a, b, c] = faces[f];
-        let w = [
-            near - 0.1 * rng.next(),
-            0.5 * (1.0 - near) * (1.0 + rng.next()),
-            0.0,
-        ];
-        let w = [w[0], w[1], 1.0 - w[0] - w[1]];
-        let (pa, pb, pc) = (pos[a as usize], pos[b as usize], pos[c as usize]);
-        let p = [0, 1, 2].map(|k| w[0] * pa[k] + w[1] * pb[k] + w[2] * pc[k]);
-        let v = pos.len() as u32;
-        pos.push(p);
-        faces[f] = [a, b, v];
-        faces.push([b, c, v]);
-        faces.push([c, a, v]);
-    }
-    Surface::new(pos, faces).unwrap()
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -61,17 +27,7 @@ fn main() {
     }
     let count: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(120);
     let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(7);
-    let d = generate::disk(16).unwrap();
-    let pos: Vec<[f64; 3]> = d
-        .positions
-        .iter()
-        .map(|p| {
-            let (x, y) = (p[0], p[1]);
-            [x, y, 0.5 * (3.0 * x).sin() * (2.0 * y).cos() + 0.7 * x * x]
-        })
-        .collect();
-    let s = Surface::new(pos, d.mesh.faces().to_vec()).unwrap();
-    let s = split_off_centre(&s, count, &mut Lcg(seed), 0.75);
+    let s = generate::bumpy_split_disk(count, seed, 0.75, true).unwrap();
     let m = &s.mesh;
     println!(
         "surface: {} vertices, {} faces, {} boundary edges",
@@ -259,7 +215,11 @@ fn half_region(m: &ricci::mesh::Mesh, r: &ricci::flow::double::DoubleFlow) {
         t.boundary_loops(),
         all_fixed
     );
-    match ricci::layout::place::layout::<ricci::metric::Euclidean>(&region, &lengths, None) {
+    match ricci::layout::place::layout::<ricci::metric::Euclidean>(
+        &region,
+        &IntrinsicMetric::new(ricci::metric::Geometry::Euclidean, lengths.to_vec()),
+        None,
+    ) {
         Ok(l) => println!(
             "  layout: {} flipped, {} degenerate, max length error {:.2e}",
             l.flipped_faces.len(),

@@ -11,6 +11,7 @@ use ricci::layout::deck::deck_group;
 use ricci::layout::pipeline::cut_disk;
 use ricci::layout::place::layout;
 use ricci::layout::subdivision_uv::common_subdivision_uvs;
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Euclidean, Geometry, Scheme};
 use ricci::progress::NoProgress;
 
@@ -37,8 +38,7 @@ fn main() {
     let work = &it.simplicial.mesh;
     let d = cut_disk(
         work,
-        &r.lengths,
-        Geometry::Euclidean,
+        &IntrinsicMetric::new(Geometry::Euclidean, r.lengths.to_vec()),
         None,
         None,
         &mut NoProgress,

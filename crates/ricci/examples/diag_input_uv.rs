@@ -2,6 +2,7 @@
 use ricci::layout::input_uv::input_face_uvs;
 use ricci::layout::pipeline::{cut_disk, uniformization_metric};
 use ricci::layout::{deck_group, layout_dd};
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Geometry, Hyperbolic, Scheme};
 use ricci::progress::NoProgress;
 
@@ -10,7 +11,7 @@ fn main() {
     let (s, _) = ricci::mesh::io::read_surface(std::path::Path::new(&path)).unwrap();
     let f = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Geometry::Hyperbolic,
         Scheme::Conformal,
         1e-12,
@@ -20,8 +21,7 @@ fn main() {
     let work = &f.triangulation.as_ref().unwrap().simplicial.mesh;
     let d = cut_disk(
         work,
-        &f.lengths,
-        Geometry::Hyperbolic,
+        &IntrinsicMetric::new(Geometry::Hyperbolic, f.lengths.to_vec()),
         None,
         None,
         &mut NoProgress,

@@ -6,6 +6,7 @@
 use ricci::layout::input_uv::input_face_uvs;
 use ricci::layout::pipeline::{cut_disk_polished, polish_uniformization, uniformization_metric};
 use ricci::layout::{deck_group, layout_dd};
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Geometry, Hyperbolic, Scheme};
 use ricci::progress::NoProgress;
 use std::time::Instant;
@@ -49,7 +50,7 @@ fn main() {
     let mut clock = Clock::new();
     let f = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Geometry::Hyperbolic,
         scheme,
         1e-12,
@@ -62,7 +63,8 @@ fn main() {
         .as_ref()
         .map(|t| t.simplicial.mesh.clone())
         .unwrap_or(s.mesh.clone());
-    let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &f).unwrap();
+    let p =
+        polish_uniformization(&s.mesh, &IntrinsicMetric::euclidean(s.edge_lengths()), &f).unwrap();
     clock.lap(
         "polish",
         format!(

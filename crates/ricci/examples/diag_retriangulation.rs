@@ -10,6 +10,7 @@ use ricci::layout::pipeline::{cut_disk, uniformization_metric};
 use ricci::layout::place::layout;
 use ricci::mesh::generate::{irregular_torus, midpoint_subdivision, random_face_splits};
 use ricci::mesh::Surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Euclidean, Geometry, Scheme};
 use ricci::progress::NoProgress;
 use std::time::Instant;
@@ -17,7 +18,7 @@ use std::time::Instant;
 fn spectrum(s: &Surface, scheme: Scheme) -> Result<Vec<f64>, String> {
     let flow = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Geometry::Euclidean,
         scheme,
         1e-11,
@@ -32,8 +33,7 @@ fn spectrum(s: &Surface, scheme: Scheme) -> Result<Vec<f64>, String> {
     }
     let disk = cut_disk(
         &s.mesh,
-        &flow.lengths,
-        Geometry::Euclidean,
+        &IntrinsicMetric::new(Geometry::Euclidean, flow.lengths.to_vec()),
         None,
         None,
         &mut NoProgress,

@@ -13,6 +13,7 @@ use ricci::layout::pipeline::{cut_disk_polished, polish_uniformization};
 use ricci::layout::place::layout_dd;
 use ricci::layout::subdivision_uv::{common_subdivision_uvs, common_subdivision_uvs_ext, LaidOut};
 use ricci::metric::common_subdivision::disk_orientation;
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Geometry, Hyperbolic, Scheme};
 use ricci::progress::NoProgress;
 
@@ -36,7 +37,7 @@ fn main() {
     };
     let r = ricci_flow(&s.mesh, &l, &o, &mut NoProgress).unwrap();
     let it = r.triangulation.as_ref().unwrap();
-    let p = polish_uniformization(&s.mesh, &l, &r).unwrap();
+    let p = polish_uniformization(&s.mesh, &IntrinsicMetric::euclidean(l.to_vec()), &r).unwrap();
     let work = &it.simplicial.mesh;
     let d = cut_disk_polished(work, &p.metric, None, None, &mut NoProgress).unwrap();
     let lay = layout_dd::<Hyperbolic>(&d.mesh, &d.metric, None).unwrap();

@@ -12,6 +12,7 @@ use ricci::error::Error;
 use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
 use ricci::mesh::io::read_surface;
 use ricci::mesh::{generate, Mesh, Surface};
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::Scheme;
 use ricci::progress::NoProgress;
 use std::f64::consts::PI;
@@ -74,7 +75,7 @@ fn botijo_candidate_converges_on_the_graded_mesh() {
     let mut budget = usize::MAX;
     let c = confirm_candidate(
         mesh,
-        &lengths,
+        &IntrinsicMetric::euclidean(lengths.to_vec()),
         v,
         Scheme::Thurston,
         1e-9,
@@ -85,7 +86,14 @@ fn botijo_candidate_converges_on_the_graded_mesh() {
     .expect("botijo's candidate converges on the graded mesh");
     assert!(c.graded, "converged without grading: {c:?}");
 
-    let refined = candidate_mesh(mesh, &lengths, v, kappa, true).unwrap();
+    let refined = candidate_mesh(
+        mesh,
+        &IntrinsicMetric::euclidean(lengths.to_vec()),
+        v,
+        kappa,
+        true,
+    )
+    .unwrap();
     let f = ricci_flow(
         &refined.mesh,
         &refined.lengths,
@@ -156,7 +164,7 @@ fn candidate_flows_stop_when_the_budget_is_spent() {
     let mut budget = 5;
     let e = confirm_candidate(
         &s.mesh,
-        &lengths,
+        &IntrinsicMetric::euclidean(lengths.to_vec()),
         v,
         Scheme::Thurston,
         1e-12,
@@ -172,7 +180,7 @@ fn candidate_flows_stop_when_the_budget_is_spent() {
     let mut budget = usize::MAX;
     confirm_candidate(
         &s.mesh,
-        &lengths,
+        &IntrinsicMetric::euclidean(lengths.to_vec()),
         v,
         Scheme::Thurston,
         1e-12,
@@ -197,7 +205,13 @@ fn no_converging_candidate_is_one_sentence() {
         },
         ..AtlasOptions::default()
     };
-    let e = place(&s, &s.edge_lengths(), &options, &mut NoProgress).unwrap_err();
+    let e = place(
+        &s,
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
+        &options,
+        &mut NoProgress,
+    )
+    .unwrap_err();
     assert!(matches!(e, Error::Numerical { .. }), "{e:?}");
     let m = e.to_string();
     assert!(m.contains("tried 4 of the"), "{m}");

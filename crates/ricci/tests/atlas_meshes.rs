@@ -17,6 +17,7 @@ use ricci::atlas::{fit_rigid, AffineAtlas, AtlasOptions, FlatCharts, Singularity
 use ricci::layout::isometry::Isometry;
 use ricci::mesh::io::read_surface;
 use ricci::mesh::{generate, Surface};
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{curvature, Geometry};
 use ricci::progress::NoProgress;
 use std::f64::consts::PI;
@@ -451,8 +452,7 @@ fn flip_ring_valence_keeps_the_cut_and_the_metric() {
     let step2 = r.finish().unwrap();
     let cut = canonical_cut(
         &step2.mesh,
-        &step2.lengths,
-        Geometry::Euclidean,
+        &IntrinsicMetric::new(Geometry::Euclidean, step2.lengths.to_vec()),
         step2.positions.as_deref(),
         &CutOptions {
             base: Some(cone),

@@ -7,6 +7,7 @@ use ricci::atlas::placement::{brute_force, estimate, place, PlacementOptions};
 use ricci::atlas::AtlasOptions;
 use ricci::mesh::io::read_surface;
 use ricci::mesh::{generate, Surface};
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::Scheme;
 use ricci::progress::NoProgress;
 use std::path::PathBuf;
@@ -44,10 +45,16 @@ fn spearman(x: &[f64], y: &[f64]) -> f64 {
 fn compare(name: &str, s: &Surface, candidates: Vec<u32>) -> (usize, usize, f64) {
     let lengths = s.edge_lengths();
     let opts = AtlasOptions::default();
-    let p = place(s, &lengths, &opts, &mut NoProgress).unwrap();
+    let p = place(
+        s,
+        &IntrinsicMetric::euclidean(lengths.to_vec()),
+        &opts,
+        &mut NoProgress,
+    )
+    .unwrap();
     let (est, _) = estimate(
         &s.mesh,
-        &lengths,
+        &IntrinsicMetric::euclidean(lengths.to_vec()),
         Scheme::Thurston,
         &PlacementOptions::default(),
     )
@@ -56,7 +63,13 @@ fn compare(name: &str, s: &Surface, candidates: Vec<u32>) -> (usize, usize, f64)
     if !cand.contains(&p.chosen) {
         cand.push(p.chosen);
     }
-    let bf = brute_force(&s.mesh, &lengths, &cand, Scheme::Thurston, &mut NoProgress);
+    let bf = brute_force(
+        &s.mesh,
+        &IntrinsicMetric::euclidean(lengths.to_vec()),
+        &cand,
+        Scheme::Thurston,
+        &mut NoProgress,
+    );
     let ok: Vec<(u32, f64)> = bf.iter().filter_map(|&(v, d)| d.map(|d| (v, d))).collect();
     assert!(
         ok.len() * 10 >= cand.len() * 9,

@@ -9,6 +9,7 @@ use ricci::flow::conformal::{evaluate, hessian_triplets, ConformalState};
 use ricci::flow::{ricci_flow, separated_vertices, FlowOptions, FlowResult, TargetSpec};
 use ricci::mesh::{generate, Mesh, Surface};
 use ricci::metric::intrinsic::{length_of_lambda, IntrinsicTriangulation};
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{self, Geometry, Scheme};
 use ricci::progress::NoProgress;
 use std::f64::consts::PI;
@@ -511,8 +512,7 @@ fn lattice_normalized(r: &FlowResult, count: usize) -> Vec<f64> {
     let sm = &r.triangulation.as_ref().unwrap().simplicial;
     let disk = cut_disk(
         &sm.mesh,
-        &r.lengths,
-        Geometry::Euclidean,
+        &IntrinsicMetric::new(Geometry::Euclidean, r.lengths.to_vec()),
         None,
         None,
         &mut NoProgress,
@@ -561,8 +561,7 @@ fn spectra_on_the_intrinsic_triangulation() {
     assert!(y.converged);
     let disk = ricci::layout::pipeline::cut_disk(
         &s.mesh,
-        &y.lengths,
-        Geometry::Euclidean,
+        &IntrinsicMetric::new(Geometry::Euclidean, y.lengths.to_vec()),
         None,
         None,
         &mut NoProgress,

@@ -15,6 +15,7 @@ use ricci::layout::pipeline::{
 use ricci::layout::{deck_group, layout, layout_dd};
 use ricci::mesh::generate::{genus, irregular_torus, midpoint_subdivision, random_face_splits};
 use ricci::mesh::Surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Euclidean, Geometry, Hyperbolic, Scheme};
 use ricci::progress::NoProgress;
 
@@ -23,7 +24,7 @@ use ricci::progress::NoProgress;
 fn spectrum(s: &Surface, geometry: Geometry, count: usize) -> Vec<f64> {
     let f = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         geometry,
         Scheme::Conformal,
         if geometry == Geometry::Hyperbolic {
@@ -42,7 +43,14 @@ fn spectrum(s: &Surface, geometry: Geometry, count: usize) -> Vec<f64> {
     );
     let work = &f.triangulation.as_ref().unwrap().simplicial.mesh;
     if geometry == Geometry::Euclidean {
-        let d = cut_disk(work, &f.lengths, geometry, None, None, &mut NoProgress).unwrap();
+        let d = cut_disk(
+            work,
+            &IntrinsicMetric::new(geometry, f.lengths.to_vec()),
+            None,
+            None,
+            &mut NoProgress,
+        )
+        .unwrap();
         let l = layout::<Euclidean>(&d.mesh, &d.metric, None).unwrap();
         assert!(l.flipped_faces.is_empty());
         let g = deck_group::<Euclidean>(&l, &d.polygon).unwrap();
@@ -50,7 +58,8 @@ fn spectrum(s: &Surface, geometry: Geometry, count: usize) -> Vec<f64> {
         let sp = lattice_spectrum(gens[0].1.t, gens[1].1.t, count).unwrap();
         sp.iter().map(|x| x / sp[0]).collect()
     } else {
-        let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &f).unwrap();
+        let p = polish_uniformization(&s.mesh, &IntrinsicMetric::euclidean(s.edge_lengths()), &f)
+            .unwrap();
         let d = cut_disk_polished(work, &p.metric, None, None, &mut NoProgress).unwrap();
         let l = layout_dd::<Hyperbolic>(&d.mesh, &d.metric, None).unwrap();
         assert!(l.flipped_faces.is_empty());
@@ -90,7 +99,7 @@ fn irregular_tori_match_the_closed_form() {
         let s = irregular_torus(big, small, n, 5).unwrap();
         let f = uniformization_metric(
             &s.mesh,
-            &s.edge_lengths(),
+            &IntrinsicMetric::euclidean(s.edge_lengths()),
             Geometry::Euclidean,
             Scheme::Conformal,
             1e-11,
@@ -101,8 +110,7 @@ fn irregular_tori_match_the_closed_form() {
         let work = &f.triangulation.as_ref().unwrap().simplicial.mesh;
         let d = cut_disk(
             work,
-            &f.lengths,
-            Geometry::Euclidean,
+            &IntrinsicMetric::new(Geometry::Euclidean, f.lengths.to_vec()),
             None,
             None,
             &mut NoProgress,

@@ -7,6 +7,7 @@ mod cut_check;
 
 use ricci::cut::{canonical_cut, CutOptions, Generator};
 use ricci::metric::Geometry;
+use ricci::metric::IntrinsicMetric;
 use ricci::progress::NoProgress;
 
 #[test]
@@ -16,8 +17,7 @@ fn generated_surfaces_of_genus_1_to_4() {
         let lengths = s.edge_lengths();
         let c = canonical_cut(
             &s.mesh,
-            &lengths,
-            Geometry::Euclidean,
+            &IntrinsicMetric::new(Geometry::Euclidean, lengths.to_vec()),
             Some(&s.positions),
             &CutOptions::default(),
             &mut NoProgress,

@@ -9,6 +9,7 @@ use cut_check::{meshes_dir, verify};
 use ricci::cut::{canonical_cut, Construction, CutOptions};
 use ricci::mesh::io::read_surface;
 use ricci::metric::Geometry;
+use ricci::metric::IntrinsicMetric;
 use ricci::progress::NoProgress;
 
 fn run(file: &str, g: usize, nb: usize, base: Option<u32>) {
@@ -40,8 +41,7 @@ fn run_construction(
     };
     let c = canonical_cut(
         &s.mesh,
-        &lengths,
-        Geometry::Euclidean,
+        &IntrinsicMetric::new(Geometry::Euclidean, lengths.to_vec()),
         Some(&s.positions),
         &opts,
         &mut NoProgress,
@@ -213,8 +213,7 @@ fn one_attempt_suffices_on_a_closed_surface() {
     };
     let c = canonical_cut(
         &s.mesh,
-        &lengths,
-        Geometry::Euclidean,
+        &IntrinsicMetric::new(Geometry::Euclidean, lengths.to_vec()),
         Some(&s.positions),
         &opts,
         &mut NoProgress,

@@ -11,73 +11,15 @@ use ricci::flow::double::flow_on_double;
 use ricci::flow::target::resolve;
 use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
 use ricci::mesh::{double_cover, generate, topology, Surface};
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Geometry, Scheme};
 use ricci::progress::NoProgress;
 use std::f64::consts::PI;
 
-/// Deterministic pseudo-random numbers in [0, 1).
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
-/// `count` random faces split at a point near one corner (weight `near`), boundary faces too
-/// unless `interior_only` (as `tests/subdivision_uv.rs` does).
-fn split_off_centre(
-    s: &Surface,
-    count: usize,
-    rng: &mut Lcg,
-    near: f64,
-    interior_only: bool,
-) -> Surface {
-    let mut pos = s.positions.clone();
-    let mut faces = s.mesh.faces().to_vec();
-    for _ in 0..count {
-        let f = ((rng.next() * faces.len() as f64) as usize).min(faces.len() - 1);
-        let [a, b, c] = faces[f];
-        if interior_only
-            && [a, b, c]
-                .iter()
-                .any(|&v| (v as usize) < s.mesh.n_vertices() && s.mesh.is_boundary_vertex(v))
-        {
-            continue;
-        }
-        let w = [
-            near - 0.1 * rng.next(),
-            0.5 * (1.0 - near) * (1.0 + rng.next()),
-            0.0,
-        ];
-        let w = [w[0], w[1], 1.0 - w[0] - w[1]];
-        let (pa, pb, pc) = (pos[a as usize], pos[b as usize], pos[c as usize]);
-        let p = [0, 1, 2].map(|k| w[0] * pa[k] + w[1] * pb[k] + w[2] * pc[k]);
-        let v = pos.len() as u32;
-        pos.push(p);
-        faces[f] = [a, b, v];
-        faces.push([b, c, v]);
-        faces.push([c, a, v]);
-    }
-    Surface::new(pos, faces).unwrap()
-}
-
-/// The bumpy disk of `tests/subdivision_uv.rs`, split off-centre.
+/// The bumpy disk of issue 15 (`ricci::mesh::generate::bumpy_split_disk`), 120 faces split
+/// off-centre, boundary faces too unless `interior_only`.
 fn bumpy_disk(interior_only: bool) -> Surface {
-    let d = generate::disk(16).unwrap();
-    let pos: Vec<[f64; 3]> = d
-        .positions
-        .iter()
-        .map(|p| {
-            let (x, y) = (p[0], p[1]);
-            [x, y, 0.5 * (3.0 * x).sin() * (2.0 * y).cos() + 0.7 * x * x]
-        })
-        .collect();
-    let s = Surface::new(pos, d.mesh.faces().to_vec()).unwrap();
-    split_off_centre(&s, 120, &mut Lcg(7), 0.75, interior_only)
+    generate::bumpy_split_disk(120, 7, 0.75, !interior_only).unwrap()
 }
 
 /// The checks every solution must pass; returns the flow.
@@ -187,7 +129,7 @@ fn double_agrees_with_the_surface_flow_when_no_boundary_edge_flips() {
 #[test]
 fn flat_disk_on_the_double_keeps_its_metric() {
     let d = generate::disk(12).unwrap();
-    let s = split_off_centre(&d, 80, &mut Lcg(3), 0.8, false);
+    let s = generate::split_off_centre(&d, 80, 3, 0.8, true).unwrap();
     assert!(s.positions.iter().all(|p| p[2] == 0.0));
     let r = checked_double_flow("flat disk", &s);
     let umax = r.u_double.iter().fold(0.0f64, |a, x| a.max(x.abs()));
@@ -256,17 +198,7 @@ fn faces_meeting_the_surface_form_a_flat_disk() {
     use ricci::mesh::Mesh;
     use ricci::metric::Euclidean;
     for (count, seed) in [(120, 7), (200, 3), (300, 11)] {
-        let d = generate::disk(16).unwrap();
-        let pos: Vec<[f64; 3]> = d
-            .positions
-            .iter()
-            .map(|p| {
-                let (x, y) = (p[0], p[1]);
-                [x, y, 0.5 * (3.0 * x).sin() * (2.0 * y).cos() + 0.7 * x * x]
-            })
-            .collect();
-        let s = Surface::new(pos, d.mesh.faces().to_vec()).unwrap();
-        let s = split_off_centre(&s, count, &mut Lcg(seed), 0.75, false);
+        let s = generate::bumpy_split_disk(count, seed, 0.75, true).unwrap();
         let name = format!("disk {count}/{seed}");
         let r = checked_double_flow(&name, &s);
         assert!(r.boundary_edges_flipped > 0, "{name}");
@@ -317,7 +249,12 @@ fn faces_meeting_the_surface_form_a_flat_disk() {
                 sm.lengths[sm.mesh.he_edge(h) as usize]
             })
             .collect();
-        let l = layout::<Euclidean>(&region, &lengths, None).unwrap();
+        let l = layout::<Euclidean>(
+            &region,
+            &IntrinsicMetric::new(ricci::metric::Geometry::Euclidean, lengths.to_vec()),
+            None,
+        )
+        .unwrap();
         eprintln!(
             "{name}: region {} faces ({rungs} rung faces), {} flipped, {} degenerate, length error {:.1e}",
             region.n_faces(),

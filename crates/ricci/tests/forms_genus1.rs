@@ -13,6 +13,7 @@ use ricci::layout::pipeline::{cut_disk, uniformization_metric};
 use ricci::layout::{deck_group, layout};
 use ricci::mesh::generate::{irregular_torus, torus};
 use ricci::mesh::Surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Euclidean, Geometry, Scheme};
 use ricci::progress::NoProgress;
 
@@ -20,7 +21,7 @@ use ricci::progress::NoProgress;
 fn deck_modulus(s: &Surface) -> (f64, f64) {
     let f = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Geometry::Euclidean,
         Scheme::Conformal,
         1e-11,
@@ -31,8 +32,7 @@ fn deck_modulus(s: &Surface) -> (f64, f64) {
     let work = &f.triangulation.as_ref().unwrap().simplicial.mesh;
     let d = cut_disk(
         work,
-        &f.lengths,
-        Geometry::Euclidean,
+        &IntrinsicMetric::new(Geometry::Euclidean, f.lengths.to_vec()),
         None,
         None,
         &mut NoProgress,
@@ -55,7 +55,7 @@ fn forms_modulus(s: &Surface, triangulation: FormsTriangulation, base: Option<u3
     };
     let h = holomorphic_forms(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Some(&s.positions),
         &opts,
         &mut NoProgress,

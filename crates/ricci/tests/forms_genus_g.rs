@@ -10,6 +10,7 @@ use ricci::analysis::forms::cochain::{on_halfedge, period};
 use ricci::analysis::forms::{holomorphic_forms, FormsOptions, HolomorphicForms};
 use ricci::cut::CutOptions;
 use ricci::mesh::Surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::progress::NoProgress;
 
 fn forms(s: &Surface, base: Option<u32>) -> HolomorphicForms {
@@ -22,7 +23,7 @@ fn forms(s: &Surface, base: Option<u32>) -> HolomorphicForms {
     };
     holomorphic_forms(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Some(&s.positions),
         &opts,
         &mut NoProgress,

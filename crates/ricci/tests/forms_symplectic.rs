@@ -18,6 +18,7 @@ use ricci::analysis::forms::{
 use ricci::cut::CutOptions;
 use ricci::layout::isometry::Complex;
 use ricci::mesh::{Mesh, Surface};
+use ricci::metric::IntrinsicMetric;
 use ricci::progress::NoProgress;
 use std::collections::HashMap;
 
@@ -84,7 +85,7 @@ fn chain(m: &Mesh, split: &HashMap<(u32, u32), u32>, u: u32, v: u32, out: &mut V
 fn check(name: &str, s: &Surface, base2: u32) -> bool {
     let h1 = holomorphic_forms(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Some(&s.positions),
         &FormsOptions::default(),
         &mut NoProgress,
@@ -204,7 +205,14 @@ fn check(name: &str, s: &Surface, base2: u32) -> bool {
             .collect()
     };
     let predicted = solve(periods1(0), periods1(1));
-    let direct = complex(&period_matrix_of_loops(&r2.mesh, &r2.lengths, &loops1).unwrap());
+    let direct = complex(
+        &period_matrix_of_loops(
+            &r2.mesh,
+            &IntrinsicMetric::euclidean(r2.lengths.to_vec()),
+            &loops1,
+        )
+        .unwrap(),
+    );
     let first = complex(&h1.period_matrix);
     let (same, other) = (max_diff(&predicted, &direct), max_diff(&predicted, &first));
     eprintln!("  Ω undone vs first basis: same mesh {same:.1e}, first mesh {other:.1e}");

@@ -12,6 +12,7 @@ use ricci::analysis::forms::trajectories::{critical_trajectories, EdgePoint, Tra
 use ricci::analysis::forms::{holomorphic_forms, FormsOptions, HolomorphicForm, HolomorphicForms};
 use ricci::layout::isometry::Complex;
 use ricci::mesh::{Mesh, Surface};
+use ricci::metric::IntrinsicMetric;
 use ricci::progress::NoProgress;
 
 /// `φ(x) − φ(r)` of the 1-form `w` at the point `x` of a face that also holds `r`.
@@ -46,7 +47,7 @@ fn variation(m: &Mesh, form: &HolomorphicForm, tr: &Trajectory) -> (f64, f64, f6
 fn check(name: &str, s: &Surface) {
     let h: HolomorphicForms = holomorphic_forms(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Some(&s.positions),
         &FormsOptions::default(),
         &mut NoProgress,
@@ -64,7 +65,14 @@ fn check(name: &str, s: &Surface) {
         let zs = h.zeros(form).unwrap();
         assert_eq!(zs.count as usize, 2 * g - 2, "{name}: {zs:?}");
         let at: Vec<u32> = zs.zeros.iter().map(|z| z.vertex).collect();
-        let trs = critical_trajectories(m, h.lengths(), form, &at, 1.0, 100_000);
+        let trs = critical_trajectories(
+            m,
+            &IntrinsicMetric::euclidean((h.lengths()).to_vec()),
+            form,
+            &at,
+            1.0,
+            100_000,
+        );
         let want: u32 = zs.zeros.iter().map(|z| 2 * (z.multiplicity + 1)).sum();
         eprintln!(
             "{name} form {k}: zeros {:?}, {} trajectories (Σ 2(m + 1) = {want})",
@@ -183,7 +191,14 @@ fn horizontal_lines_of_a_constant_form_are_straight() {
         })
         .collect();
     let p = id(6, 6);
-    let trs = critical_trajectories(&mesh, &lengths, &form, &[p], 4.0, 1000);
+    let trs = critical_trajectories(
+        &mesh,
+        &IntrinsicMetric::euclidean(lengths.to_vec()),
+        &form,
+        &[p],
+        4.0,
+        1000,
+    );
     assert_eq!(trs.len(), 2, "{trs:?}");
     assert!(trs[0].outgoing != trs[1].outgoing);
     let z0 = Complex::new(6.0, 6.0);

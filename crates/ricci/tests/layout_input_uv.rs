@@ -12,6 +12,7 @@ use ricci::layout::pipeline::{
 use ricci::layout::{deck_group, layout_dd, DeckGroup, Isometry, Space};
 use ricci::mesh::generate::genus;
 use ricci::mesh::Surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Euclidean, Geometry, Hyperbolic, Scheme};
 use ricci::progress::NoProgress;
 
@@ -44,7 +45,7 @@ where
 {
     let f = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         geometry,
         Scheme::Conformal,
         1e-11,
@@ -63,10 +64,19 @@ where
         // sides of a seam are laid out along different paths; in double precision they
         // disagree by the flow's residual times sinh of the distance from the seed).
         let d = if geometry == Geometry::Hyperbolic {
-            let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &f).unwrap();
+            let p =
+                polish_uniformization(&s.mesh, &IntrinsicMetric::euclidean(s.edge_lengths()), &f)
+                    .unwrap();
             cut_disk_polished(work, &p.metric, None, None, &mut NoProgress).unwrap()
         } else {
-            cut_disk(work, &f.lengths, geometry, None, None, &mut NoProgress).unwrap()
+            cut_disk(
+                work,
+                &IntrinsicMetric::new(geometry, f.lengths.to_vec()),
+                None,
+                None,
+                &mut NoProgress,
+            )
+            .unwrap()
         };
         let l = layout_dd::<S>(&d.mesh, &d.metric, None).unwrap();
         assert!(l.flipped_faces.is_empty(), "{name}: intrinsic layout");

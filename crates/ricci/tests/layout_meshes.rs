@@ -8,6 +8,7 @@ use ricci::layout::pipeline::{
 use ricci::layout::place::{align_layouts, layout, layout_dd};
 use ricci::layout::{deck_group, Layout};
 use ricci::mesh::io::read_surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Geometry, Hyperbolic, Scheme};
 use ricci::progress::NoProgress;
 use std::path::PathBuf;
@@ -35,7 +36,7 @@ fn accuracy(file: &str) -> Accuracy {
     assert_eq!(geometry, Geometry::Hyperbolic);
     let flow = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         geometry,
         Scheme::Thurston,
         1e-12,
@@ -49,7 +50,12 @@ fn accuracy(file: &str) -> Accuracy {
     );
     // The metric polished to double-double (the pipeline's default for H²): the residual
     // reaches the tolerance and the metric moves by no more than the flow's last step allows.
-    let polished = polish_uniformization(&s.mesh, &s.edge_lengths(), &flow).unwrap();
+    let polished = polish_uniformization(
+        &s.mesh,
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
+        &flow,
+    )
+    .unwrap();
     assert!(polished.converged, "{file}: polish {:?}", polished.history);
     let moved = polished
         .metric
@@ -184,7 +190,7 @@ fn no_flipped_faces_on_the_flow_list() {
         let geometry = uniformization_geometry(&s.mesh).unwrap();
         let flow = match uniformization_metric(
             &s.mesh,
-            &s.edge_lengths(),
+            &IntrinsicMetric::euclidean(s.edge_lengths()),
             geometry,
             Scheme::Thurston,
             1e-10,
@@ -208,24 +214,44 @@ fn no_flipped_faces_on_the_flow_list() {
                 && s.mesh.boundary_loops().len() == 1;
         let flipped = if simply {
             match geometry {
-                Geometry::Spherical => layout::<Spherical>(&s.mesh, &flow.lengths, None)
-                    .unwrap()
-                    .flipped_faces
-                    .len(),
-                Geometry::Hyperbolic => layout::<Hyperbolic>(&s.mesh, &flow.lengths, None)
-                    .unwrap()
-                    .flipped_faces
-                    .len(),
-                Geometry::Euclidean => layout::<Euclidean>(&s.mesh, &flow.lengths, None)
-                    .unwrap()
-                    .flipped_faces
-                    .len(),
+                Geometry::Spherical => layout::<Spherical>(
+                    &s.mesh,
+                    &IntrinsicMetric::new(
+                        ricci::metric::Geometry::Spherical,
+                        flow.lengths.to_vec(),
+                    ),
+                    None,
+                )
+                .unwrap()
+                .flipped_faces
+                .len(),
+                Geometry::Hyperbolic => layout::<Hyperbolic>(
+                    &s.mesh,
+                    &IntrinsicMetric::new(
+                        ricci::metric::Geometry::Hyperbolic,
+                        flow.lengths.to_vec(),
+                    ),
+                    None,
+                )
+                .unwrap()
+                .flipped_faces
+                .len(),
+                Geometry::Euclidean => layout::<Euclidean>(
+                    &s.mesh,
+                    &IntrinsicMetric::new(
+                        ricci::metric::Geometry::Euclidean,
+                        flow.lengths.to_vec(),
+                    ),
+                    None,
+                )
+                .unwrap()
+                .flipped_faces
+                .len(),
             }
         } else {
             let d = match cut_disk(
                 &s.mesh,
-                &flow.lengths,
-                geometry,
+                &IntrinsicMetric::new(geometry, flow.lengths.to_vec()),
                 None,
                 None,
                 &mut NoProgress,

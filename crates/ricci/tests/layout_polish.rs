@@ -18,7 +18,7 @@ fn double_double_curvature_agrees_with_the_flow_kernel_and_the_polish_converges(
     let input = s.edge_lengths();
     let flow = uniformization_metric(
         &s.mesh,
-        &input,
+        &IntrinsicMetric::euclidean(input.to_vec()),
         Geometry::Hyperbolic,
         Scheme::Thurston,
         1e-12,
@@ -61,7 +61,8 @@ fn double_double_curvature_agrees_with_the_flow_kernel_and_the_polish_converges(
     );
     // Iterative refinement from the flow's u: the residual drops from the double-precision
     // floor to the double-double one in a few steps, and the metric hardly moves.
-    let p = polish_uniformization(&s.mesh, &input, &flow).unwrap();
+    let p =
+        polish_uniformization(&s.mesh, &IntrinsicMetric::euclidean(input.to_vec()), &flow).unwrap();
     assert!(p.residual_start > 1e-17, "{:?}", p.history);
     assert!(p.converged && p.residual_dd <= 1e-26, "{:?}", p.history);
     assert!(p.steps <= 3, "{:?}", p.history);
@@ -89,7 +90,7 @@ fn polished_metric_makes_deck_maps_from_different_edges_agree() {
     let input = s.edge_lengths();
     let flow = uniformization_metric(
         &s.mesh,
-        &input,
+        &IntrinsicMetric::euclidean(input.to_vec()),
         Geometry::Hyperbolic,
         Scheme::Thurston,
         1e-12,
@@ -98,8 +99,7 @@ fn polished_metric_makes_deck_maps_from_different_edges_agree() {
     .unwrap();
     let plain = cut_disk(
         &s.mesh,
-        &flow.lengths,
-        Geometry::Hyperbolic,
+        &IntrinsicMetric::new(Geometry::Hyperbolic, flow.lengths.to_vec()),
         None,
         None,
         &mut NoProgress,
@@ -107,7 +107,8 @@ fn polished_metric_makes_deck_maps_from_different_edges_agree() {
     .unwrap();
     let lp = layout::<Hyperbolic>(&plain.mesh, &plain.metric, None).unwrap();
     let gp = deck_group::<Hyperbolic>(&lp, &plain.polygon).unwrap();
-    let p = polish_uniformization(&s.mesh, &input, &flow).unwrap();
+    let p =
+        polish_uniformization(&s.mesh, &IntrinsicMetric::euclidean(input.to_vec()), &flow).unwrap();
     let disk = cut_disk_polished(&s.mesh, &p.metric, None, None, &mut NoProgress).unwrap();
     if let Some(r) = disk.refined_polish {
         assert!(r.converged, "{r:?}");
@@ -143,14 +144,19 @@ fn polish_refuses_what_it_cannot_do() {
     let t = generate::torus(1.0, 0.4, 12).unwrap();
     let flow = uniformization_metric(
         &t.mesh,
-        &t.edge_lengths(),
+        &IntrinsicMetric::euclidean(t.edge_lengths()),
         Geometry::Euclidean,
         Scheme::Thurston,
         1e-10,
         &mut NoProgress,
     )
     .unwrap();
-    let e = polish_uniformization(&t.mesh, &t.edge_lengths(), &flow).unwrap_err();
+    let e = polish_uniformization(
+        &t.mesh,
+        &IntrinsicMetric::euclidean(t.edge_lengths()),
+        &flow,
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("hyperbolic"), "{e}");
     // A nonzero target is refused, naming the vertex.
     let s = generate::genus(2, 12).unwrap();
@@ -184,7 +190,7 @@ fn vertex_scaling_metrics_are_polished_too() {
     let s = generate::genus(2, 12).unwrap();
     let flow = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Geometry::Hyperbolic,
         Scheme::Yamabe,
         1e-12,
@@ -192,7 +198,12 @@ fn vertex_scaling_metrics_are_polished_too() {
     )
     .unwrap();
     assert!(flow.converged);
-    let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &flow).unwrap();
+    let p = polish_uniformization(
+        &s.mesh,
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
+        &flow,
+    )
+    .unwrap();
     assert!(p.converged && p.residual_dd <= 1e-26, "{:?}", p.history);
     let moved = p
         .metric
@@ -214,7 +225,7 @@ fn a_double_precision_uniform_metric_is_polished_once_on_the_refined_mesh() {
     let input = s.edge_lengths();
     let flow = uniformization_metric(
         &s.mesh,
-        &input,
+        &IntrinsicMetric::euclidean(input.to_vec()),
         Geometry::Hyperbolic,
         Scheme::Conformal,
         1e-12,
@@ -231,7 +242,8 @@ fn a_double_precision_uniform_metric_is_polished_once_on_the_refined_mesh() {
     assert!(l.flipped_faces.is_empty());
     assert!(g.relation_error.unwrap() < 1e-20, "{:?}", g.relation_error);
     assert!(g.max_edge_spread < 1e-20, "{}", g.max_edge_spread);
-    let p = polish_uniformization(&s.mesh, &input, &flow).unwrap();
+    let p =
+        polish_uniformization(&s.mesh, &IntrinsicMetric::euclidean(input.to_vec()), &flow).unwrap();
     let twice = cut_disk_polished(work, &p.metric, None, None, &mut NoProgress).unwrap();
     // The polished metrics, by the refined-mesh vertices of their cut-mesh edges.
     let by_pair = |d: &ricci::layout::pipeline::CutDisk| {

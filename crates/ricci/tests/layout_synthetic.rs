@@ -8,6 +8,7 @@ use ricci::layout::place::{align, layout, Space};
 use ricci::layout::synthetic::{flat_torus, regular_polygon_surface, Gluing, SyntheticSurface};
 use ricci::layout::{deck_group, Layout};
 use ricci::mesh::Mesh;
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Euclidean, Geometry, Hyperbolic, Spherical};
 
 fn seeds(m: &Mesh) -> [Option<u32>; 3] {
@@ -19,7 +20,12 @@ fn seeds(m: &Mesh) -> [Option<u32>; 3] {
 fn check_layouts<S: Space<Point = C>>(s: &SyntheticSurface, tol: f64) -> Layout<C> {
     let mut first = None;
     for seed in seeds(&s.cut) {
-        let l = layout::<S>(&s.cut, &s.cut_lengths, seed).unwrap();
+        let l = layout::<S>(
+            &s.cut,
+            &IntrinsicMetric::new(S::KIND, s.cut_lengths.to_vec()),
+            seed,
+        )
+        .unwrap();
         assert!(
             l.flipped_faces.is_empty(),
             "{} flipped",
@@ -178,7 +184,12 @@ fn closed_genus_zero_surface_goes_onto_the_sphere() {
         })
         .collect();
     for seed in seeds(&m) {
-        let l = layout::<Spherical>(&m, &lengths, seed).unwrap();
+        let l = layout::<Spherical>(
+            &m,
+            &IntrinsicMetric::new(ricci::metric::Geometry::Spherical, lengths.to_vec()),
+            seed,
+        )
+        .unwrap();
         assert!(l.flipped_faces.is_empty());
         assert!(l.max_length_error < 1e-12, "{}", l.max_length_error);
         let (r, dev) = align::<Spherical>(&p, &l.positions).unwrap();
@@ -186,19 +197,42 @@ fn closed_genus_zero_surface_goes_onto_the_sphere() {
         assert!(r.compose(&r.inverse()).distance(&Rotation::identity()) < 1e-12);
     }
     // The plane and the disk refuse a closed surface.
-    assert!(layout::<Euclidean>(&m, &lengths, None).is_err());
+    assert!(layout::<Euclidean>(
+        &m,
+        &IntrinsicMetric::new(ricci::metric::Geometry::Euclidean, lengths.to_vec()),
+        None
+    )
+    .is_err());
 }
 
 #[test]
 fn errors_name_the_problem() {
     let s = flat_torus(C::new(1.0, 0.0), C::new(0.0, 1.0), 4, 4, 0.0, 1).unwrap();
-    let e = layout::<Euclidean>(&s.closed, &s.closed_lengths, None).unwrap_err();
+    let e = layout::<Euclidean>(
+        &s.closed,
+        &IntrinsicMetric::new(
+            ricci::metric::Geometry::Euclidean,
+            s.closed_lengths.to_vec(),
+        ),
+        None,
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("genus 1"), "{e}");
     let mut bad = s.cut_lengths.clone();
     bad[3] = f64::NAN;
-    let e = layout::<Euclidean>(&s.cut, &bad, None).unwrap_err();
+    let e = layout::<Euclidean>(
+        &s.cut,
+        &IntrinsicMetric::new(ricci::metric::Geometry::Euclidean, bad.to_vec()),
+        None,
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("edge 3"), "{e}");
-    let e = layout::<Euclidean>(&s.cut, &s.cut_lengths, Some(10_000)).unwrap_err();
+    let e = layout::<Euclidean>(
+        &s.cut,
+        &IntrinsicMetric::new(ricci::metric::Geometry::Euclidean, s.cut_lengths.to_vec()),
+        Some(10_000),
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("seed face 10000"), "{e}");
 }
 
@@ -206,7 +240,12 @@ fn errors_name_the_problem() {
 fn universal_cover_tiles_carry_words_that_evaluate_to_their_maps() {
     use ricci::layout::cover::{tiles_by_radius, tiles_by_words};
     let s = regular_polygon_surface(Geometry::Hyperbolic, 2, Gluing::Canonical, 3).unwrap();
-    let l = layout::<Hyperbolic>(&s.cut, &s.cut_lengths, None).unwrap();
+    let l = layout::<Hyperbolic>(
+        &s.cut,
+        &IntrinsicMetric::new(ricci::metric::Geometry::Hyperbolic, s.cut_lengths.to_vec()),
+        None,
+    )
+    .unwrap();
     let g = deck_group::<Hyperbolic>(&l, &s.polygon).unwrap();
     let base = l.positions[s.cut.face(ricci::layout::place::central_face(&s.cut))[0] as usize];
     let tiles = tiles_by_radius::<Hyperbolic>(&g, &s.polygon, base, 6.0, 5000).unwrap();
@@ -256,8 +295,18 @@ fn hyperbolic_layout_keeps_its_accuracy_far_from_the_centre() {
         })
         .collect();
     let nf = mesh.n_faces() as u32;
-    let from_start = layout::<Hyperbolic>(&mesh, &lengths, Some(0)).unwrap();
-    let from_end = layout::<Hyperbolic>(&mesh, &lengths, Some(nf - 1)).unwrap();
+    let from_start = layout::<Hyperbolic>(
+        &mesh,
+        &IntrinsicMetric::new(ricci::metric::Geometry::Hyperbolic, lengths.to_vec()),
+        Some(0),
+    )
+    .unwrap();
+    let from_end = layout::<Hyperbolic>(
+        &mesh,
+        &IntrinsicMetric::new(ricci::metric::Geometry::Hyperbolic, lengths.to_vec()),
+        Some(nf - 1),
+    )
+    .unwrap();
     for l in [&from_start, &from_end] {
         assert!(l.max_radius > 29.0, "radius {}", l.max_radius);
         assert!(l.flipped_faces.is_empty() && l.degenerate_faces.is_empty());

@@ -12,6 +12,7 @@ mod ricci_meshes;
 
 use ricci::mesh::generate::{disk, genus, icosphere, torus};
 use ricci::mesh::Surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::param::sphere::sphere_map;
 use ricci::param::{parametrize, ConeSpec, ParamOptions, Parametrization};
 use ricci::progress::NoProgress;
@@ -421,12 +422,26 @@ fn cone_correction_lowers_the_log_scale_spread() {
         r.u
     };
     let u0 = flow(&greedy);
-    let same = correct_cone_curvatures(&s.mesh, &l, &greedy, &vec![0.3; u0.len()], 1.0).unwrap();
+    let same = correct_cone_curvatures(
+        &s.mesh,
+        &IntrinsicMetric::euclidean(l.to_vec()),
+        &greedy,
+        &vec![0.3; u0.len()],
+        1.0,
+    )
+    .unwrap();
     for (a, b) in greedy.iter().zip(&same) {
         assert_eq!(a.0, b.0);
         assert!((a.1 - b.1).abs() < 1e-9, "{a:?} {b:?}");
     }
-    let fixed = correct_cone_curvatures(&s.mesh, &l, &greedy, &u0, 1.0).unwrap();
+    let fixed = correct_cone_curvatures(
+        &s.mesh,
+        &IntrinsicMetric::euclidean(l.to_vec()),
+        &greedy,
+        &u0,
+        1.0,
+    )
+    .unwrap();
     let sum: f64 = fixed.iter().map(|c| c.1).sum();
     assert!((sum - 4.0 * PI).abs() < 1e-9, "{sum}");
     assert!(fixed.iter().all(|c| c.1 < 2.0 * PI));
@@ -445,11 +460,22 @@ fn cone_correction_lowers_the_log_scale_spread() {
         "{:?}",
         p.charts[0]
     );
-    let ours = greedy_cones(&s.mesh, &l, ConeBudget::Count(8))
-        .unwrap()
-        .cones;
+    let ours = greedy_cones(
+        &s.mesh,
+        &IntrinsicMetric::euclidean(l.to_vec()),
+        ConeBudget::Count(8),
+    )
+    .unwrap()
+    .cones;
     let u2 = flow(&ours);
-    let again = correct_cone_curvatures(&s.mesh, &l, &ours, &u2, 1.0).unwrap();
+    let again = correct_cone_curvatures(
+        &s.mesh,
+        &IntrinsicMetric::euclidean(l.to_vec()),
+        &ours,
+        &u2,
+        1.0,
+    )
+    .unwrap();
     let (s2, s3) = (sigma_2u(&s, &u2), sigma_2u(&s, &flow(&again)));
     assert!((s3 - s2).abs() < 0.01 * s2, "σ(2u) {s2} → {s3}");
 }

@@ -11,6 +11,7 @@ mod ricci_meshes;
 
 use ricci::mesh::generate::{genus, torus};
 use ricci::mesh::Surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::param::seamless::{homology_loops, loop_value, quarter_turn_holonomy};
 use ricci::param::{parametrize, ConeSpec, ParamOptions, Parametrization};
 use ricci::progress::NoProgress;
@@ -129,7 +130,13 @@ fn homology_loops_count_and_flat_torus() {
         assert!((x - x.round()).abs() < 1e-9, "flat torus loop value {x}π");
     }
     let sums = vec![2.0 * PI; tm.n_vertices()];
-    let fix = quarter_turn_holonomy(tm, &r.lengths, &sums, 1e-11).unwrap();
+    let fix = quarter_turn_holonomy(
+        tm,
+        &IntrinsicMetric::euclidean(r.lengths.to_vec()),
+        &sums,
+        1e-11,
+    )
+    .unwrap();
     assert!(
         fix.max_log_length_change < 1e-8,
         "{}",

@@ -8,13 +8,14 @@ use ricci::layout::pipeline::{cut_disk, uniformization_metric};
 use ricci::layout::place::layout;
 use ricci::mesh::generate;
 use ricci::mesh::Surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Euclidean, Geometry, Hyperbolic, Scheme};
 use ricci::progress::NoProgress;
 
 fn spectrum(s: &Surface, geometry: Geometry, scheme: Scheme, count: usize) -> Vec<f64> {
     let flow = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         geometry,
         scheme,
         1e-11,
@@ -24,8 +25,7 @@ fn spectrum(s: &Surface, geometry: Geometry, scheme: Scheme, count: usize) -> Ve
     assert!(flow.converged, "flow: {:e}", flow.max_curvature_error);
     let disk = cut_disk(
         &s.mesh,
-        &flow.lengths,
-        geometry,
+        &IntrinsicMetric::new(geometry, flow.lengths.to_vec()),
         None,
         None,
         &mut NoProgress,
@@ -120,7 +120,7 @@ fn compact_domain_spectrum_matches_the_canonical_polygon() {
     let want = spectrum(&s, Geometry::Hyperbolic, Scheme::Yamabe, 10);
     let flow = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Geometry::Hyperbolic,
         Scheme::Yamabe,
         1e-11,

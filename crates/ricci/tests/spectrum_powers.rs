@@ -10,6 +10,7 @@ mod ricci_meshes;
 
 use ricci::analysis::spectrum::surface_spectrum;
 use ricci::layout::pipeline::{polish_uniformization, uniformization_metric};
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Geometry, Scheme};
 use ricci::progress::NoProgress;
 
@@ -19,7 +20,7 @@ fn squares(name: &str) -> Option<(usize, f64)> {
     let (s, _) = ricci::mesh::io::read_surface(&dir.join(name)).unwrap();
     let f = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Geometry::Hyperbolic,
         Scheme::Conformal,
         1e-12,
@@ -27,7 +28,8 @@ fn squares(name: &str) -> Option<(usize, f64)> {
     )
     .unwrap();
     let work = f.triangulation.as_ref().unwrap().simplicial.mesh.clone();
-    let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &f).unwrap();
+    let p =
+        polish_uniformization(&s.mesh, &IntrinsicMetric::euclidean(s.edge_lengths()), &f).unwrap();
     let (sp, _) = surface_spectrum(&work, &p.metric, None, 12, 2_000_000).unwrap();
     let l = sp.lengths();
     let mut pairs = 0;

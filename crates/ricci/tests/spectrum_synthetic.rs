@@ -4,6 +4,7 @@ use num_complex::Complex64 as C;
 use ricci::analysis::spectrum::{fuchsian_spectrum, lattice_spectrum};
 use ricci::layout::synthetic::{flat_torus, regular_polygon_surface, Gluing};
 use ricci::layout::{deck_group, layout};
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Euclidean, Geometry, Hyperbolic};
 
 /// All lattice vectors up to sign with |m|, |n| ≤ 40, sorted: a brute-force reference.
@@ -29,7 +30,12 @@ fn torus_spectrum_from_layout_matches_the_lattice() {
         (C::new(2.0, 0.5), C::new(-3.1, 1.2)), // far from reduced
     ] {
         let s = flat_torus(w1, w2, 10, 10, 0.2, 3).unwrap();
-        let l = layout::<Euclidean>(&s.cut, &s.cut_lengths, None).unwrap();
+        let l = layout::<Euclidean>(
+            &s.cut,
+            &IntrinsicMetric::new(ricci::metric::Geometry::Euclidean, s.cut_lengths.to_vec()),
+            None,
+        )
+        .unwrap();
         let g = deck_group::<Euclidean>(&l, &s.polygon).unwrap();
         let gens = g.named_generators();
         let got = lattice_spectrum(gens[0].1.t, gens[1].1.t, 12).unwrap();
@@ -50,7 +56,12 @@ fn bolza_surface_has_twelve_systoles() {
     let mut spectra = Vec::new();
     for n in [3, 6] {
         let s = regular_polygon_surface(Geometry::Hyperbolic, 2, Gluing::Opposite, n).unwrap();
-        let l = layout::<Hyperbolic>(&s.cut, &s.cut_lengths, None).unwrap();
+        let l = layout::<Hyperbolic>(
+            &s.cut,
+            &IntrinsicMetric::new(ricci::metric::Geometry::Hyperbolic, s.cut_lengths.to_vec()),
+            None,
+        )
+        .unwrap();
         let g = deck_group::<Hyperbolic>(&l, &s.polygon).unwrap();
         let sp = fuchsian_spectrum(&l, &s.polygon, &g, 20, 200_000).unwrap();
         assert_eq!(sp.unmatched_links, 0);

@@ -9,6 +9,7 @@ mod ricci_meshes;
 
 use ricci::analysis::spectrum::surface_spectrum;
 use ricci::layout::pipeline::{polish_uniformization, uniformization_metric};
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Geometry, Scheme};
 use ricci::progress::NoProgress;
 use std::time::Instant;
@@ -22,7 +23,7 @@ fn time(name: &str) {
     let t = Instant::now();
     let f = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Geometry::Hyperbolic,
         Scheme::Conformal,
         1e-12,
@@ -31,7 +32,8 @@ fn time(name: &str) {
     .unwrap();
     let t_flow = t.elapsed().as_secs_f64();
     let work = f.triangulation.as_ref().unwrap().simplicial.mesh.clone();
-    let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &f).unwrap();
+    let p =
+        polish_uniformization(&s.mesh, &IntrinsicMetric::euclidean(s.edge_lengths()), &f).unwrap();
     let t1 = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let (sp, d) = surface_spectrum(&work, &p.metric, None, 12, 2_000_000).unwrap();

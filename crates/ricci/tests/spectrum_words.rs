@@ -9,6 +9,7 @@ use ricci::layout::isometry::{Isometry, Mobius};
 use ricci::layout::synthetic::{regular_polygon_surface, Gluing};
 use ricci::layout::{deck_group, layout, pipeline::cut_disk, pipeline::uniformization_metric};
 use ricci::mesh::generate;
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Geometry, Hyperbolic, Scheme};
 use ricci::progress::NoProgress;
 
@@ -76,7 +77,12 @@ fn check_against_words(name: &str, sp: &HyperbolicSpectrum, gens: &[Mobius]) {
 fn brute_force_words_agree_with_the_search() {
     // Exact metric: the Bolza surface (regular octagon).
     let s = regular_polygon_surface(Geometry::Hyperbolic, 2, Gluing::Opposite, 3).unwrap();
-    let l = layout::<Hyperbolic>(&s.cut, &s.cut_lengths, None).unwrap();
+    let l = layout::<Hyperbolic>(
+        &s.cut,
+        &IntrinsicMetric::new(ricci::metric::Geometry::Hyperbolic, s.cut_lengths.to_vec()),
+        None,
+    )
+    .unwrap();
     let g = deck_group::<Hyperbolic>(&l, &s.polygon).unwrap();
     let sp = fuchsian_spectrum(&l, &s.polygon, &g, 40, 400_000).unwrap();
     let gens: Vec<Mobius> = g.named_generators().iter().map(|x| x.1).collect();
@@ -90,7 +96,7 @@ fn generated_spectrum(base: Option<u32>, count: usize) -> (HyperbolicSpectrum, V
     let s = generate::genus(2, 40).unwrap();
     let flow = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Geometry::Hyperbolic,
         Scheme::Yamabe,
         1e-11,
@@ -99,8 +105,7 @@ fn generated_spectrum(base: Option<u32>, count: usize) -> (HyperbolicSpectrum, V
     .unwrap();
     let disk = cut_disk(
         &s.mesh,
-        &flow.lengths,
-        Geometry::Hyperbolic,
+        &IntrinsicMetric::new(Geometry::Hyperbolic, flow.lengths.to_vec()),
         None,
         base,
         &mut NoProgress,
@@ -127,7 +132,7 @@ fn spectrum_does_not_depend_on_the_base_vertex() {
     let s = generate::genus(2, 40).unwrap();
     let flow = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Geometry::Hyperbolic,
         Scheme::Yamabe,
         1e-11,
@@ -152,7 +157,12 @@ fn spectrum_does_not_depend_on_the_base_vertex() {
 #[test]
 fn powers_of_primitive_classes_are_listed() {
     let s = regular_polygon_surface(Geometry::Hyperbolic, 2, Gluing::Opposite, 3).unwrap();
-    let l = layout::<Hyperbolic>(&s.cut, &s.cut_lengths, None).unwrap();
+    let l = layout::<Hyperbolic>(
+        &s.cut,
+        &IntrinsicMetric::new(ricci::metric::Geometry::Hyperbolic, s.cut_lengths.to_vec()),
+        None,
+    )
+    .unwrap();
     let g = deck_group::<Hyperbolic>(&l, &s.polygon).unwrap();
     let sp = fuchsian_spectrum(&l, &s.polygon, &g, 120, 2_000_000).unwrap();
     for (name, sp) in [

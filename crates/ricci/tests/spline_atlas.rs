@@ -204,7 +204,7 @@ fn check(s: &Surface, name: &str, stride: usize) {
     // face's neighbourhood, independent of the atlas): the level the recurrence reaches.
     let local = LocalCharts::new(
         atlas.mesh().clone(),
-        atlas.lengths().to_vec(),
+        ricci::metric::IntrinsicMetric::euclidean(atlas.lengths().to_vec()),
         atlas.positions().to_vec(),
         atlas.singular_vertices().to_vec(),
         None,

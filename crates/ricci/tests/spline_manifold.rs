@@ -295,7 +295,7 @@ fn generated_genus2_partition_of_unity_charts_and_providers() {
     let charts = &dom.charts;
     let other = LocalCharts::new(
         charts.mesh().clone(),
-        charts.lengths().to_vec(),
+        ricci::metric::IntrinsicMetric::euclidean(charts.lengths().to_vec()),
         charts.positions().to_vec(),
         charts.singular_vertices().to_vec(),
         Some(77),
@@ -612,7 +612,7 @@ fn atlas_vs_local(s: &Surface, name: &str, stride: usize) {
     assert!(compared > 0);
     let local = LocalCharts::new(
         atlas.mesh().clone(),
-        atlas.lengths().to_vec(),
+        ricci::metric::IntrinsicMetric::euclidean(atlas.lengths().to_vec()),
         atlas.positions().to_vec(),
         atlas.singular_vertices().to_vec(),
         None,

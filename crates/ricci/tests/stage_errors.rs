@@ -10,6 +10,7 @@ use ricci::error::{Error, Kind};
 use ricci::flow::{ricci_flow, FlowError, FlowOptions, TargetSpec};
 use ricci::layout::{layout, LayoutError};
 use ricci::mesh::{generate, Mesh};
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Euclidean, Geometry, MetricError, Scheme};
 use ricci::progress::NoProgress;
 use std::f64::consts::PI;
@@ -129,8 +130,7 @@ fn a_missing_base_vertex_is_named_with_the_vertex_count() {
     };
     let e = canonical_cut(
         &s.mesh,
-        &s.edge_lengths(),
-        Geometry::Euclidean,
+        &IntrinsicMetric::new(Geometry::Euclidean, s.edge_lengths()),
         None,
         &options,
         &mut NoProgress,
@@ -151,7 +151,12 @@ fn layout_errors_name_the_edge_and_the_seed_face() {
     let mesh = square();
     let mut lengths = vec![1.0; mesh.n_edges()];
     lengths[edge(&mesh, 0, 2)] = 2f64.sqrt();
-    let e = layout::<Euclidean>(&mesh, &lengths, Some(7)).unwrap_err();
+    let e = layout::<Euclidean>(
+        &mesh,
+        &IntrinsicMetric::new(ricci::metric::Geometry::Euclidean, lengths.to_vec()),
+        Some(7),
+    )
+    .unwrap_err();
     assert_eq!(
         e.stage_error::<LayoutError>(),
         Some(&LayoutError::SeedFaceMissing {
@@ -161,7 +166,12 @@ fn layout_errors_name_the_edge_and_the_seed_face() {
     );
     let bad = edge(&mesh, 2, 3);
     lengths[bad] = -1.0;
-    let e = layout::<Euclidean>(&mesh, &lengths, None).unwrap_err();
+    let e = layout::<Euclidean>(
+        &mesh,
+        &IntrinsicMetric::new(ricci::metric::Geometry::Euclidean, lengths.to_vec()),
+        None,
+    )
+    .unwrap_err();
     let Some(LayoutError::InvalidLength {
         edge: got,
         vertices,

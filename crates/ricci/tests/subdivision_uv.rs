@@ -16,20 +16,9 @@ use ricci::layout::subdivision_uv::{
     common_subdivision_uvs, sphere_common_subdivision, SubdivisionUv,
 };
 use ricci::mesh::{generate, topology, Mesh, Surface};
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Euclidean, Geometry, Scheme};
 use ricci::progress::NoProgress;
-
-/// Deterministic pseudo-random numbers in [0, 1).
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
@@ -46,50 +35,6 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
-}
-
-/// Split `count` random faces at points close to one of their corners (weights 0.9, 0.05,
-/// 0.05 up to noise): thin triangles, so that the input metric is far from Delaunay.
-fn split_off_centre(s: &Surface, count: usize, rng: &mut Lcg) -> Surface {
-    split_off_centre_at(s, count, rng, 0.9, false)
-}
-
-/// `count` random faces split at a point near one corner (weight `near`); faces at the
-/// boundary too when `boundary`.
-fn split_off_centre_at(
-    s: &Surface,
-    count: usize,
-    rng: &mut Lcg,
-    near: f64,
-    boundary: bool,
-) -> Surface {
-    let mut pos = s.positions.clone();
-    let mut faces = s.mesh.faces().to_vec();
-    for _ in 0..count {
-        let f = ((rng.next() * faces.len() as f64) as usize).min(faces.len() - 1);
-        let [a, b, c] = faces[f];
-        if !boundary
-            && [a, b, c]
-                .iter()
-                .any(|&v| (v as usize) < s.mesh.n_vertices() && s.mesh.is_boundary_vertex(v))
-        {
-            continue;
-        }
-        let w = [
-            near - 0.1 * rng.next(),
-            0.5 * (1.0 - near) * (1.0 + rng.next()),
-            0.0,
-        ];
-        let w = [w[0], w[1], 1.0 - w[0] - w[1]];
-        let (pa, pb, pc) = (pos[a as usize], pos[b as usize], pos[c as usize]);
-        let p = [0, 1, 2].map(|k| w[0] * pa[k] + w[1] * pb[k] + w[2] * pc[k]);
-        let v = pos.len() as u32;
-        pos.push(p);
-        faces[f] = [a, b, v];
-        faces.push([b, c, v]);
-        faces.push([c, a, v]);
-    }
-    Surface::new(pos, faces).unwrap()
 }
 
 fn face_normal(p: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {
@@ -271,7 +216,7 @@ fn flattened_disk_with_thin_triangles_has_a_valid_common_subdivision() {
 /// docs/notes/wave2-s9-half9.md).
 #[test]
 fn flattened_disk_with_split_boundary_faces_has_a_valid_common_subdivision() {
-    let s = bumpy_disk(120, 7, true);
+    let s = generate::bumpy_split_disk(120, 7, 0.75, true).unwrap();
     let (r, h) = through_the_double("split-boundary disk", &s, true);
     assert!(
         r.initial_flips > 20,
@@ -299,7 +244,7 @@ fn flattened_disk_with_split_boundary_faces_has_a_valid_common_subdivision() {
 #[test]
 fn split_boundary_disks_map_through_the_double() {
     for (count, seed, full) in [(120, 7, true), (200, 3, true), (300, 11, false)] {
-        let s = bumpy_disk(count, seed, true);
+        let s = generate::bumpy_split_disk(count, seed, 0.75, true).unwrap();
         through_the_double(&format!("split disk {count}/{seed}"), &s, full);
     }
 }
@@ -447,25 +392,9 @@ fn through_the_double(name: &str, s: &Surface, full: bool) -> (DoubleFlow, HalfM
     (r, h)
 }
 
-/// A bumpy disk with thin triangles: `count` faces split off-centre (seed `seed`), faces at the
-/// boundary too when `boundary`.
-fn bumpy_disk(count: usize, seed: u64, boundary: bool) -> Surface {
-    let d = generate::disk(16).unwrap();
-    let pos: Vec<[f64; 3]> = d
-        .positions
-        .iter()
-        .map(|p| {
-            let (x, y) = (p[0], p[1]);
-            [x, y, 0.5 * (3.0 * x).sin() * (2.0 * y).cos() + 0.7 * x * x]
-        })
-        .collect();
-    let s = Surface::new(pos, d.mesh.faces().to_vec()).unwrap();
-    split_off_centre_at(&s, count, &mut Lcg(seed), 0.75, boundary)
-}
-
 /// A bumpy disk with thin triangles (faces at the boundary split too when `boundary`).
 fn flattened_disk_case(boundary: bool) {
-    let s = bumpy_disk(120, 7, boundary);
+    let s = generate::bumpy_split_disk(120, 7, 0.75, boundary).unwrap();
     let r = conformal(&s, Geometry::Euclidean, TargetSpec::FreeBoundary);
     let it = r.triangulation.as_ref().unwrap();
     assert!(
@@ -473,7 +402,12 @@ fn flattened_disk_case(boundary: bool) {
         "only {} isometric flips",
         it.initial_flips
     );
-    let l = layout::<Euclidean>(&it.simplicial.mesh, &r.lengths, None).unwrap();
+    let l = layout::<Euclidean>(
+        &it.simplicial.mesh,
+        &IntrinsicMetric::new(ricci::metric::Geometry::Euclidean, r.lengths.to_vec()),
+        None,
+    )
+    .unwrap();
     let origin: Vec<u32> = (0..it.simplicial.mesh.n_vertices() as u32).collect();
     let sub = common_subdivision_uvs::<Euclidean>(
         &s.mesh,
@@ -511,7 +445,7 @@ fn bumpy_sphere_with_thin_triangles_has_a_valid_common_subdivision() {
         })
         .collect();
     let s = Surface::new(x, ico.mesh.faces().to_vec()).unwrap();
-    let s = split_off_centre(&s, 300, &mut Lcg(11));
+    let s = generate::split_off_centre(&s, 300, 11, 0.9, false).unwrap();
     let r = conformal(&s, Geometry::Spherical, TargetSpec::Uniform);
     let it = r.triangulation.as_ref().unwrap();
     assert!(
@@ -571,7 +505,8 @@ fn beetle_common_subdivision_has_no_flipped_triangle() {
     let it = r.triangulation.as_ref().unwrap();
     assert!(it.initial_flips > 0);
     // As `ricci layout` does: the metric polished to double-double, cut, laid out.
-    let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &r).unwrap();
+    let p =
+        polish_uniformization(&s.mesh, &IntrinsicMetric::euclidean(s.edge_lengths()), &r).unwrap();
     let d = cut_disk_polished(&it.simplicial.mesh, &p.metric, None, None, &mut NoProgress).unwrap();
     let l = layout_dd::<Hyperbolic>(&d.mesh, &d.metric, None).unwrap();
     let g = deck_group::<Hyperbolic>(&l, &d.polygon).unwrap();
@@ -654,7 +589,8 @@ fn far_out_hyperbolic_layout_keeps_every_piece_positively_oriented() {
     let r = ricci_flow(&s.mesh, &s.edge_lengths(), &o, &mut NoProgress).unwrap();
     assert!(r.converged, "{:?}", r.notes);
     let it = r.triangulation.as_ref().unwrap();
-    let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &r).unwrap();
+    let p =
+        polish_uniformization(&s.mesh, &IntrinsicMetric::euclidean(s.edge_lengths()), &r).unwrap();
     let d = cut_disk_polished(&it.simplicial.mesh, &p.metric, None, None, &mut NoProgress).unwrap();
     let l = layout_dd::<Hyperbolic>(&d.mesh, &d.metric, None).unwrap();
     let (g, frames) = deck_group_ext::<Hyperbolic>(&l, &d.polygon).unwrap();
@@ -805,8 +741,7 @@ fn bunny_free_boundary_common_subdivision_has_no_flipped_triangle() {
     let it = r.triangulation.as_ref().unwrap();
     let d = cut_disk(
         &it.simplicial.mesh,
-        &r.lengths,
-        Geometry::Euclidean,
+        &IntrinsicMetric::new(Geometry::Euclidean, r.lengths.to_vec()),
         None,
         None,
         &mut NoProgress,
@@ -865,8 +800,7 @@ fn camel_common_subdivision_has_no_flipped_piece() {
     let it = r.triangulation.as_ref().unwrap();
     let d = cut_disk(
         &it.simplicial.mesh,
-        &r.lengths,
-        g,
+        &IntrinsicMetric::new(g, r.lengths.to_vec()),
         None,
         None,
         &mut NoProgress,

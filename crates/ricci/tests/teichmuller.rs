@@ -22,6 +22,7 @@ use ricci::layout::{deck_group, layout_dd};
 use ricci::mesh::generate::{genus, midpoint_subdivision, random_face_splits};
 use ricci::mesh::io::read_surface;
 use ricci::mesh::Surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::metric::{Geometry, Hyperbolic, Scheme};
 use ricci::progress::NoProgress;
 
@@ -30,7 +31,7 @@ use ricci::progress::NoProgress;
 fn marked_group(s: &Surface, base: Option<u32>) -> (MarkedGroup, Vec<f64>, f64) {
     let f = uniformization_metric(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Geometry::Hyperbolic,
         Scheme::Conformal,
         1e-12,
@@ -39,7 +40,8 @@ fn marked_group(s: &Surface, base: Option<u32>) -> (MarkedGroup, Vec<f64>, f64) 
     .unwrap();
     assert!(f.converged);
     let work = &f.triangulation.as_ref().unwrap().simplicial.mesh;
-    let p = polish_uniformization(&s.mesh, &s.edge_lengths(), &f).unwrap();
+    let p =
+        polish_uniformization(&s.mesh, &IntrinsicMetric::euclidean(s.edge_lengths()), &f).unwrap();
     let d = cut_disk_polished(work, &p.metric, None, base, &mut NoProgress).unwrap();
     let l = layout_dd::<Hyperbolic>(&d.mesh, &d.metric, None).unwrap();
     assert!(l.flipped_faces.is_empty());
@@ -227,7 +229,13 @@ fn coords(s: &Surface, base: Option<u32>) -> TeichmullerCoordinates {
         base,
         ..Default::default()
     };
-    let r = surface_teichmuller(&s.mesh, &s.edge_lengths(), &opts, &mut NoProgress).unwrap();
+    let r = surface_teichmuller(
+        &s.mesh,
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
+        &opts,
+        &mut NoProgress,
+    )
+    .unwrap();
     assert_eq!(r.flipped_faces, 0);
     assert!(r.deck_relation_error < 1e-20, "{}", r.deck_relation_error);
     eprintln!(

@@ -10,13 +10,14 @@ mod ricci_meshes;
 
 use ricci::analysis::forms::{holomorphic_forms, FormsOptions, HolomorphicForms};
 use ricci::mesh::Surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::progress::NoProgress;
 use ricci::spline::tspline::cylinders::{cylinders, integral_form, CylinderDecomposition};
 
 fn forms(s: &Surface) -> HolomorphicForms {
     holomorphic_forms(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Some(&s.positions),
         &FormsOptions::default(),
         &mut NoProgress,

@@ -10,6 +10,7 @@ mod ricci_meshes;
 
 use ricci::analysis::forms::{holomorphic_forms, FormsOptions, HolomorphicForms};
 use ricci::mesh::Surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::progress::NoProgress;
 use ricci::spline::tspline::cylinder_fit::{fit_cylinders, GenusFitOptions};
 use ricci::spline::tspline::genus_domain::{best_genus_domain, GenusDomain};
@@ -17,7 +18,7 @@ use ricci::spline::tspline::genus_domain::{best_genus_domain, GenusDomain};
 fn forms(s: &Surface) -> HolomorphicForms {
     holomorphic_forms(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Some(&s.positions),
         &FormsOptions::default(),
         &mut NoProgress,

@@ -17,7 +17,7 @@ use crate::util::{print_json, write_atomic, UsageError};
 use indicatif::{ProgressBar, ProgressStyle};
 use ricci::cut::{canonical_cut, CanonicalCut, CutOptions};
 use ricci::mesh::Surface;
-use ricci::metric::Geometry;
+use ricci::metric::{Geometry, IntrinsicMetric};
 use ricci_render::loops::{loops_svg, SurfaceLoop};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
@@ -153,8 +153,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     let c = canonical_cut(
         &s.mesh,
-        &lengths,
-        geometry,
+        &IntrinsicMetric::new(geometry, lengths),
         Some(&s.positions),
         &opts,
         &mut progress,

@@ -26,6 +26,7 @@ use ricci::analysis::forms::{
 use ricci::cut::CutOptions;
 use ricci::layout::export::obj_with_corner_uv;
 use ricci::layout::isometry::Complex;
+use ricci::metric::IntrinsicMetric;
 use ricci_render::render::Uvs;
 use ricci_render::{Checker, Paint, Polyline, RenderOptions, Style};
 use serde_json::json;
@@ -96,7 +97,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     let h = holomorphic_forms(
         &surface.mesh,
-        &surface.edge_lengths(),
+        &IntrinsicMetric::euclidean(surface.edge_lengths()),
         Some(&surface.positions),
         &opts,
         &mut bar,
@@ -226,7 +227,7 @@ pub fn critical_lines(
         return Vec::new();
     };
     let at: Vec<u32> = zeros.zeros.iter().map(|z| z.vertex).collect();
-    critical_trajectories(h.mesh(), h.lengths(), form, &at, 1.5 * scale, 200_000)
+    critical_trajectories(h.mesh(), &h.metric(), form, &at, 1.5 * scale, 200_000)
         .iter()
         .map(|t| t.points.iter().map(|p| p.position(pos)).collect())
         .collect()

@@ -195,7 +195,11 @@ pub fn polished_metric(
     }
     progress.report("polish", None, "polishing the metric to double-double");
     let res = match (&flow, &out.mesh) {
-        (Some(f), _) => polish_uniformization(&surface.mesh, &surface.edge_lengths(), f),
+        (Some(f), _) => polish_uniformization(
+            &surface.mesh,
+            &IntrinsicMetric::euclidean(surface.edge_lengths()),
+            f,
+        ),
         (None, own) => polish_lengths(own.as_ref().unwrap_or(&surface.mesh), &out.metric),
     };
     match res {
@@ -553,7 +557,7 @@ fn sphere_layout(
     a: &Args,
     surface: &Surface,
     work: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     flow: Option<&FlowResult>,
     out: &mut Value,
 ) -> anyhow::Result<()> {
@@ -566,7 +570,7 @@ fn sphere_layout(
             .map(|t| (t, &f.u))
     });
     let Some((t, u)) = conformal else {
-        return sphere_from_lengths(a, work, lengths, out);
+        return sphere_from_lengths(a, work, metric, out);
     };
     let tri = &t.triangulation;
     let points = &t.points;
@@ -668,10 +672,10 @@ fn sphere_layout(
 fn sphere_from_lengths(
     a: &Args,
     work: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     out: &mut Value,
 ) -> anyhow::Result<()> {
-    let l = layout::<Spherical>(work, lengths, a.seed_face)?;
+    let l = layout::<Spherical>(work, metric, a.seed_face)?;
     out["flipped_faces"] = json!(l.flipped_faces.len());
     out["degenerate_faces"] = json!(l.degenerate_faces.len());
     out["seed_face"] = json!(l.seed_face);
@@ -796,7 +800,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 }
                 d
             } else {
-                cut_disk(work, &metric, geometry, work_positions, a.base, &mut bar)?
+                cut_disk(work, &metric, work_positions, a.base, &mut bar)?
             };
             out["boundary_word"] = json!(d.polygon.word());
             out["base_vertex"] = json!(d.cut.base);

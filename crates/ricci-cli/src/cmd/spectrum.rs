@@ -107,7 +107,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let geometry = metric.geometry();
     let (abs, extra, word) = if geometry == Geometry::Euclidean {
         bar.0.set_message("cutting along canonical loops");
-        let disk = cut_disk(work, &metric, geometry, None, a.base, &mut bar)?;
+        let disk = cut_disk(work, &metric, None, a.base, &mut bar)?;
         bar.0.set_message("layout, deck group and spectrum");
         let l = layout::<Euclidean>(&disk.mesh, &disk.metric, None)?;
         let g = deck_group::<Euclidean>(&l, &disk.polygon)?;

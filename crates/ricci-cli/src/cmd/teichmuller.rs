@@ -12,6 +12,7 @@ use crate::util::{print_json, read_surface, Reporter, UsageError};
 use ricci::analysis::teichmuller::{
     coordinate_distance, surface_teichmuller, SurfaceTeichmuller, TeichmullerOptions,
 };
+use ricci::metric::IntrinsicMetric;
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -45,8 +46,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             base: a.base,
             ..Default::default()
         };
-        let r = surface_teichmuller(&surface.mesh, &surface.edge_lengths(), &opts, &mut rep)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let r = surface_teichmuller(
+            &surface.mesh,
+            &IntrinsicMetric::euclidean(surface.edge_lengths()),
+            &opts,
+            &mut rep,
+        )
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
         if r.coordinates.misplaced_seams > 0 {
             eprintln!(
                 "ricci teichmuller: {}: {} seam(s) were not on the expected side of their curve; \

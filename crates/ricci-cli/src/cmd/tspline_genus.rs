@@ -14,6 +14,7 @@ use crate::cmd::tspline::Args;
 use crate::util::{print_json, write_atomic};
 use ricci::analysis::forms::{holomorphic_forms, FormsOptions};
 use ricci::mesh::Surface;
+use ricci::metric::IntrinsicMetric;
 use ricci::spline::tspline::cylinder_fit::{fit_cylinders, GenusFit, GenusFitOptions};
 use ricci::spline::tspline::cylinder_jumps::{GluedSeams, Seam};
 use ricci::spline::tspline::export::{iges, obj, step};
@@ -104,7 +105,7 @@ pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> an
     bar.0.set_message("holomorphic 1-forms");
     let h = holomorphic_forms(
         &surface.mesh,
-        &surface.edge_lengths(),
+        &IntrinsicMetric::euclidean(surface.edge_lengths()),
         Some(&surface.positions),
         &FormsOptions::default(),
         &mut bar,

@@ -83,6 +83,7 @@ use crate::error::{Error, Result};
 use crate::layout::dd::MobiusDd;
 use crate::layout::deck::{DeckGroup, Polygon};
 use crate::layout::isometry::{Complex, Mobius};
+use crate::metric::IntrinsicMetric;
 use crate::numeric::dd::Cdd;
 
 /// A word in the canonical generators: `(letter, inverse)` with letter `2(k−1)` for `a_k` and
@@ -714,7 +715,7 @@ pub struct SurfaceTeichmuller {
 /// in the canonical handle order ([`MarkedGroup::with_canonical_handle_order`]). A flow that did not converge is an error.
 pub fn surface_teichmuller(
     mesh: &crate::mesh::Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     opts: &TeichmullerOptions,
     progress: &mut dyn crate::progress::Progress,
 ) -> Result<SurfaceTeichmuller> {
@@ -739,7 +740,7 @@ pub fn surface_teichmuller(
     }
     let flow = uniformization_metric(
         mesh,
-        lengths,
+        metric,
         Geometry::Hyperbolic,
         Scheme::Conformal,
         opts.tolerance,
@@ -752,7 +753,7 @@ pub fn surface_teichmuller(
             flow.max_curvature_error, flow.iterations
         )));
     }
-    let polished = polish_uniformization(mesh, lengths, &flow)?;
+    let polished = polish_uniformization(mesh, metric, &flow)?;
     let work = flow
         .triangulation
         .as_ref()

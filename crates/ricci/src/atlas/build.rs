@@ -15,7 +15,7 @@ use crate::flow::{FlowError, FlowResult, TargetSpec};
 use crate::layout::place::layout;
 use crate::mesh::{topology, Mesh, Surface, NONE};
 use crate::metric::refine::{Refined, Refiner};
-use crate::metric::{Euclidean, Geometry, Scheme};
+use crate::metric::{Euclidean, Geometry, IntrinsicMetric, Scheme};
 use crate::progress::Progress;
 use std::collections::HashSet;
 use std::f64::consts::PI;
@@ -60,7 +60,7 @@ impl AffineAtlas {
         let t0 = Instant::now();
         let mesh = &surface.mesh;
         let (genus, nb) = connected_topology(mesh)?;
-        let lengths0 = surface.edge_lengths();
+        let lengths0 = IntrinsicMetric::euclidean(surface.edge_lengths());
         // Step 1: the cones.
         let Cones {
             cones,
@@ -77,7 +77,7 @@ impl AffineAtlas {
             notes,
         } = flat_metric(
             &rmesh,
-            &conn.refined.lengths,
+            &IntrinsicMetric::euclidean(conn.refined.lengths.clone()),
             &cones,
             target_name,
             options,
@@ -183,7 +183,7 @@ fn connected_topology(mesh: &Mesh) -> Result<(i64, usize)> {
 /// automatically, [`placement`]).
 fn choose_cones(
     surface: &Surface,
-    lengths0: &[f64],
+    lengths0: &IntrinsicMetric,
     genus: i64,
     nb: usize,
     options: &AtlasOptions,
@@ -319,8 +319,7 @@ fn modify_connectivity(
     progress.report("cut", Some(0.0), "canonical cut");
     let cut = canonical_cut(
         &step2.mesh,
-        &step2.lengths,
-        Geometry::Euclidean,
+        &IntrinsicMetric::euclidean(step2.lengths.clone()),
         step2.positions.as_deref(),
         &CutOptions {
             base: cones.first().map(|c| c.0),
@@ -391,7 +390,7 @@ fn modify_connectivity(
 /// retried with inversive distance.
 fn flat_metric(
     rmesh: &Mesh,
-    input: &[f64],
+    input: &IntrinsicMetric,
     cones: &[(u32, f64)],
     target_name: &str,
     options: &AtlasOptions,
@@ -497,7 +496,7 @@ fn central_chart(
         }
     }
     progress.report("layout", Some(0.0), "central chart");
-    let central = layout::<Euclidean>(&disk, &dl, None)?;
+    let central = layout::<Euclidean>(&disk, &IntrinsicMetric::euclidean(dl), None)?;
     Ok((0..rmesh.n_faces() as u32)
         .map(|f| {
             let v = disk.face(f);

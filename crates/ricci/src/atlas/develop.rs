@@ -33,7 +33,7 @@ pub struct Development {
 /// Develop the faces with `in_region[f]` true, starting from `seed` (which must be in the
 /// region), with the flat metric `lengths` (by edge id). `tol` is the absolute tolerance of
 /// the closure checks.
-pub fn develop(
+pub(crate) fn develop(
     mesh: &Mesh,
     lengths: &[f64],
     in_region: &[bool],
@@ -118,7 +118,7 @@ pub fn develop(
 }
 
 /// Largest |(side in the coordinates) − (metric length)| of face `f`.
-pub fn face_length_error(mesh: &Mesh, lengths: &[f64], f: u32, c: &[[f64; 2]; 3]) -> f64 {
+pub(crate) fn face_length_error(mesh: &Mesh, lengths: &[f64], f: u32, c: &[[f64; 2]; 3]) -> f64 {
     let hs = mesh.face_halfedges(f);
     let mut err: f64 = 0.0;
     for i in 0..3 {

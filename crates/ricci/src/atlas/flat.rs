@@ -6,7 +6,7 @@
 use crate::error::Result;
 use crate::flow::{flow_with_fallback, FallbackFlow, TargetSpec, UniformizationOptions};
 use crate::mesh::Mesh;
-use crate::metric::Scheme;
+use crate::metric::{Geometry, IntrinsicMetric, Scheme};
 use crate::progress::NoProgress;
 
 /// The flat metric of `target` by Newton's method (tolerance `tolerance`, at most 400
@@ -15,21 +15,13 @@ use crate::progress::NoProgress;
 /// Returns the result, the scheme used and notes.
 pub fn flat_flow(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     target: TargetSpec,
     scheme: Scheme,
     tolerance: f64,
 ) -> Result<(crate::flow::FlowResult, Scheme, Vec<String>)> {
     let mut unlimited = usize::MAX;
-    let f = flat_flow_limited(
-        mesh,
-        lengths,
-        target,
-        scheme,
-        tolerance,
-        400,
-        &mut unlimited,
-    )?;
+    let f = flat_flow_limited(mesh, metric, target, scheme, tolerance, 400, &mut unlimited)?;
     Ok((f.result, f.scheme, f.notes))
 }
 
@@ -43,13 +35,14 @@ pub type FlatFlow = FallbackFlow;
 /// ([`placement::PlacementOptions`]).
 pub fn flat_flow_limited(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     target: TargetSpec,
     scheme: Scheme,
     tolerance: f64,
     max_iterations: usize,
     budget: &mut usize,
 ) -> Result<FlatFlow> {
+    metric.require(Geometry::Euclidean, "the flat flow of the atlas")?;
     let opts = UniformizationOptions::flat(target, scheme, tolerance, max_iterations);
-    flow_with_fallback(mesh, lengths, &opts, Some(budget), &mut NoProgress)
+    flow_with_fallback(mesh, metric, &opts, Some(budget), &mut NoProgress)
 }

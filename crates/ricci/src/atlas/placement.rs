@@ -35,6 +35,7 @@ use crate::error::{Error, Result};
 use crate::flow::TargetSpec;
 use crate::mesh::{Mesh, Surface};
 use crate::metric::refine::Refiner;
+use crate::metric::IntrinsicMetric;
 use crate::metric::Scheme;
 use crate::metric::{
     euler_characteristic, ConformalStructure, Evaluator, Geometry, HessianPattern,
@@ -134,10 +135,11 @@ pub struct RejectedCandidate {
 /// and the method used ("exact" or "sampled"; unevaluated vertices get `INFINITY` too).
 pub fn estimate(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     scheme: Scheme,
     options: &PlacementOptions,
 ) -> Result<(Vec<f64>, &'static str)> {
+    let lengths = metric.lengths();
     let nv = mesh.n_vertices();
     let nf = mesh.n_faces();
     let chi = euler_characteristic(mesh);
@@ -381,11 +383,12 @@ fn within_hops(mesh: &Mesh, v: u32, hops: usize) -> Vec<u32> {
 /// bounded by `m Θ / n` wherever the input mesh is too coarse.
 pub fn candidate_mesh(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     v: u32,
     kappa: f64,
     graded: bool,
 ) -> Result<crate::metric::refine::Refined> {
+    let lengths = metric.lengths();
     let need = (4.0 - 2.0 * kappa / PI - 1e-9).ceil().max(3.0) as usize;
     let mut r = Refiner::new(mesh, lengths, Geometry::Euclidean, None)?;
     r.raise_valence(v, need)?;
@@ -431,7 +434,7 @@ pub struct CandidateFailure {
 #[allow(clippy::too_many_arguments)]
 pub fn confirm_candidate(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     v: u32,
     scheme: Scheme,
     tolerance: f64,
@@ -449,7 +452,7 @@ pub fn confirm_candidate(
             break;
         }
         let what = if graded { "graded mesh" } else { "mesh" };
-        let refined = match candidate_mesh(mesh, lengths, v, kappa, graded) {
+        let refined = match candidate_mesh(mesh, metric, v, kappa, graded) {
             Ok(r) => r,
             Err(e) => {
                 reasons.push(format!("{what}: {e}"));
@@ -459,7 +462,7 @@ pub fn confirm_candidate(
         let limit = max_iterations.min(*budget).max(1);
         let run = super::flat_flow_limited(
             &refined.mesh,
-            &refined.lengths,
+            &IntrinsicMetric::euclidean(refined.lengths.clone()),
             TargetSpec::Cones(vec![(v, kappa)]),
             scheme,
             tolerance,
@@ -506,7 +509,7 @@ pub fn confirm_candidate(
 /// `tolerance`.
 pub fn measured_distortion(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     v: u32,
     scheme: Scheme,
     tolerance: f64,
@@ -514,7 +517,7 @@ pub fn measured_distortion(
     let mut budget = usize::MAX;
     confirm_candidate(
         mesh,
-        lengths,
+        metric,
         v,
         scheme,
         tolerance,
@@ -542,13 +545,13 @@ pub fn measured_distortion(
 /// time spent.
 pub fn place(
     surface: &Surface,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     options: &AtlasOptions,
     progress: &mut dyn Progress,
 ) -> Result<Placement> {
     let t0 = Instant::now();
     let mesh = &surface.mesh;
-    let (est, method) = estimate(mesh, lengths, options.scheme, &options.placement)?;
+    let (est, method) = estimate(mesh, metric, options.scheme, &options.placement)?;
     let estimate_seconds = t0.elapsed().as_secs_f64();
     let mut order: Vec<u32> = (0..mesh.n_vertices() as u32)
         .filter(|&v| est[v as usize].is_finite())
@@ -591,7 +594,7 @@ pub fn place(
         let tc = Instant::now();
         match confirm_candidate(
             mesh,
-            lengths,
+            metric,
             v,
             options.scheme,
             1e-9,
@@ -726,7 +729,7 @@ fn no_candidate_error(
 /// (`None` where the flow did not converge). Slow: one full flow per candidate.
 pub fn brute_force(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     candidates: &[u32],
     scheme: Scheme,
     progress: &mut dyn Progress,
@@ -741,7 +744,7 @@ pub fn brute_force(
                 Some(i as f64 / n as f64),
                 &format!("vertex {v}"),
             );
-            (v, measured_distortion(mesh, lengths, v, scheme, 1e-9).ok())
+            (v, measured_distortion(mesh, metric, v, scheme, 1e-9).ok())
         })
         .collect()
 }

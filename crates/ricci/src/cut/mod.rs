@@ -54,7 +54,7 @@ pub(crate) mod system;
 use crate::error::{Error, Result};
 use crate::mesh::{topology, Mesh, NONE};
 use crate::metric::refine::{Refined, Refiner};
-use crate::metric::Geometry;
+use crate::metric::{Geometry, IntrinsicMetric};
 use crate::progress::Progress;
 use assemble::assemble;
 use serde::Serialize;
@@ -225,16 +225,16 @@ pub struct CanonicalCut {
 }
 
 /// Compute a canonical system of loops through a base vertex and slice the mesh along it into
-/// a disk (see the module docs). `lengths` is the metric (edge lengths by edge id, in
-/// `geometry`); `positions` are optional and only interpolated for new vertices.
+/// a disk (see the module docs). `metric` gives the edge lengths by edge id and their
+/// geometry; `positions` are optional and only interpolated for new vertices.
 pub fn canonical_cut(
     mesh: &Mesh,
-    lengths: &[f64],
-    geometry: Geometry,
+    metric: &IntrinsicMetric,
     positions: Option<&[[f64; 3]]>,
     options: &CutOptions,
     progress: &mut dyn Progress,
 ) -> Result<CanonicalCut> {
+    let (lengths, geometry) = (metric.lengths(), metric.geometry());
     let t0 = std::time::Instant::now();
     let surface = Surface {
         mesh,
@@ -746,7 +746,7 @@ pub(crate) fn distances(mesh: &Mesh, lengths: &[f64], sources: &[u32]) -> Vec<f6
 
 /// A central interior vertex: with `v₁` farthest from an arbitrary vertex and `v₂` farthest
 /// from `v₁` (double sweep), the interior vertex minimizing `max(d(v₁, ·), d(v₂, ·))`.
-pub fn central_vertex(mesh: &Mesh, lengths: &[f64]) -> Result<u32> {
+pub(crate) fn central_vertex(mesh: &Mesh, lengths: &[f64]) -> Result<u32> {
     let start = (0..mesh.n_vertices() as u32)
         .find(|&v| !mesh.is_isolated(v))
         .ok_or_else(|| Error::topology("the mesh has no faces"))?;

@@ -35,14 +35,15 @@ pub use crate::flow::uniformize::uniformization_geometry;
 /// E², `geodesic-boundary` for other bordered surfaces in H² ([`crate::flow::uniformize`]).
 pub fn uniformization_metric(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     geometry: Geometry,
     scheme: Scheme,
     tolerance: f64,
     progress: &mut dyn Progress,
 ) -> Result<FlowResult> {
+    metric.require(Geometry::Euclidean, "the uniformization flow")?;
     let opts = UniformizationOptions::single(Some(geometry), scheme, tolerance);
-    Ok(flow_with_fallback(mesh, lengths, &opts, None, progress)?.result)
+    Ok(flow_with_fallback(mesh, metric, &opts, None, progress)?.result)
 }
 
 /// A surface cut open into a disk, with the metric on the cut mesh.
@@ -63,12 +64,11 @@ pub struct CutDisk {
     pub cut: CanonicalCut,
 }
 
-/// Cut a surface with metric `lengths` (in `geometry`) along a canonical system of loops
+/// Cut a surface with `metric` along a canonical system of loops
 /// through `base` (or an automatic base vertex) and carry the metric to the cut mesh.
 pub fn cut_disk(
     mesh: &Mesh,
-    lengths: &[f64],
-    geometry: Geometry,
+    metric: &IntrinsicMetric,
     positions: Option<&[[f64; 3]]>,
     base: Option<u32>,
     progress: &mut dyn Progress,
@@ -80,11 +80,11 @@ pub fn cut_disk(
         construction: Construction::GreedyThenCutAndPaste,
         ..CutOptions::default()
     };
-    let cut = canonical_cut(mesh, lengths, geometry, positions, &opts, progress)?;
+    let cut = canonical_cut(mesh, metric, positions, &opts, progress)?;
     let refined = &cut.refined;
     let cm = cut.cut_mesh.clone();
-    let metric =
-        IntrinsicMetric::new(geometry, refined.lengths.clone()).carried_to(&refined.mesh, &cm);
+    let metric = IntrinsicMetric::new(metric.geometry(), refined.lengths.clone())
+        .carried_to(&refined.mesh, &cm);
     let polygon = Polygon::from_labelled(
         cut.polygon
             .iter()
@@ -130,9 +130,10 @@ impl From<&PolishedMetric> for PolishReport {
 /// (uniform / geodesic boundary), a flow that did not converge.
 pub fn polish_uniformization(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     flow: &FlowResult,
 ) -> Result<PolishedMetric> {
+    metric.require(Geometry::Euclidean, "the polish of a uniformization flow")?;
     if flow.geometry != Geometry::Hyperbolic {
         return Err(Error::input(format!(
             "only hyperbolic metrics are polished, this one is {}",
@@ -158,7 +159,7 @@ pub fn polish_uniformization(
         return polish_lengths(m, &flow.metric());
     }
     let structure =
-        ConformalStructure::new(mesh, lengths, flow.geometry, flow.scheme, flow.input_scale)?;
+        ConformalStructure::new(mesh, metric, flow.geometry, flow.scheme, flow.input_scale)?;
     polish_metric(
         mesh,
         &structure,
@@ -243,14 +244,7 @@ pub fn cut_disk_polished(
             mesh.n_edges()
         )));
     }
-    let mut disk = cut_disk(
-        mesh,
-        metric,
-        Geometry::Hyperbolic,
-        positions,
-        base,
-        progress,
-    )?;
+    let mut disk = cut_disk(mesh, metric, positions, base, progress)?;
     let refined = &disk.cut.refined;
     let rm = &refined.mesh;
     let nv0 = refined.original_vertices as u32;

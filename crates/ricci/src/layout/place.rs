@@ -330,7 +330,7 @@ pub struct Layout<P> {
 
 /// Check that a metric fits the mesh: one finite positive length per edge (below π on the
 /// sphere).
-pub fn check_lengths(mesh: &Mesh, lengths: &[f64], geometry: Geometry) -> Result<()> {
+pub(crate) fn check_lengths(mesh: &Mesh, lengths: &[f64], geometry: Geometry) -> Result<()> {
     if lengths.len() != mesh.n_edges() {
         return Err(Error::input(format!(
             "the metric has {} edge lengths but the mesh has {} edges",
@@ -409,26 +409,38 @@ pub fn central_face(mesh: &Mesh) -> u32 {
 }
 
 /// Lay out a simply connected mesh (a disk, e.g. a cut mesh, or a closed genus-0 surface on
-/// the sphere) with edge lengths `lengths` (by edge id) in the model space `S`.
+/// the sphere) with the edge lengths of `metric` (leading parts; a metric of `S`'s geometry)
+/// in the model space `S`.
 ///
-/// Errors: wrong number of lengths or invalid values (naming the edge), a mesh that is not
-/// connected and simply connected (naming its topology), an out-of-range seed face.
+/// Errors: wrong number of lengths or invalid values (naming the edge), a metric of another
+/// geometry, a mesh that is not connected and simply connected (naming its topology), an
+/// out-of-range seed face.
 pub fn layout<S: Space>(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     seed_face: Option<u32>,
 ) -> Result<Layout<S::Point>> {
-    layout_parts::<S>(mesh, lengths, None, seed_face)
+    layout_parts::<S>(mesh, metric, false, seed_face)
 }
 
 /// [`layout`] for an [`IntrinsicMetric`] of `S`'s geometry; its low parts, where present
 /// (e.g. [`super::pipeline::cut_disk_polished`]), enter the canonical triangles in the working
 /// precision of the space ([`Space::seed_ext`]: double-double in H²; E² and S² ignore them).
 ///
-/// Errors: as [`layout`], a metric of another geometry, low parts that are not finite.
+/// Errors: as [`layout`], low parts that are not finite.
 pub fn layout_dd<S: Space>(
     mesh: &Mesh,
     metric: &IntrinsicMetric,
+    seed_face: Option<u32>,
+) -> Result<Layout<S::Point>> {
+    layout_parts::<S>(mesh, metric, true, seed_face)
+}
+
+/// [`layout`] (`with_low_parts` false) or [`layout_dd`] (true).
+fn layout_parts<S: Space>(
+    mesh: &Mesh,
+    metric: &IntrinsicMetric,
+    with_low_parts: bool,
     seed_face: Option<u32>,
 ) -> Result<Layout<S::Point>> {
     if metric.geometry() != S::KIND {
@@ -438,16 +450,10 @@ pub fn layout_dd<S: Space>(
             S::KIND.name()
         )));
     }
-    layout_parts::<S>(mesh, metric, metric.lengths_lo(), seed_face)
-}
-
-/// [`layout`] with optional low parts (one per edge, as an [`IntrinsicMetric`] guarantees).
-fn layout_parts<S: Space>(
-    mesh: &Mesh,
-    lengths: &[f64],
-    lengths_lo: Option<&[f64]>,
-    seed_face: Option<u32>,
-) -> Result<Layout<S::Point>> {
+    let (lengths, lengths_lo) = (
+        metric.lengths(),
+        metric.lengths_lo().filter(|_| with_low_parts),
+    );
     check_lengths(mesh, lengths, S::KIND)?;
     if let Some(lo) = lengths_lo {
         if let Some(e) = lo.iter().position(|x| !x.is_finite()) {

@@ -38,6 +38,12 @@ impl IntrinsicMetric {
         }
     }
 
+    /// A Euclidean metric given in double precision (the input of the flows: edge lengths of
+    /// a mesh in R³, [`crate::mesh::Surface::edge_lengths`]).
+    pub fn euclidean(lengths: Vec<f64>) -> IntrinsicMetric {
+        IntrinsicMetric::new(Geometry::Euclidean, lengths)
+    }
+
     /// A metric given to double-double precision: edge `e` has length
     /// `lengths[e] + lengths_lo[e]`. Errors when there is not one low part per length.
     pub fn with_low_parts(
@@ -62,6 +68,19 @@ impl IntrinsicMetric {
     /// The background geometry.
     pub fn geometry(&self) -> Geometry {
         self.geometry
+    }
+
+    /// Errors unless the metric is of `geometry`; `consumer` names what needs it ("the
+    /// uniformization flow").
+    pub fn require(&self, geometry: Geometry, consumer: &str) -> Result<()> {
+        if self.geometry == geometry {
+            return Ok(());
+        }
+        Err(Error::input(format!(
+            "{consumer} takes a {} metric, this one is {}",
+            geometry.name(),
+            self.geometry.name()
+        )))
     }
 
     /// The lengths (leading parts), by edge id.

@@ -33,7 +33,7 @@ pub mod intrinsic;
 pub mod kernel;
 pub(crate) mod lengths;
 pub mod refine;
-pub mod scheme;
+pub(crate) mod scheme;
 
 pub use conformal::ConformalStructure;
 pub use error::MetricError;

@@ -124,30 +124,3 @@ impl Law for VertexScaling {
         (l, d, d)
     }
 }
-
-/// Euclidean edge length with its first and second derivatives in the variables of its end
-/// vertices: `(l, [∂l/∂u_a, ∂l/∂u_b], [∂²l/∂u_a², ∂²l/∂u_a∂u_b, ∂²l/∂u_b²])`. Circle packing
-/// (`γ = e^u`, `l² = γa² + γb² + 2γaγbη`): `∂l/∂u_a = γa(γa + γbη)/l`,
-/// `∂²l/∂u_a² = (2γa² + γaγbη − (∂l/∂u_a)²)/l`, `∂²l/∂u_a∂u_b = (γaγbη − ∂l/∂u_a ∂l/∂u_b)/l`;
-/// vertex scaling (`l = 2η e^{(u_a+u_b)/2}`): first derivatives `l/2`, second `l/4`.
-/// Used by round boundaries, whose target depends on the boundary length.
-pub fn euclidean_length_hessian(
-    scheme: Scheme,
-    eta: f64,
-    ua: f64,
-    ub: f64,
-) -> (f64, [f64; 2], [f64; 3]) {
-    if scheme.is_circle_packing() {
-        let (ga, gb) = (ua.exp(), ub.exp());
-        let l = super::geometry::Euclidean::circle_packing_length(ga, gb, eta);
-        let la = ga * (ga + gb * eta) / l;
-        let lb = gb * (gb + ga * eta) / l;
-        let laa = (2.0 * ga * ga + ga * gb * eta - la * la) / l;
-        let lab = (ga * gb * eta - la * lb) / l;
-        let lbb = (2.0 * gb * gb + ga * gb * eta - lb * lb) / l;
-        (l, [la, lb], [laa, lab, lbb])
-    } else {
-        let l = 2.0 * eta * (0.5 * (ua + ub)).exp();
-        (l, [0.5 * l, 0.5 * l], [0.25 * l, 0.25 * l, 0.25 * l])
-    }
-}

@@ -6,18 +6,16 @@
 //! * [`sparse`] — sparse symmetric positive-definite (and indefinite) solves with faer: a
 //!   symbolic factorization reused across numeric refactorizations, LU with a reused symbolic
 //!   analysis, one-shot Cholesky; each leaves the vector registers clean ([`simd`]).
-//! * [`dense`] — dense products with faer, likewise followed by `vzeroupper`.
-//! * [`simd`] — `vzeroupper` after faer's AVX kernels (called inside [`sparse`] and [`dense`]).
+//! * [`simd`] — `vzeroupper` after faer's AVX kernels (called inside [`sparse`] and after the dense products of the callers).
 //! * [`dijkstra`] — single- and multi-source shortest paths on a graph given by a neighbour
 //!   closure, with the tie-breaking every caller relies on (smaller distance, then smaller
 //!   vertex id, first).
 //! * [`vec3`] — small vector helpers in R³ and Kahan's stable Heron formula ([`heron`]).
 
 pub mod dd;
-pub mod dense;
 pub(crate) mod dijkstra;
 pub(crate) mod simd;
-pub mod sparse;
+pub(crate) mod sparse;
 pub mod vec3;
 
 pub use dd::{Cdd, Dd};

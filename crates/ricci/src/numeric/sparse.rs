@@ -159,11 +159,6 @@ impl SymmetricSolver {
         })
     }
 
-    /// Dimension of the matrix.
-    pub fn n(&self) -> usize {
-        self.n
-    }
-
     /// Numeric LLᵀ factorization of the matrix with the pattern's lower-triangle `values`.
     /// Returns false if the matrix is not numerically positive definite (or `values` does not
     /// fit the pattern).

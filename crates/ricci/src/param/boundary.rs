@@ -6,11 +6,12 @@
 
 use super::cones::round_to_quarter_turns;
 use crate::mesh::Mesh;
+use crate::metric::IntrinsicMetric;
 use std::f64::consts::PI;
 
 /// Boundary targets of `fixed-angles` (module docs), optionally rounded to quarter turns.
-pub fn fixed_angle_targets(mesh: &Mesh, lengths: &[f64], seamless: bool) -> Vec<f64> {
-    let k = super::cones::angle_defects(mesh, lengths);
+pub(crate) fn fixed_angle_targets(mesh: &Mesh, lengths: &[f64], seamless: bool) -> Vec<f64> {
+    let k = super::cones::angle_defects(mesh, &IntrinsicMetric::euclidean(lengths.to_vec()));
     let n = mesh.n_vertices();
     let chi = crate::metric::euler_characteristic(mesh) as f64;
     let mut dual = vec![0.0; n];

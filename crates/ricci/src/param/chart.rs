@@ -15,7 +15,7 @@ use super::{ParamOptions, Piece};
 use crate::error::{Error, Result};
 use crate::flow::{flow_with_fallback, FlowResult, TargetSpec, UniformizationOptions};
 use crate::mesh::{topology, Mesh};
-use crate::metric::{Geometry, Scheme};
+use crate::metric::{Geometry, IntrinsicMetric, Scheme};
 use crate::progress::Progress;
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -116,7 +116,7 @@ fn closed_target(
     };
     if let Some(b) = budget {
         progress.report("cones", None, "greedy cone placement");
-        let p = greedy_cones(mesh, lengths, b)?;
+        let p = greedy_cones(mesh, &IntrinsicMetric::euclidean(lengths.to_vec()), b)?;
         cones = p.cones;
         history = p.distortion_history;
         source = "greedy".into();
@@ -203,9 +203,10 @@ fn flow_with_corrections(
     } else {
         0
     };
+    let metric = IntrinsicMetric::euclidean(lengths.to_vec());
     for _ in 0..rounds {
         progress.report("cones", None, "cone curvatures corrected on the flow");
-        let Ok(next) = correct_cone_curvatures(mesh, lengths, &kept.cones, &kept.r.u, 1.0) else {
+        let Ok(next) = correct_cone_curvatures(mesh, &metric, &kept.cones, &kept.r.u, 1.0) else {
             break;
         };
         kept.runs += 1;
@@ -257,7 +258,7 @@ pub(super) fn chart_uv(
             .mesh;
         let lengths = super::seamless::chart_holonomy(
             t_mesh,
-            &kept.r.lengths,
+            &kept.r.metric(),
             mesh.n_vertices(),
             &kept.cones,
             progress,

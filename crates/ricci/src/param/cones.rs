@@ -31,6 +31,7 @@ mod green;
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
+use crate::metric::IntrinsicMetric;
 use crate::numeric::sparse::{LowerCsc, SymmetricSolver};
 use green::GreenBasis;
 use std::f64::consts::PI;
@@ -125,7 +126,8 @@ fn laplacian(mesh: &Mesh, lengths: &[f64]) -> Result<Laplacian> {
 }
 
 /// Angle defects of the input metric (`2π − Σθ` inside, `π − Σθ` on the boundary).
-pub fn angle_defects(mesh: &Mesh, lengths: &[f64]) -> Vec<f64> {
+pub fn angle_defects(mesh: &Mesh, metric: &IntrinsicMetric) -> Vec<f64> {
+    let lengths = metric.lengths();
     let n = mesh.n_vertices();
     let mut k: Vec<f64> = (0..n as u32)
         .map(|v| {
@@ -159,10 +161,15 @@ pub fn angle_defects(mesh: &Mesh, lengths: &[f64]) -> Vec<f64> {
 /// The greedy placement (module docs) on a connected mesh with Euclidean `lengths`: closed
 /// surfaces by `closed::place_cones`; with a boundary, boundary vertices are held at
 /// `u = 0` and never become cones.
-pub fn greedy_cones(mesh: &Mesh, lengths: &[f64], budget: ConeBudget) -> Result<ConePlacement> {
+pub fn greedy_cones(
+    mesh: &Mesh,
+    metric: &IntrinsicMetric,
+    budget: ConeBudget,
+) -> Result<ConePlacement> {
+    let lengths = metric.lengths();
     let lap = laplacian(mesh, lengths)?;
     let n = lap.n;
-    let k0 = angle_defects(mesh, lengths);
+    let k0 = angle_defects(mesh, metric);
     let used: Vec<bool> = (0..n as u32).map(|v| !mesh.is_isolated(v)).collect();
     let boundary: Vec<bool> = (0..n as u32).map(|v| mesh.is_boundary_vertex(v)).collect();
     if !boundary.iter().any(|&b| b) {
@@ -276,13 +283,14 @@ fn greedy_with_boundary(
 /// on the common subdivision.
 pub fn correct_cone_curvatures(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     cones: &[(u32, f64)],
     u: &[f64],
     damping: f64,
 ) -> Result<Vec<(u32, f64)>> {
+    let lengths = metric.lengths();
     let lap = laplacian(mesh, lengths)?;
-    let k0 = angle_defects(mesh, lengths);
+    let k0 = angle_defects(mesh, metric);
     let total: f64 = cones.iter().map(|c| c.1).sum();
     let used: Vec<bool> = (0..lap.n as u32).map(|v| !mesh.is_isolated(v)).collect();
     let mut g = GreenBasis::new(&lap, &k0, total / (2.0 * PI), used)?;
@@ -391,11 +399,19 @@ mod tests {
         ];
         let mesh = Mesh::from_triangles(6, faces).unwrap();
         let l = vec![1.0; mesh.n_edges()];
-        let k = angle_defects(&mesh, &l);
+        let k = angle_defects(
+            &mesh,
+            &crate::metric::IntrinsicMetric::euclidean(l.to_vec()),
+        );
         for x in &k {
             assert!((x - 2.0 * PI / 3.0).abs() < 1e-12);
         }
-        let p = greedy_cones(&mesh, &l, ConeBudget::Count(3)).unwrap();
+        let p = greedy_cones(
+            &mesh,
+            &crate::metric::IntrinsicMetric::euclidean(l.to_vec()),
+            ConeBudget::Count(3),
+        )
+        .unwrap();
         assert_eq!(p.cones.len(), 3);
         let s: f64 = p.cones.iter().map(|c| c.1).sum();
         assert!((s - 4.0 * PI).abs() < 1e-9, "{s}");

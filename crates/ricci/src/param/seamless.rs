@@ -30,7 +30,7 @@
 
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, NONE};
-use crate::metric::{corner_angles, Geometry};
+use crate::metric::{corner_angles, Geometry, IntrinsicMetric};
 use faer::sparse::{SparseColMat, Triplet};
 use std::f64::consts::PI;
 
@@ -272,10 +272,11 @@ fn max_abs(r: &[f64]) -> f64 {
 /// of `π/2` (module docs), to `tolerance` (radians).
 pub fn quarter_turn_holonomy(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     angle_sum: &[f64],
     tolerance: f64,
 ) -> Result<HolonomyFix> {
+    let lengths = metric.lengths();
     if mesh.has_boundary() || angle_sum.len() != mesh.n_vertices() || mesh.n_vertices() < 2 {
         return Err(Error::input(
             "seamless holonomy constraints need a closed surface and one angle sum per vertex",
@@ -411,7 +412,7 @@ fn valid(mesh: &Mesh, l: &[f64]) -> bool {
 /// mesh: the chart's `n` vertices first, split vertices flat), cones `(vertex, K̄)`, to 1e-11 rad.
 pub fn chart_holonomy(
     t_mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     n: usize,
     cones: &[(u32, f64)],
     progress: &mut dyn crate::progress::Progress,
@@ -427,5 +428,5 @@ pub fn chart_holonomy(
             angle_sum[v as usize] = 2.0 * PI - k;
         }
     }
-    Ok(quarter_turn_holonomy(t_mesh, lengths, &angle_sum, 1e-11)?.lengths)
+    Ok(quarter_turn_holonomy(t_mesh, metric, &angle_sum, 1e-11)?.lengths)
 }

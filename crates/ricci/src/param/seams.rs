@@ -23,7 +23,7 @@ use crate::numeric::dijkstra::Dijkstra;
 
 /// Cut edges (`cut[e]`) of `mesh` with `lengths`; `allowed[e]` says which edges may be cut;
 /// `cones` must all end up on the cut (or the boundary).
-pub fn cut_graph(
+pub(crate) fn cut_graph(
     mesh: &Mesh,
     lengths: &[f64],
     allowed: &[bool],

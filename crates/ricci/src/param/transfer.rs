@@ -20,7 +20,7 @@ use crate::flow::FlowResult;
 use crate::layout::place::layout;
 use crate::mesh::{Mesh, Surface};
 use crate::metric::common_subdivision::CommonSubdivision;
-use crate::metric::{Euclidean, Geometry};
+use crate::metric::{Euclidean, Geometry, IntrinsicMetric};
 use std::collections::HashMap;
 use std::f64::consts::PI;
 
@@ -68,7 +68,7 @@ fn cut_layout(mesh: &Mesh, lengths: &[f64], cut: &[bool]) -> Result<Vec<[f64; 2]
     for h in 0..disk.n_corners() as u32 {
         dl[disk.he_edge(h) as usize] = lengths[mesh.he_edge(h) as usize];
     }
-    let lay = layout::<Euclidean>(&disk, &dl, None)?;
+    let lay = layout::<Euclidean>(&disk, &IntrinsicMetric::euclidean(dl), None)?;
     Ok((0..disk.n_corners() as u32)
         .map(|h| {
             let p = lay.positions[disk.he_origin(h) as usize];

@@ -296,27 +296,12 @@ pub struct Workspace {
     pub indices: Vec<u32>,
     /// Their values and partials, `n_partials(order)` per function.
     pub values: Vec<f64>,
-    /// Per point of [`crate::spline::space::SplineSpace::basis_at_many`]: the `indices` and
-    /// `values` that [`DmsSpace::basis_at`] would give at it.
-    pub lane_indices: Vec<Vec<u32>>,
-    pub lane_values: Vec<Vec<f64>>,
     /// Order-2 rotations of the manifold spline's candidate bases, one slot per candidate of
     /// the face last evaluated (`crate::spline::manifold::charts::rotate_partials2_cached`).
     pub(crate) rot2: Vec<Option<([f64; 2], [f64; 36])>>,
 }
 
 impl Workspace {
-    /// Empty per-point lists for `n` points of a batched evaluation.
-    pub(crate) fn clear_lanes(&mut self, n: usize) {
-        if self.lane_indices.len() < n {
-            self.lane_indices.resize(n, Vec::new());
-            self.lane_values.resize(n, Vec::new());
-        }
-        for l in 0..n {
-            self.lane_indices[l].clear();
-            self.lane_values[l].clear();
-        }
-    }
     /// An empty workspace whose evaluations use `precision`.
     pub fn with_precision(precision: Precision) -> Workspace {
         Workspace {

@@ -91,7 +91,7 @@ use super::dms::{
     blossom_weights_of, general_position_involving, hash64, multi_indices, needs_shrink,
     per_triangle, unit, KnotOptions, Precision, TriangleBasis, Workspace, MAX_DEGREE,
 };
-use super::simplex::{det3, n_partials, partial_index, Point, LANES};
+use super::simplex::{det3, n_partials, partial_index, Point};
 use super::space::SplineSpace;
 
 mod build;
@@ -324,79 +324,6 @@ impl<'a, A: FlatCharts + Sync + ?Sized> ManifoldSpace<'a, A> {
         Ok(ws.indices.len())
     }
 
-    /// [`Self::basis_at_point`] at several points `us` of face `g` (at most
-    /// [`LANES`]): point `l`'s functions go to `ws.lane_indices[l]` / `ws.lane_values[l]`,
-    /// bitwise the numbers of [`Self::basis_at_point`] (same offsets, directions and rotations
-    /// per point; the simplex recurrence batched by [`TriangleBasis::eval_offset_many`]).
-    pub fn basis_at_points(
-        &self,
-        g: u32,
-        us: &[Point],
-        order: usize,
-        ws: &mut Workspace,
-    ) -> Result<()> {
-        let n = us.len();
-        if n > LANES || (ws.precision == Precision::Extended && order > 0) {
-            return SplineSpace::basis_at_many_one_by_one(self, g, us, order, ws);
-        }
-        ws.clear_lanes(n);
-        let c = self.canon_coords[g as usize];
-        let mut bary = [[0.0; 3]; LANES];
-        let mut dir = [[0.0; 2]; LANES];
-        for (l, &u) in us.iter().enumerate() {
-            self.check_point(g, u)?;
-            bary[l] = barycentric(&c, u);
-            self.check_point(g, [bary[l][0], bary[l][1] + bary[l][2]])?;
-            dir[l] = inward_direction_bary(&c, bary[l]);
-        }
-        let (nb, np) = (per_triangle(self.degree), n_partials(order));
-        let stride = nb * np;
-        if ws.local.len() < LANES * stride {
-            ws.local.resize(LANES * stride, 0.0);
-        }
-        let (a, b) = (
-            self.cand_start[g as usize] as usize,
-            self.cand_start[g as usize + 1] as usize,
-        );
-        for &(i, m, x) in &self.cand[a..b] {
-            let Some(basis) = self.bases[i as usize].as_ref() else {
-                continue;
-            };
-            let o = basis.origin();
-            let mut off = [[0.0; 2]; LANES];
-            let mut rdir = [[0.0; 2]; LANES];
-            let mut inside = 0u8;
-            for l in 0..n {
-                let by = bary[l];
-                off[l] = std::array::from_fn(|k| {
-                    (x[0][k] - o[k]) + by[1] * (x[1][k] - x[0][k]) + by[2] * (x[2][k] - x[0][k])
-                });
-                rdir[l] = rotate(m.rot, dir[l]);
-                if basis.may_contain([o[0] + off[l][0], o[1] + off[l][1]]) {
-                    inside |= 1 << l;
-                }
-            }
-            if inside == 0 {
-                continue;
-            }
-            basis.eval_offset_many(
-                &off[..n],
-                &rdir[..n],
-                order,
-                &mut ws.simplex,
-                &mut ws.local,
-                stride,
-            );
-            for l in (0..n).filter(|l| inside >> l & 1 == 1) {
-                let vals = &mut ws.local[l * stride..(l + 1) * stride];
-                rotate_partials(order, m.rot, vals);
-                ws.lane_indices[l].extend((0..nb).map(|b| (i as usize * nb + b) as u32));
-                ws.lane_values[l].extend_from_slice(vals);
-            }
-        }
-        Ok(())
-    }
-
     /// Like [`Self::basis_at_point`] for a point given in any chart `chart` containing `g`,
     /// with partials in that chart. The point is carried to the home charts by its barycentric
     /// coordinates in `g` (the affine map of `g`'s corners, which is the transition up to the
@@ -610,15 +537,6 @@ impl<A: FlatCharts + Sync + ?Sized> SplineSpace for ManifoldSpace<'_, A> {
     }
     fn basis_at(&self, face: u32, param: Point, order: usize, ws: &mut Workspace) -> Result<usize> {
         self.basis_at_point(face, param, order, ws)
-    }
-    fn basis_at_many(
-        &self,
-        face: u32,
-        params: &[Point],
-        order: usize,
-        ws: &mut Workspace,
-    ) -> Result<()> {
-        self.basis_at_points(face, params, order, ws)
     }
     fn quadrature_with(&self, rule: &[([f64; 3], f64)]) -> Vec<(u32, Point, f64)> {
         let mut q = Vec::new();

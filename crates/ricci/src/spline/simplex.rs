@@ -43,9 +43,6 @@ use std::collections::HashMap;
 use crate::error::{Error, Result};
 use crate::numeric::dd::Dd;
 
-mod many;
-pub use many::LANES;
-
 /// A point or vector in the plane.
 pub type Point = [f64; 2];
 

@@ -35,37 +35,6 @@ pub trait SplineSpace: Sync {
     /// All basis functions that may be non-zero at `param` in triangle `face`, with partials
     /// up to `order` (see [`DmsSpace::basis_at`]).
     fn basis_at(&self, face: u32, param: Point, order: usize, ws: &mut Workspace) -> Result<usize>;
-    /// [`Self::basis_at`] at several points `params` of one triangle `face` (at most
-    /// [`crate::spline::simplex::LANES`] for the batched paths): point `l`'s functions and
-    /// partials go to `ws.lane_indices[l]` / `ws.lane_values[l]`, the same numbers as
-    /// [`Self::basis_at`] there. By default one point at a time
-    /// ([`Self::basis_at_many_one_by_one`]).
-    fn basis_at_many(
-        &self,
-        face: u32,
-        params: &[Point],
-        order: usize,
-        ws: &mut Workspace,
-    ) -> Result<()> {
-        self.basis_at_many_one_by_one(face, params, order, ws)
-    }
-    /// [`Self::basis_at_many`] by [`Self::basis_at`] at each point in turn.
-    fn basis_at_many_one_by_one(
-        &self,
-        face: u32,
-        params: &[Point],
-        order: usize,
-        ws: &mut Workspace,
-    ) -> Result<()> {
-        ws.clear_lanes(params.len());
-        for (l, &u) in params.iter().enumerate() {
-            self.basis_at(face, u, order, ws)?;
-            let (idx, val) = (&mut ws.lane_indices[l], &mut ws.lane_values[l]);
-            idx.extend_from_slice(&ws.indices);
-            val.extend_from_slice(&ws.values);
-        }
-        Ok(())
-    }
     /// Quadrature of the thin-plate energy with `rule` on every triangle — barycentric
     /// points with weights as fractions of the triangle's area: `(face, parameter point,
     /// weight)`.

@@ -4,6 +4,7 @@
 #![allow(dead_code, clippy::needless_range_loop)]
 
 use ricci::mesh::Surface;
+use ricci::metric::IntrinsicMetric;
 use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -202,7 +203,12 @@ use ricci_meshes::ricci_meshes;
 /// (`ricci::layout`); the worst over the loops.
 pub fn boundary_circle_spread(mesh: &ricci::mesh::Mesh, lengths: &[f64]) -> f64 {
     use ricci::metric::geometry::Euclidean;
-    let lay = ricci::layout::layout::<Euclidean>(mesh, lengths, None).unwrap();
+    let lay = ricci::layout::layout::<Euclidean>(
+        mesh,
+        &IntrinsicMetric::new(ricci::metric::Geometry::Euclidean, lengths.to_vec()),
+        None,
+    )
+    .unwrap();
     assert!(lay.flipped_faces.is_empty() && lay.degenerate_faces.is_empty());
     let mut worst = 0.0f64;
     for lp in mesh.boundary_loops() {

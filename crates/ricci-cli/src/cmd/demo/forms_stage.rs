@@ -8,6 +8,7 @@ use super::{Ctx, Env};
 use crate::cmd::forms::{critical_lines, net_picture};
 use ricci::analysis::forms::{holomorphic_forms, FormsOptions};
 use ricci::layout::isometry::Complex;
+use ricci::metric::IntrinsicMetric;
 use ricci::progress::NoProgress;
 use serde_json::json;
 
@@ -24,7 +25,7 @@ pub fn forms(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         .step("holomorphic 1-forms: harmonic basis, Hodge star, period matrix, net");
     let h = holomorphic_forms(
         &s.mesh,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         Some(&s.positions),
         &FormsOptions::default(),
         &mut NoProgress,

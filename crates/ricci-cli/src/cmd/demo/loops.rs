@@ -7,7 +7,7 @@ use super::Env;
 use crate::cmd::cut::cut_obj;
 use ricci::layout::pipeline::cut_disk;
 use ricci::mesh::topology;
-use ricci::metric::Geometry;
+use ricci::metric::{Geometry, IntrinsicMetric};
 use ricci_render::{render, Polyline, Style, View};
 use serde_json::json;
 
@@ -20,8 +20,7 @@ pub fn loops(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         .ok_or_else(|| anyhow::anyhow!("no hyperbolic metric"))?;
     let d = cut_disk(
         &s.mesh,
-        &h.lengths,
-        Geometry::Hyperbolic,
+        &IntrinsicMetric::new(Geometry::Hyperbolic, h.lengths.clone()),
         Some(&s.positions),
         None,
         env.bar,

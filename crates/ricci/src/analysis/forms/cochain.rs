@@ -118,8 +118,10 @@ mod tests {
         let lengths = s.edge_lengths();
         let cut = crate::cut::canonical_cut(
             m,
-            &lengths,
-            crate::metric::Geometry::Euclidean,
+            &crate::metric::IntrinsicMetric::new(
+                crate::metric::Geometry::Euclidean,
+                lengths.to_vec(),
+            ),
             None,
             &Default::default(),
             &mut crate::progress::NoProgress,

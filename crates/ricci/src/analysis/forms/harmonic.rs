@@ -21,7 +21,7 @@ use faer::Mat;
 /// The cotangent weight `(cot α + cot β)/2` of every edge (α, β the angles opposite it; one
 /// term on boundary edges), from the Euclidean edge lengths. Errors on a face whose lengths
 /// violate the triangle inequality.
-pub fn cotan_weights(mesh: &Mesh, lengths: &[f64]) -> Result<Vec<f64>> {
+pub(crate) fn cotan_weights(mesh: &Mesh, lengths: &[f64]) -> Result<Vec<f64>> {
     if lengths.len() != mesh.n_edges() {
         return Err(Error::input(format!(
             "{} edge lengths given for a mesh with {} edges",
@@ -117,11 +117,6 @@ impl HarmonicProjector {
             chol,
             n,
         })
-    }
-
-    /// The cotangent weights the projector was built with.
-    pub fn weights(&self) -> &[f64] {
-        &self.weights
     }
 
     /// The harmonic representatives `ω_k + du_k` of the closed forms `forms` (one solve with

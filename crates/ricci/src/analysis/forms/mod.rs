@@ -18,12 +18,12 @@
 //!    [`uniform`]: the combination of least area distortion (§4.2.1).
 
 pub mod cochain;
-pub mod harmonic;
+pub(crate) mod harmonic;
 pub(crate) mod hodge;
 pub(crate) mod net;
 pub(crate) mod period;
 pub mod placement;
-pub mod small;
+pub(crate) mod small;
 pub mod trajectories;
 pub mod uniform;
 pub(crate) mod working;
@@ -34,7 +34,7 @@ use crate::cut::{canonical_cut, CanonicalCut, CutOptions};
 use crate::error::{Error, Result};
 use crate::layout::isometry::Complex;
 use crate::mesh::Mesh;
-use crate::metric::Geometry;
+use crate::metric::IntrinsicMetric;
 use crate::progress::Progress;
 use serde::Serialize;
 use small::Matrix;
@@ -113,12 +113,12 @@ pub struct HolomorphicForms {
 /// edge lengths (positions optional, carried to the outputs).
 pub fn holomorphic_forms(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     positions: Option<&[[f64; 3]]>,
     options: &FormsOptions,
     progress: &mut dyn Progress,
 ) -> Result<HolomorphicForms> {
-    let working = working_surface(mesh, lengths, positions, options.triangulation, progress)?;
+    let working = working_surface(mesh, metric, positions, options.triangulation, progress)?;
     holomorphic_forms_on(working, &options.cut, progress)
 }
 
@@ -132,8 +132,7 @@ pub fn holomorphic_forms_on(
     progress.report("forms", Some(0.0), "canonical cut");
     let cut = canonical_cut(
         &working.mesh,
-        &working.lengths,
-        Geometry::Euclidean,
+        &IntrinsicMetric::euclidean(working.lengths.clone()),
         working.positions.as_deref(),
         cut_options,
         progress,
@@ -191,9 +190,10 @@ pub fn holomorphic_forms_on(
 /// no discretization difference between them.
 pub fn period_matrix_of_loops(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     loops: &[Vec<u32>],
 ) -> Result<PeriodMatrix> {
+    let lengths = metric.lengths();
     if loops.is_empty() || !loops.len().is_multiple_of(2) {
         return Err(Error::input(format!(
             "{} loops given; a homology basis a1, b1, …, ag, bg has an even, positive number",
@@ -341,6 +341,11 @@ impl HolomorphicForms {
     /// Its edge lengths.
     pub fn lengths(&self) -> &[f64] {
         &self.cut.refined.lengths
+    }
+
+    /// Its metric (Euclidean, the edge lengths of [`HolomorphicForms::lengths`]).
+    pub fn metric(&self) -> IntrinsicMetric {
+        IntrinsicMetric::euclidean(self.lengths().to_vec())
     }
 
     /// `Σ c_i ω_i`.

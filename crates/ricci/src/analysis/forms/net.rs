@@ -37,7 +37,7 @@ pub struct NetQuality {
 
 /// Integrate `re + i im` (1-forms on the refined mesh, whose interior half-edges share their
 /// ids with the cut mesh's) over the cut mesh, starting at 0 on cut vertex `start`.
-pub fn integrate(
+pub(crate) fn integrate(
     refined: &Mesh,
     lengths: &[f64],
     cut_mesh: &Mesh,

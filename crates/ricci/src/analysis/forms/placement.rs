@@ -25,7 +25,7 @@ use std::f64::consts::PI;
 
 /// The value of the face-constant field of the closed form `w` at vertex `v` in the common
 /// tangent frame at `v`, as `(x, y)`.
-pub fn vertex_value(mesh: &Mesh, lengths: &[f64], w: &[f64], v: u32) -> Result<[f64; 2]> {
+pub(crate) fn vertex_value(mesh: &Mesh, lengths: &[f64], w: &[f64], v: u32) -> Result<[f64; 2]> {
     if v as usize >= mesh.n_vertices() || mesh.is_isolated(v) {
         return Err(Error::input(format!(
             "vertex {v} is not a vertex of the surface"

@@ -29,6 +29,7 @@ use super::cochain::on_halfedge;
 use super::zeros::{angle_between, face_vector, wrap};
 use super::HolomorphicForm;
 use crate::mesh::{Mesh, NONE};
+use crate::metric::IntrinsicMetric;
 use std::f64::consts::PI;
 
 /// A point on edge `from → to` of the mesh at `(1 − t)·from + t·to` (`t = 0`: the vertex).
@@ -318,12 +319,13 @@ impl Field<'_> {
 /// order `m`, each traced for at most `length` (in `∫|ω|`) and `max_faces` faces.
 pub fn critical_trajectories(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     form: &HolomorphicForm,
     zeros: &[u32],
     length: f64,
     max_faces: usize,
 ) -> Vec<Trajectory> {
+    let lengths = metric.lengths();
     let frames = (0..mesh.n_faces() as u32)
         .map(|f| face_vector(mesh, lengths, &form.re, f))
         .collect();

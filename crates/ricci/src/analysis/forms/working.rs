@@ -14,6 +14,7 @@ use crate::error::{Error, Result};
 use crate::flow::{flow_with_fallback, TargetSpec, UniformizationOptions};
 use crate::mesh::{topology, Mesh, NONE};
 use crate::metric::intrinsic::IntrinsicTriangulation;
+use crate::metric::IntrinsicMetric;
 use crate::metric::{Geometry, Scheme};
 use crate::progress::Progress;
 use serde::Serialize;
@@ -55,11 +56,12 @@ pub struct WorkingSurface {
 /// Build the working triangulation of a closed connected surface of genus ≥ 1.
 pub fn working_surface(
     mesh: &Mesh,
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     positions: Option<&[[f64; 3]]>,
     kind: FormsTriangulation,
     progress: &mut dyn Progress,
 ) -> Result<WorkingSurface> {
+    let lengths = metric.lengths();
     let t = topology(mesh);
     if t.components.len() != 1 {
         return Err(Error::topology(format!(

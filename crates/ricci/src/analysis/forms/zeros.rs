@@ -89,7 +89,7 @@ pub(super) fn wrap(x: f64) -> f64 {
 
 /// The Poincaré–Hopf index of the face-constant field of the closed 1-form `w` at every
 /// vertex of a closed mesh (Euclidean lengths).
-pub fn vertex_indices(mesh: &Mesh, lengths: &[f64], w: &[f64]) -> Result<Vec<i64>> {
+pub(crate) fn vertex_indices(mesh: &Mesh, lengths: &[f64], w: &[f64]) -> Result<Vec<i64>> {
     let nf = mesh.n_faces();
     let mut vec = Vec::with_capacity(nf);
     for f in 0..nf as u32 {
@@ -133,7 +133,7 @@ pub fn vertex_indices(mesh: &Mesh, lengths: &[f64], w: &[f64]) -> Result<Vec<i64
 }
 
 /// The zeros of the holomorphic form whose real part is `w` (module docs).
-pub fn zeros(mesh: &Mesh, lengths: &[f64], w: &[f64]) -> Result<ZeroSet> {
+pub(crate) fn zeros(mesh: &Mesh, lengths: &[f64], w: &[f64]) -> Result<ZeroSet> {
     let ind = vertex_indices(mesh, lengths, w)?;
     let mut zs = Vec::new();
     let mut spurious = Vec::new();

@@ -44,7 +44,9 @@ use std::f64::consts::PI;
 
 pub use implicit::ToriChain;
 pub use remesh::Implicit;
-pub use retriangulate::{irregular_torus, midpoint_subdivision, random_face_splits};
+pub use retriangulate::{
+    bumpy_split_disk, irregular_torus, midpoint_subdivision, random_face_splits, split_off_centre,
+};
 pub use sphere::icosphere;
 pub use torus::{torus, torus_grid};
 

@@ -7,6 +7,10 @@
 //! * [`random_face_splits`] — a given fraction of the faces split 1 → 3 at a random,
 //!   off-centre interior point (barycentric coordinates drawn away from the centroid): the
 //!   same polyhedral surface, worse triangles.
+//! * [`split_off_centre`] — a number of faces drawn at random split 1 → 3 at a point near
+//!   one of their corners (thin triangles; boundary faces too if asked), and
+//!   [`bumpy_split_disk`], the bumpy disk so split that the tests of the conformal flow on the
+//!   double and of the common subdivision use (issue 15).
 //! * [`irregular_torus`] — a torus of revolution `(R, r)` sampled at random points of its
 //!   parameter square `(u, v) ∈ [0, 2π)²` and triangulated by the periodic Delaunay
 //!   triangulation **in the parameter square** (not in conformal coordinates, so the
@@ -14,7 +18,7 @@
 //!   conformal to the rectangle of side ratio `√(R² − r²) / r` (long side around the axis);
 //!   a fine irregular mesh tends to it.
 //!
-//! All three are deterministic for a given seed and keep the input vertices (ids and
+//! All are deterministic for a given seed and keep the input vertices (ids and
 //! positions) first.
 
 use crate::error::{Error, Result};
@@ -112,6 +116,77 @@ pub fn random_face_splits(s: &Surface, fraction: f64, seed: u64) -> Result<Surfa
         faces.push([c, a, n]);
     }
     Surface::new(positions, faces)
+}
+
+/// Split `count` faces drawn at random 1 → 3 at a point near one of their corners: the
+/// barycentric weights are `(near − 0.1 r₁, (1 − near)(1 + r₂)/2, rest)`, so the new
+/// triangles are thin and the metric is far from Delaunay. A face is drawn among all faces so
+/// far (new ones included; a draw may hit the same face twice); a draw that hits a face with a
+/// vertex on the boundary of `s` is skipped unless `boundary`. The numbers come from the
+/// linear congruential generator `x ← 6364136223846793005 x + 1442695040888963407` started
+/// at `seed` (top 53 bits), the generator of the tests of issue 15 that built these disks.
+pub fn split_off_centre(
+    s: &Surface,
+    count: usize,
+    seed: u64,
+    near: f64,
+    boundary: bool,
+) -> Result<Surface> {
+    if !(0.1..=1.0).contains(&near) {
+        return Err(Error::input(format!(
+            "off-centre splits: the corner weight {near} is not in [0.1, 1]"
+        )));
+    }
+    let mut state = seed;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let m = &s.mesh;
+    let mut pos = s.positions.clone();
+    let mut faces = m.faces().to_vec();
+    if faces.is_empty() {
+        return Err(Error::input("off-centre splits: the surface has no faces"));
+    }
+    for _ in 0..count {
+        let f = ((next() * faces.len() as f64) as usize).min(faces.len() - 1);
+        let [a, b, c] = faces[f];
+        let on_boundary = |v: u32| (v as usize) < m.n_vertices() && m.is_boundary_vertex(v);
+        if !boundary && [a, b, c].into_iter().any(on_boundary) {
+            continue;
+        }
+        let w0 = near - 0.1 * next();
+        let w1 = 0.5 * (1.0 - near) * (1.0 + next());
+        let w = [w0, w1, 1.0 - w0 - w1];
+        let (pa, pb, pc) = (pos[a as usize], pos[b as usize], pos[c as usize]);
+        let p = [0, 1, 2].map(|k| w[0] * pa[k] + w[1] * pb[k] + w[2] * pc[k]);
+        let v = pos.len() as u32;
+        pos.push(p);
+        faces[f] = [a, b, v];
+        faces.push([b, c, v]);
+        faces.push([c, a, v]);
+    }
+    Surface::new(pos, faces)
+}
+
+/// The bumpy disk of issue 15: [`super::disk`]`(16)` lifted to the height field
+/// `z = sin(3x) cos(2y) / 2 + 0.7 x²`, then [`split_off_centre`] (`count`, `seed`, `near`,
+/// `boundary`). With `boundary` the faces at the boundary are split too, which a flow on the
+/// surface itself cannot repair (boundary edges never flip; the flow on the double can).
+pub fn bumpy_split_disk(count: usize, seed: u64, near: f64, boundary: bool) -> Result<Surface> {
+    let d = super::disk(16)?;
+    let pos: Vec<[f64; 3]> = d
+        .positions
+        .iter()
+        .map(|p| {
+            let (x, y) = (p[0], p[1]);
+            [x, y, 0.5 * (3.0 * x).sin() * (2.0 * y).cos() + 0.7 * x * x]
+        })
+        .collect();
+    let s = Surface::new(pos, d.mesh.faces().to_vec())?;
+    split_off_centre(&s, count, seed, near, boundary)
 }
 
 /// A torus of revolution `(major, minor)` through `points` random points of its parameter

@@ -237,25 +237,6 @@ impl TriangleBasis {
         self.apply_scale(order, out);
     }
 
-    /// [`Self::eval_offset`] at up to [`crate::spline::simplex::LANES`] points at once
-    /// ([`SimplexFamily::eval_offset_many`], bitwise the same results): point `l`'s go to
-    /// `out[l * stride..]`.
-    pub fn eval_offset_many(
-        &self,
-        xs: &[Point],
-        dirs: &[Point],
-        order: usize,
-        work: &mut Vec<f64>,
-        out: &mut [f64],
-        stride: usize,
-    ) {
-        self.family
-            .eval_offset_many(xs, dirs, order, work, out, stride);
-        for l in 0..xs.len() {
-            self.apply_scale(order, &mut out[l * stride..]);
-        }
-    }
-
     /// [`Self::eval_offset`] with the recurrence in double-double
     /// ([`SimplexFamily::eval_offset_extended`]).
     pub fn eval_offset_extended(

@@ -4,6 +4,7 @@
 //! [`LocalCharts`].
 
 use super::*;
+use crate::metric::{Geometry, IntrinsicMetric};
 
 #[inline]
 pub(crate) fn cz(p: Point) -> C {
@@ -291,15 +292,17 @@ pub struct LocalCharts {
 }
 
 impl LocalCharts {
-    /// Build the charts. `singular` lists the cone vertices (their incident faces get charts but
-    /// no home chart).
+    /// Build the charts of the flat `metric` (Euclidean, with cone points). `singular` lists
+    /// the cone vertices (their incident faces get charts but no home chart).
     pub fn new(
         mesh: Mesh,
-        lengths: Vec<f64>,
+        metric: IntrinsicMetric,
         positions: Vec<[f64; 3]>,
         singular: Vec<u32>,
         seed: Option<u64>,
     ) -> Result<LocalCharts> {
+        metric.require(Geometry::Euclidean, "the local charts of a manifold spline")?;
+        let (_, lengths, _) = metric.into_parts();
         check_metric(&mesh, &lengths)?;
         if positions.len() != mesh.n_vertices() {
             return Err(Error::input(format!(

@@ -35,7 +35,7 @@ use crate::layout::isometry::{Complex, Isometry, Mobius};
 use crate::layout::pipeline::{cut_disk_polished, polish_uniformization};
 use crate::layout::{deck_group, layout_dd, DeckGroup};
 use crate::mesh::{topology, Mesh, Surface};
-use crate::metric::{Geometry, Hyperbolic, Scheme};
+use crate::metric::{Geometry, Hyperbolic, IntrinsicMetric, Scheme};
 use crate::numeric::dd::Cdd;
 use crate::progress::Progress;
 
@@ -225,7 +225,7 @@ impl HyperbolicAtlas {
         let opts =
             UniformizationOptions::single(Some(Geometry::Hyperbolic), Scheme::Thurston, 1e-12)
                 .with_target(TargetSpec::Uniform);
-        let input = surface.edge_lengths();
+        let input = IntrinsicMetric::euclidean(surface.edge_lengths());
         let flow = flow_with_fallback(mesh, &input, &opts, None, progress)?.result;
         if !flow.converged {
             return Err(Error::numerical(format!(

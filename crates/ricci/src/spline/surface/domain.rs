@@ -6,7 +6,7 @@ use std::time::Instant;
 use crate::error::{Error, Result};
 use crate::flow::{flow_with_fallback, TargetSpec, UniformizationOptions};
 use crate::mesh::{topology, Surface};
-use crate::metric::{Geometry, Scheme};
+use crate::metric::{Geometry, IntrinsicMetric, Scheme};
 use crate::progress::Progress;
 use crate::spline::manifold::LocalCharts;
 
@@ -90,7 +90,7 @@ pub fn flat_domain(
                 progress.report("cone placement", None, "least area distortion");
                 crate::atlas::placement::place(
                     surface,
-                    &lengths,
+                    &IntrinsicMetric::euclidean(lengths.clone()),
                     &crate::atlas::AtlasOptions::default(),
                     progress,
                 )?
@@ -147,7 +147,7 @@ pub fn flat_domain(
     let added = m.n_vertices() - mesh.n_vertices();
     let charts = LocalCharts::new(
         m,
-        flow.lengths.clone(),
+        IntrinsicMetric::euclidean(flow.lengths.clone()),
         p,
         singular.into_iter().collect(),
         None,

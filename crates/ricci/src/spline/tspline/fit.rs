@@ -588,7 +588,13 @@ pub fn flat_torus_domain(
         .as_ref()
         .map(|t| t.simplicial.mesh.clone())
         .unwrap_or_else(|| surface.mesh.clone());
-    let disk = cut_disk(&work, &r.lengths, Geometry::Euclidean, None, None, progress)?;
+    let disk = cut_disk(
+        &work,
+        &crate::metric::IntrinsicMetric::new(Geometry::Euclidean, r.lengths.clone()),
+        None,
+        None,
+        progress,
+    )?;
     let l = layout::<Euclidean>(&disk.mesh, &disk.metric, None)?;
     let g = deck_group::<Euclidean>(&l, &disk.polygon)?;
     let gens = g.named_generators();
