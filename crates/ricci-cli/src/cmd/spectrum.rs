@@ -48,10 +48,12 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
+    crate::util::stages_start();
     if a.count == 0 || a.count > 10_000 {
         return Err(UsageError("--count must be between 1 and 10000".into()).into());
     }
     let (surface, _) = read_surface(&a.mesh)?;
+    crate::util::stage_done("input");
     if let Some(b) = a.base {
         crate::util::check_vertex("--base", b, surface.mesh.n_vertices())?;
     }
@@ -108,6 +110,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let (abs, extra, word) = if geometry == Geometry::Euclidean {
         bar.0.set_message("cutting along canonical loops");
         let disk = cut_disk(work, &metric, geometry, None, a.base, &mut bar)?;
+        crate::util::stage_done("cut");
         bar.0.set_message("layout, deck group and spectrum");
         let l = layout::<Euclidean>(&disk.mesh, &disk.metric, None)?;
         let g = deck_group::<Euclidean>(&l, &disk.polygon)?;
@@ -117,6 +120,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         let sp = lattice_spectrum(gens[0].1.t, gens[1].1.t, a.count)?;
         let tau = ricci::analysis::spectrum::torus_modulus(gens[0].1.t, gens[1].1.t)?;
+        crate::util::stage_done("layout and lattice");
         (
             sp,
             json!({"relation_error": g.relation_error, "modulus": [tau.0, tau.1]}),
@@ -128,12 +132,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         bar.0.set_message("compact fundamental domain and spectrum");
         let (sp, dom) = surface_spectrum(work, &metric, a.base, a.count, 2_000_000)
             .map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?;
+        crate::util::stage_done("spectrum");
         (
             sp.lengths(),
             json!({"method": "compact fundamental domain", "complete_up_to": sp.complete_up_to,
                    "tiles": sp.tiles, "unmatched_links": sp.unmatched_links,
                    "domain": {"radius": dom.radius, "faces": dom.faces,
-                              "boundary_edges": dom.boundary_edges, "generators": dom.generators}}),
+                              "boundary_edges": dom.boundary_edges, "generators": dom.generators,
+                              "seconds_domain": dom.seconds_domain,
+                              "seconds_search": dom.seconds_search}}),
             None,
         )
     };
@@ -145,6 +152,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     } else {
         &abs
     };
+    crate::util::stage_done("output");
+    let (timings, timings_wall) = crate::util::stages_take();
     let out = json!({
         "file": a.mesh.display().to_string(),
         "genus": comp.genus,
@@ -158,6 +167,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "details": extra,
         "boundary_word": word,
         "seconds": t0.elapsed().as_secs_f64(),
+        "timings": timings,
+        "timings_wall": timings_wall,
     });
     if a.json {
         print_json(&out);
