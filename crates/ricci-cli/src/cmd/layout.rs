@@ -150,57 +150,9 @@ pub enum Polish {
 /// (`ricci::layout::pipeline::polish_uniformization` for the flow's metric,
 /// `polish_lengths` — vertex scaling in place — for a metric file). A polish that cannot be
 /// applied (a target other than 0, a metric with cone points) is reported, not an error.
-pub fn polished_metric(
-    surface: &Surface,
-    geometry: Option<Geometry>,
-    target: Option<&str>,
-    scheme: Option<Scheme>,
-    metric_file: Option<&PathBuf>,
-    polish: Polish,
-    progress: &mut dyn ricci::progress::Progress,
-) -> anyhow::Result<PolishedLengths> {
-    // A hyperbolic uniformization polished at once to double-double needs the flow only
-    // close enough for the polish's Newton steps: flowing to `layout_tolerance` (1e-12) costs
-    // up to twice the iterations at the rounding floor of a large mesh (seahorse2_100K:
-    // 1.1e-11 at iteration 9, then 18 steps of ~1e-13 before one lands below 1e-12).
-    // If that polish fails, the flow runs again to the strict tolerance.
-    let loose = polish == Polish::Now
-        && metric_file.is_none()
-        && target.is_none()
-        && geometry == Some(Geometry::Hyperbolic);
-    if loose {
-        let out = polished_metric_at(
-            surface,
-            geometry,
-            target,
-            scheme,
-            metric_file,
-            polish,
-            Some(LOOSE_FLOW_TOLERANCE),
-            progress,
-        )?;
-        if out.polish["converged"].as_bool() == Some(true) {
-            return Ok(out);
-        }
-    }
-    polished_metric_at(
-        surface,
-        geometry,
-        target,
-        scheme,
-        metric_file,
-        polish,
-        None,
-        progress,
-    )
-}
-
-/// The flow tolerance before an immediate double-double polish ([`polished_metric`]).
-const LOOSE_FLOW_TOLERANCE: f64 = 1e-10;
-
-/// [`polished_metric`] with the flow's tolerance given (`None`: `layout_tolerance`).
+/// `flow_tolerance` replaces `layout_tolerance` for the flow (reported as `flow_tolerance`).
 #[allow(clippy::too_many_arguments)]
-fn polished_metric_at(
+pub fn polished_metric(
     surface: &Surface,
     geometry: Option<Geometry>,
     target: Option<&str>,
@@ -815,6 +767,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             (false, true) => Polish::Now,
             (false, false) => Polish::AfterCut,
         },
+        None,
         &mut bar,
     )
     .map_err(|e| anyhow::anyhow!("{}: {}", a.mesh.display(), crate::util::sentence(&e)))?;
