@@ -358,7 +358,7 @@ fn reflection(h: &HolomorphicForms, sigma: &[u32]) -> Result<Reflection> {
     let pm = &h.period_matrix;
     let period = |i: usize, k: usize| -> (f64, f64) {
         let j = k / 2;
-        if k % 2 == 0 {
+        if k.is_multiple_of(2) {
             (if i == j { 1.0 } else { 0.0 }, 0.0)
         } else {
             (pm.re[i][j], pm.im[i][j])
