@@ -20,13 +20,13 @@ use ricci::analysis::forms::placement::form_with_zeros;
 use ricci::analysis::forms::trajectories::critical_trajectories;
 use ricci::analysis::forms::uniform::{uniform_combination, UniformCombination};
 use ricci::analysis::forms::{
-    holomorphic_forms, ConformalNet, FormsOptions, FormsTriangulation, HolomorphicForm,
-    HolomorphicForms, ZeroSet,
+    double_forms, holomorphic_forms, ConformalNet, FormsOptions, FormsTriangulation,
+    HolomorphicForm, HolomorphicForms, ZeroSet,
 };
 use ricci::cut::CutOptions;
 use ricci::layout::export::obj_with_corner_uv;
 use ricci::layout::isometry::Complex;
-use ricci::metric::IntrinsicMetric;
+use ricci::metric::{Geometry, IntrinsicMetric};
 use ricci_render::render::Uvs;
 use ricci_render::{Checker, Paint, Polyline, RenderOptions, Style};
 use serde_json::json;
@@ -95,14 +95,36 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             ..Default::default()
         },
     };
-    let h = holomorphic_forms(
-        &surface.mesh,
-        &IntrinsicMetric::euclidean(surface.edge_lengths()),
-        Some(&surface.positions),
-        &opts,
-        &mut bar,
-    )?;
-    let chosen = choose_form(&a, &h, surface.mesh.n_vertices())?;
+    // A surface with boundary: the forms of its double (paper 003 §2), genus 2g + b − 1.
+    let dbl = if surface.mesh.has_boundary() {
+        let metric = IntrinsicMetric::new(Geometry::Euclidean, surface.edge_lengths());
+        let d = double_forms(
+            &surface.mesh,
+            &metric,
+            Some(&surface.positions),
+            &opts,
+            &mut bar,
+        )
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?;
+        Some(d)
+    } else {
+        None
+    };
+    let owned;
+    let h: &HolomorphicForms = match &dbl {
+        Some(d) => &d.forms,
+        None => {
+            owned = holomorphic_forms(
+                &surface.mesh,
+                &IntrinsicMetric::euclidean(surface.edge_lengths()),
+                Some(&surface.positions),
+                &opts,
+                &mut bar,
+            )?;
+            &owned
+        }
+    };
+    let chosen = choose_form(&a, h, surface.mesh.n_vertices())?;
     bar.0
         .set_message("zeros, conformal net and critical trajectories");
     let zeros = h.zeros(&chosen.form)?;
@@ -112,13 +134,37 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .map(|c| net.uv[cut_mesh.corner_vertex(c) as usize])
         .collect();
     let scale = chosen.scale();
-    let trajectories = critical_lines(&h, &chosen.form, &zeros, scale);
+    let trajectories = critical_lines(h, &chosen.form, &zeros, scale);
     if let Some(path) = &a.out {
-        let pos = refined_positions(&h)?;
+        let pos = refined_positions(h)?;
+        // On a surface with boundary, the net on the surface itself (the double's faces on it).
+        let (faces, uv) = match &dbl {
+            Some(d) => {
+                let on = d.surface_faces();
+                let faces: Vec<[u32; 3]> = h
+                    .cut
+                    .refined
+                    .mesh
+                    .faces()
+                    .iter()
+                    .zip(&on)
+                    .filter(|x| *x.1)
+                    .map(|x| *x.0)
+                    .collect();
+                let uv: Vec<[f64; 2]> = corner_uv
+                    .chunks(3)
+                    .zip(&on)
+                    .filter(|x| *x.1)
+                    .flat_map(|x| x.0.iter().copied())
+                    .collect();
+                (faces, uv)
+            }
+            None => (h.cut.refined.mesh.faces().to_vec(), corner_uv.clone()),
+        };
         let mut text = obj_with_corner_uv(
             pos,
-            h.cut.refined.mesh.faces(),
-            &corner_uv,
+            &faces,
+            &uv,
             &[
                 format!(
                     "ricci forms: conformal net of a holomorphic 1-form, genus {}",
@@ -132,15 +178,27 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         write_atomic(path, text.as_bytes())?;
     }
     if let Some(path) = &a.png {
-        let png = net_picture(&h, &zeros, &corner_uv, a.checks / scale, &trajectories)?;
+        let png = net_picture(h, &zeros, &corner_uv, a.checks / scale, &trajectories)?;
         write_atomic(path, &png)?;
     }
     bar.0.finish_and_clear();
-    let v = report_json(&a, &h, &chosen, &zeros, &net, trajectories.len(), t0)?;
+    let mut v = report_json(&a, h, &chosen, &zeros, &net, trajectories.len(), t0)?;
+    if let Some(d) = &dbl {
+        v["double"] = json!({
+            "surface_genus": d.surface_genus,
+            "boundary_loops": d.boundary_loops,
+            "genus": d.genus,
+            "chord_splits": d.chord_splits,
+            "reflection": d.reflection,
+            "orthogonal_forms": d.orthogonal.len(),
+            "orthogonal_boundary_defect": d.orthogonal_boundary_defect,
+            "surface_faces": d.surface_faces().iter().filter(|&&x| x).count(),
+        });
+    }
     if a.json {
         print_json(&v);
     } else {
-        print_text(&h, &zeros, &net, t0);
+        print_text(h, &zeros, &net, t0);
     }
     Ok(())
 }

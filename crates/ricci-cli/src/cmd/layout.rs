@@ -150,6 +150,8 @@ pub enum Polish {
 /// (`ricci::layout::pipeline::polish_uniformization` for the flow's metric,
 /// `polish_lengths` — vertex scaling in place — for a metric file). A polish that cannot be
 /// applied (a target other than 0, a metric with cone points) is reported, not an error.
+/// `flow_tolerance` replaces `layout_tolerance` for the flow (reported as `flow_tolerance`).
+#[allow(clippy::too_many_arguments)]
 pub fn polished_metric(
     surface: &Surface,
     geometry: Option<Geometry>,
@@ -157,11 +159,22 @@ pub fn polished_metric(
     scheme: Option<Scheme>,
     metric_file: Option<&PathBuf>,
     polish: Polish,
+    flow_tolerance: Option<f64>,
     progress: &mut dyn ricci::progress::Progress,
 ) -> anyhow::Result<PolishedLengths> {
     use ricci::layout::pipeline::{polish_lengths, polish_uniformization};
-    let (g, own, lengths, flow, report) =
-        metric_and_flow(surface, geometry, target, scheme, metric_file, progress)?;
+    let (g, own, lengths, flow, mut report) = metric_and_flow(
+        surface,
+        geometry,
+        target,
+        scheme,
+        metric_file,
+        flow_tolerance,
+        progress,
+    )?;
+    if let Some(t) = flow_tolerance {
+        report["flow_tolerance"] = json!(t);
+    }
     crate::util::stage_done("flow");
     let mut out = PolishedLengths {
         metric: IntrinsicMetric::new(g, lengths),
@@ -235,6 +248,7 @@ fn metric_and_flow(
     target: Option<&str>,
     scheme: Option<Scheme>,
     metric_file: Option<&PathBuf>,
+    tolerance: Option<f64>,
     progress: &mut dyn ricci::progress::Progress,
 ) -> anyhow::Result<MetricAndFlow> {
     if let Some(path) = metric_file {
@@ -270,7 +284,7 @@ fn metric_and_flow(
     let mut uniformization = ricci::flow::UniformizationOptions::single(
         Some(g),
         scheme,
-        ricci::flow::uniformize::layout_tolerance(g),
+        tolerance.unwrap_or_else(|| ricci::flow::uniformize::layout_tolerance(g)),
     );
     if let Some(t) = target {
         uniformization.target = ricci::flow::TargetPolicy::Given(
@@ -757,6 +771,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             (false, true) => Polish::Now,
             (false, false) => Polish::AfterCut,
         },
+        None,
         &mut bar,
     )
     .map_err(|e| anyhow::anyhow!("{}: {}", a.mesh.display(), crate::util::sentence(&e)))?;

@@ -18,6 +18,7 @@
 //!    [`uniform`]: the combination of least area distortion (§4.2.1).
 
 pub mod cochain;
+pub mod double;
 pub(crate) mod harmonic;
 pub(crate) mod hodge;
 pub(crate) mod net;
@@ -39,6 +40,7 @@ use crate::progress::Progress;
 use serde::Serialize;
 use small::Matrix;
 
+pub use double::{double_forms, DoubleForms, Reflection};
 pub use net::{ConformalNet, NetQuality};
 pub use period::{lattice_energies, PeriodMatrix};
 pub use working::{working_surface, FormsTriangulation, WorkingSurface};

@@ -81,6 +81,13 @@ pub fn max_diff(a: &Matrix, b: &Matrix) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The `n × n` identity.
+pub fn identity(n: usize) -> Matrix {
+    (0..n)
+        .map(|i| (0..n).map(|j| f64::from(u8::from(i == j))).collect())
+        .collect()
+}
+
 /// Eigenvalues (ascending) and eigenvectors (`vectors[k]` belongs to `values[k]`) of a
 /// symmetric matrix.
 pub fn symmetric_eigen(a: &Matrix) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {

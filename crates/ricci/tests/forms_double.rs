@@ -1,0 +1,190 @@
+//! Holomorphic 1-forms of surfaces with boundary through the double (`analysis::forms::double`,
+//! paper 003 §2). Values from elsewhere: the round annulus `r₁ < |z| < r₂` is conformal to a
+//! cylinder of height `log(r₂/r₁)` and circumference `2π`, so its double is the torus with
+//! `τ = i·log(r₂/r₁)/π` (closed form); Riemann's bilinear relations (`Ω = Ωᵀ`, `Im Ω > 0`);
+//! the reflection is antiholomorphic, so the period matrix of the reflected canonical basis
+//! `(σa, −σb)` is `−Ω̄` and `σ_*` is an involution with `G` even and `G` odd forms; Gauss–Bonnet
+//! for the zeros of a holomorphic form on a genus-`G` surface (`2G − 2`).
+
+mod ricci_meshes;
+
+use ricci::analysis::forms::{double_forms, DoubleForms, FormsOptions};
+use ricci::mesh::generate::{self, random_face_splits};
+use ricci::mesh::{Mesh, Surface};
+use ricci::metric::{Geometry, IntrinsicMetric};
+use ricci::progress::NoProgress;
+
+fn forms(s: &Surface) -> DoubleForms {
+    let metric = IntrinsicMetric::new(Geometry::Euclidean, s.edge_lengths());
+    double_forms(
+        &s.mesh,
+        &metric,
+        Some(&s.positions),
+        &FormsOptions::default(),
+        &mut NoProgress,
+    )
+    .unwrap()
+}
+
+/// `τ` reduced to the fundamental domain: `i t` with `t ≥ 1`.
+fn reduced(t: f64) -> f64 {
+    if t < 1.0 {
+        1.0 / t
+    } else {
+        t
+    }
+}
+
+#[test]
+fn round_annulus_double_is_the_torus_of_its_modulus() {
+    for (r1, r2, n, seed) in [(0.5, 1.0, 96, 3u64), (0.3, 1.2, 160, 11)] {
+        let s = generate::annulus(r1, r2, n).unwrap();
+        let s = random_face_splits(&s, 0.3, seed).unwrap();
+        let d = forms(&s);
+        assert_eq!((d.surface_genus, d.boundary_loops, d.genus), (0, 2, 1));
+        let (re, im) = d.forms.modulus().unwrap();
+        let want = reduced((r2 / r1).ln() / std::f64::consts::PI);
+        let rel = (im - want).abs() / want;
+        eprintln!(
+            "annulus {r1}/{r2} n={n}: τ = {re:.3e} + {im:.6} i, want {want:.6} i, rel {rel:.2e}"
+        );
+        assert!(re.abs() <= 3e-3 * want, "Re τ = {re}");
+        assert!(rel <= 3e-3, "Im τ = {im}, want {want} (rel {rel:.2e})");
+        // The reflection on H1 of the torus: an involution, one even and one odd form.
+        let r = &d.reflection;
+        assert!(r.integrality <= 1e-6, "integrality {}", r.integrality);
+        assert_eq!(r.involution_error, 0.0);
+        assert_eq!((r.even, r.odd), (1, 1));
+        assert!(
+            r.reflected_error <= 1e-3 * want,
+            "reflected {}",
+            r.reflected_error
+        );
+    }
+}
+
+/// A torus of revolution with the star of one vertex removed (genus 1, one boundary loop),
+/// its faces split off-centre so the mesh has no symmetry.
+fn punctured_torus() -> Surface {
+    let s = generate::torus(2.0, 0.8, 24).unwrap();
+    let s = random_face_splits(&s, 0.3, 5).unwrap();
+    let keep: Vec<[u32; 3]> = s
+        .mesh
+        .faces()
+        .iter()
+        .copied()
+        .filter(|f| !f.contains(&0))
+        .collect();
+    let mut used = vec![false; s.mesh.n_vertices()];
+    for f in &keep {
+        for &v in f {
+            used[v as usize] = true;
+        }
+    }
+    let mut id = vec![u32::MAX; used.len()];
+    let mut pos = Vec::new();
+    for (v, &u) in used.iter().enumerate() {
+        if u {
+            id[v] = pos.len() as u32;
+            pos.push(s.positions[v]);
+        }
+    }
+    let faces = keep.iter().map(|f| f.map(|v| id[v as usize])).collect();
+    Surface::new(pos, faces).unwrap()
+}
+
+fn check_genus_2g_plus_b_minus_1(name: &str, d: &DoubleForms, reflection: bool) {
+    let gg = 2 * d.surface_genus + d.boundary_loops - 1;
+    assert_eq!(d.genus, gg, "{name}");
+    let pm = &d.forms.period_matrix;
+    assert!(
+        pm.asymmetry() <= 1e-8,
+        "{name}: |Ω − Ωᵀ| = {}",
+        pm.asymmetry()
+    );
+    let ev = pm.im_eigenvalues().unwrap();
+    assert!(
+        ev.iter().all(|&x| x > 0.0),
+        "{name}: Im Ω eigenvalues {ev:?}"
+    );
+    let r = &d.reflection;
+    eprintln!(
+        "{name}: G = {gg}, N = {:?}, integrality {:.1e}, |Ω_σ + Ω̄| = {:.2e}, boundary defect {:.1e}",
+        r.matrix, r.integrality, r.reflected_error, d.orthogonal_boundary_defect
+    );
+    for (i, w) in d.forms.basis.iter().enumerate() {
+        let z = d.forms.zeros(w).unwrap();
+        assert_eq!(z.count as usize, 2 * gg - 2, "{name}: zeros of ω_{}", i + 1);
+    }
+    if !reflection {
+        return;
+    }
+    assert!(
+        r.integrality <= 1e-6,
+        "{name}: integrality {}",
+        r.integrality
+    );
+    assert_eq!(r.involution_error, 0.0, "{name}");
+    assert_eq!((r.even, r.odd), (gg, gg), "{name}");
+    let scale = pm
+        .re
+        .iter()
+        .chain(&pm.im)
+        .flatten()
+        .fold(1.0f64, |m, x| m.max(x.abs()));
+    // Not to rounding: the cut's refinement and ties of the Delaunay test (right angles at the
+    // boundary) make the discrete double slightly asymmetric (measured 1.7e-6 … 9.5e-5, 2.7e-3
+    // on the coarse pants); a wrong N is off by O(1).
+    assert!(
+        r.reflected_error <= 5e-3 * scale,
+        "{name}: the reflected basis' period matrix is not −Ω̄ ({})",
+        r.reflected_error
+    );
+    assert_eq!(d.orthogonal.len(), gg, "{name}");
+}
+
+#[test]
+fn punctured_torus_double_has_a_reflection_symmetric_period_matrix() {
+    let s = punctured_torus();
+    let d = forms(&s);
+    assert_eq!((d.surface_genus, d.boundary_loops), (1, 1));
+    check_genus_2g_plus_b_minus_1("punctured torus", &d, true);
+    // The odd forms' real parts vanish along the boundary (orthogonal to it).
+    // An even form would be O(1) there; the discrete asymmetry leaves ~1e-3.
+    assert!(
+        d.orthogonal_boundary_defect <= 2e-2,
+        "boundary defect {}",
+        d.orthogonal_boundary_defect
+    );
+}
+
+#[test]
+fn chords_are_split_before_doubling() {
+    // The generator's pair of pants has interior edges between boundary vertices.
+    let s = generate::pair_of_pants(24).unwrap();
+    let d = forms(&s);
+    assert_eq!((d.surface_genus, d.boundary_loops), (0, 3));
+    check_genus_2g_plus_b_minus_1("pants", &d, true);
+    let m: &Mesh = &s.mesh;
+    let chords = (0..m.n_edges() as u32)
+        .filter(|&e| {
+            let [a, b] = m.edge_vertices(e);
+            !m.is_boundary_edge(e) && m.is_boundary_vertex(a) && m.is_boundary_vertex(b)
+        })
+        .count();
+    assert!(chords > 0, "the generator's pants have no chord any more");
+    assert_eq!(d.chord_splits, chords);
+}
+
+#[test]
+fn shared_meshes_with_boundary() {
+    let Some(dir) = ricci_meshes::ricci_meshes().filter(|d| d.is_dir()) else {
+        eprintln!("RICCI_MESHES not set; skipped");
+        return;
+    };
+    for m in ["punctured-torus.obj", "eight.open.off", "eight.hole.off"] {
+        let (s, _) = ricci::mesh::io::read_surface(&dir.join(m)).unwrap();
+        let d = forms(&s);
+        check_genus_2g_plus_b_minus_1(m, &d, true);
+    }
+}
