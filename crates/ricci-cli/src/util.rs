@@ -344,6 +344,47 @@ impl Reporter {
     }
 }
 
+impl Reporter {
+    /// Runs `work` (a long step that reports nothing itself, e.g. the search for closed
+    /// geodesics) after reporting `stage: message`; while it runs and lines are on, a line
+    /// `stage: message (still running)` goes to stderr from [`Reporter`]'s start-up delay on
+    /// and then every 10 s, so a log shows the command is alive.
+    pub fn while_running<T: Send>(
+        &mut self,
+        stage: &str,
+        message: &str,
+        work: impl FnOnce() -> T + Send,
+    ) -> T {
+        use ricci::progress::Progress;
+        self.report(stage, None, message);
+        if !self.lines {
+            return work();
+        }
+        let done = std::sync::atomic::AtomicBool::new(false);
+        let (t0, after) = (self.t0, self.after);
+        let printed_at_start = self.last_stage == stage;
+        std::thread::scope(|scope| {
+            scope.spawn(|| {
+                let mut last = printed_at_start.then(std::time::Instant::now);
+                while !done.load(std::sync::atomic::Ordering::Relaxed) {
+                    std::thread::sleep(std::time::Duration::from_millis(100));
+                    let due = last.is_none_or(|t| t.elapsed().as_secs_f64() >= 10.0);
+                    if due && t0.elapsed().as_secs_f64() >= after {
+                        eprintln!(
+                            "ricci: [{:7.1} s] {stage}: {message} (still running)",
+                            t0.elapsed().as_secs_f64()
+                        );
+                        last = Some(std::time::Instant::now());
+                    }
+                }
+            });
+            let out = work();
+            done.store(true, std::sync::atomic::Ordering::Relaxed);
+            out
+        })
+    }
+}
+
 impl ricci::progress::Progress for Reporter {
     fn report(&mut self, stage: &str, fraction: Option<f64>, message: &str) {
         self.bar.report(stage, fraction, message);

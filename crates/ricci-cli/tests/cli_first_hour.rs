@@ -400,6 +400,33 @@ fn spectrum_with_a_large_count_estimates_its_time_up_front() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// Item 4: `spectrum` prints progress lines on stderr when it is not a terminal (before, its
+/// spinner drew nothing there): one per stage, and the search for closed geodesics says it is
+/// running. `RICCI_PROGRESS_AFTER=0` lifts the 2 s delay so that a short run shows them too.
+#[test]
+fn spectrum_prints_progress_lines_when_stderr_is_not_a_terminal() {
+    let d = tmp("spectrum-progress");
+    let g = generate(&d, "genus2", "12");
+    let o = Command::new(env!("CARGO_BIN_EXE_ricci"))
+        .args(["spectrum", g.to_str().unwrap(), "--json"])
+        .env("RICCI_PROGRESS_AFTER", "0")
+        .output()
+        .unwrap();
+    let e = err(&o);
+    assert!(o.status.success(), "{e}");
+    let lines: Vec<&str> = e.lines().filter(|l| l.starts_with("ricci: [")).collect();
+    assert!(
+        lines.iter().any(|l| l.contains("spectrum")),
+        "no progress line of the spectrum's search on stderr: {e}"
+    );
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        j["lengths"].as_array().is_some_and(|l| !l.is_empty()),
+        "{j}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 /// Item 7: `layout` says what it wrote (file, and that it holds the input's vertices and faces,
 /// which the README's `render --uv` needs) — one line, on stderr, naming the file.
 #[test]

@@ -11,7 +11,7 @@
 use ricci::flow::{ricci_flow, FlowOptions, TargetSpec};
 use ricci::layout::subdivision_uv::sphere_common_subdivision;
 use ricci::metric::common_subdivision::CommonSubdivision;
-use ricci::metric::{Geometry, Scheme};
+use ricci::metric::{Geometry, IntrinsicMetric, Scheme};
 use ricci::progress::NoProgress;
 use std::time::Instant;
 
@@ -42,7 +42,7 @@ fn main() {
             let sub = sphere_common_subdivision(
                 &s.mesh,
                 &s.positions,
-                &l,
+                &IntrinsicMetric::euclidean(l.to_vec()),
                 &it.triangulation,
                 &r.u,
                 &it.points,

@@ -71,7 +71,7 @@ fn main() {
     let sub = common_subdivision_uvs_ext::<Euclidean>(
         &s.mesh,
         &s.positions,
-        &l,
+        &IntrinsicMetric::euclidean(l.to_vec()),
         tri,
         &r.u,
         &laid,

@@ -89,7 +89,7 @@ fn main() {
     let sub = common_subdivision_uvs::<Euclidean>(
         &s.mesh,
         &s.positions,
-        &l,
+        &IntrinsicMetric::euclidean(l.to_vec()),
         tri,
         &r.u,
         &lay.positions,

@@ -69,7 +69,7 @@ fn main() {
     let f64_only = common_subdivision_uvs::<Hyperbolic>(
         &s.mesh,
         &s.positions,
-        &l,
+        &IntrinsicMetric::euclidean(l.to_vec()),
         &it.triangulation,
         &r.u,
         &lay.positions,
@@ -121,7 +121,7 @@ fn main() {
     let sub = common_subdivision_uvs_ext::<Hyperbolic>(
         &s.mesh,
         &s.positions,
-        &l,
+        &IntrinsicMetric::euclidean(l.to_vec()),
         &it.triangulation,
         &r.u,
         &laid,

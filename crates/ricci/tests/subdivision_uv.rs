@@ -297,7 +297,13 @@ fn through_the_double(name: &str, s: &Surface, full: bool) -> (DoubleFlow, HalfM
         r.max_error
     );
     assert_eq!(r.degenerate_faces, 0, "{name}");
-    let h = half_subdivision(&s.mesh, &s.positions, &s.edge_lengths(), &r).unwrap();
+    let h = half_subdivision(
+        &s.mesh,
+        &s.positions,
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
+        &r,
+    )
+    .unwrap();
     let sub = &h.subdivision;
     let scale = sub
         .corner_uv
@@ -412,7 +418,7 @@ fn flattened_disk_case(boundary: bool) {
     let sub = common_subdivision_uvs::<Euclidean>(
         &s.mesh,
         &s.positions,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         &it.triangulation,
         &r.u,
         &l.positions,
@@ -457,7 +463,7 @@ fn bumpy_sphere_with_thin_triangles_has_a_valid_common_subdivision() {
     let sub = sphere_common_subdivision(
         &s.mesh,
         &s.positions,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         &it.triangulation,
         &r.u,
         &it.points,
@@ -515,7 +521,7 @@ fn beetle_common_subdivision_has_no_flipped_triangle() {
     let sub = common_subdivision_uvs::<Hyperbolic>(
         &s.mesh,
         &s.positions,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         &it.triangulation,
         &r.u,
         &l.positions,
@@ -599,7 +605,7 @@ fn far_out_hyperbolic_layout_keeps_every_piece_positively_oriented() {
             common_subdivision_uvs_ext::<Hyperbolic>(
                 &s.mesh,
                 &s.positions,
-                &s.edge_lengths(),
+                &IntrinsicMetric::euclidean(s.edge_lengths()),
                 &it.triangulation,
                 &r.u,
                 laid,
@@ -752,7 +758,7 @@ fn bunny_free_boundary_common_subdivision_has_no_flipped_triangle() {
     let sub = common_subdivision_uvs::<Euclidean>(
         &s.mesh,
         &s.positions,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         &it.triangulation,
         &r.u,
         &l.positions,
@@ -817,7 +823,7 @@ fn camel_common_subdivision_has_no_flipped_piece() {
     let sub = common_subdivision_uvs_ext::<Euclidean>(
         &s.mesh,
         &s.positions,
-        &s.edge_lengths(),
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
         &it.triangulation,
         &r.u,
         &laid,

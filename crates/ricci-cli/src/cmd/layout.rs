@@ -472,7 +472,7 @@ where
             Some((t, u)) => match common_subdivision_uvs_ext::<S>(
                 &surface.mesh,
                 &surface.positions,
-                &surface.edge_lengths(),
+                &IntrinsicMetric::euclidean(surface.edge_lengths()),
                 t,
                 u,
                 laid,
@@ -619,7 +619,7 @@ fn sphere_layout(
         let s = sphere_common_subdivision(
             &surface.mesh,
             &surface.positions,
-            &surface.edge_lengths(),
+            &IntrinsicMetric::euclidean(surface.edge_lengths()),
             tri,
             u,
             points,

@@ -10,8 +10,9 @@
 //! absolute (curvature −1, Tables 3–4) and also given normalized. A metric that did not
 //! converge is refused.
 
-use super::layout::{polished_metric, spinner, Polish, PolishedLengths};
+use super::layout::{polished_metric, Polish, PolishedLengths};
 use crate::util::read_surface;
+use crate::util::Reporter;
 use crate::util::{print_json, UsageError};
 use ricci::analysis::spectrum::{lattice_spectrum, surface_spectrum};
 use ricci::layout::deck_group;
@@ -19,6 +20,7 @@ use ricci::layout::pipeline::cut_disk;
 use ricci::layout::place::layout;
 use ricci::mesh::topology;
 use ricci::metric::{Euclidean, Geometry};
+use ricci::progress::Progress;
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -88,7 +90,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     } else {
         Geometry::Hyperbolic
     };
-    let mut bar = spinner(a.json);
+    // Progress: the spinner on a terminal, else one line per stage on stderr (issue 22 item 4).
+    let mut bar = Reporter::new(a.json);
     let first = flowed_metric(&a, &surface, want, &mut bar)?;
     let PolishedLengths {
         metric,
@@ -102,10 +105,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // Wall seconds of the compact domain and of the search (in `timings_wall`).
     let mut split = None;
     let (abs, extra, word) = if geometry == Geometry::Euclidean {
-        bar.0.set_message("cutting along canonical loops");
+        bar.report("cut", None, "cutting along canonical loops");
         let disk = cut_disk(work, &metric, None, a.base, &mut bar)?;
         crate::util::stage_done("cut");
-        bar.0.set_message("layout, deck group and spectrum");
+        bar.report("layout", None, "layout, deck group and spectrum");
         let l = layout::<Euclidean>(&disk.mesh, &disk.metric, None)?;
         let g = deck_group::<Euclidean>(&l, &disk.polygon)?;
         let gens = g.named_generators();
@@ -123,8 +126,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     } else {
         // A compact fundamental domain grown from a central vertex (no canonical cut needed;
         // `ricci::analysis::spectrum::surface_spectrum`), searched with a tile budget.
-        bar.0.set_message("compact fundamental domain and spectrum");
-        let (sp, dom) = surface_spectrum(work, &metric, a.base, a.count, 2_000_000)
+        let (sp, dom) = bar
+            .while_running(
+                "spectrum",
+                "compact fundamental domain and the search for closed geodesics",
+                || surface_spectrum(work, &metric, a.base, a.count, 2_000_000),
+            )
             .map_err(|e| anyhow::anyhow!("{}: {e}", a.mesh.display()))?;
         crate::util::stage_done("spectrum");
         split = Some((dom.seconds_domain, dom.seconds_search));
@@ -137,7 +144,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             None,
         )
     };
-    bar.0.finish_and_clear();
+    bar.bar.0.finish_and_clear();
     let shortest = abs.first().copied().unwrap_or(1.0);
     let normalized: Vec<f64> = abs.iter().map(|x| x / shortest).collect();
     let lengths_out = if geometry == Geometry::Euclidean {
@@ -192,10 +199,10 @@ fn flowed_metric(
     a: &Args,
     surface: &ricci::mesh::Surface,
     want: Geometry,
-    bar: &mut super::layout::Bar,
+    bar: &mut Reporter,
 ) -> anyhow::Result<PolishedLengths> {
     let loose = (want == Geometry::Hyperbolic && a.metric.is_none()).then_some(1e-10);
-    let run = |tol: Option<f64>, bar: &mut super::layout::Bar| {
+    let run = |tol: Option<f64>, bar: &mut Reporter| {
         polished_metric(
             surface,
             Some(want),

@@ -32,7 +32,7 @@ use crate::mesh::double::{double_edge_origin, double_vertex_origin};
 use crate::mesh::{double_cover, Mesh, NONE};
 use crate::metric::common_subdivision::{CommonSubdivision, ThreeWayReport};
 use crate::metric::intrinsic::{length_of_lambda, IntrinsicTriangulation};
-use crate::metric::Geometry;
+use crate::metric::{Geometry, IntrinsicMetric};
 use std::collections::VecDeque;
 
 /// What [`half_subdivision`] built.
@@ -52,15 +52,17 @@ pub struct HalfMap {
     pub three_way: ThreeWayReport,
 }
 
-/// The map of `mesh` (positions, Euclidean edge `lengths`: those the flow started from) from
+/// The map of `mesh` (positions, and the Euclidean `metric` the flow started from) from
 /// `flow`, the E² flow on its double (module docs).
 pub fn half_subdivision(
     mesh: &Mesh,
     positions: &[[f64; 3]],
-    lengths: &[f64],
+    metric: &IntrinsicMetric,
     flow: &DoubleFlow,
 ) -> Result<HalfMap> {
     let geometry = Geometry::Euclidean;
+    metric.require(geometry, "the map of a surface from the flow on its double")?;
+    let lengths = metric.lengths();
     if positions.len() != mesh.n_vertices() || lengths.len() != mesh.n_edges() {
         return Err(Error::input(format!(
             "{} positions and {} lengths for a mesh with {} vertices and {} edges",

@@ -36,7 +36,7 @@ use crate::metric::common_subdivision::{
     disk_orientation, repair_rounded_pieces, CommonSubdivision,
 };
 use crate::metric::intrinsic::{length_of_lambda, IntrinsicTriangulation};
-use crate::metric::Geometry;
+use crate::metric::{Geometry, IntrinsicMetric};
 use crate::numeric::dd::Cdd;
 
 /// The common subdivision with its UVs (see the module docs).
@@ -130,7 +130,7 @@ fn base(
 pub fn common_subdivision_uvs<S: Space<Point = Complex>>(
     input: &Mesh,
     input_positions: &[[f64; 3]],
-    input_lengths: &[f64],
+    input_metric: &IntrinsicMetric,
     intrinsic: &IntrinsicTriangulation,
     u: &[f64],
     layout_positions: &[Complex],
@@ -148,7 +148,7 @@ where
     common_subdivision_uvs_ext::<S>(
         input,
         input_positions,
-        input_lengths,
+        input_metric,
         intrinsic,
         u,
         &layout,
@@ -180,7 +180,7 @@ pub struct LaidOut<'a> {
 pub fn common_subdivision_uvs_ext<S: Space<Point = Complex>>(
     input: &Mesh,
     input_positions: &[[f64; 3]],
-    input_lengths: &[f64],
+    input_metric: &IntrinsicMetric,
     intrinsic: &IntrinsicTriangulation,
     u: &[f64],
     layout: &LaidOut<'_>,
@@ -190,6 +190,8 @@ pub fn common_subdivision_uvs_ext<S: Space<Point = Complex>>(
 where
     S::Iso: super::isometry::Isometry<Point = Complex>,
 {
+    input_metric.require(Geometry::Euclidean, "the common subdivision's input metric")?;
+    let input_lengths = input_metric.lengths();
     let (layout_positions, origin) = (layout.positions, layout.origin);
     let lo = layout.positions_lo;
     if !lo.is_empty() && lo.len() != layout_positions.len() {
@@ -432,11 +434,13 @@ pub fn sphere_flipped_faces(points: &[[f64; 3]], faces: &[[u32; 3]]) -> Vec<u32>
 pub fn sphere_common_subdivision(
     input: &Mesh,
     input_positions: &[[f64; 3]],
-    input_lengths: &[f64],
+    input_metric: &IntrinsicMetric,
     intrinsic: &IntrinsicTriangulation,
     u: &[f64],
     points: &[[f64; 3]],
 ) -> Result<SubdivisionUv> {
+    input_metric.require(Geometry::Euclidean, "the common subdivision's input metric")?;
+    let input_lengths = input_metric.lengths();
     if points.len() != intrinsic.n_vertices {
         return Err(Error::input(format!(
             "{} points on the sphere for a triangulation with {} vertices",

@@ -23,7 +23,7 @@ use crate::error::{Error, Result};
 use crate::flow::{flow_with_fallback, TargetSpec, UniformizationOptions};
 use crate::layout::subdivision_uv::{sphere_common_subdivision, sphere_flipped_faces};
 use crate::mesh::{topology, Surface};
-use crate::metric::{Geometry, Scheme};
+use crate::metric::{Geometry, IntrinsicMetric, Scheme};
 use crate::numeric::vec3::{cross, dot, norm, sub};
 use crate::progress::Progress;
 use serde::Serialize;
@@ -151,7 +151,7 @@ pub fn sphere_map(surface: &Surface, progress: &mut dyn Progress) -> Result<Sphe
         let s = sphere_common_subdivision(
             mesh,
             &surface.positions,
-            &lengths,
+            &IntrinsicMetric::euclidean(lengths.to_vec()),
             &tr.triangulation,
             &r.u,
             &x,

@@ -179,7 +179,11 @@ type Split = (Mesh, Vec<f64>, Option<Vec<[f64; 3]>>, usize);
 
 /// Split every interior edge between two boundary vertices at its midpoint (the lengths of
 /// the new edges from the two triangles: half the edge, and the medians).
-pub fn split_chords(mesh: &Mesh, lengths: &[f64], positions: Option<&[[f64; 3]]>) -> Result<Split> {
+pub(crate) fn split_chords(
+    mesh: &Mesh,
+    lengths: &[f64],
+    positions: Option<&[[f64; 3]]>,
+) -> Result<Split> {
     let key = |a: u32, b: u32| (a.min(b), a.max(b));
     let mut len: HashMap<(u32, u32), f64> = (0..mesh.n_edges() as u32)
         .map(|e| {
