@@ -13,51 +13,6 @@ use ricci::mesh::{generate, Surface};
 use ricci::metric::intrinsic::{length_of_lambda, IntrinsicTriangulation};
 use ricci::metric::Geometry;
 
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
-/// As `tests/subdivision_uv.rs::bumpy_disk(count, seed, true)`.
-fn bumpy_disk(count: usize, seed: u64) -> Surface {
-    let d = generate::disk(16).unwrap();
-    let mut pos: Vec<[f64; 3]> = d
-        .positions
-        .iter()
-        .map(|p| {
-            let (x, y) = (p[0], p[1]);
-            [x, y, 0.5 * (3.0 * x).sin() * (2.0 * y).cos() + 0.7 * x * x]
-        })
-        .collect();
-    let mut faces = d.mesh.faces().to_vec();
-    let mut rng = Lcg(seed);
-    let near = 0.75;
-    for _ in 0..count {
-        let f = ((rng.next() * faces.len() as f64) as usize).min(faces.len() - 1);
-        let [a, b, c] = faces[f];
-        let w = [
-            near - 0.1 * rng.next(),
-            0.5 * (1.0 - near) * (1.0 + rng.next()),
-            0.0,
-        ];
-        let w = [w[0], w[1], 1.0 - w[0] - w[1]];
-        let (pa, pb, pc) = (pos[a as usize], pos[b as usize], pos[c as usize]);
-        let p = [0, 1, 2].map(|k| w[0] * pa[k] + w[1] * pb[k] + w[2] * pc[k]);
-        let v = pos.len() as u32;
-        pos.push(p);
-        faces[f] = [a, b, v];
-        faces.push([b, c, v]);
-        faces.push([c, a, v]);
-    }
-    Surface::new(pos, faces).unwrap()
-}
-
 fn main() {
     let args: Vec<usize> = std::env::args()
         .skip(1)
@@ -69,7 +24,7 @@ fn main() {
         vec![(120, 7), (200, 3), (300, 11)]
     };
     for (count, seed) in cases {
-        let s = bumpy_disk(count, seed);
+        let s = generate::bumpy_split_disk(count, seed, 0.75, true).unwrap();
         run(&format!("split disk {count}/{seed}"), &s);
     }
 }
