@@ -94,6 +94,12 @@ fn punctured_torus() -> Surface {
 }
 
 fn check_genus_2g_plus_b_minus_1(name: &str, d: &DoubleForms, reflection: bool) {
+    check_double(name, d, reflection, true)
+}
+
+/// With `zero_count`: `2G − 2` zeros per basis form and no positive index; without, only the
+/// index sum (`χ = 2 − 2G`, which holds for every field).
+fn check_double(name: &str, d: &DoubleForms, reflection: bool, zero_count: bool) {
     let gg = 2 * d.surface_genus + d.boundary_loops - 1;
     assert_eq!(d.genus, gg, "{name}");
     let pm = &d.forms.period_matrix;
@@ -109,12 +115,38 @@ fn check_genus_2g_plus_b_minus_1(name: &str, d: &DoubleForms, reflection: bool) 
     );
     let r = &d.reflection;
     eprintln!(
-        "{name}: G = {gg}, N = {:?}, integrality {:.1e}, |Ω_σ + Ω̄| = {:.2e}, boundary defect {:.1e}",
-        r.matrix, r.integrality, r.reflected_error, d.orthogonal_boundary_defect
+        "{name}: G = {gg}, N = {:?}, integrality {:.1e}, |Ω_σ + Ω̄| = {:.2e}, boundary defect \
+         {:.1e}, symmetric {} (residual {:?})",
+        r.matrix,
+        r.integrality,
+        r.reflected_error,
+        d.orthogonal_boundary_defect,
+        r.symmetric,
+        r.symmetry_residual
     );
+    // Gauss–Bonnet: 2G − 2 zeros per basis form, and no vertex of positive index (a
+    // holomorphic form has no poles).
     for (i, w) in d.forms.basis.iter().enumerate() {
         let z = d.forms.zeros(w).unwrap();
-        assert_eq!(z.count as usize, 2 * gg - 2, "{name}: zeros of ω_{}", i + 1);
+        eprintln!(
+            "{name}: ω_{}: zeros {:?}, positive indices {:?}",
+            i + 1,
+            z.zeros
+                .iter()
+                .map(|z| (z.vertex, z.multiplicity))
+                .collect::<Vec<_>>(),
+            z.spurious
+        );
+        let chi = 2 - 2 * gg as i64;
+        assert_eq!(z.total_index, chi, "{name}: index sum of ω_{}", i + 1);
+        if zero_count {
+            assert_eq!(z.count as usize, 2 * gg - 2, "{name}: zeros of ω_{}", i + 1);
+            assert!(
+                z.spurious.is_empty(),
+                "{name}: ω_{} has positive indices",
+                i + 1
+            );
+        }
     }
     if !reflection {
         return;
@@ -132,13 +164,29 @@ fn check_genus_2g_plus_b_minus_1(name: &str, d: &DoubleForms, reflection: bool) 
         .chain(&pm.im)
         .flatten()
         .fold(1.0f64, |m, x| m.max(x.abs()));
-    // Not to rounding: the cut's refinement and ties of the Delaunay test (right angles at the
-    // boundary) make the discrete double slightly asymmetric (measured 1.7e-6 … 9.5e-5, 2.7e-3
-    // on the coarse pants); a wrong N is off by O(1).
+    // The working triangulation of the double is σ-symmetric and the forms are computed on
+    // it: `Ω_σ = −Ω̄` to rounding (spec9 measured 1.7e-6 … 2.7e-3 with the forms on the
+    // cut's asymmetric refinement; a wrong N is off by O(1)).
     assert!(
-        r.reflected_error <= 5e-3 * scale,
+        r.symmetric,
+        "{name}: the working triangulation is not σ-symmetric"
+    );
+    let res = r.symmetry_residual.unwrap();
+    assert!(
+        res <= 1e-9,
+        "{name}: σ^*ζ is not in the span of ζ ({res:.1e})"
+    );
+    assert!(
+        r.reflected_error <= 1e-8 * scale,
         "{name}: the reflected basis' period matrix is not −Ω̄ ({})",
         r.reflected_error
+    );
+    // Even and odd forms split exactly: the odd forms' real parts vanish on the mirror line
+    // (σ fixes it pointwise, so σ^*α = −α forces α(e) = 0 there).
+    assert!(
+        d.orthogonal_boundary_defect <= 1e-9,
+        "{name}: boundary defect {}",
+        d.orthogonal_boundary_defect
     );
     assert_eq!(d.orthogonal.len(), gg, "{name}");
 }
@@ -149,13 +197,6 @@ fn punctured_torus_double_has_a_reflection_symmetric_period_matrix() {
     let d = forms(&s);
     assert_eq!((d.surface_genus, d.boundary_loops), (1, 1));
     check_genus_2g_plus_b_minus_1("punctured torus", &d, true);
-    // The odd forms' real parts vanish along the boundary (orthogonal to it).
-    // An even form would be O(1) there; the discrete asymmetry leaves ~1e-3.
-    assert!(
-        d.orthogonal_boundary_defect <= 2e-2,
-        "boundary defect {}",
-        d.orthogonal_boundary_defect
-    );
 }
 
 #[test]
@@ -187,4 +228,35 @@ fn shared_meshes_with_boundary() {
         let d = forms(&s);
         check_genus_2g_plus_b_minus_1(m, &d, true);
     }
+}
+
+fn bunny() -> Option<DoubleForms> {
+    let Some(dir) = ricci_meshes::ricci_meshes().filter(|d| d.is_dir()) else {
+        eprintln!("RICCI_MESHES not set; skipped");
+        return None;
+    };
+    let (s, _) = ricci::mesh::io::read_surface(&dir.join("bunny.off")).unwrap();
+    Some(forms(&s))
+}
+
+/// Bunny (genus 0, 5 boundary loops): its intrinsic Delaunay triangulation loses the
+/// symmetry (the vertices inserted to make it simplicial), so the double's own triangulation
+/// is used, symmetric by construction; the reflection is exact there too.
+#[test]
+fn bunny_double_is_reflection_symmetric() {
+    let Some(d) = bunny() else { return };
+    assert_eq!((d.surface_genus, d.boundary_loops, d.genus), (0, 5, 4));
+    check_double("bunny.off", &d, true, false);
+}
+
+/// Not met: 2G − 2 = 6 zeros per basis form on bunny's double. Measured: 8 zeros and 2
+/// positive indices for ω_1, the positive ones at boundary vertices 1791 and 20454, which
+/// have a single face ("ears", boundary angles 0.41 and 0.76 rad): the double has cones of
+/// 0.83 and 1.52 rad there, around which the face-constant discrete field cannot turn by the
+/// cone's curvature on four faces.
+#[test]
+#[ignore = "issue 17: spurious indices at the cones of bunny's boundary ears"]
+fn bunny_double_zero_count() {
+    let Some(d) = bunny() else { return };
+    check_double("bunny.off", &d, true, true);
 }

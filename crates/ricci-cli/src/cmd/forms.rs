@@ -178,7 +178,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         write_atomic(path, text.as_bytes())?;
     }
     if let Some(path) = &a.png {
-        let png = net_picture(h, &zeros, &corner_uv, a.checks / scale, &trajectories)?;
+        // A surface with boundary: its half of the double only (the mirror half is folded
+        // onto the same positions).
+        let half = dbl.as_ref().map(|d| d.surface_faces());
+        let png = net_picture(
+            h,
+            &zeros,
+            &corner_uv,
+            a.checks / scale,
+            &trajectories,
+            half.as_deref(),
+        )?;
         write_atomic(path, &png)?;
     }
     bar.0.finish_and_clear();
@@ -307,16 +317,28 @@ fn append_obj_lines(text: &mut String, first: usize, lines: &[Vec<[f64; 3]>]) {
 }
 
 /// Checkerboard of the net on the surface (`freq` checks per unit of uv), the zeros circled
-/// in red, the critical trajectories in dark blue; PNG bytes.
+/// in red, the critical trajectories in dark blue; PNG bytes. With `faces`, only the refined
+/// faces marked `true` are drawn (a surface with boundary: its half of the double).
 pub fn net_picture(
     h: &HolomorphicForms,
     zeros: &ZeroSet,
     corner_uv: &[[f64; 2]],
     freq: f64,
     trajectories: &[Vec<[f64; 3]>],
+    faces: Option<&[bool]>,
 ) -> anyhow::Result<Vec<u8>> {
     let pos = refined_positions(h)?;
-    let tris = h.cut.refined.mesh.faces();
+    let all = h.cut.refined.mesh.faces();
+    let keep = |f: usize| faces.is_none_or(|m| m.get(f).copied().unwrap_or(false));
+    let tris: Vec<[u32; 3]> = (0..all.len())
+        .filter(|&f| keep(f))
+        .map(|f| all[f])
+        .collect();
+    let corner_uv: Vec<[f64; 2]> = (0..all.len())
+        .filter(|&f| keep(f))
+        .flat_map(|f| corner_uv[3 * f..3 * f + 3].iter().copied())
+        .collect();
+    let tris = tris.as_slice();
     let mut polylines: Vec<Polyline> = trajectories
         .iter()
         .map(|l| Polyline {
@@ -328,7 +350,7 @@ pub fn net_picture(
         .collect();
     polylines.extend(zeros.zeros.iter().map(|z| marker(pos, tris, z.vertex)));
     let style = Style {
-        paint: Paint::Checker(Checker::new(Uvs::PerCorner(corner_uv), freq)),
+        paint: Paint::Checker(Checker::new(Uvs::PerCorner(&corner_uv), freq)),
         polylines,
         ..Default::default()
     };

@@ -41,7 +41,7 @@ pub fn forms(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         .map(|c| net.uv[cm.corner_vertex(c) as usize])
         .collect();
     let lines = critical_lines(&h, &w, &zeros, 1.0);
-    let png = net_picture(&h, &zeros, &corner_uv, FORMS_CHECKS, &lines)?;
+    let png = net_picture(&h, &zeros, &corner_uv, FORMS_CHECKS, &lines, None)?;
     env.out.write("forms-net.png", &png)?;
     let size = image_size(&png);
     sec.pictures.push(Picture {

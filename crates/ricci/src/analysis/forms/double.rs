@@ -26,7 +26,11 @@
 
 use super::cochain;
 use super::small::{self, Matrix};
-use super::{holomorphic_forms, FormsOptions, HolomorphicForm, HolomorphicForms};
+use super::symmetric;
+use super::working::working_surface;
+use super::{
+    holomorphic_forms_on, FormsOptions, FormsTriangulation, HolomorphicForm, HolomorphicForms,
+};
 use crate::error::{Error, Result};
 use crate::mesh::double::double_edge_origin;
 use crate::mesh::{double_cover, topology, Mesh};
@@ -54,6 +58,12 @@ pub struct Reflection {
     pub reflected_re: Matrix,
     pub reflected_im: Matrix,
     pub reflected_error: f64,
+    /// Whether the working triangulation is σ-symmetric; then the forms, `Ω` and `N` are
+    /// computed on it ([`super::symmetric`]) and the reflection commutes with the
+    /// discretization, otherwise `N` comes from the loops mapped by `σ`.
+    pub symmetric: bool,
+    /// Symmetric case: `max |σ^*ζ_k − Σ_m C_mk ζ_m| / max |ζ_k|` (rounding only).
+    pub symmetry_residual: Option<f64>,
 }
 
 /// The forms of a surface with boundary, computed on its double.
@@ -151,15 +161,27 @@ pub fn double_forms(
             .map(|v| p[(v as u32).min(sigma[v]) as usize])
             .collect()
     });
-    let forms = holomorphic_forms(
-        &double,
-        &IntrinsicMetric::euclidean(dl),
-        dpos.as_deref(),
-        options,
-        progress,
-    )?;
+    let metric_d = IntrinsicMetric::euclidean(dl);
+    let run = |kind: FormsTriangulation, progress: &mut dyn Progress| {
+        let working = working_surface(&double, &metric_d, dpos.as_deref(), kind, progress)?;
+        let mut forms = holomorphic_forms_on(working, &options.cut, progress)?;
+        // Not σ-symmetric, or the refinement not read (an error): the refined mesh's forms.
+        let sym = symmetric::symmetrize(&mut forms, &sigma, progress).unwrap_or(None);
+        Ok::<_, Error>((forms, sym))
+    };
+    let (mut forms, mut sym) = run(options.triangulation, progress)?;
+    if sym.is_none() && options.triangulation == FormsTriangulation::Delaunay {
+        // The intrinsic Delaunay triangulation lost the symmetry (the vertices inserted to make
+        // it simplicial, or ties): the double's own triangulation is symmetric by construction.
+        progress.report(
+            "forms",
+            Some(0.0),
+            "the Delaunay triangulation is not symmetric",
+        );
+        (forms, sym) = run(FormsTriangulation::Input, progress)?;
+    }
     let nv = split.n_vertices();
-    let reflection = reflection(&forms, &sigma)?;
+    let reflection = reflection(&forms, &sigma, sym)?;
     let (orthogonal, defect) = orthogonal_forms(&forms, &reflection, &split);
     Ok(DoubleForms {
         surface_genus: g,
@@ -341,17 +363,28 @@ fn shortest_path(r: &Mesh, lengths: &[f64], s: u32, t: u32) -> Result<Vec<u32>> 
 }
 
 /// `σ_*` on homology and the reflected period matrix (module docs).
-fn reflection(h: &HolomorphicForms, sigma: &[u32]) -> Result<Reflection> {
+fn reflection(
+    h: &HolomorphicForms,
+    sigma: &[u32],
+    sym: Option<symmetric::Symmetric>,
+) -> Result<Reflection> {
     let gg = h.genus;
     let n = 2 * gg;
     let r = &h.cut.refined;
-    let mut nm = vec![vec![0.0; n]; n];
-    for (l, lp) in h.cut.loops.iter().take(n).enumerate() {
-        let path = reflected_loop(r, sigma, &lp.vertices)?;
-        for (k, z) in h.harmonic.iter().enumerate() {
-            nm[k][l] = cochain::period(&r.mesh, z, &path);
+    let (symmetric, symmetry_residual) = (sym.is_some(), sym.as_ref().map(|s| s.residual));
+    let nm = match sym {
+        Some(s) => s.n,
+        None => {
+            let mut nm = vec![vec![0.0; n]; n];
+            for (l, lp) in h.cut.loops.iter().take(n).enumerate() {
+                let path = reflected_loop(r, sigma, &lp.vertices)?;
+                for (k, z) in h.harmonic.iter().enumerate() {
+                    nm[k][l] = cochain::period(&r.mesh, z, &path);
+                }
+            }
+            nm
         }
-    }
+    };
     let integrality = nm
         .iter()
         .flatten()
@@ -424,6 +457,8 @@ fn reflection(h: &HolomorphicForms, sigma: &[u32]) -> Result<Reflection> {
         reflected_re: re,
         reflected_im: im,
         reflected_error: err,
+        symmetric,
+        symmetry_residual,
     })
 }
 

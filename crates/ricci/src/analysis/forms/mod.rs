@@ -25,6 +25,7 @@ pub(crate) mod net;
 pub(crate) mod period;
 pub mod placement;
 pub(crate) mod small;
+pub(crate) mod symmetric;
 pub mod trajectories;
 pub mod uniform;
 pub(crate) mod working;
@@ -271,11 +272,22 @@ fn forms_of_loops(
             z
         })
         .collect();
+    forms_of_closed(mesh, lengths, &zeta0, progress)
+}
+
+/// Steps 4–6 of the module docs for closed 1-forms `zeta0` (their classes dual to a
+/// canonical basis `a₁, b₁, …`).
+fn forms_of_closed(
+    mesh: &Mesh,
+    lengths: &[f64],
+    zeta0: &[Vec<f64>],
+    progress: &mut dyn Progress,
+) -> Result<LoopForms> {
     progress.report("forms", Some(0.5), "harmonic projection");
     let weights = harmonic::cotan_weights(mesh, lengths)?;
     let negative_weights = weights.iter().filter(|&&w| w < -1e-12).count();
     let projector = harmonic::HarmonicProjector::new(mesh, &weights)?;
-    let zeta = projector.project(mesh, &zeta0);
+    let zeta = projector.project(mesh, zeta0);
     let closedness = zeta
         .iter()
         .map(|z| cochain::closedness_defect(mesh, z))
