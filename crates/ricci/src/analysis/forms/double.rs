@@ -162,15 +162,16 @@ pub fn double_forms(
             .collect()
     });
     let metric_d = IntrinsicMetric::euclidean(dl);
-    let run = |kind: FormsTriangulation, progress: &mut dyn Progress| {
-        let working = working_surface(&double, &metric_d, dpos.as_deref(), kind, progress)?;
-        let mut forms = holomorphic_forms_on(working, &options.cut, progress)?;
-        // Not σ-symmetric, or the refinement not read (an error): the refined mesh's forms.
-        let sym = symmetric::symmetrize(&mut forms, &sigma, progress).unwrap_or(None);
-        Ok::<_, Error>((forms, sym))
-    };
-    let (mut forms, mut sym) = run(options.triangulation, progress)?;
-    if sym.is_none() && options.triangulation == FormsTriangulation::Delaunay {
+    let mut working = working_surface(
+        &double,
+        &metric_d,
+        dpos.as_deref(),
+        options.triangulation,
+        progress,
+    )?;
+    if options.triangulation == FormsTriangulation::Delaunay
+        && symmetric::extend_symmetry(&working.mesh, &working.lengths, &sigma).is_none()
+    {
         // The intrinsic Delaunay triangulation lost the symmetry (the vertices inserted to make
         // it simplicial, or ties): the double's own triangulation is symmetric by construction.
         progress.report(
@@ -178,8 +179,17 @@ pub fn double_forms(
             Some(0.0),
             "the Delaunay triangulation is not symmetric",
         );
-        (forms, sym) = run(FormsTriangulation::Input, progress)?;
+        working = working_surface(
+            &double,
+            &metric_d,
+            dpos.as_deref(),
+            FormsTriangulation::Input,
+            progress,
+        )?;
     }
+    let mut forms = holomorphic_forms_on(working, &options.cut, progress)?;
+    // Not σ-symmetric, or the refinement not read (an error): the refined mesh's forms.
+    let sym = symmetric::symmetrize(&mut forms, &sigma, progress).unwrap_or(None);
     let nv = split.n_vertices();
     let reflection = reflection(&forms, &sigma, sym)?;
     let (orthogonal, defect) = orthogonal_forms(&forms, &reflection, &split);
