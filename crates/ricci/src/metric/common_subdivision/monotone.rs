@@ -30,6 +30,12 @@ pub struct MonotoneRepair {
     /// Largest move of a re-placed crossing that had a place, along its edge of `T` (as a
     /// change of the projective weight `β_1 / (β_0 + β_1)`).
     pub t_shift: f64,
+    /// Largest distance of a re-placed place outside the interval of its kept neighbours along
+    /// its input edge: how far out of order the places found were (every re-placed place lies
+    /// outside that interval, so this is the least move a repair needs).
+    pub input_disorder: f64,
+    /// The same along the edges of `T`, in the projective weight.
+    pub t_disorder: f64,
 }
 
 /// Indices of a longest strictly increasing subsequence of the finite entries of `x` for
@@ -62,13 +68,22 @@ fn longest_increasing(x: &[f64], keep: impl Fn(f64) -> bool) -> Vec<usize> {
     out
 }
 
+/// How close to the kept neighbour on their side re-placed places go (a fraction of the even
+/// spacing between the two kept neighbours), when all of a run's places lie on that side.
+const NEAR: f64 = 1e-3;
+
+/// A re-placed entry of [`make_increasing`]: its index and the kept values around it.
+type Moved = (usize, Option<f64>, Option<f64>);
+
 /// Make `x` strictly increasing: keep a longest increasing subsequence, re-place the rest by
-/// `fill(lower kept value or None, upper or None, step, steps)`. Returns the re-placed indices.
+/// `fill(lower kept value or None, upper or None, step, steps)` (even spacing); a run whose
+/// places all lie below (above) its two kept neighbours goes next to the lower (upper) one
+/// instead — the least move — when that stays strictly ordered. Returns the re-placed entries.
 fn make_increasing(
     x: &mut [f64],
     keep: impl Fn(f64) -> bool,
     fill: impl Fn(Option<f64>, Option<f64>, usize, usize) -> f64,
-) -> Vec<usize> {
+) -> Vec<Moved> {
     let kept = longest_increasing(x, keep);
     if kept.len() == x.len() {
         return Vec::new();
@@ -80,13 +95,36 @@ fn make_increasing(
         let hi = next.unwrap_or(x.len());
         let (a, b) = (prev.map(|i| x[i]), next.map(|i| x[i]));
         let steps = hi - lo + 1;
-        for k in lo..hi {
-            x[k] = fill(a, b, k - lo + 1, steps);
-            moved.push(k);
+        let even: Vec<f64> = (lo..hi).map(|k| fill(a, b, k - lo + 1, steps)).collect();
+        let near: Option<Vec<f64>> = match (a, b) {
+            (Some(a), Some(_)) if x[lo..hi].iter().all(|&o| o <= a) => {
+                Some(even.iter().map(|&e| a + NEAR * (e - a)).collect())
+            }
+            (Some(_), Some(b)) if x[lo..hi].iter().all(|&o| o >= b) => {
+                Some(even.iter().map(|&e| b - NEAR * (b - e)).collect())
+            }
+            _ => None,
+        };
+        let ordered = |v: &[f64]| {
+            a.is_none_or(|a| v.first().is_none_or(|&f| f > a))
+                && b.is_none_or(|b| v.last().is_none_or(|&l| l < b))
+                && v.windows(2).all(|w| w[0] < w[1])
+        };
+        let place = near.filter(|v| ordered(v)).unwrap_or(even);
+        for (k, v) in (lo..hi).zip(place) {
+            x[k] = v;
+            moved.push((k, a, b));
         }
         prev = next;
     }
     moved
+}
+
+/// How far `o` lies outside `[a, b]` (a missing bound is no bound), in `f`'s scale.
+fn outside(o: f64, a: Option<f64>, b: Option<f64>, f: impl Fn(f64) -> f64) -> f64 {
+    let below = a.map_or(0.0, |a| (f(a) - f(o)).max(0.0));
+    let above = b.map_or(0.0, |b| (f(o) - f(b)).max(0.0));
+    below.max(above)
 }
 
 /// Re-place crossings so that their places are strictly monotone along every input edge and
@@ -117,9 +155,11 @@ pub(super) fn repair(mesh: &Mesh, sub: &mut CommonSubdivision, out: &mut Monoton
                 a + (b - a) * k as f64 / n as f64
             },
         );
-        for k in moved {
+        for (k, a, b) in moved {
             if old[k].is_finite() {
                 out.input_shift = out.input_shift.max((x[k] - old[k]).abs());
+                let d = outside(old[k], a, b, |t| t);
+                out.input_disorder = out.input_disorder.max(d);
             }
             sub.crossings[ids[k] as usize].input_t = x[k];
             out.input_placed += 1;
@@ -149,9 +189,10 @@ pub(super) fn repair(mesh: &Mesh, sub: &mut CommonSubdivision, out: &mut Monoton
                 (None, None) => ln2 * (k as f64 - 0.5 * n as f64),
             },
         );
-        for k in moved {
+        for (k, a, b) in moved {
             if old[k].is_finite() {
                 out.t_shift = out.t_shift.max((weight(x[k]) - weight(old[k])).abs());
+                out.t_disorder = out.t_disorder.max(outside(old[k], a, b, weight));
             }
             sub.crossings[lo + k].t_log_ratio = -x[k];
             out.t_placed += 1;
@@ -186,5 +227,23 @@ mod tests {
         assert_eq!(moved.len(), 2);
         assert!(x.windows(2).all(|w| w[0] < w[1]), "{x:?}");
         assert!(x.iter().all(|&v| v > 0.0 && v < 1.0));
+    }
+
+    #[test]
+    fn a_place_above_both_kept_neighbours_goes_next_to_the_upper_one() {
+        // Kept: 0.1, 0.2, 0.5; 0.3 lies above the interval (0.1, 0.2) it must go into.
+        let mut x = [0.1, 0.3, 0.2, 0.5];
+        let moved = make_increasing(
+            &mut x,
+            |_| true,
+            |a, b, k, n| {
+                let (a, b) = (a.unwrap_or(0.0), b.unwrap_or(1.0));
+                a + (b - a) * k as f64 / n as f64
+            },
+        );
+        assert_eq!(moved, vec![(1, Some(0.1), Some(0.2))]);
+        // Even spacing would give 0.15; next to 0.2 instead: 0.2 − NEAR · (0.2 − 0.15).
+        assert!((x[1] - (0.2 - NEAR * 0.05)).abs() < 1e-15, "{x:?}");
+        assert!((outside(0.3, Some(0.1), Some(0.2), |t| t) - 0.1).abs() < 1e-15);
     }
 }
