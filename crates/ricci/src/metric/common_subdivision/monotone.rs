@@ -3,7 +3,7 @@
 //! The pieces of the common subdivision are polygons whose corners lie on the boundary of
 //! their input face (crossings on its edges, placed by `input_t`) and on the boundary of their
 //! face of `T` (the same crossings, placed by `t_log_ratio`). Both boundaries are convex, so
-//! every piece is positively oriented — in 3D and in the layout — exactly when the places are
+//! every piece is positively oriented — in 3D and in the layout — whenever the places are
 //! strictly monotone in the combinatorial order (the normal coordinates' ranks) along every
 //! input edge and every edge of `T`. Places computed from edge lengths can break that order
 //! where a vertex lies within rounding of an input edge (the split disk 300/11 of issue 15: an
