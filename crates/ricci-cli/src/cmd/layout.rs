@@ -40,9 +40,12 @@ use serde_json::{json, Value};
 use std::path::PathBuf;
 use std::time::Instant;
 
+mod double;
 mod json;
+mod text;
 use json::deck_json;
 pub use json::JsonIso;
+use text::print_text;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -754,13 +757,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .first()
         .is_some_and(|c| c.genus == 0 && c.boundary_loops == 1);
     let mut bar = spinner(a.json);
-    let PolishedLengths {
-        metric,
-        mesh: own_mesh,
-        report: metric_report,
-        polish: mut polish_report,
-        flow,
-    } = polished_metric(
+    let polished = polished_metric(
         &surface,
         geometry,
         a.target.as_deref(),
@@ -773,8 +770,25 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         },
         None,
         &mut bar,
-    )
-    .map_err(|e| anyhow::anyhow!("{}: {}", a.mesh.display(), crate::util::sentence(&e)))?;
+    );
+    let PolishedLengths {
+        metric,
+        mesh: own_mesh,
+        report: metric_report,
+        polish: mut polish_report,
+        flow,
+    } = match polished {
+        Ok(p) => p,
+        // The surface's own flow failed or stalled: a disk is laid out through its double.
+        Err(e)
+            if e.downcast_ref::<UsageError>().is_none()
+                && double::applies(&a, geometry, &surface.mesh) =>
+        {
+            let reason = crate::util::sentence(&e).replace("; no layout computed", "");
+            return double::run_double(&a, &surface, &reason, &mut bar, t0);
+        }
+        Err(e) => anyhow::bail!("{}: {}", a.mesh.display(), crate::util::sentence(&e)),
+    };
     let geometry = metric.geometry();
     // The triangulation the metric lives on, and the input's positions when it is the input.
     let work: &Mesh = own_mesh.as_ref().unwrap_or(&surface.mesh);
@@ -863,22 +877,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if a.json {
         print_json(&out);
     } else {
-        println!("{}: {} layout", a.mesh.display(), geometry.name());
-        println!("  flipped faces: {}", out["flipped_faces"]);
-        if let Some(w) = out.get("boundary_word") {
-            println!("  boundary word: {}", w.as_str().unwrap_or(""));
-        }
-        if !out["relation_error"].is_null() {
-            println!(
-                "  relation error: {:.3e}",
-                out["relation_error"].as_f64().unwrap_or(f64::NAN)
-            );
-            println!(
-                "  max edge spread: {:.3e}",
-                out["max_edge_spread"].as_f64().unwrap_or(f64::NAN)
-            );
-        }
-        println!("  seconds: {:.3}", out["seconds"].as_f64().unwrap_or(0.0));
+        print_text(&a, geometry, &out);
     }
     Ok(())
 }

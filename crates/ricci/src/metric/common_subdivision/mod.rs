@@ -59,6 +59,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod develop;
+mod monotone;
 mod normal;
 mod polygons;
 mod rounding;
@@ -75,6 +76,7 @@ use normal::{replay, replay_on};
 use trace::build;
 
 pub use develop::{layout_euclidean, layout_hyperbolic};
+pub use monotone::MonotoneRepair;
 pub use normal::{flipped_normal_coordinate, TriangleArcs};
 pub use rounding::repair_rounded_pieces;
 pub use three_way::ThreeWayReport;
