@@ -174,3 +174,61 @@ fn bunny_domain_puts_the_poles_at_the_ear_tips_and_fills_the_five_holes() {
     assert!(dist > 0.1 * (hi[1] - lo[1]), "poles {dist} apart");
     check_seams(&s, &d, 1e-6);
 }
+
+/// Paper 003 Table 1, bunny (models scaled to the unit cube: errors in % of the longest
+/// bounding-box side): 1 304 control points, rms 0.09 %, L∞ 0.81 %. Ours must use at most the
+/// paper's control points (the empty half of the torus included) and reach at most both its
+/// errors, recomputed here from the spline at the returned parameters over every input vertex.
+/// Ignored: 125–135 CPU-s (BENCHMARKS.md "Session 10 (tfit10)"); run with
+/// `RICCI_MESHES=../shared/meshes cargo test --release -p ricci --test tspline_genus0 -- --ignored`.
+#[test]
+#[ignore]
+fn bunny_meets_paper_003_table_1_count_rms_and_max_error() {
+    use ricci::spline::tspline::fit::{fit, FitOptions};
+    let Some(dir) = ricci_meshes() else {
+        eprintln!("RICCI_MESHES is not set: skipping bunny_meets_paper_003_table_1_count_rms_and_max_error");
+        return;
+    };
+    let (s, _) = ricci::mesh::io::read_surface(&dir.join("bunny.off")).unwrap();
+    let mut quiet = ricci::progress::NoProgress;
+    let d = genus0_domain(&s, &mut quiet).unwrap();
+    let opts = bunny_table_1_options();
+    let r = fit(&s.positions, &d.uv, d.lattice, &opts, &mut quiet).unwrap();
+    let cp = r.spline.control.len();
+    let errors: Vec<f64> = r
+        .params
+        .iter()
+        .zip(&s.positions)
+        .map(|(uv, q)| {
+            let p = r.spline.point(uv[0], uv[1]);
+            ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+        })
+        .collect();
+    assert_eq!(errors.len(), 34_834, "one error per bunny vertex");
+    let rms =
+        100.0 * (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt() / r.scale;
+    let max = 100.0 * errors.iter().cloned().fold(0.0, f64::max) / r.scale;
+    eprintln!("bunny: {cp} control points, rms {rms:.4} %, L∞ {max:.4} %");
+    assert!(cp <= 1304, "bunny: {cp} control points > 1 304");
+    assert!(max <= 0.81, "bunny: L∞ {max} % > 0.81 %");
+    assert!(rms <= 0.09, "bunny: rms {rms} % > 0.09 %");
+}
+
+/// The settings of the bunny's Table-1 fit (README, BENCHMARKS.md "Session 10 (tfit10)"):
+/// L∞ 0.81 %, rms target 0.09 %, budget 1 304, 8 rounds of parameter correction, a coarse
+/// start (16 faces, faces split while they hold more than 200 points), the worst faces only in
+/// the L∞ phase (θ = 0.7) and the 20 worst per step in the rms phase.
+fn bunny_table_1_options() -> ricci::spline::tspline::fit::FitOptions {
+    ricci::spline::tspline::fit::FitOptions {
+        tolerance: 0.0081,
+        rms_tolerance: 0.0009,
+        max_control_points: 1304,
+        parameter_correction: 8,
+        initial_faces: 16,
+        max_points_per_face: 200,
+        mark_fraction: 0.7,
+        rms_marks: 20,
+        max_iterations: 60,
+        ..Default::default()
+    }
+}
