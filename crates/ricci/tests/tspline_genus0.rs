@@ -184,7 +184,7 @@ fn bunny_domain_puts_the_poles_at_the_ear_tips_and_fills_the_five_holes() {
 #[test]
 #[ignore]
 fn bunny_meets_paper_003_table_1_count_rms_and_max_error() {
-    use ricci::spline::tspline::fit::{fit, FitOptions};
+    use ricci::spline::tspline::fit::fit;
     let Some(dir) = ricci_meshes() else {
         eprintln!("RICCI_MESHES is not set: skipping bunny_meets_paper_003_table_1_count_rms_and_max_error");
         return;
