@@ -122,7 +122,13 @@ def test_eight_step_and_iges_open_in_open_cascade(tmp_path):
         check_file(tmp_path / name, samples)
 
 
-def test_other_topologies_are_refused_naming_the_missing_domain(generated):
-    code, out, err = cli("tspline", generated["disk"], "--json", check=False)
+def test_other_topologies_are_refused_naming_the_missing_domain(generated, tmp_path):
+    # two closed components: no domain (a disk has one since session 10: genus 0)
+    two = tmp_path / "two.off"
+    two.write_text(
+        "OFF\n8 8 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 0\n4 0 0\n3 1 0\n3 0 1\n"
+        "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n3 4 6 5\n3 4 5 7\n3 4 7 6\n3 5 6 7\n"
+    )
+    code, out, err = cli("tspline", two, "--json", check=False)
     assert code == 1
     assert "boundary loop" in out["error"] and "double cover" in out["error"]

@@ -14,6 +14,27 @@ from conftest import cli, shared
 TIMING = {"seconds", "seconds_fit"}
 
 
+TWO_TETRAHEDRA = """OFF
+8 8 0
+0 0 0
+1 0 0
+0 1 0
+0 0 1
+3 0 0
+4 0 0
+3 1 0
+3 0 1
+3 0 2 1
+3 0 1 3
+3 0 3 2
+3 1 2 3
+3 4 6 5
+3 4 5 7
+3 4 7 6
+3 5 6 7
+"""
+
+
 def strip_timing(v):
     if isinstance(v, dict):
         return {k: strip_timing(x) for k, x in v.items() if k not in TIMING}
@@ -103,8 +124,11 @@ def test_tspline_equals_cli_on_kitten_with_parameter_correction(tmp_path):
     )
 
 
-def test_tspline_refuses_other_topologies_with_the_sentence(generated):
+def test_tspline_refuses_other_topologies_with_the_sentence(generated, tmp_path):
+    # two components (a disk, genus 0 with a boundary loop, has a domain since session 10)
+    two = tmp_path / "two.off"
+    two.write_text(TWO_TETRAHEDRA)
     with pytest.raises(ricci.RicciError, match="supports closed surfaces of genus ≥ 1"):
-        ricci.tspline(generated["disk"])
+        ricci.tspline(two)
     with pytest.raises(ricci.UsageError):
         ricci.tspline(generated["torus"], rms_tolerance="-1%")

@@ -30,7 +30,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         vec![FitOptions::default().mark_fraction]
     };
     let t = Instant::now();
-    let (uv, lattice) = flat_torus_domain(&surface, &mut NoProgress)?;
+    let topo = ricci::mesh::topology(&surface.mesh);
+    let genus0 = topo.components.len() == 1 && topo.components[0].genus == 0;
+    let (uv, lattice) = if genus0 {
+        let d = ricci::spline::tspline::genus0::genus0_domain(&surface, &mut NoProgress)?;
+        let p = d.poles.map(|v| surface.positions[v as usize]);
+        println!(
+            "genus 0: {} loops filled, poles {:?} at {:?}, cut faces {:?}, double {} vertices",
+            d.filled_loops, d.poles, p, d.cut_faces, d.double_vertices
+        );
+        (d.uv, d.lattice)
+    } else {
+        flat_torus_domain(&surface, &mut NoProgress)?
+    };
     println!(
         "{}: {} points, lattice W {:.4} H {:.4} s {:.2e}, domain {:.2} s",
         args[1],

@@ -3,8 +3,10 @@
 //!
 //! Supported now: closed surfaces of genus 1, over the flat torus of the default conformal flow
 //! (for genus 1 the flat layout is the conformal net), and closed surfaces of genus ≥ 2 over
-//! the cylinders of a holomorphic 1-form (`tspline_genus`). Other topologies are refused with a
-//! sentence naming the missing domain.
+//! the cylinders of a holomorphic 1-form (`tspline_genus`), and connected surfaces of genus 0,
+//! closed or with boundary loops, over the flat torus of the double of an annulus (loops
+//! filled, one face cut at each of two poles: `ricci::spline::tspline::genus0`; the data lie on
+//! half of the torus). Other topologies are refused with a sentence naming the missing domain.
 //!
 //! `--out DIR` writes `tspline.step` (AP214, one `B_SPLINE_SURFACE_WITH_KNOTS` face per Bézier
 //! patch), `tspline.igs` (entity 128 per patch), `surface.obj` (closed welded tessellation on a lattice grid), `tmesh.svg`
@@ -20,6 +22,7 @@ use ricci::spline::tspline::export::{iges, step, torus_obj};
 use ricci::spline::tspline::fit::{
     area_weighted_rms, fit, flat_torus_domain, vertex_areas, FitOptions, FitResult,
 };
+use ricci::spline::tspline::genus0::genus0_domain;
 use ricci::spline::tspline::{
     chart_independence, continuity, extract, BezierPatch, ChartIndependence, Continuity, TSpline,
 };
@@ -31,7 +34,8 @@ use std::time::Instant;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Mesh file (OBJ, OFF, PLY, STL); closed surfaces of genus ≥ 1 for now.
+    /// Mesh file (OBJ, OFF, PLY, STL); closed surfaces of genus ≥ 1, and genus 0 (closed or
+    /// with boundary loops).
     pub mesh: PathBuf,
     /// Fitting tolerance L∞, as a fraction of the longest bounding-box side ("0.5%" or 0.005).
     #[arg(long, default_value = "0.5%")]
@@ -331,15 +335,29 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
     if comps == 1 && genus >= 2 && loops == 0 {
         return crate::cmd::tspline_genus::run_genus(&a, &surface, tolerance, t0);
     }
-    if comps != 1 || genus != 1 || loops != 0 {
+    let genus0 = comps == 1 && genus == 0;
+    if !genus0 && (comps != 1 || genus != 1 || loops != 0) {
         anyhow::bail!(
-            "{}: ricci tspline supports closed surfaces of genus ≥ 1 for now (domains: the flat torus, the cylinders of a holomorphic 1-form); this mesh has {comps} component(s), genus {genus} and {loops} boundary loop(s), whose domain manifold (paper 003 §2: the sphere map for genus 0, the double cover for boundaries) is not built yet",
+            "{}: ricci tspline supports closed surfaces of genus ≥ 1 and connected surfaces of genus 0 for now (domains: the flat torus, the cylinders of a holomorphic 1-form, the double of an annulus); this mesh has {comps} component(s), genus {genus} and {loops} boundary loop(s), whose domain manifold (paper 003 §2: the double cover for boundaries of genus ≥ 1) is not built yet",
             a.mesh.display()
         );
     }
     let mut bar = spinner(a.json);
     bar.0.set_message("flat metric and layout");
-    let (uv, lattice) = flat_torus_domain(&surface, &mut bar)?;
+    let (uv, lattice, domain, genus0_json) = if genus0 {
+        let d = genus0_domain(&surface, &mut bar)?;
+        let info = json!({
+            "filled_loops": d.filled_loops,
+            "poles": d.poles,
+            "cut_faces": d.cut_faces,
+            "double_vertices": d.double_vertices,
+        });
+        let name = "flat torus of the double of an annulus (genus 0: loops filled, a face cut at two poles; data on half of the torus)";
+        (d.uv, d.lattice, name, Some(info))
+    } else {
+        let (uv, lattice) = flat_torus_domain(&surface, &mut bar)?;
+        (uv, lattice, "flat torus (genus 1)", None)
+    };
     let opts = FitOptions {
         tolerance,
         smoothing: a.smoothing,
@@ -383,7 +401,8 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
     let rms = 100.0 * (r.errors.iter().map(|e| e * e).sum::<f64>() / n).sqrt() / r.scale;
     let mut out = json!({
         "file": a.mesh.display().to_string(),
-        "domain": "flat torus (genus 1)",
+        "domain": domain,
+        "genus0": genus0_json,
         "lattice": {"width": lattice.width, "height": lattice.height, "shift": lattice.shift},
         "control_points": r.spline.control.len(),
         "faces": r.spline.basis.mesh.faces().len(),

@@ -18,9 +18,12 @@
 //!   (conjugate gradients), adaptive refinement (1-to-4 where `L∞ > 2ε`, else 1-to-2), and the
 //!   genus-1 domain from the flat metric (the flat torus *is* the conformal net for genus 1).
 //!
-//! What is not here yet: domains of genus 0, and for genus ≥ 2 the T-mesh over the cylinders
-//! (glued along the critical trajectories, extraordinary points at the zeros) and the fit over
-//! it; only the cylinder decomposition is computed.
+//! * [`genus0`] — genus 0, closed or with boundary loops: the flat torus of the double of an
+//!   annulus (loops filled, one face cut at each of two poles), the data on half of it.
+//!
+//! What is not here yet: for genus ≥ 2 a T-mesh (with T-junctions) over the cylinders; the
+//! cylinders carry tensor-product splines ([`cylinder_fit`]); surfaces of genus ≥ 1 with
+//! boundary.
 
 #![allow(clippy::needless_range_loop)]
 
@@ -34,6 +37,7 @@ pub mod cylinder_jumps;
 pub mod cylinders;
 pub mod export;
 pub mod fit;
+pub mod genus0;
 pub mod genus_domain;
 pub mod glue;
 pub(crate) mod surface;
