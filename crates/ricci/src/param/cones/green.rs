@@ -97,6 +97,26 @@ impl GreenBasis {
         x
     }
 
+    /// The adjoint `φ = L⁺ M (u − ū)` (zero area mean) of a field `u`: `φ_v` is the
+    /// derivative of `½‖u − ū‖²_M` with respect to curvature added at `v`
+    /// (`∂/∂k_v` of `u = w₀ + Σ k g` is `g_v`, and `g_vᵀ M ũ = φ_v`; Soliman–Slepčev–Crane
+    /// 2018 §4). At least-squares curvatures `φ` is equal at every cone (the multiplier of
+    /// `Σ k = 2πχ`); where it differs most from that value a new cone lowers the energy most
+    /// to first order.
+    pub fn adjoint(&mut self, u: &[f64]) -> Vec<f64> {
+        let m = self.mean(u);
+        let rhs: Vec<f64> = (0..self.n)
+            .map(|v| {
+                if self.used[v] {
+                    self.area[v] * (u[v] - m)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        self.solve_zero_mean(rhs)
+    }
+
     /// Area-weighted mean.
     pub fn mean(&self, x: &[f64]) -> f64 {
         (0..self.n).map(|v| x[v] * self.area[v]).sum::<f64>() / self.total_area
