@@ -50,8 +50,7 @@ fn spread(g: &GreenBasis, u: &[f64], used: &[bool]) -> f64 {
 
 /// Area-weighted `σ(2u)` of the least-squares curvatures at `cones` (step 3).
 fn energy(g: &mut GreenBasis, cones: &[u32]) -> Result<f64> {
-    let (_, u) = g.least_squares(cones)?;
-    Ok(g.sigma_2x(&u))
+    g.least_squares_sigma(cones)
 }
 
 /// The greedy from `first` (step 1), with its spread history.
