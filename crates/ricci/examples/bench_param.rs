@@ -12,6 +12,7 @@
 //! ```
 
 use ricci::mesh::io::read_surface;
+use ricci::param::cones::ConeSearch;
 use ricci::param::{parametrize, ConeSpec, ParamOptions};
 use ricci::progress::NoProgress;
 use std::path::PathBuf;
@@ -49,6 +50,11 @@ fn main() {
         ("maxplanck-8", "maxplanck.nf25k.off", ConeSpec::Count(8)),
         ("maxplanck-8+c", "maxplanck.nf25k.off", ConeSpec::Count(8)),
         ("camel-8", "camel.off", ConeSpec::Count(8)),
+        ("botijo-8w", "botijo.off", ConeSpec::Count(8)),
+        ("seahorse-8w", "seahorse2_100K.off", ConeSpec::Count(8)),
+        ("horse-8w", "horse.ply", ConeSpec::Count(8)),
+        ("maxplanck-8w", "maxplanck.nf25k.off", ConeSpec::Count(8)),
+        ("camel-8w", "camel.off", ConeSpec::Count(8)),
         ("eight-auto", "eight.off", ConeSpec::Default),
         ("eight-auto+c", "eight.off", ConeSpec::Default),
     ];
@@ -88,6 +94,12 @@ fn main() {
             cones,
             // `+c`: one round of cone-curvature correction on the nonlinear flow.
             cone_corrections: usize::from(name.ends_with("+c")),
+            // `w`: the wide cone search (`ConeSearch::Energy`).
+            cone_search: if name.ends_with('w') {
+                ConeSearch::Energy
+            } else {
+                ConeSearch::Greedy
+            },
             ..ParamOptions::default()
         };
         match parametrize(&s, &opts, &mut NoProgress) {

@@ -166,6 +166,29 @@ pub fn greedy_cones(
     metric: &IntrinsicMetric,
     budget: ConeBudget,
 ) -> Result<ConePlacement> {
+    greedy_cones_with(mesh, metric, budget, ConeSearch::Greedy)
+}
+
+/// How widely the placement on a closed surface searches (see submodule `closed`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ConeSearch {
+    /// The Dirichlet greedy from two first cones and its moves (the default).
+    #[default]
+    Greedy,
+    /// Also the greedy on the least-squares energy with adjoint candidates, and moves over
+    /// the same candidates (cone count only). Lower σ (session 10: horse 8 cones 1.02 →
+    /// 0.72), more CPU, and stronger cones, on which the `--seamless` holonomy solve of
+    /// `tests/param_seamless.rs` genus 2 does not converge — hence opt-in.
+    Energy,
+}
+
+/// [`greedy_cones`] with a choice of search on closed surfaces.
+pub fn greedy_cones_with(
+    mesh: &Mesh,
+    metric: &IntrinsicMetric,
+    budget: ConeBudget,
+    search: ConeSearch,
+) -> Result<ConePlacement> {
     let lengths = metric.lengths();
     let lap = laplacian(mesh, lengths)?;
     let n = lap.n;
@@ -175,7 +198,7 @@ pub fn greedy_cones(
     if !boundary.iter().any(|&b| b) {
         let chi = crate::metric::euler_characteristic(mesh) as f64;
         let mut g = GreenBasis::new(&lap, &k0, chi, used.clone())?;
-        let mut p = closed::place_cones(&mut g, &k0, &used, budget)?;
+        let mut p = closed::place_cones(&mut g, &k0, &used, budget, search == ConeSearch::Energy)?;
         keep_angles_positive(&mut p.cones, 2.0 * PI * chi);
         return Ok(p);
     }

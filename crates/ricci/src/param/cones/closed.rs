@@ -7,15 +7,17 @@
 //!    two first cones — BFF's, and the extremum of the smooth solution `w₀` (the total
 //!    curvature spread by area) — and the set with the smaller area-weighted `σ(2u)` is kept.
 //!
-//!    1b. With a cone count (not a distortion bound), also the **greedy on the energy**
+//!    1b. Only with the wide search ([`super::ConeSearch::Energy`], opt-in) and a cone
+//!    count (not a distortion bound), also the **greedy on the energy**
 //!    from the same two first cones: each new cone is the best, by the energy below, of a
 //!    few candidates — the extremes of the adjoint `φ = L⁺M(u − ū)` of the least-squares
 //!    field (`φ_v − λ` is the derivative of the energy with respect to curvature moved to
 //!    `v`; Soliman–Slepčev–Crane 2018 §4), its largest `|u|`, and the Dirichlet greedy's
 //!    vertex. The set of least energy among all runs is kept.
 //! 2. **Cone moves** (a Lloyd-type local search): each cone in turn is taken out and put
-//!    back at the best of the same candidates for the others when that lowers the energy
-//!    below; rounds until nothing moves (at most [`MOVE_ROUNDS`]).
+//!    back at the largest `|u|` of the others' Dirichlet solution (with the wide search: at
+//!    the best of step 1b's candidates) when that lowers the energy below; rounds until
+//!    nothing moves (at most [`MOVE_ROUNDS`]).
 //! 3. **Curvatures** of least area-weighted `‖u − ū‖²` at the final positions
 //!    (Soliman–Slepčev–Crane 2018 with the positions fixed), not the Dirichlet ones: on
 //!    botijo with 8 cones the linearised `σ(2u)` drops from 1.41 to 1.21.
@@ -82,7 +84,12 @@ fn greedy_from(
 /// the adjoint `φ − λ` of the least-squares field (the first-order best places for positive
 /// and for negative curvature), the largest `|u|` of that field, and the largest `|u|` of the
 /// Dirichlet field (the classic greedy's choice). Deduplicated.
-fn candidates(g: &mut GreenBasis, cones: &[u32], used: &[bool]) -> Result<Vec<u32>> {
+fn candidates(g: &mut GreenBasis, cones: &[u32], used: &[bool], wide: bool) -> Result<Vec<u32>> {
+    if !wide {
+        // The classic move: the largest |u| of the Dirichlet field only.
+        let (_, ud) = g.dirichlet(cones)?;
+        return Ok(farthest(&ud, cones, used).into_iter().collect());
+    }
     let (_, u) = g.least_squares(cones)?;
     let phi = g.adjoint(&u);
     let lambda = cones.iter().map(|&c| phi[c as usize]).sum::<f64>() / cones.len() as f64;
@@ -123,7 +130,7 @@ fn greedy_by_energy(
     let mut cones = vec![first];
     while cones.len() < max_cones {
         let mut best: Option<(f64, u32)> = None;
-        for c in candidates(g, &cones, used)? {
+        for c in candidates(g, &cones, used, true)? {
             let mut trial = cones.clone();
             trial.push(c);
             let s = energy(g, &trial)?;
@@ -144,6 +151,7 @@ fn move_cones(
     mut cones: Vec<u32>,
     used: &[bool],
     bound: f64,
+    wide: bool,
 ) -> Result<Vec<u32>> {
     let mut best = energy(g, &cones)?;
     for _ in 0..MOVE_ROUNDS {
@@ -154,7 +162,7 @@ fn move_cones(
             if others.is_empty() {
                 continue;
             }
-            for c in candidates(g, &others, used)? {
+            for c in candidates(g, &others, used, wide)? {
                 if c == cones[i] {
                     continue;
                 }
@@ -185,6 +193,7 @@ pub(super) fn place_cones(
     k0: &[f64],
     used: &[bool],
     budget: ConeBudget,
+    wide: bool,
 ) -> Result<ConePlacement> {
     let (max_cones, bound) = match budget {
         ConeBudget::Count(c) => (c, -1.0),
@@ -212,7 +221,7 @@ pub(super) fn place_cones(
         if best.as_ref().is_none_or(|b| s < b.0) {
             best = Some((s, cones, history));
         }
-        if bound < 0.0 {
+        if wide && bound < 0.0 {
             let cones = greedy_by_energy(g, first as u32, used, max_cones)?;
             let s = energy(g, &cones)?;
             if best.as_ref().is_none_or(|b| s < b.0) {
@@ -231,7 +240,7 @@ pub(super) fn place_cones(
             distortion_history: Vec::new(),
         });
     };
-    let cones = move_cones(g, cones, used, bound)?;
+    let cones = move_cones(g, cones, used, bound, wide)?;
     let (k, _) = g.least_squares(&cones)?;
     Ok(ConePlacement {
         cones: k,
