@@ -1,6 +1,6 @@
 //! `ricci param` benchmark: conformal UV maps (`ricci::param::parametrize`) of the shared
 //! meshes of issue 16 with the cone counts of the BFF comparison. Prints per case: faces,
-//! cones, flipped input faces, qc mean / p95 / max, σ(log area ratio), seam length, flow
+//! cones, flipped input faces, qc mean / p95 (count- and area-weighted) / max, σ(log area ratio), seam length, flow
 //! flips, wall seconds. Cases ending in `+c` run one round of
 //! `ParamOptions::cone_corrections`; `BENCH_PARAM_CHARTS=1` also prints per chart the flow
 //! runs, corrections and the flow's σ(2u).
@@ -12,6 +12,7 @@
 //! ```
 
 use ricci::mesh::io::read_surface;
+use ricci::param::cones::ConeSearch;
 use ricci::param::{parametrize, ConeSpec, ParamOptions};
 use ricci::progress::NoProgress;
 use std::path::PathBuf;
@@ -49,17 +50,24 @@ fn main() {
         ("maxplanck-8", "maxplanck.nf25k.off", ConeSpec::Count(8)),
         ("maxplanck-8+c", "maxplanck.nf25k.off", ConeSpec::Count(8)),
         ("camel-8", "camel.off", ConeSpec::Count(8)),
+        ("botijo-8w", "botijo.off", ConeSpec::Count(8)),
+        ("seahorse-8w", "seahorse2_100K.off", ConeSpec::Count(8)),
+        ("horse-8w", "horse.ply", ConeSpec::Count(8)),
+        ("maxplanck-8w", "maxplanck.nf25k.off", ConeSpec::Count(8)),
+        ("camel-8w", "camel.off", ConeSpec::Count(8)),
         ("eight-auto", "eight.off", ConeSpec::Default),
         ("eight-auto+c", "eight.off", ConeSpec::Default),
     ];
     println!(
-        "{:<14} {:>7} {:>5} {:>6} {:>7} {:>7} {:>8} {:>7} {:>9} {:>7} {:>8}",
+        "{:<14} {:>7} {:>5} {:>6} {:>7} {:>7} {:>8} {:>8} {:>8} {:>7} {:>9} {:>7} {:>8}",
         "case",
         "faces",
         "cones",
         "flips",
         "qc_mean",
         "qc_p95",
+        "qcA_mean",
+        "qcA_p95",
         "qc_max",
         "σ_logA",
         "seam_len",
@@ -86,6 +94,12 @@ fn main() {
             cones,
             // `+c`: one round of cone-curvature correction on the nonlinear flow.
             cone_corrections: usize::from(name.ends_with("+c")),
+            // `w`: the wide cone search (`ConeSearch::Energy`).
+            cone_search: if name.ends_with('w') {
+                ConeSearch::Energy
+            } else {
+                ConeSearch::Greedy
+            },
             ..ParamOptions::default()
         };
         match parametrize(&s, &opts, &mut NoProgress) {
@@ -94,13 +108,15 @@ fn main() {
                 let flips: usize = p.charts.iter().map(|c| c.flips).sum();
                 let seam: f64 = p.charts.iter().map(|c| c.seam_length).sum();
                 println!(
-                    "{:<14} {:>7} {:>5} {:>6} {:>7.4} {:>7.4} {:>8.3} {:>7.4} {:>9.3} {:>7} {:>8.3}",
+                    "{:<14} {:>7} {:>5} {:>6} {:>7.4} {:>7.4} {:>8.4} {:>8.4} {:>8.3} {:>7.4} {:>9.3} {:>7} {:>8.3}",
                     name,
                     s.mesh.n_faces(),
                     cones,
                     p.stats.flipped_faces,
                     p.stats.qc_mean,
                     p.stats.qc_p95,
+                    p.stats.qc_mean_area,
+                    p.stats.qc_p95_area,
                     p.stats.qc_max,
                     p.stats.log_area_sigma,
                     seam,

@@ -12,6 +12,10 @@
 //! (rigid transitions across the seams); a map whose seams bend has curvature spread along
 //! them.
 //!
+//! `qcA_mean`, `qcA_p95`: the same qc weighted by 3D face area (slivers of a common
+//! subdivision count by their area). With `UV_CONES=T` also the list `V=K,…` of the vertices
+//! with `|K| > T` (e.g. another tool's cones, to be imposed with `ricci param --cones`).
+//!
 //! ```sh
 //! cargo run --release -p ricci --example uv_obj_stats -- uv.obj [more.obj …]
 //! ```
@@ -95,8 +99,18 @@ fn main() {
         std::process::exit(1);
     }
     println!(
-        "{:<32} {:>7} {:>6} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8}",
-        "file", "faces", "flips", "qc_mean", "qc_p95", "qc_max", "σ_logA", "σ_unw", "σ_logA/2"
+        "{:<32} {:>7} {:>6} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8}",
+        "file",
+        "faces",
+        "flips",
+        "qc_mean",
+        "qc_p95",
+        "qcA_mean",
+        "qcA_p95",
+        "qc_max",
+        "σ_logA",
+        "σ_unw",
+        "σ_logA/2"
     );
     for f in files {
         let text = match std::fs::read_to_string(&f) {
@@ -125,12 +139,14 @@ fn main() {
         let unw =
             (logs.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / logs.len().max(1) as f64).sqrt();
         println!(
-            "{:<32} {:>7} {:>6} {:>8.4} {:>8.4} {:>8.3} {:>8.3} {:>8.3} {:>8.3}",
+            "{:<32} {:>7} {:>6} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>8.3} {:>8.3} {:>8.3} {:>8.3}",
             f.rsplit('/').next().unwrap_or(&f),
             s.faces,
             s.flipped_faces,
             s.qc_mean,
             s.qc_p95,
+            s.qc_mean_area,
+            s.qc_p95_area,
             s.qc_max,
             s.log_area_sigma,
             unw,
@@ -148,5 +164,20 @@ fn main() {
             all,
             big.iter().take(8).map(|x| (x * 1000.0).round() / 1000.0).collect::<Vec<_>>()
         );
+        if let Some(t) = std::env::var("UV_CONES")
+            .ok()
+            .and_then(|x| x.parse::<f64>().ok())
+        {
+            // The vertices carrying |K| > t, as `--cones V=K,…` (0-based position indices).
+            let mut c: Vec<(usize, f64)> = k
+                .iter()
+                .enumerate()
+                .filter(|x| x.1.abs() > t)
+                .map(|(v, &x)| (v, x))
+                .collect();
+            c.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+            let list: Vec<String> = c.iter().map(|(v, x)| format!("{v}={x:.4}")).collect();
+            println!("    cones (|K| > {t}): {}", list.join(","));
+        }
     }
 }

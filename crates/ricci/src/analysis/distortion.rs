@@ -105,6 +105,11 @@ pub struct DistortionStats {
     pub qc_mean: f64,
     pub qc_p95: f64,
     pub qc_max: f64,
+    /// Mean of qc weighted by 3D face area (the surface's average, whatever the triangle
+    /// sizes; on a common subdivision its slivers count by their area, not as whole faces).
+    pub qc_mean_area: f64,
+    /// The qc below which 95 % of the measured 3D area lies (area-weighted p95).
+    pub qc_p95_area: f64,
     /// Area-weighted standard deviation of `log(A_uv/A_3d)` over the faces not flipped.
     pub log_area_sigma: f64,
     /// Largest `|log(A_uv/A_3d) − mean|` over the faces not flipped.
@@ -135,6 +140,7 @@ pub fn face_distortions(
 /// [`DistortionStats`] of per-face distortions.
 pub fn stats(d: &[FaceDistortion]) -> DistortionStats {
     let mut qc = Vec::with_capacity(d.len());
+    let mut qc_area: Vec<(f64, f64)> = Vec::with_capacity(d.len());
     let mut flipped = 0;
     let mut degenerate = 0;
     let (mut w, mut s1) = (0.0, 0.0);
@@ -148,6 +154,7 @@ pub fn stats(d: &[FaceDistortion]) -> DistortionStats {
             continue;
         }
         qc.push(x.qc());
+        qc_area.push((x.qc(), x.area_3d));
         w += x.area_3d;
         s1 += x.area_3d * x.area_ratio.ln();
     }
@@ -167,6 +174,7 @@ pub fn stats(d: &[FaceDistortion]) -> DistortionStats {
     } else {
         qc[((0.95 * (n - 1) as f64).round() as usize).min(n - 1)]
     };
+    let (qc_mean_area, qc_p95_area) = area_weighted_qc(&mut qc_area, w);
     DistortionStats {
         faces: d.len(),
         flipped_faces: flipped,
@@ -178,9 +186,29 @@ pub fn stats(d: &[FaceDistortion]) -> DistortionStats {
         },
         qc_p95: p95,
         qc_max: qc.last().copied().unwrap_or(f64::NAN),
+        qc_mean_area,
+        qc_p95_area,
         log_area_sigma: if w > 0.0 { (s2 / w).sqrt() } else { f64::NAN },
         log_area_max: lmax,
     }
+}
+
+/// Area-weighted mean and p95 of `(qc, area)` pairs (`total` their area): the p95 is the
+/// smallest qc such that the faces with qc at most it cover ≥ 95 % of the area.
+fn area_weighted_qc(qc_area: &mut [(f64, f64)], total: f64) -> (f64, f64) {
+    if qc_area.is_empty() || total <= 0.0 {
+        return (f64::NAN, f64::NAN);
+    }
+    let mean = qc_area.iter().map(|&(q, a)| q * a).sum::<f64>() / total;
+    qc_area.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut acc = 0.0;
+    for &(q, a) in qc_area.iter() {
+        acc += a;
+        if acc >= 0.95 * total {
+            return (mean, q);
+        }
+    }
+    (mean, qc_area[qc_area.len() - 1].0)
 }
 
 /// [`stats`] of corner UVs on a surface.

@@ -5,7 +5,9 @@
 //! flat triangulation.
 
 use super::boundary::fixed_angle_targets;
-use super::cones::{correct_cone_curvatures, greedy_cones, round_to_quarter_turns, ConeBudget};
+use super::cones::{
+    correct_cone_curvatures, greedy_cones_with, round_to_quarter_turns, ConeBudget,
+};
 use super::transfer::{
     folded_faces, input_route, scale_to_area, seam_edges, seam_report, subdivision_route,
     SubdivisionChart,
@@ -99,6 +101,17 @@ fn closed_target(
             max_cones: opts.max_cones,
         }),
         ConeSpec::Given(c) => {
+            // Checked here, by input vertex id: the flow would name the chart-local vertex.
+            if let Some((v, k)) = c
+                .iter()
+                .find(|(v, k)| piece.vertices.contains(v) && (k.is_nan() || *k >= 2.0 * PI))
+            {
+                return Err(Error::input(format!(
+                    "cone at vertex {v}: curvature {k:.6} leaves no cone angle (it must be \
+                     below 2π = {:.6})",
+                    2.0 * PI
+                )));
+            }
             let to_local: HashMap<u32, u32> = piece
                 .vertices
                 .iter()
@@ -116,7 +129,12 @@ fn closed_target(
     };
     if let Some(b) = budget {
         progress.report("cones", None, "greedy cone placement");
-        let p = greedy_cones(mesh, &IntrinsicMetric::euclidean(lengths.to_vec()), b)?;
+        let p = greedy_cones_with(
+            mesh,
+            &IntrinsicMetric::euclidean(lengths.to_vec()),
+            b,
+            opts.cone_search,
+        )?;
         cones = p.cones;
         history = p.distortion_history;
         source = "greedy".into();

@@ -166,6 +166,29 @@ pub fn greedy_cones(
     metric: &IntrinsicMetric,
     budget: ConeBudget,
 ) -> Result<ConePlacement> {
+    greedy_cones_with(mesh, metric, budget, ConeSearch::Greedy)
+}
+
+/// How widely the placement on a closed surface searches (see submodule `closed`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ConeSearch {
+    /// The Dirichlet greedy from two first cones and its moves (the default).
+    #[default]
+    Greedy,
+    /// Also the greedy on the least-squares energy with adjoint candidates, and moves over
+    /// the same candidates (cone count only). Lower σ (session 10: horse 8 cones 1.02 →
+    /// 0.72), more CPU, and stronger cones, on which the `--seamless` holonomy solve of
+    /// `tests/param_seamless.rs` genus 2 does not converge — hence opt-in.
+    Energy,
+}
+
+/// [`greedy_cones`] with a choice of search on closed surfaces.
+pub fn greedy_cones_with(
+    mesh: &Mesh,
+    metric: &IntrinsicMetric,
+    budget: ConeBudget,
+    search: ConeSearch,
+) -> Result<ConePlacement> {
     let lengths = metric.lengths();
     let lap = laplacian(mesh, lengths)?;
     let n = lap.n;
@@ -175,11 +198,53 @@ pub fn greedy_cones(
     if !boundary.iter().any(|&b| b) {
         let chi = crate::metric::euler_characteristic(mesh) as f64;
         let mut g = GreenBasis::new(&lap, &k0, chi, used.clone())?;
-        let mut p = closed::place_cones(&mut g, &k0, &used, budget)?;
+        let mut p = closed::place_cones(&mut g, &k0, &used, budget, search == ConeSearch::Energy)?;
         keep_angles_positive(&mut p.cones, 2.0 * PI * chi);
         return Ok(p);
     }
     greedy_with_boundary(&lap, &k0, &boundary, &used, budget)
+}
+
+/// How cones at given positions get their curvatures (see [`cone_curvatures_at`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CurvatureRule {
+    /// `u = 0` at every cone (Ben-Chen–Gotsman–Bunin; BFF's cone angles).
+    Dirichlet,
+    /// Least area-weighted `‖u − ū‖²` (Soliman–Slepčev–Crane 2018 with positions fixed).
+    LeastSquares,
+}
+
+/// Curvatures `(vertex, K̄)` (`Σ K̄ = 2πχ`) of cones at `vertices` of a closed, connected
+/// mesh by `rule`, and the linearised area-weighted `σ(2u)` they leave: the placement's
+/// energy, so that positions from elsewhere (another tool's cones) can be compared with
+/// [`greedy_cones`]' at equal footing.
+pub fn cone_curvatures_at(
+    mesh: &Mesh,
+    metric: &IntrinsicMetric,
+    vertices: &[u32],
+    rule: CurvatureRule,
+) -> Result<(Vec<(u32, f64)>, f64)> {
+    let lap = laplacian(mesh, metric.lengths())?;
+    let n = lap.n;
+    if let Some(&v) = vertices.iter().find(|&&v| v as usize >= n) {
+        return Err(Error::input(format!(
+            "cone vertex {v} is not a vertex of the mesh ({n} vertices)"
+        )));
+    }
+    if (0..n as u32).any(|v| mesh.is_boundary_vertex(v)) {
+        return Err(Error::input(
+            "cone curvatures at given positions need a closed surface",
+        ));
+    }
+    let k0 = angle_defects(mesh, metric);
+    let used: Vec<bool> = (0..n as u32).map(|v| !mesh.is_isolated(v)).collect();
+    let chi = crate::metric::euler_characteristic(mesh) as f64;
+    let mut g = GreenBasis::new(&lap, &k0, chi, used)?;
+    let (k, u) = match rule {
+        CurvatureRule::Dirichlet => g.dirichlet(vertices)?,
+        CurvatureRule::LeastSquares => g.least_squares(vertices)?,
+    };
+    Ok((k, g.sigma_2x(&u)))
 }
 
 /// The greedy with the boundary held at `u = 0`: one factorization per cone.

@@ -123,6 +123,9 @@ pub struct ParamOptions {
     /// Write every chart on the common subdivision of the input and the flat triangulation,
     /// also where the input's own faces would not fold (default false: only where needed).
     pub on_subdivision: bool,
+    /// Search of the automatic cone placement on closed surfaces (default
+    /// [`cones::ConeSearch::Greedy`]; `Energy` is the wider, opt-in search).
+    pub cone_search: cones::ConeSearch,
 }
 
 impl Default for ParamOptions {
@@ -136,6 +139,7 @@ impl Default for ParamOptions {
             max_cones: 64,
             cone_corrections: 0,
             on_subdivision: false,
+            cone_search: cones::ConeSearch::Greedy,
         }
     }
 }

@@ -6,10 +6,18 @@
 //!    Dirichlet solution (`u = 0` at the cones) has the largest `|u|`. The greedy is run from
 //!    two first cones — BFF's, and the extremum of the smooth solution `w₀` (the total
 //!    curvature spread by area) — and the set with the smaller area-weighted `σ(2u)` is kept.
-//! 2. **Cone moves** (a Lloyd-type local search): each cone in turn is taken out, the
-//!    Dirichlet solution of the others is computed, and the cone is put back at its largest
-//!    `|u|` when that lowers the energy below; rounds until nothing moves (at most
-//!    [`MOVE_ROUNDS`]).
+//!
+//!    1b. Only with the wide search ([`super::ConeSearch::Energy`], opt-in) and a cone
+//!    count (not a distortion bound), also the **greedy on the energy**
+//!    from the same two first cones: each new cone is the best, by the energy below, of a
+//!    few candidates — the extremes of the adjoint `φ = L⁺M(u − ū)` of the least-squares
+//!    field (`φ_v − λ` is the derivative of the energy with respect to curvature moved to
+//!    `v`; Soliman–Slepčev–Crane 2018 §4), its largest `|u|`, and the Dirichlet greedy's
+//!    vertex. The set of least energy among all runs is kept.
+//! 2. **Cone moves** (a Lloyd-type local search): each cone in turn is taken out and put
+//!    back at the largest `|u|` of the others' Dirichlet solution (with the wide search: at
+//!    the best of step 1b's candidates) when that lowers the energy below; rounds until
+//!    nothing moves (at most [`MOVE_ROUNDS`]).
 //! 3. **Curvatures** of least area-weighted `‖u − ū‖²` at the final positions
 //!    (Soliman–Slepčev–Crane 2018 with the positions fixed), not the Dirichlet ones: on
 //!    botijo with 8 cones the linearised `σ(2u)` drops from 1.41 to 1.21.
@@ -44,8 +52,7 @@ fn spread(g: &GreenBasis, u: &[f64], used: &[bool]) -> f64 {
 
 /// Area-weighted `σ(2u)` of the least-squares curvatures at `cones` (step 3).
 fn energy(g: &mut GreenBasis, cones: &[u32]) -> Result<f64> {
-    let (_, u) = g.least_squares(cones)?;
-    Ok(g.sigma_2x(&u))
+    g.least_squares_sigma(cones)
 }
 
 /// The greedy from `first` (step 1), with its spread history.
@@ -73,6 +80,70 @@ fn greedy_from(
     Ok((cones, history))
 }
 
+/// Where one more cone may go, given `cones` (step 1b of the module docs): the extremes of
+/// the adjoint `φ − λ` of the least-squares field (the first-order best places for positive
+/// and for negative curvature), the largest `|u|` of that field, and the largest `|u|` of the
+/// Dirichlet field (the classic greedy's choice). Deduplicated.
+fn candidates(g: &mut GreenBasis, cones: &[u32], used: &[bool], wide: bool) -> Result<Vec<u32>> {
+    if !wide {
+        // The classic move: the largest |u| of the Dirichlet field only.
+        let (_, ud) = g.dirichlet(cones)?;
+        return Ok(farthest(&ud, cones, used).into_iter().collect());
+    }
+    let (_, u) = g.least_squares(cones)?;
+    let phi = g.adjoint(&u);
+    let lambda = cones.iter().map(|&c| phi[c as usize]).sum::<f64>() / cones.len() as f64;
+    let free = |v: &usize| used[*v] && !cones.contains(&(*v as u32));
+    let d: Vec<f64> = phi.iter().map(|x| x - lambda).collect();
+    let mut out = Vec::new();
+    out.extend(
+        (0..d.len())
+            .filter(free)
+            .max_by(|&a, &b| d[a].total_cmp(&d[b])),
+    );
+    out.extend(
+        (0..d.len())
+            .filter(free)
+            .min_by(|&a, &b| d[a].total_cmp(&d[b])),
+    );
+    out.extend(
+        (0..u.len())
+            .filter(free)
+            .max_by(|&a, &b| u[a].abs().total_cmp(&u[b].abs())),
+    );
+    let (_, ud) = g.dirichlet(cones)?;
+    out.extend(farthest(&ud, cones, used).map(|v| v as usize));
+    let mut c: Vec<u32> = out.into_iter().map(|v| v as u32).collect();
+    c.sort_unstable();
+    c.dedup();
+    Ok(c)
+}
+
+/// The greedy on the energy itself (step 1b): from `first`, each new cone is the candidate
+/// of [`candidates`] whose least-squares `σ(2u)` is smallest.
+fn greedy_by_energy(
+    g: &mut GreenBasis,
+    first: u32,
+    used: &[bool],
+    max_cones: usize,
+) -> Result<Vec<u32>> {
+    let mut cones = vec![first];
+    while cones.len() < max_cones {
+        let mut best: Option<(f64, u32)> = None;
+        for c in candidates(g, &cones, used, true)? {
+            let mut trial = cones.clone();
+            trial.push(c);
+            let s = energy(g, &trial)?;
+            if best.is_none_or(|b| s < b.0) {
+                best = Some((s, c));
+            }
+        }
+        let Some((_, c)) = best else { break };
+        cones.push(c);
+    }
+    Ok(cones)
+}
+
 /// Cone moves (step 2): returns the improved set and its `σ(2u)`. With a distortion bound,
 /// a move is kept only if the linearised spread stays within it.
 fn move_cones(
@@ -80,6 +151,7 @@ fn move_cones(
     mut cones: Vec<u32>,
     used: &[bool],
     bound: f64,
+    wide: bool,
 ) -> Result<Vec<u32>> {
     let mut best = energy(g, &cones)?;
     for _ in 0..MOVE_ROUNDS {
@@ -90,24 +162,22 @@ fn move_cones(
             if others.is_empty() {
                 continue;
             }
-            let (_, u) = g.dirichlet(&others)?;
-            let Some(c) = farthest(&u, &others, used) else {
-                continue;
-            };
-            if c == cones[i] {
-                continue;
-            }
-            let mut trial = others;
-            trial.insert(i, c);
-            let s = energy(g, &trial)?;
-            let within = bound < 0.0 || {
-                let (_, u) = g.dirichlet(&trial)?;
-                spread(g, &u, used) <= bound
-            };
-            if s < best - 1e-12 && within {
-                best = s;
-                cones = trial;
-                moved = true;
+            for c in candidates(g, &others, used, wide)? {
+                if c == cones[i] {
+                    continue;
+                }
+                let mut trial = others.clone();
+                trial.insert(i, c);
+                let s = energy(g, &trial)?;
+                let within = bound < 0.0 || {
+                    let (_, u) = g.dirichlet(&trial)?;
+                    spread(g, &u, used) <= bound
+                };
+                if s < best - 1e-12 && within {
+                    best = s;
+                    cones = trial;
+                    moved = true;
+                }
             }
         }
         if !moved {
@@ -123,6 +193,7 @@ pub(super) fn place_cones(
     k0: &[f64],
     used: &[bool],
     budget: ConeBudget,
+    wide: bool,
 ) -> Result<ConePlacement> {
     let (max_cones, bound) = match budget {
         ConeBudget::Count(c) => (c, -1.0),
@@ -150,6 +221,18 @@ pub(super) fn place_cones(
         if best.as_ref().is_none_or(|b| s < b.0) {
             best = Some((s, cones, history));
         }
+        if wide && bound < 0.0 {
+            let cones = greedy_by_energy(g, first as u32, used, max_cones)?;
+            let s = energy(g, &cones)?;
+            if best.as_ref().is_none_or(|b| s < b.0) {
+                let mut history = Vec::with_capacity(cones.len());
+                for k in 1..=cones.len() {
+                    let (_, u) = g.dirichlet(&cones[..k])?;
+                    history.push(spread(g, &u, used));
+                }
+                best = Some((s, cones, history));
+            }
+        }
     }
     let Some((_, cones, history)) = best else {
         return Ok(ConePlacement {
@@ -157,7 +240,7 @@ pub(super) fn place_cones(
             distortion_history: Vec::new(),
         });
     };
-    let cones = move_cones(g, cones, used, bound)?;
+    let cones = move_cones(g, cones, used, bound, wide)?;
     let (k, _) = g.least_squares(&cones)?;
     Ok(ConePlacement {
         cones: k,

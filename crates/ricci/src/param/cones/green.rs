@@ -35,6 +35,10 @@ pub(super) struct GreenBasis {
     pub chi: f64,
     pub w0: Vec<f64>,
     columns: HashMap<u32, Vec<f64>>,
+    /// Cached `g_aᵀ M g_b` (key `(min, max)`), `g_aᵀ M w₀` and `w₀ᵀ M w₀`.
+    gram: HashMap<(u32, u32), f64>,
+    gram_w0: HashMap<u32, f64>,
+    w0_norm2: f64,
 }
 
 impl GreenBasis {
@@ -73,11 +77,15 @@ impl GreenBasis {
             chi,
             w0: Vec::new(),
             columns: HashMap::new(),
+            gram: HashMap::new(),
+            gram_w0: HashMap::new(),
+            w0_norm2: 0.0,
         };
         let rhs: Vec<f64> = (0..n)
             .map(|v| -(k0[v] - 2.0 * PI * chi * g.area[v] / total_area))
             .collect();
         g.w0 = g.solve_zero_mean(rhs);
+        g.w0_norm2 = (0..n).map(|v| g.area[v] * g.w0[v] * g.w0[v]).sum();
         Ok(g)
     }
 
@@ -95,6 +103,26 @@ impl GreenBasis {
             *y = if u { *y - m } else { 0.0 };
         }
         x
+    }
+
+    /// The adjoint `φ = L⁺ M (u − ū)` (zero area mean) of a field `u`: `φ_v` is the
+    /// derivative of `½‖u − ū‖²_M` with respect to curvature added at `v`
+    /// (`∂/∂k_v` of `u = w₀ + Σ k g` is `g_v`, and `g_vᵀ M ũ = φ_v`; Soliman–Slepčev–Crane
+    /// 2018 §4). At least-squares curvatures `φ` is equal at every cone (the multiplier of
+    /// `Σ k = 2πχ`); where it differs most from that value a new cone lowers the energy most
+    /// to first order.
+    pub fn adjoint(&mut self, u: &[f64]) -> Vec<f64> {
+        let m = self.mean(u);
+        let rhs: Vec<f64> = (0..self.n)
+            .map(|v| {
+                if self.used[v] {
+                    self.area[v] * (u[v] - m)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        self.solve_zero_mean(rhs)
     }
 
     /// Area-weighted mean.
@@ -156,6 +184,77 @@ impl GreenBasis {
         rhs[m] = 2.0 * PI * self.chi;
         let x = crate::analysis::forms::small::solve(&a, &rhs);
         self.finish(cones, &x, true)
+    }
+
+    /// `g_aᵀ M g_b`, computed once.
+    fn gram(&mut self, a: u32, b: u32) -> f64 {
+        let key = (a.min(b), a.max(b));
+        if let Some(&v) = self.gram.get(&key) {
+            return v;
+        }
+        self.column(a);
+        self.column(b);
+        let (x, y) = (&self.columns[&a], &self.columns[&b]);
+        let v: f64 = x
+            .iter()
+            .zip(y)
+            .zip(&self.area)
+            .map(|((p, q), w)| p * q * w)
+            .sum();
+        self.gram.insert(key, v);
+        v
+    }
+
+    /// `g_aᵀ M w₀`, computed once.
+    fn gram_w0(&mut self, a: u32) -> f64 {
+        if let Some(&v) = self.gram_w0.get(&a) {
+            return v;
+        }
+        self.column(a);
+        let x = &self.columns[&a];
+        let v: f64 = x
+            .iter()
+            .zip(&self.w0)
+            .zip(&self.area)
+            .map(|((p, q), w)| p * q * w)
+            .sum();
+        self.gram_w0.insert(a, v);
+        v
+    }
+
+    /// The area-weighted `σ(2u)` of [`GreenBasis::least_squares`]' field, from the cached
+    /// inner products alone (`u = w₀ + Σ k g` has zero area mean, so
+    /// `σ² = (w₀ᵀMw₀ + 2 Σ k_c g_cᵀMw₀ + Σ k_a k_b g_aᵀMg_b) / A`): no pass over the
+    /// vertices once the cones' Green's functions are known.
+    pub fn least_squares_sigma(&mut self, cones: &[u32]) -> Result<f64> {
+        let m = cones.len();
+        let mut a = vec![vec![0.0; m + 1]; m + 1];
+        let mut rhs = vec![0.0; m + 1];
+        for i in 0..m {
+            for j in i..m {
+                let d = self.gram(cones[i], cones[j]);
+                a[i][j] = d;
+                a[j][i] = d;
+            }
+            a[i][m] = 1.0;
+            a[m][i] = 1.0;
+            rhs[i] = -self.gram_w0(cones[i]);
+        }
+        rhs[m] = 2.0 * PI * self.chi;
+        let x = crate::analysis::forms::small::solve(&a, &rhs);
+        if x.iter().any(|v| !v.is_finite()) {
+            return Err(Error::numerical(
+                "the cone curvature system is singular (two cones at one vertex?)",
+            ));
+        }
+        let mut s = self.w0_norm2;
+        for i in 0..m {
+            s -= 2.0 * x[i] * rhs[i];
+            for j in 0..m {
+                s += x[i] * x[j] * a[i][j];
+            }
+        }
+        Ok(2.0 * (s.max(0.0) / self.total_area).sqrt())
     }
 
     /// Cone curvatures of least area-weighted `‖u − ū‖²` at fixed positions (module docs).
