@@ -7,6 +7,9 @@ use ricci::metric::{self, Geometry};
 use std::path::PathBuf;
 use std::process::Command;
 
+#[path = "../../ricci/tests/ricci_meshes/mod.rs"]
+mod ricci_meshes;
+
 fn ricci() -> Command {
     Command::new(env!("CARGO_BIN_EXE_ricci"))
 }
@@ -342,4 +345,40 @@ fn refine_degenerate_writes_the_refined_mesh() {
         m["vertices"].as_u64().unwrap() as usize,
         r.mesh.n_vertices()
     );
+}
+
+/// `--refine-degenerate` with the default conformal scheme (the README's face.off example):
+/// that flow's lengths belong to its intrinsic triangulation, so there is nothing of the input
+/// to bisect. The refined mesh must be the one `--widen-boundary 3` alone writes, and the flow
+/// converged. (Read as lengths of the input's edges, they flagged thousands of faces: 2 rounds
+/// added 3 788 vertices and reported "not converged"; 40 rounds doubled the mesh until it
+/// ran out of time.)
+#[test]
+fn refine_degenerate_with_the_conformal_scheme_bisects_nothing() {
+    let Some(meshes) = ricci_meshes::ricci_meshes() else {
+        eprintln!("RICCI_MESHES not set: skipped");
+        return;
+    };
+    let face = meshes.join("face.off");
+    let run = |extra: &[&str], refined: &PathBuf| {
+        let o = ricci()
+            .arg("flow")
+            .arg(&face)
+            .args(["--target", "round-boundary", "--widen-boundary", "3"])
+            .args(extra)
+            .args(["--json", "--refined-out"])
+            .arg(refined)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(j["scheme"], "conformal");
+        assert_eq!(j["converged"], true, "{j}");
+        assert_eq!(j["degenerate_faces"], 0);
+        read_surface(refined).unwrap().0.mesh
+    };
+    let widened = run(&[], &scratch("face-widened.off"));
+    let refined = run(&["--refine-degenerate", "3"], &scratch("face-refined.off"));
+    assert_eq!(refined.n_vertices(), widened.n_vertices());
+    assert_eq!(refined.faces(), widened.faces());
 }

@@ -78,6 +78,10 @@ pub fn ricci_flow_refined(
     loop {
         let attempt = ricci_flow(&refined.mesh, &refined.lengths, options, progress);
         let bad = match &attempt {
+            // A conformal flow's lengths belong to its intrinsic triangulation, not to these
+            // faces (read as the input's, they flagged thousands of faces and every round
+            // doubled the mesh); its metric has no degenerate face.
+            Ok(r) if r.triangulation.is_some() => Vec::new(),
             Ok(r) => under_resolved_faces(&refined.mesh, r.geometry, &r.lengths),
             Err(_) => Vec::new(),
         };

@@ -632,15 +632,25 @@ pub fn check_chow_luo(mesh: &Mesh, geometry: Geometry, target: &Target, phi: &[f
         }
         let margin = 1e-12 * (1.0 + bound.abs());
         if sum <= bound + margin {
+            // An ear (a boundary vertex with one face) needs a split, not more neighbours.
+            let ear = set.len() == 1
+                && mesh.is_boundary_vertex(set[0])
+                && mesh.vertex_faces(set[0]).count() == 1;
+            let why = if ear {
+                "split the edge opposite the ear to give it two faces: `--widen-boundary 2 \
+                 --refined-out MESH`"
+            } else {
+                "too few neighbours for the curvature asked; `ricci atlas` raises the valence \
+                 around a cone"
+            };
             return Err(chow_luo(
                 set,
                 format!(
                     "target curvature is not admissible (Chow–Luo condition, paper 000 eq. 7) at \
                  {label}: Σ K̄ = {sum:.6} must exceed −Σ(π − φ) + 2πχ(F_I) = {bound:.6} (short by \
                  {:.3e}): circle packing cannot give these vertices their target on this \
-                 triangulation (too few neighbours for the curvature asked; `ricci atlas` \
-                 raises the valence around a cone); try: --scheme conformal (the default), \
-                 which has no such condition",
+                 triangulation ({why}); try: --scheme conformal (the default), which has no \
+                 such condition",
                     bound - sum
                 ),
                 bound - sum,
@@ -655,7 +665,7 @@ pub fn check_chow_luo(mesh: &Mesh, geometry: Geometry, target: &Target, phi: &[f
         let label = if mesh.is_boundary_vertex(v) && mesh.vertex_faces(v).count() == 1 {
             format!(
                 "the single vertex {v}, a boundary vertex with one face (an ear: its one corner \
-                 would have to open to π − K̄; split the opposite edge to give it two faces: `ricci flow --widen-boundary 2`)"
+                 would have to open to π − K̄)"
             )
         } else {
             format!("the single vertex {v} (valence {})", mesh.valence(v))

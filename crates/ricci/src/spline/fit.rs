@@ -618,15 +618,23 @@ pub fn fit_with_progress<S: SplineSpace + ?Sized>(
             "fit: the normal equations produced non-finite control points",
         ));
     }
-    // Objective pieces and the residual of the normal equations.
+    // Objective pieces and the residual of the normal equations (the products are independent
+    // of each other: run side by side, each with its own operations in its own order).
     let hx = |c: &[f64]| {
-        let mut y = vec![0.0; nc * dim];
-        data_blocks.apply(c, dim, &mut y);
-        let mut t = vec![0.0; nc * dim];
-        energy_blocks.apply(c, dim, &mut t);
-        (y, t)
+        rayon::join(
+            || {
+                let mut y = vec![0.0; nc * dim];
+                data_blocks.apply(c, dim, &mut y);
+                y
+            },
+            || {
+                let mut t = vec![0.0; nc * dim];
+                energy_blocks.apply(c, dim, &mut t);
+                t
+            },
+        )
     };
-    let (dx, tx) = hx(&x);
+    let ((dx, tx), (_, t0)) = rayon::join(|| hx(&x), || hx(initial));
     let mut res2 = 0.0;
     let mut b2 = 0.0;
     for k in 0..nc * dim {
@@ -654,11 +662,16 @@ pub fn fit_with_progress<S: SplineSpace + ?Sized>(
         let ridge: f64 = c.iter().zip(initial).map(|(a, b)| (a - b) * (a - b)).sum();
         Ok(s / kdata + lam * e + gamma * ridge)
     };
-    let (_, t0) = hx(initial);
     let e0 = energy(initial, &t0);
-    let obj0 = objective(initial, e0, &mut errs, &mut ws, &mut out)?;
     let e1 = energy(&x, &tx);
-    let obj1 = objective(&x, e1, &mut errs, &mut ws, &mut out)?;
+    let (obj0, obj1) = rayon::join(
+        || {
+            let mut ws0 = Workspace::with_precision(Precision::Double);
+            objective(initial, e0, &mut Vec::new(), &mut ws0, &mut vec![0.0; dim])
+        },
+        || objective(&x, e1, &mut errs, &mut ws, &mut out),
+    );
+    let (obj0, obj1) = (obj0?, obj1?);
     let rms = (errs.iter().map(|e| e * e).sum::<f64>() / kdata).sqrt();
     let max = errs.iter().fold(0.0f64, |a, &b| a.max(b));
     Ok((

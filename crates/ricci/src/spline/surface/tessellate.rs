@@ -224,7 +224,7 @@ struct Welded {
 /// vertex or edge is one vertex of the tessellation, shared by the faces around it (its value
 /// and seam level are taken from the first face that reaches it), so the spline part is one
 /// connected mesh and vertex normals average across patch boundaries instead of stopping at
-/// them.
+/// them. The owners are decided first (in face order), so each shared point is evaluated once.
 fn sample_welded<A: FlatCharts + Sync + ?Sized>(
     space: &ManifoldSpace<'_, A>,
     spline: &ManifoldSpline,
@@ -233,15 +233,37 @@ fn sample_welded<A: FlatCharts + Sync + ?Sized>(
 ) -> Result<Welded> {
     use rayon::prelude::*;
     let (m, mesh, control) = (grid.m, space.charts().mesh(), &spline.control);
+    // Owners: a shared point is the first face's to reach it; `own[k]`: face k's new points.
+    let mut shared: HashMap<GridKey, u32> = HashMap::new();
+    let mut ids: Vec<Vec<u32>> = Vec::with_capacity(faces.len());
+    let mut own: Vec<Vec<usize>> = Vec::with_capacity(faces.len());
+    let mut n = 0u32;
+    for &f in faces {
+        let mut local = Vec::with_capacity(grid.points.len());
+        let mut mine = Vec::with_capacity(grid.points.len());
+        for (q, &(i, j)) in grid.points.iter().enumerate() {
+            let id = match grid_key(mesh, f, [m - i - j, i, j]) {
+                Some(key) => *shared.entry(key).or_insert(n),
+                None => n,
+            };
+            if id == n {
+                mine.push(q);
+                n += 1;
+            }
+            local.push(id);
+        }
+        ids.push(local);
+        own.push(mine);
+    }
     #[allow(clippy::type_complexity)]
     let per: Vec<(Vec<[f64; 3]>, Vec<SeamLevel>)> = faces
         .par_iter()
-        .map(|&f| -> Result<(Vec<[f64; 3]>, Vec<SeamLevel>)> {
-            let mut ws = Workspace::default();
-            let mut out = [0.0; 3];
-            let mut p = Vec::with_capacity(grid.points.len());
-            let mut lv = Vec::with_capacity(grid.points.len());
-            for q in 0..grid.points.len() {
+        .zip(&own)
+        .map(|(&f, mine)| -> Result<(Vec<[f64; 3]>, Vec<SeamLevel>)> {
+            let (mut ws, mut out) = (Workspace::default(), [0.0; 3]);
+            let mut p = Vec::with_capacity(mine.len());
+            let mut lv = Vec::with_capacity(mine.len());
+            for &q in mine {
                 let b = grid.bary(q);
                 space.evaluate(control, 3, f, b, 0, &mut ws, &mut out)?;
                 p.push(out);
@@ -251,30 +273,17 @@ fn sample_welded<A: FlatCharts + Sync + ?Sized>(
         })
         .collect::<Result<_>>()?;
     let mut t = Tessellation::default();
-    let mut level: Vec<SeamLevel> = Vec::new();
-    let mut shared: HashMap<GridKey, u32> = HashMap::new();
-    let mut ids: Vec<Vec<u32>> = Vec::with_capacity(faces.len());
+    let mut level: Vec<SeamLevel> = Vec::with_capacity(n as usize);
     for (k, (p, lv)) in per.into_iter().enumerate() {
         let f = faces[k];
         let chart = space.canonical_chart(f) as i64;
-        let mut local = Vec::with_capacity(grid.points.len());
-        for (q, &(i, j)) in grid.points.iter().enumerate() {
-            let key = grid_key(mesh, f, [m - i - j, i, j]);
-            let next = t.positions.len() as u32;
-            let id = match key {
-                Some(key) => *shared.entry(key).or_insert(next),
-                None => next,
-            };
-            if id == next {
-                t.positions.push(p[q]);
-                t.vertex_face.push(f as i64);
-                t.vertex_chart.push(chart);
-                t.vertex_bary.push(grid.bary(q));
-                level.push(lv[q]);
-            }
-            local.push(id);
+        for (&q, (x, l)) in own[k].iter().zip(p.into_iter().zip(lv)) {
+            t.positions.push(x);
+            t.vertex_face.push(f as i64);
+            t.vertex_chart.push(chart);
+            t.vertex_bary.push(grid.bary(q));
+            level.push(l);
         }
-        ids.push(local);
     }
     Ok(Welded { t, level, ids })
 }
@@ -615,54 +624,70 @@ fn domain_edge_lines<A: FlatCharts + Sync + ?Sized>(
     spline: &ManifoldSpline,
     m: usize,
 ) -> Result<Vec<Vec<[f64; 3]>>> {
+    use rayon::prelude::*;
     let (mesh, control, holes) = (space.charts().mesh(), &spline.control, &spline.holes);
-    let mut ws = Workspace::default();
-    let mut out = [0.0; 3];
-    let mut lines = Vec::new();
-    for h in 0..mesh.n_corners() as u32 {
-        let f = h / 3;
-        let tw = mesh.he_twin(h);
-        if !space.is_active(f)
-            || (!mesh.is_boundary_halfedge(tw) && space.is_active(tw / 3) && tw < h)
-        {
-            continue;
-        }
-        let i = h as usize % 3;
-        let mut line: Vec<[f64; 3]> = Vec::with_capacity(m + 1);
-        let mut prev: Option<([f64; 3], SeamLevel)> = None;
-        for s in 0..=m {
-            let a = s as f64 / m as f64;
-            let mut b = [0.0; 3];
-            b[i] = 1.0 - a;
-            b[(i + 1) % 3] = a;
-            let lv = level_at(holes, f, b);
-            if let Some((pb, pl)) = prev {
-                if inside(pl) != inside(lv) {
-                    // The edge enters or leaves a seam between two samples: end or start the
-                    // polyline on the seam.
-                    let hh = pl.or(lv).map(|x| x.0).unwrap_or(0);
-                    if let Some((_, bc, _)) = holes[hh].seam_crossing(f, pb, b) {
-                        space.evaluate(control, 3, f, bc, 0, &mut ws, &mut out)?;
-                        line.push(out);
+    // Each domain edge once (from its higher half-edge's active face), side by side.
+    let edges: Vec<u32> = (0..mesh.n_corners() as u32)
+        .filter(|&h| {
+            let tw = mesh.he_twin(h);
+            space.is_active(h / 3)
+                && !(!mesh.is_boundary_halfedge(tw) && space.is_active(tw / 3) && tw < h)
+        })
+        .collect();
+    let per: Vec<Vec<Vec<[f64; 3]>>> = edges
+        .par_iter()
+        .map_init(Workspace::default, |ws, &h| {
+            edge_lines(space, control, holes, h, m, ws)
+        })
+        .collect::<Result<_>>()?;
+    Ok(per.into_iter().flatten().collect())
+}
+
+/// The polylines of half-edge `h`'s domain edge (see [`domain_edge_lines`]).
+fn edge_lines<A: FlatCharts + Sync + ?Sized>(
+    space: &ManifoldSpace<'_, A>,
+    control: &[f64],
+    holes: &[Hole],
+    h: u32,
+    m: usize,
+    ws: &mut Workspace,
+) -> Result<Vec<Vec<[f64; 3]>>> {
+    let (mut out, mut lines) = ([0.0; 3], Vec::new());
+    let (f, i) = (h / 3, h as usize % 3);
+    let mut line: Vec<[f64; 3]> = Vec::with_capacity(m + 1);
+    let mut prev: Option<([f64; 3], SeamLevel)> = None;
+    for s in 0..=m {
+        let a = s as f64 / m as f64;
+        let mut b = [0.0; 3];
+        b[i] = 1.0 - a;
+        b[(i + 1) % 3] = a;
+        let lv = level_at(holes, f, b);
+        if let Some((pb, pl)) = prev {
+            if inside(pl) != inside(lv) {
+                // The edge enters or leaves a seam between two samples: end or start the
+                // polyline on the seam.
+                let hh = pl.or(lv).map(|x| x.0).unwrap_or(0);
+                if let Some((_, bc, _)) = holes[hh].seam_crossing(f, pb, b) {
+                    space.evaluate(control, 3, f, bc, 0, ws, &mut out)?;
+                    line.push(out);
+                }
+                if inside(lv) {
+                    if line.len() >= 2 {
+                        lines.push(std::mem::take(&mut line));
                     }
-                    if inside(lv) {
-                        if line.len() >= 2 {
-                            lines.push(std::mem::take(&mut line));
-                        }
-                        line.clear();
-                    }
+                    line.clear();
                 }
             }
-            prev = Some((b, lv));
-            if inside(lv) {
-                continue;
-            }
-            space.evaluate(control, 3, f, b, 0, &mut ws, &mut out)?;
-            line.push(out);
         }
-        if line.len() >= 2 {
-            lines.push(line);
+        prev = Some((b, lv));
+        if inside(lv) {
+            continue;
         }
+        space.evaluate(control, 3, f, b, 0, ws, &mut out)?;
+        line.push(out);
+    }
+    if line.len() >= 2 {
+        lines.push(line);
     }
     Ok(lines)
 }
