@@ -310,6 +310,18 @@ pub struct Reporter {
     after: f64,
     last: Option<std::time::Instant>,
     last_stage: String,
+    /// The last stage and message reported and when a line was last printed, shared with the
+    /// heartbeat thread of [`Reporter::with_heartbeat`].
+    beat: std::sync::Arc<std::sync::Mutex<Beat>>,
+    /// Seconds between heartbeat lines (10; `RICCI_PROGRESS_EVERY`).
+    every: f64,
+}
+
+/// What [`Reporter::with_heartbeat`]'s thread needs to print its line.
+struct Beat {
+    stage: String,
+    message: String,
+    printed: std::time::Instant,
 }
 
 impl Reporter {
@@ -328,6 +340,16 @@ impl Reporter {
                 .unwrap_or(2.0),
             last: None,
             last_stage: String::new(),
+            beat: std::sync::Arc::new(std::sync::Mutex::new(Beat {
+                stage: String::new(),
+                message: String::new(),
+                printed: std::time::Instant::now(),
+            })),
+            every: std::env::var("RICCI_PROGRESS_EVERY")
+                .ok()
+                .and_then(|s| s.parse::<f64>().ok())
+                .filter(|s| s.is_finite() && *s > 0.0)
+                .unwrap_or(10.0),
         }
     }
 
@@ -383,11 +405,54 @@ impl Reporter {
             out
         })
     }
+
+    /// Runs `work` with this reporter and, when lines are on, a heartbeat: whenever no line
+    /// went to stderr for `every` seconds (10; `RICCI_PROGRESS_EVERY`), one line
+    /// `stage: message (still running)` with the last stage reported — for steps that report
+    /// nothing while they work (one large sparse factorisation, e.g. the spline's fairing),
+    /// so that a log shows the command is alive (issue 22 item 4).
+    pub fn with_heartbeat<T>(&mut self, work: impl FnOnce(&mut Reporter) -> T) -> T {
+        if !self.lines {
+            return work(self);
+        }
+        let done = std::sync::atomic::AtomicBool::new(false);
+        let (t0, after, every) = (self.t0, self.after, self.every);
+        let beat = std::sync::Arc::clone(&self.beat);
+        std::thread::scope(|scope| {
+            scope.spawn(|| {
+                while !done.load(std::sync::atomic::Ordering::Relaxed) {
+                    std::thread::sleep(std::time::Duration::from_millis(50));
+                    let Ok(mut b) = beat.lock() else { return };
+                    if t0.elapsed().as_secs_f64() >= after
+                        && b.printed.elapsed().as_secs_f64() >= every
+                        && !b.stage.is_empty()
+                    {
+                        eprintln!(
+                            "ricci: [{:7.1} s] {}: {} (still running)",
+                            t0.elapsed().as_secs_f64(),
+                            b.stage,
+                            b.message
+                        );
+                        b.printed = std::time::Instant::now();
+                    }
+                }
+            });
+            let out = work(self);
+            done.store(true, std::sync::atomic::Ordering::Relaxed);
+            out
+        })
+    }
 }
 
 impl ricci::progress::Progress for Reporter {
     fn report(&mut self, stage: &str, fraction: Option<f64>, message: &str) {
         self.bar.report(stage, fraction, message);
+        if let Ok(mut b) = self.beat.lock() {
+            b.stage.clear();
+            b.stage.push_str(stage);
+            b.message.clear();
+            b.message.push_str(message);
+        }
         if !self.lines || self.t0.elapsed().as_secs_f64() < self.after {
             return;
         }
@@ -402,6 +467,9 @@ impl ricci::progress::Progress for Reporter {
             );
             self.last = Some(std::time::Instant::now());
             self.last_stage = stage.to_string();
+            if let Ok(mut b) = self.beat.lock() {
+                b.printed = std::time::Instant::now();
+            }
         }
     }
 }

@@ -427,6 +427,39 @@ fn spectrum_prints_progress_lines_when_stderr_is_not_a_terminal() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// Item 4: a step that reports nothing while it works (the spline's fairing: one sparse
+/// factorisation) still shows the command is alive — a heartbeat line `(still running)` on
+/// stderr when it is not a terminal (every 10 s; here every 0.02 s, so the disk's
+/// steps of ~0.1 s are long enough). Before the heartbeat the spline printed no such line.
+#[test]
+fn spline_heartbeat_shows_it_is_alive_during_silent_steps() {
+    let d = tmp("spline-heartbeat");
+    let disk = generate(&d, "disk", "24");
+    let o = Command::new(env!("CARGO_BIN_EXE_ricci"))
+        .args(["spline", disk.to_str().unwrap(), "--json"])
+        .env("RICCI_PROGRESS_AFTER", "0")
+        .env("RICCI_PROGRESS_EVERY", "0.02")
+        .output()
+        .unwrap();
+    let e = err(&o);
+    assert!(o.status.success(), "{e}");
+    let beats: Vec<&str> = e
+        .lines()
+        .filter(|l| l.starts_with("ricci: [") && l.ends_with("(still running)"))
+        .collect();
+    assert!(!beats.is_empty(), "no heartbeat line on stderr: {e}");
+    // Each names a stage the spline reported (not an empty one).
+    assert!(
+        beats
+            .iter()
+            .all(|l| ["knots", "fairing", "fit", "fill", "measure"]
+                .iter()
+                .any(|s| l.contains(&format!("] {s}")))),
+        "{beats:?}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 /// Item 7: `layout` says what it wrote (file, and that it holds the input's vertices and faces,
 /// which the README's `render --uv` needs) — one line, on stderr, naming the file.
 #[test]

@@ -148,7 +148,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     let t_ricci = t_ricci.elapsed().as_secs_f64();
     let charts: &(dyn FlatCharts + Sync) = provider.as_ref();
-    let (rep, tess, control) = run_spline(charts, &dist, &opts, a.tessellation, &mut bar)?;
+    // The fairing and the fit's solves report nothing while they run: a heartbeat line every
+    // 10 s on stderr (when it is not a terminal) shows the command is alive.
+    let (rep, tess, control) =
+        bar.with_heartbeat(|bar| run_spline(charts, &dist, &opts, a.tessellation, bar))?;
     bar.bar.0.finish_and_clear();
     let topo = ricci::mesh::topology(&surface.mesh);
     let singular: Option<u32> = charts.singular_vertices().first().copied();
