@@ -101,7 +101,7 @@ pub fn estimate(faces: usize, degree: usize, fairness: usize, fit: bool) -> (f64
 /// degree 4 r = 2 without fit (CPU-seconds, peak GB).
 const EST_D3: (f64, f64) = (2.8, 0.26);
 const EST_D3_FIT: (f64, f64) = (8.2, 0.57);
-const EST_D4: (f64, f64) = (108.0, 0.74);
+const EST_D4: (f64, f64) = (6.7, 0.39);
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
@@ -182,6 +182,24 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "timings": {"knots": rep.seconds_knots, "fairing": rep.seconds_fairing, "fit": rep.seconds_fit, "fill": rep.seconds_fill},
         "tessellation": {"vertices": tess.positions.len(), "triangles": tess.triangles.len(), "spline_triangles": tess.spline_triangles},
     });
+    // A fairing that stopped above its tolerance is said, on stderr and in the JSON, before
+    // anything is written (the result is usable, but its continuity is only as good as the
+    // residual reached).
+    let f = &rep.fairing;
+    out["converged"] = json!(f.converged);
+    if !f.converged {
+        eprintln!(
+            "warning: {}: the fairing (r = {}) stopped at a relative constraint residual of \
+             {:.1e} after {} steps (tolerance {:.0e}): the pieces meet only to that accuracy; \
+             try: --fairness {}",
+            a.mesh.display(),
+            f.fairness,
+            f.max_constraint_residual,
+            f.refinement_steps,
+            f.tolerance,
+            f.fairness.saturating_sub(1)
+        );
+    }
     if let Some(dir) = &a.out {
         write_outputs(dir, charts, &rep, &tess, &control, &mut out, t0)?;
     }
