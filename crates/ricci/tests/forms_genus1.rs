@@ -52,6 +52,7 @@ fn forms_modulus(s: &Surface, triangulation: FormsTriangulation, base: Option<u3
             base,
             ..Default::default()
         },
+        ..Default::default()
     };
     let h = holomorphic_forms(
         &s.mesh,

@@ -94,6 +94,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             base: a.base,
             ..Default::default()
         },
+        keep_sharp_corners: false,
     };
     // A surface with boundary: the forms of its double (paper 003 §2), genus 2g + b − 1.
     let dbl = if surface.mesh.has_boundary() {
@@ -199,6 +200,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "boundary_loops": d.boundary_loops,
             "genus": d.genus,
             "chord_splits": d.chord_splits,
+            "widened_corners": d.widened,
             "reflection": d.reflection,
             "orthogonal_forms": d.orthogonal.len(),
             "orthogonal_boundary_defect": d.orthogonal_boundary_defect,

@@ -9,6 +9,12 @@
 //! `details` gives the domain's radius, the tiles and the bound `complete_up_to`); lengths are
 //! absolute (curvature −1, Tables 3–4) and also given normalized. A metric that did not
 //! converge is refused.
+//!
+//! A surface with boundary: the spectrum of its double ([`double`]; genus `2g + b − 1`, the
+//! JSON's `spectrum_of` is `double` and `double` describes it). `--base` names a vertex of the
+//! surface (the double keeps its ids).
+
+mod double;
 
 use super::layout::{polished_metric, Polish, PolishedLengths};
 use crate::util::read_surface;
@@ -18,7 +24,6 @@ use ricci::analysis::spectrum::{lattice_spectrum, surface_spectrum};
 use ricci::layout::deck_group;
 use ricci::layout::pipeline::cut_disk;
 use ricci::layout::place::layout;
-use ricci::mesh::topology;
 use ricci::metric::{Euclidean, Geometry};
 use ricci::progress::Progress;
 use serde_json::json;
@@ -59,33 +64,20 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if let Some(b) = a.base {
         crate::util::check_vertex("--base", b, surface.mesh.n_vertices())?;
     }
-    let t = topology(&surface.mesh);
-    let comp = t
-        .components
-        .first()
-        .ok_or_else(|| anyhow::anyhow!("the mesh has no faces"))?;
-    if t.components.len() != 1 || comp.boundary_loops != 0 || comp.genus < 1 {
-        anyhow::bail!(
-            "{}: the length spectrum needs one closed surface of genus ≥ 1; this mesh has {} component(s), genus {} and {} boundary loop(s); try: ricci layout {} (its layout and, for a surface with boundary, its geometry)",
-            a.mesh.display(),
-            t.components.len(),
-            comp.genus,
-            comp.boundary_loops,
-            a.mesh.display()
-        );
-    }
+    // A closed surface, or a bordered one's double (module docs of [`double`]).
+    let (surface, double_info, genus) = double::spectrum_surface(&a, surface)?;
     // An estimate up front: the enumeration grows steeply with N (measured on eight.off, a
     // genus-2 surface, on a loaded 2-core machine: 100 lengths ~3 CPU-s, 400 lengths > 75).
-    if a.count > 100 && comp.genus >= 2 {
+    if a.count > 100 && genus >= 2 {
         let est = 3.0 * (a.count as f64 / 100.0).powf(2.3);
         eprintln!(
             "ricci spectrum: --count {} on a genus-{} surface: the search for closed geodesics \
              grows steeply with N (100 lengths take ~3 CPU-seconds, 400 more than 75); expect \
              roughly {:.0} s",
-            a.count, comp.genus, est
+            a.count, genus, est
         );
     }
-    let want = if comp.genus == 1 {
+    let want = if genus == 1 {
         Geometry::Euclidean
     } else {
         Geometry::Hyperbolic
@@ -160,7 +152,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let out = json!({
         "file": a.mesh.display().to_string(),
-        "genus": comp.genus,
+        "genus": genus,
+        "spectrum_of": if double_info.is_some() { "double" } else { "surface" },
+        "double": double_info,
         "geometry": geometry.name(),
         "lengths": lengths_out,
         "absolute_lengths": abs,
@@ -178,9 +172,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         print_json(&out);
     } else {
         println!(
-            "{}: genus {}, {} metric",
+            "{}: genus {}{}, {} metric",
             a.mesh.display(),
-            comp.genus,
+            genus,
+            double_info.as_ref().map_or("", |_| " (its double)"),
             geometry.name()
         );
         for (i, (x, n)) in abs.iter().zip(&normalized).enumerate() {

@@ -22,9 +22,12 @@
 //! is a basis of the `G` of them.
 //!
 //! An interior edge of `M` between two boundary vertices (a chord: the double would have two
-//! edges between them) is split at its midpoint first (same flat metric).
+//! edges between them) is split at its midpoint first (same flat metric). Before that, boundary
+//! corners sharper than π/2 are widened by a vertex scaling (same discrete conformal class;
+//! [`super::corners`]): their cones on the double are too sharp for the discrete forms' zeros.
 
 use super::cochain;
+use super::corners::{widen_sharp_corners, WidenedCorner};
 use super::small::{self, Matrix};
 use super::symmetric;
 use super::working::working_surface;
@@ -33,7 +36,7 @@ use super::{
 };
 use crate::error::{Error, Result};
 use crate::mesh::double::double_edge_origin;
-use crate::mesh::{double_cover, topology, Mesh};
+use crate::mesh::{double_cover, topology, Mesh, Surface};
 use crate::metric::refine::Refined;
 use crate::metric::{Geometry, IntrinsicMetric};
 use crate::progress::Progress;
@@ -77,6 +80,8 @@ pub struct DoubleForms {
     /// vertices `0..surface_vertices` are the surface's, the rest their mirrors).
     pub chord_splits: usize,
     pub surface_vertices: usize,
+    /// Boundary corners widened by a vertex scaling before doubling ([`super::corners`]).
+    pub widened: Vec<WidenedCorner>,
     /// `σ` on the vertices of the double.
     pub sigma: Vec<u32>,
     /// The forms of the double.
@@ -152,7 +157,12 @@ pub fn double_forms(
         ));
     }
     progress.report("forms", Some(0.0), "doubling the surface");
-    let (split, lengths, pos, chord_splits) = split_chords(mesh, metric.lengths(), positions)?;
+    let (widened_lengths, widened) = if options.keep_sharp_corners {
+        (metric.lengths().to_vec(), Vec::new())
+    } else {
+        widen_sharp_corners(mesh, metric.lengths())
+    };
+    let (split, lengths, pos, chord_splits) = split_chords(mesh, &widened_lengths, positions)?;
     let (double, sigma) = double_cover(&split)?;
     let origin = double_edge_origin(&split, &double, &sigma)?;
     let dl: Vec<f64> = origin.iter().map(|&e| lengths[e as usize]).collect();
@@ -199,12 +209,34 @@ pub fn double_forms(
         genus: forms.genus,
         chord_splits,
         surface_vertices: nv,
+        widened,
         sigma,
         forms,
         reflection,
         orthogonal,
         orthogonal_boundary_defect: defect,
     })
+}
+
+/// The double of a surface with boundary as a surface ([`split_chords`], then
+/// [`double_cover`]), mirror vertices at their originals' positions (folded, so its edge
+/// lengths from positions are the surface's): the closed surface, `σ` on its vertices and the
+/// number of chords split.
+pub fn folded_double(surface: &Surface) -> Result<(Surface, Vec<u32>, usize)> {
+    let lengths = surface.edge_lengths();
+    let (split, _, pos, chord_splits) =
+        split_chords(&surface.mesh, &lengths, Some(&surface.positions))?;
+    let pos = pos.unwrap_or_else(|| surface.positions.clone());
+    let (mesh, sigma) = double_cover(&split)?;
+    let positions: Vec<[f64; 3]> = (0..mesh.n_vertices())
+        .map(|v| pos[(v as u32).min(sigma[v]) as usize])
+        .collect();
+    let s = Surface {
+        mesh,
+        positions,
+        uvs: None,
+    };
+    Ok((s, sigma, chord_splits))
 }
 
 type Split = (Mesh, Vec<f64>, Option<Vec<[f64; 3]>>, usize);

@@ -18,6 +18,7 @@
 //!    [`uniform`]: the combination of least area distortion (§4.2.1).
 
 pub mod cochain;
+pub mod corners;
 pub mod double;
 pub(crate) mod harmonic;
 pub(crate) mod hodge;
@@ -52,6 +53,9 @@ pub use zeros::{Zero, ZeroSet};
 pub struct FormsOptions {
     pub triangulation: FormsTriangulation,
     pub cut: CutOptions,
+    /// Surfaces with boundary: do not widen boundary corners sharper than π/2 before doubling
+    /// ([`corners`]; for comparisons — their zeros are then not faithful).
+    pub keep_sharp_corners: bool,
 }
 
 /// A holomorphic 1-form `re + i·im` (1-forms per edge of the refined mesh of the cut).
