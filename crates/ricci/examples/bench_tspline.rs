@@ -32,16 +32,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let t = Instant::now();
     let topo = ricci::mesh::topology(&surface.mesh);
     let genus0 = topo.components.len() == 1 && topo.components[0].genus == 0;
-    let (uv, lattice) = if genus0 {
+    let (uv, lattice, half) = if genus0 {
         let d = ricci::spline::tspline::genus0::genus0_domain(&surface, &mut NoProgress)?;
         let p = d.poles.map(|v| surface.positions[v as usize]);
         println!(
             "genus 0: {} loops filled, poles {:?} at {:?}, cut faces {:?}, double {} vertices",
             d.filled_loops, d.poles, p, d.cut_faces, d.double_vertices
         );
-        (d.uv, d.lattice)
+        (d.uv, d.lattice, d.half)
     } else {
-        flat_torus_domain(&surface, &mut NoProgress)?
+        let (uv, lattice) = flat_torus_domain(&surface, &mut NoProgress)?;
+        (uv, lattice, None)
     };
     println!(
         "{}: {} points, lattice W {:.4} H {:.4} s {:.2e}, domain {:.2} s",
@@ -84,14 +85,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             } else {
                 Vec::new()
             },
+            // HALF=0: count the control points of the empty half of a genus-0 torus too
+            budget_half: if env("HALF", 1) == 1 { half } else { None },
             ..FitOptions::default()
         };
         let t = Instant::now();
         let r = fit(&surface.positions, &uv, lattice, &opts, &mut NoProgress)?;
         let s = r.steps.last().ok_or("no fit step")?;
         println!(
-            "{f} | {} | {:.4} | {:.4} | {} | {} | {:.2}",
+            "{f} | {} (on the surface's half: {}) | {:.4} | {:.4} | {} | {} | {:.2}",
             s.control_points,
+            ricci::spline::tspline::fit::counted(&r.spline.basis.anchors, opts.budget_half),
             s.rms_error_percent,
             s.max_error_percent,
             r.steps.len(),

@@ -6,7 +6,9 @@
 //! the cylinders of a holomorphic 1-form (`tspline_genus`), and connected surfaces of genus 0,
 //! closed or with boundary loops, over the flat torus of the double of an annulus (loops
 //! filled, one face cut at each of two poles: `ricci::spline::tspline::genus0`; the data lie on
-//! half of the torus). Other topologies are refused with a sentence naming the missing domain.
+//! half of the torus), and surfaces of genus 1 with boundary loops over the flat torus of the
+//! surface with its loops filled by fans (no data on the fills). Other topologies are refused
+//! with a sentence naming the missing domain and what works.
 //!
 //! `--out DIR` writes `tspline.step` (AP214, one `B_SPLINE_SURFACE_WITH_KNOTS` face per Bézier
 //! patch), `tspline.igs` (entity 128 per patch), `surface.obj` (closed welded tessellation on a lattice grid), `tmesh.svg`
@@ -14,17 +16,24 @@
 //! points of our evaluation, to check readers against), `tmesh-surface.png` (the T-mesh's
 //! edges mapped onto the surface through the fit, T-junctions in red: paper 003 Fig. 5/7),
 //! `zebra.png` (reflection lines of the fitted surface) and `tspline.json` (the report).
+//! For genus 0 it writes only the surface's half of the torus (the Bézier patches clipped to
+//! the strip between the seams): `tspline.step`, `tspline.igs`, `surface.obj` (per-patch
+//! tessellation), `samples.json`, `spline.json`, `tspline.json`; and JSON `control_points`
+//! counts the control points whose blending function meets that half (the budget
+//! `--max-control-points` counts the same), `control_points_total` all of them.
 
 use crate::cmd::layout::spinner;
 use crate::util::{print_json, read_surface, write_atomic, write_json_atomic, UsageError};
 use ricci::spline::tspline::curves::{tmesh_on_surface, torus_tessellation};
-use ricci::spline::tspline::export::{iges, step, torus_obj};
+use ricci::spline::tspline::export::{iges, obj, step, torus_obj};
 use ricci::spline::tspline::fit::{
-    area_weighted_rms, fit, flat_torus_domain, vertex_areas, FitOptions, FitResult,
+    area_weighted_rms, counted, fit, flat_torus_domain, vertex_areas, FitOptions, FitResult,
 };
-use ricci::spline::tspline::genus0::genus0_domain;
+use ricci::spline::tspline::genus0::{fill_boundary_loops, genus0_domain};
+use ricci::spline::tspline::half::Half;
 use ricci::spline::tspline::{
-    chart_independence, continuity, extract, BezierPatch, ChartIndependence, Continuity, TSpline,
+    chart_independence, continuity, extract, BezierPatch, ChartIndependence, Continuity, Lattice,
+    TSpline,
 };
 use ricci_render::{render, Image, Paint, Polyline, RenderOptions, Style, View};
 use serde_json::json;
@@ -321,6 +330,46 @@ fn check_ranges(a: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The flat-torus domain of a genus-0 or genus-1 surface: one parameter per input vertex, the
+/// lattice, the domain's name, the genus-0 report and the surface's half of the torus.
+type Domain = (
+    Vec<[f64; 2]>,
+    Lattice,
+    &'static str,
+    Option<serde_json::Value>,
+    Option<Half>,
+);
+
+fn flat_domain(
+    surface: &ricci::mesh::Surface,
+    genus0: bool,
+    loops: usize,
+    bar: &mut crate::cmd::layout::Bar,
+) -> anyhow::Result<Domain> {
+    Ok(if genus0 {
+        let d = genus0_domain(surface, bar)?;
+        let info = json!({
+            "filled_loops": d.filled_loops,
+            "poles": d.poles,
+            "cut_faces": d.cut_faces,
+            "double_vertices": d.double_vertices,
+            "surface_half": d.half,
+        });
+        let name = "flat torus of the double of an annulus (genus 0: loops filled, a face cut at two poles; data on half of the torus)";
+        (d.uv, d.lattice, name, Some(info), d.half)
+    } else if loops > 0 {
+        // genus 1 with boundary: the loops filled by fans (no data on them), the flat torus
+        let (filled, _) = fill_boundary_loops(surface)?;
+        let (uv, lattice) = flat_torus_domain(&filled, bar)?;
+        let n = surface.positions.len();
+        let name = "flat torus of the surface with its boundary loops filled by fans (genus 1 with boundary; the fills carry no data)";
+        (uv[..n].to_vec(), lattice, name, None, None)
+    } else {
+        let (uv, lattice) = flat_torus_domain(surface, bar)?;
+        (uv, lattice, "flat torus (genus 1)", None, None)
+    })
+}
+
 pub fn run_cmd(a: Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let tolerance = parse_tolerance(&a.tolerance)?;
@@ -336,28 +385,20 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         return crate::cmd::tspline_genus::run_genus(&a, &surface, tolerance, t0);
     }
     let genus0 = comps == 1 && genus == 0;
-    if !genus0 && (comps != 1 || genus != 1 || loops != 0) {
+    if !genus0 && (comps != 1 || genus != 1) {
+        let what = if comps != 1 {
+            "fit each component on its own (one file per component); the double cover of paper 003 §2 for boundaries of genus ≥ 2 is not built yet".to_string()
+        } else {
+            format!("its domain manifold (paper 003 §2: the double cover, genus {}) is not built yet; with its holes closed it is a closed genus-{genus} surface, which works", 2 * genus + loops as i64 - 1)
+        };
         anyhow::bail!(
-            "{}: ricci tspline supports closed surfaces of genus ≥ 1 and connected surfaces of genus 0 for now (domains: the flat torus, the cylinders of a holomorphic 1-form, the double of an annulus); this mesh has {comps} component(s), genus {genus} and {loops} boundary loop(s), whose domain manifold (paper 003 §2: the double cover for boundaries of genus ≥ 1) is not built yet",
+            "{}: ricci tspline supports closed surfaces of genus ≥ 1, connected surfaces of genus 0 (closed or with boundary loops) and of genus 1 with boundary loops for now (domains: the flat torus, the cylinders of a holomorphic 1-form, the double of an annulus, the flat torus of the filled surface); this mesh has {comps} component(s), genus {genus} and {loops} boundary loop(s): {what}",
             a.mesh.display()
         );
     }
     let mut bar = spinner(a.json);
     bar.0.set_message("flat metric and layout");
-    let (uv, lattice, domain, genus0_json) = if genus0 {
-        let d = genus0_domain(&surface, &mut bar)?;
-        let info = json!({
-            "filled_loops": d.filled_loops,
-            "poles": d.poles,
-            "cut_faces": d.cut_faces,
-            "double_vertices": d.double_vertices,
-        });
-        let name = "flat torus of the double of an annulus (genus 0: loops filled, a face cut at two poles; data on half of the torus)";
-        (d.uv, d.lattice, name, Some(info))
-    } else {
-        let (uv, lattice) = flat_torus_domain(&surface, &mut bar)?;
-        (uv, lattice, "flat torus (genus 1)", None)
-    };
+    let (uv, lattice, domain, genus0_json, half) = flat_domain(&surface, genus0, loops, &mut bar)?;
     let opts = FitOptions {
         tolerance,
         smoothing: a.smoothing,
@@ -377,6 +418,7 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         } else {
             Vec::new()
         },
+        budget_half: half,
         ..FitOptions::default()
     };
     bar.0.set_message("fitting");
@@ -404,7 +446,13 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         "domain": domain,
         "genus0": genus0_json,
         "lattice": {"width": lattice.width, "height": lattice.height, "shift": lattice.shift},
-        "control_points": r.spline.control.len(),
+        "control_points": counted(&r.spline.basis.anchors, half),
+        "control_points_total": r.spline.control.len(),
+        "control_points_counted": if half.is_some() {
+            "those whose blending function's support meets the surface's half of the torus (genus0.surface_half; the mirror half holds no data); control_points_total counts the mirror half's too"
+        } else {
+            "all"
+        },
         "faces": r.spline.basis.mesh.faces().len(),
         "t_junctions": r.spline.basis.mesh.t_junctions().len(),
         "analysis_suitable": r.spline.basis.mesh.is_analysis_suitable(),
@@ -441,7 +489,7 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         );
     }
     if let Some(dir) = &a.out {
-        write_outputs(dir, &a, &r, &patches)?;
+        write_outputs(dir, &a, &r, &patches, half)?;
         out["out"] = json!(dir.display().to_string());
         out["seconds"] = json!(t0.elapsed().as_secs_f64());
         write_atomic(
@@ -478,7 +526,11 @@ fn write_outputs(
     a: &Args,
     r: &FitResult,
     patches: &[BezierPatch],
+    half: Option<Half>,
 ) -> anyhow::Result<()> {
+    if let Some(h) = half {
+        return write_half_outputs(dir, a, r, &h.clip(patches));
+    }
     let lattice = r.spline.basis.mesh.lattice;
     write_atomic(
         &dir.join("tspline.step"),
@@ -508,6 +560,34 @@ fn write_outputs(
         write_atomic(&dir.join("tmesh-surface.png"), &net.to_png()?)?;
         write_atomic(&dir.join("zebra.png"), &zebra.to_png()?)?;
     }
+    write_atomic(
+        &dir.join("samples.json"),
+        serde_json::to_string(&samples_json(&r.spline, patches))?.as_bytes(),
+    )?;
+    write_json_atomic(&dir.join("spline.json"), spline_json(r, patches))?;
+    Ok(())
+}
+
+/// The files of `--out DIR` for the genus-0 domain: only the surface's half of the torus (the
+/// Bézier patches clipped to it), tessellated patch by patch; no pictures of the torus.
+fn write_half_outputs(
+    dir: &std::path::Path,
+    a: &Args,
+    r: &FitResult,
+    patches: &[BezierPatch],
+) -> anyhow::Result<()> {
+    write_atomic(
+        &dir.join("tspline.step"),
+        step(patches, "tspline").as_bytes(),
+    )?;
+    write_atomic(
+        &dir.join("tspline.igs"),
+        iges(patches, "tspline").as_bytes(),
+    )?;
+    write_atomic(
+        &dir.join("surface.obj"),
+        obj(patches, a.tessellation).as_bytes(),
+    )?;
     write_atomic(
         &dir.join("samples.json"),
         serde_json::to_string(&samples_json(&r.spline, patches))?.as_bytes(),

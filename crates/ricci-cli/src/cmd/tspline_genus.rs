@@ -2,8 +2,10 @@
 //! decomposition of a holomorphic 1-form with integer imaginary periods
 //! (`ricci::spline::tspline::{cylinders, genus_domain}`), and each cylinder carries its own
 //! tensor-product cubic spline (`cylinder_fit`: C² inside a cylinder except C⁰ along the knot
-//! lines through the zero copies; the glued boundary rows are shared, so C⁰ across the
-//! critical trajectories — the JSON `continuity` reports the gaps and normal angles, measured).
+//! lines through the zero copies, pulled towards C¹ by a tangent penalty; the glued boundary
+//! rows are shared, so C⁰ across the critical trajectories — the JSON `continuity` reports the
+//! gaps and normal angles, measured). At the zeros themselves (the extraordinary points):
+//! C⁰, G¹ not guaranteed, the corner normals' angle measured (`continuity.at_zeros`).
 //!
 //! Writes the same files as the genus-1 path except the pictures and `tmesh.svg`:
 //! `tspline.step`, `tspline.igs`, `surface.obj` (per-patch tessellation), `samples.json` and
@@ -16,7 +18,7 @@ use ricci::analysis::forms::{holomorphic_forms, FormsOptions};
 use ricci::mesh::Surface;
 use ricci::metric::IntrinsicMetric;
 use ricci::spline::tspline::cylinder_fit::{fit_cylinders, GenusFit, GenusFitOptions};
-use ricci::spline::tspline::cylinder_jumps::{GluedSeams, Seam};
+use ricci::spline::tspline::cylinder_jumps::{AtZero, GluedSeams, Seam};
 use ricci::spline::tspline::export::{iges, obj, step};
 use ricci::spline::tspline::genus_domain::best_genus_domain;
 use ricci::spline::tspline::{BezierPatch, Continuity};
@@ -100,6 +102,25 @@ fn continuity_json(
     (v, class_inside, across_class, gap_percent)
 }
 
+/// The JSON `continuity.at_zeros`: what the spline guarantees at an extraordinary point (C⁰:
+/// the patches around every copy of the zero meet in one point) and what it does not (G¹: the
+/// angle between their normals there, measured; it shrinks under refinement, README).
+fn zeros_json(at: &[AtZero], scale: f64) -> serde_json::Value {
+    let gap = at.iter().map(|z| z.max_gap).fold(0.0, f64::max);
+    let angle = at
+        .iter()
+        .map(|z| z.max_normal_angle_degrees)
+        .fold(0.0, f64::max);
+    let c0 = !at.is_empty() && gap <= 1e-9 * scale;
+    json!({
+        "class": if c0 { "C0 (G1 not guaranteed: normals measured)" } else { "not measured or discontinuous" },
+        "max_gap_percent": 100.0 * gap / scale,
+        "max_normal_angle_degrees": angle,
+        "zeros": at,
+        "note": "paper 003: the manifold T-spline is well defined except at the extraordinary points; every copy of a zero is the corner of the two strips on either side of its knot line, on the cylinder above or below it; all these corner patches are evaluated at the zero: their points agree (C0) and their normals differ by the angle given",
+    })
+}
+
 pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> anyhow::Result<()> {
     let mut bar = spinner(a.json);
     bar.0.set_message("holomorphic 1-forms");
@@ -125,8 +146,9 @@ pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> an
     let patches = fit.patches();
     let (inside, lines) = fit.interior_jumps(&patches, 3);
     let seams = fit.glued_seams(&patches, &domain, 3);
+    let at_zeros = fit.at_zeros(&patches, &domain);
     bar.0.finish_and_clear();
-    let (continuity, class_inside, across_class, gap_percent) = continuity_json(
+    let (mut continuity, class_inside, across_class, gap_percent) = continuity_json(
         &fit,
         &inside,
         &lines,
@@ -134,6 +156,7 @@ pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> an
         domain.decomposition.zeros.len(),
         opts.glue,
     );
+    continuity["at_zeros"] = zeros_json(&at_zeros, fit.scale);
     let last = fit.steps.last().cloned();
     let (rms, max) = last.as_ref().map_or((f64::NAN, f64::NAN), |s| {
         (s.rms_error_percent, s.max_error_percent)

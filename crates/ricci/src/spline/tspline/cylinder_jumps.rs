@@ -10,7 +10,11 @@
 //!   independently of the gluing), at the midpoints of consecutive crossings glued by the
 //!   same translation, and, when the boundary rows are shared, at points along every glued
 //!   strip; crossings and midpoints within [`NEAR_ZERO`] of the circumference from a copy of
-//!   a zero are reported apart ([`GluedSeams::near_zeros`]). The two sides' parameters differ by a translation and a shear, which keep the
+//!   a zero are reported apart ([`GluedSeams::near_zeros`]);
+//! * at the zeros themselves ([`GenusFit::at_zeros`]): every copy of a zero is a corner of two
+//!   strips (the knot line through it), so a simple zero of a genus-2 form (cone angle 4π) is
+//!   the common corner of eight patches; the spread of their eight corner points (C⁰ at the
+//!   zero) and the largest angle between their normals there (the G¹ defect at the zero). The two sides' parameters differ by a translation and a shear, which keep the
 //!   normal's direction, so the normals compare directly.
 
 use super::bezier::{BezierPatch, Continuity};
@@ -249,5 +253,85 @@ impl GenusFit {
             }
         }
         out
+    }
+}
+
+/// What the spline does at one zero (an extraordinary point): see [`GenusFit::at_zeros`].
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct AtZero {
+    /// The zero's vertex (of the cut mesh, as in [`GenusDomain::zero_copies`]).
+    pub saddle: u32,
+    /// Its copies on the cylinders' circles, and the patch corners evaluated there.
+    pub copies: usize,
+    pub corners: usize,
+    /// Largest distance between two corner points (0 up to rounding: C⁰ at the zero).
+    pub max_gap: f64,
+    /// Largest angle between two corner normals `∂u × ∂v`, degrees (0 would be G¹).
+    pub max_normal_angle_degrees: f64,
+}
+
+impl GenusFit {
+    /// At every zero: the corners of the patches meeting at its copies — on each copy's knot
+    /// line, the patch on either side (left: the strip ending there, right: the one starting
+    /// there), on the cylinder's top or bottom row — evaluated at the copy, compared point by
+    /// point (gap) and normal by normal (angle). The copies are snapped to their cylinder's
+    /// nearest knot line (they are its ends, up to the gluing's mismatch). Empty without
+    /// shared boundary rows (no knot lines).
+    pub fn at_zeros(&self, patches: &[BezierPatch], domain: &GenusDomain) -> Vec<AtZero> {
+        if self.gluing.is_err() {
+            return Vec::new();
+        }
+        let first = self.first_patch();
+        let mut saddles: Vec<u32> = domain.zero_copies.iter().map(|z| z.saddle).collect();
+        saddles.sort_unstable();
+        saddles.dedup();
+        saddles
+            .into_iter()
+            .map(|saddle| {
+                let mut corners: Vec<([f64; 3], [f64; 3])> = Vec::new();
+                let mut copies = 0;
+                for z in domain.zero_copies.iter().filter(|z| z.saddle == saddle) {
+                    let s = &self.splines[z.cylinder];
+                    if s.lines.is_empty() {
+                        continue;
+                    }
+                    copies += 1;
+                    let l = s.circumference;
+                    let v = if z.top { s.height } else { 0.0 };
+                    let u = s.param(z.u, v);
+                    let line = s
+                        .lines
+                        .iter()
+                        .chain(std::iter::once(&l))
+                        .copied()
+                        .min_by(|a, b| (a - u).abs().total_cmp(&(b - u).abs()))
+                        .unwrap_or(0.0)
+                        .rem_euclid(l);
+                    // right of the line: the strip starting there; left: the one ending there
+                    let (right, ur) = self.locate(&first, z.cylinder, line, v);
+                    let (left, _) = self.locate(&first, z.cylinder, line - 1e-9 * l, v);
+                    let ul = patches[left].u1;
+                    for (p, u) in [(right, ur), (left, ul)] {
+                        let q = &patches[p];
+                        corners.push((q.point(u, v), normal(q, u, v)));
+                    }
+                }
+                let (mut gap, mut angle) = (0.0f64, 0.0f64);
+                for (i, a) in corners.iter().enumerate() {
+                    for b in &corners[..i] {
+                        gap = gap.max(dist(a.0, b.0));
+                        let dot = a.1[0] * b.1[0] + a.1[1] * b.1[1] + a.1[2] * b.1[2];
+                        angle = angle.max(norm(cross(a.1, b.1)).atan2(dot).to_degrees());
+                    }
+                }
+                AtZero {
+                    saddle,
+                    copies,
+                    corners: corners.len(),
+                    max_gap: gap,
+                    max_normal_angle_degrees: angle,
+                }
+            })
+            .collect()
     }
 }

@@ -25,6 +25,7 @@
 //! iterations / control points is spent (reported, not hidden).
 
 use super::correction::correct_parameters;
+use super::half::Half;
 use super::surface::{TBasis, TSpline};
 use super::system::FitSystem;
 use super::tmesh::{Lattice, TMesh};
@@ -81,6 +82,10 @@ pub struct FitOptions {
     /// [`vertex_areas`] makes `Σ_k w_k |S(u_k) − p_k|²` the integral of the squared error over
     /// the surface rather than a sum dominated by where the mesh is dense.
     pub weights: Vec<f64>,
+    /// Count only the control points whose blending function meets this strip against
+    /// [`FitOptions::max_control_points`] (the genus-0 domain: the surface's half of the
+    /// torus, [`super::genus0::Genus0Domain::half`]); `None`: all of them.
+    pub budget_half: Option<Half>,
 }
 
 impl Default for FitOptions {
@@ -102,6 +107,7 @@ impl Default for FitOptions {
             smoothing_decay: 1.0,
             rms_marks: 0,
             weights: Vec::new(),
+            budget_half: None,
         }
     }
 }
@@ -349,7 +355,7 @@ pub fn fit(
         let converged = max <= eps && (rms_target == 0.0 || rms <= rms_target);
         let marks = if converged
             || iteration >= opts.max_iterations
-            || ts.control.len() >= opts.max_control_points
+            || counted(&ts.basis.anchors, opts.budget_half) >= opts.max_control_points
         {
             Vec::new()
         } else {
@@ -365,7 +371,7 @@ pub fn fit(
         let refined = if marks.is_empty() {
             None
         } else {
-            refine_within_budget(&mesh, &marks, opts.max_control_points)?
+            refine_within_budget(&mesh, &marks, opts.max_control_points, opts.budget_half)?
         };
         let Some(refined) = refined else {
             return Ok(FitResult {
@@ -406,6 +412,11 @@ fn check_weights(weights: &[f64], n: usize) -> Result<()> {
     Ok(())
 }
 
+/// The control points counted against the budget: those meeting `half`, or all.
+pub fn counted(anchors: &[super::tmesh::Anchor], half: Option<Half>) -> usize {
+    half.map_or(anchors.len(), |h| h.anchors_on(anchors))
+}
+
 /// The refinement rule's parameters (see [`refinement_marks`]).
 struct Marking<'a> {
     eps: f64,
@@ -422,13 +433,18 @@ fn refine_within_budget(
     mesh: &TMesh,
     marks: &[(usize, bool)],
     budget: usize,
+    half: Option<Half>,
 ) -> Result<Option<TMesh>> {
     let mut k = marks.len();
     while k > 0 {
         let mut m = mesh.clone();
         m.refine_faces(&marks[..k]);
         m.make_analysis_suitable(50_000)?;
-        if m.vertices().len() <= budget {
+        let n = match half {
+            Some(h) => h.anchors_on(&m.anchors()?),
+            None => m.vertices().len(),
+        };
+        if n <= budget {
             return Ok(Some(m));
         }
         k /= 2;

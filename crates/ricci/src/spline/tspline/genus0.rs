@@ -30,6 +30,7 @@
 //! control points are counted in full (those of the empty half included).
 
 use super::fit::flat_torus_domain;
+use super::half::Half;
 use super::tmesh::Lattice;
 use crate::error::{Error, Result};
 use crate::mesh::{double::double_cover, Mesh, Surface};
@@ -54,6 +55,57 @@ pub struct Genus0Domain {
     pub filled_loops: usize,
     /// Vertices of the double (the closed genus-1 surface the flat metric is computed on).
     pub double_vertices: usize,
+    /// The surface's half of the torus (the strip between the seams holding the input
+    /// vertices); `None` when the lattice is not rectangular across the seams (then the whole
+    /// torus counts).
+    pub half: Option<Half>,
+}
+
+/// `x − c` reduced to `[−P/2, P/2)`.
+fn wrap(x: f64, c: f64, period: f64) -> f64 {
+    let d = (x - c) / period;
+    (d - d.round()) * period
+}
+
+/// The strip between the two seams through the cut faces that holds most input vertices: the
+/// seams are lines `u = const` or `v = const` (the axis along which a cut face's vertices
+/// spread least), at the cut faces' mean coordinates.
+fn surface_half(mesh: &Mesh, uv: &[[f64; 2]], lattice: &Lattice, cut: [u32; 2]) -> Option<Half> {
+    let periods = [lattice.width, lattice.height];
+    let spread = |axis: usize| {
+        let vs = mesh.face(cut[0]);
+        let c = uv[vs[0] as usize][axis];
+        vs.iter()
+            .map(|&v| wrap(uv[v as usize][axis], c, periods[axis]).abs() / periods[axis])
+            .fold(0.0, f64::max)
+    };
+    let axis = if spread(0) <= spread(1) { 0 } else { 1 };
+    if axis == 0 && lattice.shift != 0.0 {
+        return None;
+    }
+    let p = periods[axis];
+    let seam = |f: u32| {
+        let vs = mesh.face(f);
+        let c = uv[vs[0] as usize][axis];
+        c + vs
+            .iter()
+            .map(|&v| wrap(uv[v as usize][axis], c, p))
+            .sum::<f64>()
+            / 3.0
+    };
+    let (c0, c1) = (seam(cut[0]), seam(cut[1]));
+    let positive = uv.iter().filter(|q| wrap(q[axis], c0, p) > 0.0).count();
+    let (from, to) = if 2 * positive >= uv.len() {
+        (c0, c1)
+    } else {
+        (c1, c0)
+    };
+    Some(Half {
+        axis,
+        from: from.rem_euclid(p),
+        width: (to - from).rem_euclid(p),
+        period: p,
+    })
 }
 
 /// Graph distances (Euclidean edge lengths) from `sources` on `surface` (Dijkstra).
@@ -216,7 +268,9 @@ pub fn genus0_domain(surface: &Surface, progress: &mut dyn Progress) -> Result<G
         uvs: None,
     };
     let (uv_d, lattice) = flat_torus_domain(&ds, progress)?;
+    let half = surface_half(&surface.mesh, &uv_d[..n], &lattice, cut_faces);
     Ok(Genus0Domain {
+        half,
         uv: uv_d[..n].to_vec(),
         lattice,
         poles,

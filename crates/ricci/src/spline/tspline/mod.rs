@@ -19,7 +19,9 @@
 //!   genus-1 domain from the flat metric (the flat torus *is* the conformal net for genus 1).
 //!
 //! * [`genus0`] — genus 0, closed or with boundary loops: the flat torus of the double of an
-//!   annulus (loops filled, one face cut at each of two poles), the data on half of it.
+//!   annulus (loops filled, one face cut at each of two poles), the data on half of it;
+//! * [`half`] — that half (the strip between the seams): the control points that influence
+//!   the surface, the Bézier patches clipped to it for export.
 //!
 //! What is not here yet: for genus ≥ 2 a T-mesh (with T-junctions) over the cylinders; the
 //! cylinders carry tensor-product splines ([`cylinder_fit`]); surfaces of genus ≥ 1 with
@@ -40,6 +42,7 @@ pub mod fit;
 pub mod genus0;
 pub mod genus_domain;
 pub mod glue;
+pub mod half;
 pub(crate) mod surface;
 pub(crate) mod system;
 pub(crate) mod tmesh;
