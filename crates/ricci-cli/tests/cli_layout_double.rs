@@ -54,8 +54,14 @@ fn a_split_disk_is_laid_out_through_the_double() {
     assert!(j["metric"]["boundary_edges_flipped"].as_u64().unwrap() > 0);
     assert_eq!(j["uv"]["on"], "common_subdivision");
     assert_eq!(j["flipped_faces"], 0);
-    // The file alone: positions, UVs, faces.
-    let text = std::fs::read_to_string(&obj).unwrap();
+    check_obj(&obj, input_area, s.mesh.n_faces(), false);
+}
+
+/// The OBJ written at `obj` from the file alone: more faces than the input's `n_faces`, their
+/// 3D area the input's (`input_area`, 1e-9), every UV triangle positively oriented, and when
+/// `unit_square` every UV in `[0, 1]²`.
+fn check_obj(obj: &PathBuf, input_area: f64, n_faces: usize, unit_square: bool) {
+    let text = std::fs::read_to_string(obj).unwrap();
     let (mut v, mut vt, mut f) = (Vec::new(), Vec::new(), Vec::new());
     for line in text.lines() {
         let w: Vec<&str> = line.split_whitespace().collect();
@@ -69,7 +75,7 @@ fn a_split_disk_is_laid_out_through_the_double() {
             _ => {}
         }
     }
-    assert!(f.len() > s.mesh.n_faces(), "{} faces", f.len());
+    assert!(f.len() > n_faces, "{} faces", f.len());
     let sub_area: f64 = f.iter().map(|t| area(t.map(|c| v[c.0]))).sum();
     assert!(
         (sub_area - input_area).abs() <= 1e-9 * input_area,
@@ -84,6 +90,44 @@ fn a_split_disk_is_laid_out_through_the_double() {
         })
         .count();
     assert_eq!(flipped, 0, "flipped UV triangles in the file");
+    if unit_square {
+        assert!(
+            vt.iter().flatten().all(|&x| (0.0..=1.0).contains(&x)),
+            "a UV outside [0, 1]²"
+        );
+    }
+}
+
+/// `ricci param` takes the same route (issue 15, session 11): the split disk's own flow does
+/// not converge, the map comes from the flow on the double — `"route": "double"`, the common
+/// subdivision written with UVs in [0, 1]², its area the input's, 0 flipped UV triangles.
+#[test]
+fn a_split_disk_is_parametrized_through_the_double() {
+    let s = generate::bumpy_split_disk(120, 7, 0.75, true).unwrap();
+    let input_area: f64 = (0..s.mesh.n_faces() as u32)
+        .map(|f| area(s.mesh.face(f).map(|v| s.positions[v as usize])))
+        .sum();
+    let (mesh, obj) = (tmp("split_disk_param.obj"), tmp("param_uv.obj"));
+    write_surface(&mesh, &s).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_ricci"))
+        .arg("param")
+        .arg(&mesh)
+        .arg("--json")
+        .arg("--out")
+        .arg(&obj)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["route"], "double", "{j}");
+    assert!(!j["route_reason"].as_str().unwrap().is_empty());
+    assert_eq!(j["metric"]["converged"], true);
+    assert!(j["metric"]["max_curvature_error"].as_f64().unwrap() <= 1e-10);
+    assert_eq!(j["uv"]["on"], "common_subdivision");
+    assert_eq!(j["uv_faces"], "common_subdivision");
+    assert_eq!(j["flipped_faces"], 0);
+    check_obj(&obj, input_area, s.mesh.n_faces(), true);
 }
 
 /// Two disks in one file: not a disk, so the failing flow is refused (one sentence, exit 1)

@@ -17,10 +17,13 @@
 //! the input surface, every triangle inside one input face), and the JSON says so:
 //! `uv.on` / `uv_faces` = "common_subdivision" (else "input"), with `uv.vertices`,
 //! `uv.triangles`, `uv.input_flipped_faces`.
+//! A disk whose own flow fails or stalls (free boundary, no cones asked for) is mapped through
+//! the flow on its double instead (`"route": "double"`, `"route_reason"`; [`double`]).
 //! The JSON report: `uv_faces`, `flipped_faces` (of what is written), `qc_mean`/`qc_p95`/`qc_max`
 //! (σmax/σmin per face), `log_area_sigma` (σ of log(A_uv/A_3d)), `cones`, `seam_length`,
 //! per-chart details and `seconds`.
 
+mod double;
 mod picture;
 
 use crate::util::read_surface;
@@ -165,7 +168,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         cone_corrections: a.cone_corrections,
         ..ParamOptions::default()
     };
-    let p = parametrize(&surface, &opts, &mut bar).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+    let p = match parametrize(&surface, &opts, &mut bar) {
+        Ok(p) => p,
+        // The surface's own flow failed or stalled: a disk is mapped through its double.
+        Err(e) if double::applies(&a, boundary, &surface.mesh) => {
+            bar.0.set_message("flow on the double");
+            let reason = e.to_string();
+            let r = double::run_double(&a, &surface, &reason, &mut bar, t0);
+            bar.0.finish_and_clear();
+            return r;
+        }
+        Err(e) => anyhow::bail!("{name}: {e}"),
+    };
     bar.0.finish_and_clear();
     let cones: Vec<_> = p
         .charts

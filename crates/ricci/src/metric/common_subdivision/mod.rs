@@ -25,8 +25,11 @@
 //! at `k` and `l`, the arcs leaving `i` or `j`, the pieces running from the `i`-side of one
 //! triangle to the `j`-side of the other, and `ij` itself when it was an input edge. A piece
 //! running from `k` to `l` makes `kl` an input edge (`n_kl = −1`). (This is our derivation of
-//! the flip formula of Gillespie–Sharp–Crane; no roundabouts are needed because the input has
-//! no multi-edges, so an input edge is identified by its two end vertices.)
+//! the flip formula of Gillespie–Sharp–Crane. No roundabouts are kept: an input edge is
+//! identified by its two end vertices, and where the input is a Δ-complex with two edges
+//! between the same vertices — the input metric's Delaunay triangulation in the three-way
+//! overlay — by its log Penner coordinate as well, which the strip's development recomputes;
+//! see [`input`].)
 //!
 //! **Geometry: λ-lengths along a strip.** Tracing an input edge `ab` through `T` gives the
 //! strip of triangles it crosses. Developing the strip, the λ-length from the cusp `a` to every
@@ -59,6 +62,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod develop;
+mod input;
 mod monotone;
 mod normal;
 mod polygons;
@@ -197,6 +201,17 @@ impl CommonSubdivision {
         t: &IntrinsicTriangulation,
         u: &[f64],
     ) -> Result<CommonSubdivision> {
+        Self::from_triangulation_on_input(mesh, start, t, u)
+    }
+
+    /// [`CommonSubdivision::from_triangulation_on`] for any input triangulation (a Δ-complex:
+    /// [`input::DeltaInput`]).
+    fn from_triangulation_on_input<M: input::InputComplex>(
+        mesh: &M,
+        start: IntrinsicTriangulation,
+        t: &IntrinsicTriangulation,
+        u: &[f64],
+    ) -> Result<CommonSubdivision> {
         if start.origin.len() != mesh.n_corners() || start.n_edges() != mesh.n_edges() {
             return Err(Error::input(
                 "the start triangulation is not a triangulation of the input mesh",
@@ -206,8 +221,8 @@ impl CommonSubdivision {
         Self::from_replayed(mesh, tri, normal, t, u)
     }
 
-    fn from_replayed(
-        mesh: &Mesh,
+    fn from_replayed<M: input::InputComplex>(
+        mesh: &M,
         mut tri: IntrinsicTriangulation,
         normal: Vec<i32>,
         t: &IntrinsicTriangulation,

@@ -2,10 +2,11 @@
 //! convex polygons cut out by the chords of the input edges, their input faces, and their fan
 //! triangulation (see the parent module).
 
+use super::input::InputComplex;
 use super::normal::{arc_end, face_counts, ArcEnd, TriangleArcs};
 use super::CommonSubdivision;
 use crate::error::{Error, Result};
-use crate::mesh::{Mesh, NONE};
+use crate::mesh::NONE;
 
 /// A point on the boundary of a face of `T`: its subdivision vertex and its weights on the
 /// face's corners (input decoration).
@@ -18,8 +19,8 @@ struct BoundaryPoint {
 }
 
 /// Cut face `f` of `T` along its arcs into convex polygons, fan-triangulate them.
-pub(super) fn face_polygons(
-    mesh: &Mesh,
+pub(super) fn face_polygons<M: InputComplex>(
+    mesh: &M,
     sub: &mut CommonSubdivision,
     arcs: &TriangleArcs,
     f: u32,
@@ -167,8 +168,8 @@ pub(super) fn face_polygons(
 /// The input face left of the polygon side from boundary point `a` to `b` of face `f` of `T`,
 /// when that side lies on an input edge.
 #[allow(clippy::too_many_arguments)]
-fn side_input_face(
-    mesh: &Mesh,
+fn side_input_face<M: InputComplex>(
+    mesh: &M,
     sub: &CommonSubdivision,
     pts: &[BoundaryPoint],
     f: u32,
@@ -201,12 +202,15 @@ fn side_input_face(
         if sub.normal[tri.edge[h as usize] as usize] != -1 {
             return Ok(None);
         }
-        let h0 = mesh.halfedge_between(pa.vertex, pb.vertex).ok_or_else(|| {
-            Error::numerical(format!(
-                "face {f} of T: side {j} is marked as an input edge, but its ends are not \
+        let lambda = tri.lambda[tri.edge[h as usize] as usize];
+        let h0 = mesh
+            .halfedge_between_near(pa.vertex, pb.vertex, lambda)?
+            .ok_or_else(|| {
+                Error::numerical(format!(
+                    "face {f} of T: side {j} is marked as an input edge, but its ends are not \
                  adjacent in the input"
-            ))
-        })?;
+                ))
+            })?;
         return left_of(h0);
     }
     // A chord: a piece of one input edge.
@@ -247,8 +251,8 @@ fn side_input_face(
 }
 
 /// Barycentric coordinates of a boundary point on input face `fv`.
-fn input_barycentric(
-    mesh: &Mesh,
+fn input_barycentric<M: InputComplex>(
+    mesh: &M,
     sub: &CommonSubdivision,
     fv: &[u32; 3],
     p: &BoundaryPoint,

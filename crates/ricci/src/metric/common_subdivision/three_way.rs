@@ -31,6 +31,7 @@
 //! face has height 7.1e-9 × its side, below what its edge lengths resolve), the places are
 //! made monotone in the combinatorial order ([`super::monotone`]), and the change reported.
 
+use super::input::{DeltaInput, InputComplex};
 use super::monotone::MonotoneRepair;
 use super::normal::{face_counts, replay_on, TriangleArcs};
 use super::polygons::face_polygons;
@@ -72,6 +73,9 @@ pub struct ThreeWayReport {
     pub moved: f64,
     /// The monotone repair of the places found (a vertex within rounding of an input edge).
     pub repair: MonotoneRepair,
+    /// Pairs of vertices joined by two or more edges of the input metric's Delaunay
+    /// triangulation `T_iso` (a Δ-complex; camelhead's double has such pairs).
+    pub iso_multi_edges: usize,
 }
 
 /// A chord of an edge `eps` of `T` inside a triangle of `T_iso`: from `a` to `b` (barycentric
@@ -152,22 +156,19 @@ fn place_through_iso(
                 "the isometric flips do not replay to the same triangulation",
             ));
         }
-        // T_iso as the input of the Ptolemy part: its overlay with T.
-        let faces: Vec<[u32; 3]> = (0..iso.n_faces() as u32).map(|f| iso.face(f)).collect();
-        let mesh_iso = Mesh::from_triangles(iso.n_vertices, faces).map_err(|e| {
+        // T_iso as the input of the Ptolemy part (a Δ-complex: two of its edges may join the
+        // same vertices, told apart by their λ): its overlay with T.
+        let mesh_iso = DeltaInput::new(&iso).map_err(|e| {
             Error::numerical(format!(
-                "the input metric's Delaunay triangulation is not a simplicial mesh ({e}); the \
-                 three-way overlay needs one"
+                "the input metric's Delaunay triangulation is not a triangulation the three-way \
+                 overlay takes ({e})"
             ))
         })?;
-        if (0..iso.n_faces() as u32).any(|f| mesh_iso.face(f) != iso.face(f)) {
-            return Err(Error::numerical(
-                "the input metric's Delaunay triangulation changed its faces as a mesh",
-            ));
-        }
+        report.iso_multi_edges = mesh_iso.multi_edges();
         let mut t_rest = t.clone();
         t_rest.flip_log = log[isometric..].to_vec();
-        let s2 = CommonSubdivision::from_triangulation_on(&mesh_iso, iso.clone(), &t_rest, u)?;
+        let s2 =
+            CommonSubdivision::from_triangulation_on_input(&mesh_iso, iso.clone(), &t_rest, u)?;
         let chords = chords_in_iso_faces(&mesh_iso, &iso, &s2, report)?;
         place_crossings(mesh, &iso, &normal_iso, &s2, &chords, full, report)?;
         super::monotone::repair(mesh, full, &mut report.repair);
@@ -178,7 +179,7 @@ fn place_through_iso(
 /// The chords of the edges of `T` in every triangle of `T_iso` (from `s2`, the overlay of
 /// `T_iso` as the input with `T`).
 fn chords_in_iso_faces(
-    mesh_iso: &Mesh,
+    mesh_iso: &DeltaInput,
     iso: &Tri,
     s2: &CommonSubdivision,
     report: &mut ThreeWayReport,

@@ -2,11 +2,12 @@
 //! coordinates, with the λ-lengths along each strip that place the crossings (see the parent
 //! module, "Geometry: λ-lengths along a strip").
 
+use super::input::InputComplex;
 use super::normal::{arc_end, face_counts, ArcEnd, TriangleArcs};
 use super::polygons::face_polygons;
 use super::{CommonSubdivision, Crossing, SubdivisionReport, Tri};
 use crate::error::{Error, Result};
-use crate::mesh::{Mesh, NONE};
+use crate::mesh::NONE;
 
 /// `log(e^a + e^b)` without overflow.
 #[inline]
@@ -64,8 +65,8 @@ fn half_lambda(tri: &Tri, h: u32) -> f64 {
 }
 
 /// Input edges traced so far: the crossing ids of every edge of `T` and what was found there.
-struct Tracer<'a> {
-    mesh: &'a Mesh,
+struct Tracer<'a, M: InputComplex> {
+    mesh: &'a M,
     tri: &'a Tri,
     normal: &'a [i32],
     arcs: Vec<TriangleArcs>,
@@ -78,8 +79,8 @@ struct Tracer<'a> {
 }
 
 /// The common subdivision of `mesh` and `tri` (replayed, with normal coordinates `normal`).
-pub(super) fn build(
-    mesh: &Mesh,
+pub(super) fn build<M: InputComplex>(
+    mesh: &M,
     tri: Tri,
     normal: Vec<i32>,
     flips: usize,
@@ -173,7 +174,7 @@ pub(super) fn build(
     Ok(sub)
 }
 
-impl Tracer<'_> {
+impl<M: InputComplex> Tracer<'_, M> {
     /// Mark the input edges that are edges of `T` (normal coordinate −1); their number.
     fn mark_shared_edges(&mut self) -> Result<usize> {
         let mut shared = 0;
@@ -181,12 +182,16 @@ impl Tracer<'_> {
             if self.normal[e as usize] == -1 {
                 shared += 1;
                 let [a, b] = self.tri.edge_vertices(e);
-                let h0 = self.mesh.halfedge_between(a, b).ok_or_else(|| {
-                    Error::numerical(format!(
-                        "edge {e} of the intrinsic triangulation is marked as an input edge, \
+                let lambda = self.tri.lambda[e as usize];
+                let h0 = self
+                    .mesh
+                    .halfedge_between_near(a, b, lambda)?
+                    .ok_or_else(|| {
+                        Error::numerical(format!(
+                            "edge {e} of the intrinsic triangulation is marked as an input edge, \
                          but vertices {a} and {b} are not adjacent in the input"
-                    ))
-                })?;
+                        ))
+                    })?;
                 self.input_seen[self.mesh.he_edge(h0) as usize] = true;
             }
         }
@@ -222,12 +227,16 @@ impl Tracer<'_> {
         let (mesh, tri, normal) = (self.mesh, self.tri, self.normal);
         let a = tri.origin[start as usize];
         let b = tri.origin[end as usize];
-        let h0 = mesh.halfedge_between(a, b).ok_or_else(|| {
-            Error::numerical(format!(
-                "an input edge traced through the intrinsic triangulation joins vertices {a} \
+        let (la, lb) = strip_lambdas(tri, &path);
+        let lambda_ab = strip_end_lambda(tri, &path, &la);
+        let h0 = mesh
+            .halfedge_between_near(a, b, lambda_ab)?
+            .ok_or_else(|| {
+                Error::numerical(format!(
+                    "an input edge traced through the intrinsic triangulation joins vertices {a} \
                  and {b}, which are not adjacent in the input"
-            ))
-        })?;
+                ))
+            })?;
         let e0 = mesh.he_edge(h0);
         if self.input_seen[e0 as usize] {
             return Err(Error::numerical(format!(
@@ -236,7 +245,6 @@ impl Tracer<'_> {
         }
         self.input_seen[e0 as usize] = true;
         let forward = mesh.edge_vertices(e0)[0] == a;
-        let (la, lb) = strip_lambdas(tri, &path);
         let m = path.len();
         let mut last_t = f64::NEG_INFINITY;
         for k in 0..m {
@@ -279,6 +287,18 @@ impl Tracer<'_> {
         }
         Ok(())
     }
+}
+
+/// The log Penner coordinate `λ_ab` of the traced input edge from the strip's first cusp `a`
+/// to its last `b` (Ptolemy in the last triangle, as in [`strip_lambdas`]).
+fn strip_end_lambda(tri: &Tri, path: &[Step], la: &[[f64; 2]]) -> f64 {
+    let m = path.len();
+    let h = path[m - 1].0;
+    let w = log_add_exp(
+        la[m - 1][0] + half_lambda(tri, Tri::next(h)),
+        la[m - 1][1] + half_lambda(tri, Tri::prev(h)),
+    ) - half_lambda(tri, h);
+    2.0 * w
 }
 
 /// Log λ-lengths along a strip (Ptolemy, triangle by triangle, positive terms only): for every
