@@ -3,7 +3,8 @@
 //! cones, flipped input faces, qc mean / p95 (count- and area-weighted) / max, σ(log area ratio), seam length, flow
 //! flips, wall seconds. Cases ending in `+c` run one round of
 //! `ParamOptions::cone_corrections`; `BENCH_PARAM_CHARTS=1` also prints per chart the flow
-//! runs, corrections and the flow's σ(2u).
+//! runs, corrections and the flow's σ(2u). Cases ending in `w` use the wide cone search
+//! (`ConeSearch::Energy`), in `f` free homology seams (`SeamMode::Free`, `--seams free`).
 //!
 //! ```sh
 //! RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_param
@@ -13,7 +14,7 @@
 
 use ricci::mesh::io::read_surface;
 use ricci::param::cones::ConeSearch;
-use ricci::param::{parametrize, ConeSpec, ParamOptions};
+use ricci::param::{parametrize, ConeSpec, ParamOptions, SeamMode};
 use ricci::progress::NoProgress;
 use std::path::PathBuf;
 
@@ -55,6 +56,12 @@ fn main() {
         ("horse-8w", "horse.ply", ConeSpec::Count(8)),
         ("maxplanck-8w", "maxplanck.nf25k.off", ConeSpec::Count(8)),
         ("camel-8w", "camel.off", ConeSpec::Count(8)),
+        ("botijo-8f", "botijo.off", ConeSpec::Count(8)),
+        ("seahorse-8f", "seahorse2_100K.off", ConeSpec::Count(8)),
+        ("camel-8f", "camel.off", ConeSpec::Count(8)),
+        ("kitten-8f", "kitten.nf20k.off", ConeSpec::Count(8)),
+        ("eight-8f", "eight.off", ConeSpec::Count(8)),
+        ("eight-8", "eight.off", ConeSpec::Count(8)),
         ("eight-auto", "eight.off", ConeSpec::Default),
         ("eight-auto+c", "eight.off", ConeSpec::Default),
     ];
@@ -99,6 +106,12 @@ fn main() {
                 ConeSearch::Energy
             } else {
                 ConeSearch::Greedy
+            },
+            // `f`: free homology seams (`SeamMode::Free`).
+            seams: if name.ends_with('f') {
+                SeamMode::Free
+            } else {
+                SeamMode::Rigid
             },
             ..ParamOptions::default()
         };
