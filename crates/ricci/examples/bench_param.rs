@@ -13,7 +13,7 @@
 //! ```
 
 use ricci::mesh::io::read_surface;
-use ricci::param::cones::ConeSearch;
+use ricci::param::cones::{ConeSearch, CurvatureRule};
 use ricci::param::{parametrize, ConeSpec, ParamOptions, SeamMode};
 use ricci::progress::NoProgress;
 use std::path::PathBuf;
@@ -62,6 +62,9 @@ fn main() {
         ("kitten-8f", "kitten.nf20k.off", ConeSpec::Count(8)),
         ("eight-8f", "eight.off", ConeSpec::Count(8)),
         ("eight-8", "eight.off", ConeSpec::Count(8)),
+        ("botijo-8fd", "botijo.off", ConeSpec::Count(8)),
+        ("seahorse-8fd", "seahorse2_100K.off", ConeSpec::Count(8)),
+        ("camel-8fd", "camel.off", ConeSpec::Count(8)),
         ("eight-auto", "eight.off", ConeSpec::Default),
         ("eight-auto+c", "eight.off", ConeSpec::Default),
     ];
@@ -108,7 +111,13 @@ fn main() {
                 ConeSearch::Greedy
             },
             // `f`: free homology seams (`SeamMode::Free`).
-            seams: if name.ends_with('f') {
+            // `fd`: free seams with the Dirichlet rule for the cone curvatures (BFF's).
+            free_cone_rule: if name.ends_with("fd") {
+                CurvatureRule::Dirichlet
+            } else {
+                CurvatureRule::LeastSquares
+            },
+            seams: if name.ends_with('f') || name.ends_with("fd") {
                 SeamMode::Free
             } else {
                 SeamMode::Rigid

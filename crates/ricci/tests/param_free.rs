@@ -16,6 +16,7 @@ mod ricci_meshes;
 
 use ricci::mesh::generate::genus;
 use ricci::mesh::Surface;
+use ricci::param::cones::CurvatureRule;
 use ricci::param::{parametrize, ConeSpec, ParamOptions, Parametrization, SeamMode};
 use ricci::progress::NoProgress;
 use std::collections::HashMap;
@@ -161,7 +162,7 @@ fn seamless_with_free_seams_is_refused() {
 }
 
 /// Issue 16, must-show 2 with free seams (RICCI_MESHES): `eight` (genus 2) and `kitten`
-/// (genus 1) pass the checks of the module docs; on `botijo` (genus 5) with 8 cones the map
+/// (genus 1) pass the checks of the module docs (also with BFF's Dirichlet cone curvatures); on `botijo` (genus 5) with 8 cones the map
 /// has no flipped face and beats Boundary First Flattening's own map at the same cone count
 /// (BFF 6924b2f, `--nCones=8`, measured in session 10: qc p95 1.0557 by face count, 1.0563
 /// by area, σ(log area) 0.706), and free seams have less area distortion than rigid ones on
@@ -178,6 +179,17 @@ fn shared_meshes_with_free_seams() {
     check_free(&eight, &p, -2.0, 1e-8);
     let rigid = run(&eight, ConeSpec::Count(8), SeamMode::Rigid);
     assert!(p.stats.log_area_sigma < rigid.stats.log_area_sigma);
+    // The greedy's own curvatures (u = 0 at the cones, BFF's rule) are one candidate of the
+    // least-squares problem the default solves: the default is no worse.
+    let opts = ParamOptions {
+        cones: ConeSpec::Count(8),
+        seams: SeamMode::Free,
+        free_cone_rule: CurvatureRule::Dirichlet,
+        ..ParamOptions::default()
+    };
+    let dirichlet = parametrize(&eight, &opts, &mut NoProgress).unwrap();
+    check_free(&eight, &dirichlet, -2.0, 1e-8);
+    assert!(p.stats.log_area_sigma < dirichlet.stats.log_area_sigma);
     let kitten = read("kitten.nf20k.off");
     let p = run(&kitten, ConeSpec::Count(8), SeamMode::Free);
     check_free(&kitten, &p, 0.0, 1e-8);
@@ -188,4 +200,9 @@ fn shared_meshes_with_free_seams() {
     assert!(p.stats.qc_p95 <= 1.0557, "{:?}", p.stats);
     assert!(p.stats.qc_p95_area <= 1.0563, "{:?}", p.stats);
     assert!(p.stats.log_area_sigma <= 0.706, "{:?}", p.stats);
+    // camel (genus 1), 8 cones: BFF's map has 24 flipped faces and σ(log area) 2.462.
+    let camel = read("camel.off");
+    let p = run(&camel, ConeSpec::Count(8), SeamMode::Free);
+    assert_eq!(p.stats.flipped_faces, 0);
+    assert!(p.stats.log_area_sigma <= 2.462, "{:?}", p.stats);
 }

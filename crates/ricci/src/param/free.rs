@@ -3,8 +3,10 @@
 //! (the cut graph of [`super::seams`] with no cones) into a disk, and the disk is flattened with
 //! `u = 0` on its boundary — the "minimal area distortion" boundary of Boundary First
 //! Flattening (Sawhney–Crane 2017 §4.3) — and cones inside, placed by the greedy of
-//! [`super::cones`] with the boundary held (Ben-Chen–Gotsman–Bunin 2008, the Dirichlet rule:
-//! BFF's cones on such surfaces). The flat metric is flat at every interior vertex of the disk
+//! [`super::cones`] with the boundary held (Ben-Chen–Gotsman–Bunin 2008: BFF's cone positions
+//! on such surfaces), with the curvatures of least linearised σ(2u) at those positions
+//! ([`super::cones::free_boundary_least_squares`]; [`super::ParamOptions::free_cone_rule`]
+//! `Dirichlet` keeps the greedy's own, `u = 0` at the cones, BFF's rule). The flat metric is flat at every interior vertex of the disk
 //! except the cones; the seam vertices keep whatever curvature the boundary condition leaves, so
 //! the transition across a homology seam is not a rigid motion (the two sides have equal edge
 //! lengths, `u = 0` on both, but different turning). Cone seams (cut from each cone to the
@@ -12,7 +14,7 @@
 //! (no Gauss–Bonnet constraint on the cones alone); the disk's boundary turns by
 //! `2π − Σ K̄_cones` in total.
 
-use super::cones::{greedy_cones, ConeBudget};
+use super::cones::{free_boundary_least_squares, greedy_cones, ConeBudget, CurvatureRule};
 use super::{ConeSpec, ParamOptions, Piece};
 use crate::error::{Error, Result};
 use crate::flow::TargetSpec;
@@ -159,8 +161,17 @@ pub(super) fn free_seam_target(
         Some(b) => {
             progress.report("cones", None, "greedy cone placement, seams held");
             let lengths = disk.piece.surface.edge_lengths();
-            let p = greedy_cones(mesh, &IntrinsicMetric::euclidean(lengths), b)?;
-            (p.cones, p.distortion_history)
+            let metric = IntrinsicMetric::euclidean(lengths);
+            let p = greedy_cones(mesh, &metric, b)?;
+            // The greedy's positions; curvatures for the least linearised σ(2u) (the
+            // greedy's own, u = 0 at the cones, are one candidate of that least-squares
+            // problem, so this is never worse in the linear model).
+            let at: Vec<u32> = p.cones.iter().map(|c| c.0).collect();
+            let cones = match opts.free_cone_rule {
+                CurvatureRule::LeastSquares => free_boundary_least_squares(mesh, &metric, &at)?.0,
+                CurvatureRule::Dirichlet => p.cones,
+            };
+            (cones, p.distortion_history)
         }
         None => (Vec::new(), Vec::new()),
     };

@@ -166,6 +166,9 @@ pub struct ParamOptions {
     pub cone_search: cones::ConeSearch,
     /// Rigid (default) or free homology seams on closed components of genus ≥ 1.
     pub seams: SeamMode,
+    /// Curvatures of the greedy cones with free seams (default least squares: the least
+    /// linearised σ(2u) at the greedy's positions; `Dirichlet`: `u = 0` at the cones, BFF's).
+    pub free_cone_rule: cones::CurvatureRule,
 }
 
 impl Default for ParamOptions {
@@ -181,6 +184,7 @@ impl Default for ParamOptions {
             on_subdivision: false,
             cone_search: cones::ConeSearch::Greedy,
             seams: SeamMode::Rigid,
+            free_cone_rule: cones::CurvatureRule::LeastSquares,
         }
     }
 }
