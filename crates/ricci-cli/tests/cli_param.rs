@@ -117,3 +117,48 @@ fn given_cones_usage_errors_and_sphere() {
     assert_eq!(v["mode"], "sphere");
     assert_eq!(v["flipped_faces"], 0);
 }
+
+/// `--seams free` on a genus-2 surface: the JSON says which seams (top level and per chart),
+/// the OBJ keeps the input's faces with seams as extra `vt`, no face flips; the default is
+/// `rigid`; an unknown value is a usage error.
+#[test]
+fn free_seams_are_reported_and_written_on_the_input_faces() {
+    let mesh = generate("genus2", "genus2.obj");
+    let out = tmp("genus2-free.obj");
+    let o = Command::new(bin())
+        .arg("param")
+        .arg(&mesh)
+        .args(["--cones", "6", "--seams", "free", "--json", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["seams"], "free");
+    assert_eq!(v["chart_details"][0]["seams"], "free");
+    assert_eq!(v["flipped_faces"], 0);
+    assert_eq!(v["cone_count"], 6);
+    if v["uv_faces"] == "input" {
+        let (nv_in, _, f_in) = obj_faces(&std::fs::read_to_string(&mesh).unwrap());
+        let (nv, nvt, f) = obj_faces(&std::fs::read_to_string(&out).unwrap());
+        assert_eq!((nv, f.len()), (nv_in, f_in.len()));
+        assert!(nvt > nv, "seams need extra vt ({nvt} vt, {nv} v)");
+    }
+    let d = Command::new(bin())
+        .arg("param")
+        .arg(&mesh)
+        .args(["--cones", "6", "--json"])
+        .output()
+        .unwrap();
+    assert!(d.status.success(), "{}", String::from_utf8_lossy(&d.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&d.stdout).unwrap();
+    assert_eq!(v["seams"], "rigid");
+    let bad = Command::new(bin())
+        .arg("param")
+        .arg(&mesh)
+        .args(["--seams", "loose", "--json"])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown seams 'loose'"));
+}

@@ -3,7 +3,8 @@
 //! cones, flipped input faces, qc mean / p95 (count- and area-weighted) / max, σ(log area ratio), seam length, flow
 //! flips, wall seconds. Cases ending in `+c` run one round of
 //! `ParamOptions::cone_corrections`; `BENCH_PARAM_CHARTS=1` also prints per chart the flow
-//! runs, corrections and the flow's σ(2u).
+//! runs, corrections and the flow's σ(2u). Cases ending in `w` use the wide cone search
+//! (`ConeSearch::Energy`), in `f` free homology seams (`SeamMode::Free`, `--seams free`).
 //!
 //! ```sh
 //! RICCI_MESHES=/work/shared/meshes cargo run --release -p ricci --example bench_param
@@ -12,8 +13,8 @@
 //! ```
 
 use ricci::mesh::io::read_surface;
-use ricci::param::cones::ConeSearch;
-use ricci::param::{parametrize, ConeSpec, ParamOptions};
+use ricci::param::cones::{ConeSearch, CurvatureRule};
+use ricci::param::{parametrize, ConeSpec, ParamOptions, SeamMode};
 use ricci::progress::NoProgress;
 use std::path::PathBuf;
 
@@ -55,6 +56,15 @@ fn main() {
         ("horse-8w", "horse.ply", ConeSpec::Count(8)),
         ("maxplanck-8w", "maxplanck.nf25k.off", ConeSpec::Count(8)),
         ("camel-8w", "camel.off", ConeSpec::Count(8)),
+        ("botijo-8f", "botijo.off", ConeSpec::Count(8)),
+        ("seahorse-8f", "seahorse2_100K.off", ConeSpec::Count(8)),
+        ("camel-8f", "camel.off", ConeSpec::Count(8)),
+        ("kitten-8f", "kitten.nf20k.off", ConeSpec::Count(8)),
+        ("eight-8f", "eight.off", ConeSpec::Count(8)),
+        ("eight-8", "eight.off", ConeSpec::Count(8)),
+        ("botijo-8fd", "botijo.off", ConeSpec::Count(8)),
+        ("seahorse-8fd", "seahorse2_100K.off", ConeSpec::Count(8)),
+        ("camel-8fd", "camel.off", ConeSpec::Count(8)),
         ("eight-auto", "eight.off", ConeSpec::Default),
         ("eight-auto+c", "eight.off", ConeSpec::Default),
     ];
@@ -99,6 +109,18 @@ fn main() {
                 ConeSearch::Energy
             } else {
                 ConeSearch::Greedy
+            },
+            // `f`: free homology seams (`SeamMode::Free`).
+            // `fd`: free seams with the Dirichlet rule for the cone curvatures (BFF's).
+            free_cone_rule: if name.ends_with("fd") {
+                CurvatureRule::Dirichlet
+            } else {
+                CurvatureRule::LeastSquares
+            },
+            seams: if name.ends_with('f') || name.ends_with("fd") {
+                SeamMode::Free
+            } else {
+                SeamMode::Rigid
             },
             ..ParamOptions::default()
         };

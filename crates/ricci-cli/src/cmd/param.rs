@@ -1,6 +1,6 @@
 //! `ricci param MESH [--out UV.obj] [--svg UV.svg] [--png UV.png] [--cones auto|none|N|V=K,…|file:PATH]
 //! [--max-area-distortion D] [--boundary free|round|fixed-angles] [--sphere] [--seamless]
-//! [--cone-corrections R] [--margin M] [--json]`: a conformal UV map of the mesh in one command
+//! [--seams rigid|free] [--cone-corrections R] [--margin M] [--json]`: a conformal UV map of the mesh in one command
 //! (`ricci::param::parametrize`): conformal flow with intrinsic Delaunay flips, a cut through
 //! the cones and the handles, a flat layout, UVs on the input's own faces (seams as extra
 //! `vt`), charts packed into [0, 1]².
@@ -10,6 +10,13 @@
 //! `V=K,…` gives vertex ids and curvatures (`K` in radians, `pi/2`, `-pi` accepted; cone angle
 //! 2π − K); `file:PATH` reads per-vertex curvatures (the `--target file:` format of
 //! `ricci flow`; nonzero entries are cones); `none` (a torus).
+//! `--seams free` (closed components of genus ≥ 1): the homology seams are free — the surface
+//! cut along its homology generators is flattened as a disk with the least area distortion
+//! along the cut (`u = 0`, Boundary First Flattening's kind of map) and greedy cones inside;
+//! transitions across those seams are not rigid motions (cone seams stay rigid). The default
+//! `rigid` gives a flat metric with cones on the closed surface (every transition a rotation),
+//! what `--seamless` and quad meshing need; `free` has less area distortion at equal cone
+//! count. The JSON says which (`"seams"`).
 //! `--sphere` maps a closed genus-0 surface onto the unit sphere instead (UV.obj then holds
 //! the sphere points as `v`).
 //! When the input's own faces would fold (or the cut needs edges the flow flipped), UV.obj
@@ -33,7 +40,7 @@ use ricci::flow::TargetSpec;
 use ricci::layout::export::obj_with_corner_uv;
 use ricci::metric::Geometry;
 use ricci::param::sphere::{sphere_map, SphereMap};
-use ricci::param::{parametrize, BoundaryMode, ConeSpec, ParamOptions};
+use ricci::param::{parametrize, BoundaryMode, ConeSpec, ParamOptions, SeamMode};
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -66,6 +73,11 @@ pub struct Args {
     /// Cone angles multiples of π/2 (transitions across seams: rotations by k·90° on genus 0).
     #[arg(long)]
     pub seamless: bool,
+    /// Homology seams of closed components of genus ≥ 1: rigid (a flat metric with cones;
+    /// transitions are rotations) | free (the cut disk flattened with least area distortion
+    /// along the cut; less distortion, transitions not rigid).
+    #[arg(long, default_value = "rigid")]
+    pub seams: String,
     /// Rounds of correcting greedy cone curvatures on the nonlinear flow (least L² norm of
     /// the log scale factor; each round runs the flow once more; kept when σ(2u) drops).
     #[arg(long, default_value_t = 0)]
@@ -140,6 +152,7 @@ fn cone_spec(a: &Args, surface: &ricci::mesh::Surface) -> anyhow::Result<ConeSpe
 pub fn run(a: Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let boundary: BoundaryMode = a.boundary.parse().map_err(UsageError)?;
+    let seams: SeamMode = a.seams.parse().map_err(UsageError)?;
     let (surface, _) = read_surface(&a.mesh)?;
     let mut bar = super::layout::spinner(a.json);
     let name = a.mesh.display().to_string();
@@ -166,6 +179,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         seamless: a.seamless,
         margin: a.margin,
         cone_corrections: a.cone_corrections,
+        seams,
         ..ParamOptions::default()
     };
     let p = match parametrize(&surface, &opts, &mut bar) {
@@ -260,7 +274,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "log_area_sigma": p.stats.log_area_sigma, "distortion": p.stats,
         "cone_count": cones.len(), "cones": cones, "seam_length": seam_length,
         "seam_edges": p.seam.iter().filter(|&&s| s).count(),
-        "seamless": a.seamless, "boundary": boundary, "chart_details": p.charts,
+        "seamless": a.seamless, "seams": seams, "boundary": boundary, "chart_details": p.charts,
         "seconds": t0.elapsed().as_secs_f64(),
     });
     report(&a, &out)

@@ -52,6 +52,10 @@ pub enum TargetSpec {
     Cones(Vec<(u32, f64)>),
     SingleCone(Option<u32>),
     FreeBoundary,
+    /// `free-boundary` with cones `(vertex, K̄)` at interior vertices: `u` held on the
+    /// boundary, `K̄` at the cones, flat elsewhere inside (library use: `ricci param --seams
+    /// free`, the boundary being the cut through the homology generators).
+    FreeBoundaryCones(Vec<(u32, f64)>),
     RoundBoundary,
     GeodesicBoundary,
     File(PathBuf),
@@ -70,6 +74,10 @@ impl fmt::Display for TargetSpec {
             TargetSpec::SingleCone(Some(v)) => write!(f, "single-cone:{v}"),
             TargetSpec::SingleCone(None) => write!(f, "single-cone"),
             TargetSpec::FreeBoundary => write!(f, "free-boundary"),
+            TargetSpec::FreeBoundaryCones(c) => {
+                let s: Vec<String> = c.iter().map(|(v, k)| format!("{v}={k}")).collect();
+                write!(f, "free-boundary+cone:{}", s.join(","))
+            }
             TargetSpec::RoundBoundary => write!(f, "round-boundary"),
             TargetSpec::GeodesicBoundary => write!(f, "geodesic-boundary"),
             TargetSpec::File(p) => write!(f, "file:{}", p.display()),
@@ -419,7 +427,7 @@ pub fn resolve(mesh: &Mesh, geometry: Geometry, spec: &TargetSpec) -> Result<Tar
             check_vertex(v)?;
             t.curvature[v as usize] = 2.0 * PI * chi as f64;
         }
-        TargetSpec::FreeBoundary => {
+        TargetSpec::FreeBoundary | TargetSpec::FreeBoundaryCones(_) => {
             if !mesh.has_boundary() {
                 return Err(Error::topology(
                     "free-boundary needs a mesh with boundary; this mesh is closed",
@@ -428,6 +436,17 @@ pub fn resolve(mesh: &Mesh, geometry: Geometry, spec: &TargetSpec) -> Result<Tar
             for v in 0..n as u32 {
                 if mesh.is_boundary_vertex(v) {
                     t.fixed[v as usize] = true;
+                }
+            }
+            if let TargetSpec::FreeBoundaryCones(list) = spec {
+                for &(v, k) in list {
+                    check_vertex(v)?;
+                    if mesh.is_boundary_vertex(v) {
+                        return Err(Error::input(format!(
+                            "cone vertex {v} lies on the boundary, where u is held"
+                        )));
+                    }
+                    t.curvature[v as usize] = k;
                 }
             }
         }

@@ -8,12 +8,13 @@ use super::boundary::fixed_angle_targets;
 use super::cones::{
     correct_cone_curvatures, greedy_cones_with, round_to_quarter_turns, ConeBudget,
 };
+use super::free::{free_seam_target, homology_disk, HomologyDisk};
 use super::transfer::{
     folded_faces, input_route, scale_to_area, seam_edges, seam_report, subdivision_route,
     SubdivisionChart,
 };
 use super::{log_scale_sigma, BoundaryMode, Chart, Cone, ConeSpec};
-use super::{ParamOptions, Piece};
+use super::{ParamOptions, Piece, SeamMode};
 use crate::error::{Error, Result};
 use crate::flow::{flow_with_fallback, FlowResult, TargetSpec, UniformizationOptions};
 use crate::mesh::{topology, Mesh};
@@ -216,7 +217,7 @@ fn flow_with_corrections(
         corrections: 0,
         runs: 1,
     };
-    let rounds = if plan.source == "greedy" && !opts.seamless {
+    let rounds = if plan.source == "greedy" && !opts.seamless && !mesh.has_boundary() {
         opts.cone_corrections
     } else {
         0
@@ -244,6 +245,47 @@ fn flow_with_corrections(
     Ok(kept)
 }
 
+/// The target of a chart, and with free seams (closed, genus ≥ 1, `--seams free`) the disk
+/// it is cut into along its homology generators ([`super::free`]).
+fn open_and_plan(
+    piece: &Piece,
+    component: usize,
+    genus: i64,
+    boundary_loops: usize,
+    opts: &ParamOptions,
+    progress: &mut dyn Progress,
+) -> Result<(Option<HomologyDisk>, ConePlan)> {
+    let lengths = piece.surface.edge_lengths();
+    if boundary_loops > 0 {
+        return Ok((None, boundary_target(piece, component, opts, &lengths)?));
+    }
+    if opts.seams != SeamMode::Free || genus == 0 {
+        let plan = closed_target(piece, component, genus, opts, &lengths, progress)?;
+        return Ok((None, plan));
+    }
+    if opts.seamless {
+        return Err(Error::input(
+            "--seamless needs rigid seams (free homology seams are not rotations by k·90°); \
+             drop --seams free",
+        ));
+    }
+    progress.report(
+        "cut",
+        None,
+        "cut through the homology generators (free seams)",
+    );
+    let disk = homology_disk(piece, component)?;
+    let (target, cones, source, history) =
+        free_seam_target(&disk, component, genus, opts, progress)?;
+    let plan = ConePlan {
+        target,
+        cones,
+        source,
+        history,
+    };
+    Ok((Some(disk), plan))
+}
+
 /// UVs of one connected component (module docs, steps 1–5).
 pub(super) fn chart_uv(
     piece: &Piece,
@@ -252,17 +294,22 @@ pub(super) fn chart_uv(
     progress: &mut dyn Progress,
 ) -> Result<ChartUv> {
     let t0 = Instant::now();
-    let s = &piece.surface;
-    let mesh = &s.mesh;
-    let topo = topology(mesh);
+    let topo = topology(&piece.surface.mesh);
     let comp = &topo.components[0];
+    let (disk, plan) = open_and_plan(
+        piece,
+        component,
+        comp.genus,
+        comp.boundary_loops,
+        opts,
+        progress,
+    )?;
+    // With free seams the rest runs on the disk (same faces, seam vertices doubled).
+    let work = disk.as_ref().map_or(piece, |d| &d.piece);
+    let s = &work.surface;
+    let mesh = &s.mesh;
     let lengths = s.edge_lengths();
-    let plan = if comp.boundary_loops > 0 {
-        boundary_target(piece, component, opts, &lengths)?
-    } else {
-        closed_target(piece, component, comp.genus, opts, &lengths, progress)?
-    };
-    let kept = flow_with_corrections(piece, component, &lengths, &plan, opts, progress)?;
+    let kept = flow_with_corrections(work, component, &lengths, &plan, opts, progress)?;
     let seamless_metric;
     let r = if opts.seamless && comp.genus > 0 && comp.boundary_loops == 0 {
         // Closed genus ≥ 1: the least change of log lengths that makes the holonomy of the
@@ -290,7 +337,8 @@ pub(super) fn chart_uv(
         &kept.r
     };
     let cone_vertices: Vec<u32> = kept.cones.iter().map(|c| c.0).collect();
-    let needs_cut = comp.boundary_loops != 1 || comp.genus > 0 || !cone_vertices.is_empty();
+    let needs_cut =
+        disk.is_none() && (comp.boundary_loops != 1 || comp.genus > 0) || !cone_vertices.is_empty();
     progress.report("cut", None, "cut graph through the cones and the handles");
     let faces = mesh.faces();
     let on_input = input_route(s, &lengths, r, &cone_vertices, needs_cut);
@@ -339,7 +387,7 @@ pub(super) fn chart_uv(
         .cones
         .iter()
         .map(|&(v, k)| Cone {
-            vertex: piece.vertices[v as usize],
+            vertex: work.vertices[v as usize],
             curvature: k,
             angle: 2.0 * PI - k,
         })
@@ -347,10 +395,11 @@ pub(super) fn chart_uv(
     let chart = Chart {
         component,
         faces: mesh.n_faces(),
-        vertices: mesh.n_vertices(),
+        vertices: piece.surface.mesh.n_vertices(),
         genus: comp.genus,
         boundary_loops: comp.boundary_loops,
         target: r.target_description.clone(),
+        seams: if disk.is_some() { "free" } else { "rigid" }.into(),
         cones,
         cone_source: plan.source,
         cone_distortion_history: plan.history,
@@ -376,6 +425,10 @@ pub(super) fn chart_uv(
         cone_corrections: kept.corrections,
         log_scale_sigma: log_scale_sigma(s, &r.u),
         seconds: t0.elapsed().as_secs_f64(),
+    };
+    let cut = match &disk {
+        Some(d) => d.lift_cut(piece, &cut),
+        None => cut,
     };
     Ok(ChartUv {
         corner_uv,

@@ -247,6 +247,113 @@ pub fn cone_curvatures_at(
     Ok((k, g.sigma_2x(&u)))
 }
 
+/// Curvatures of cones at `cones` (interior vertices of a connected mesh **with boundary**,
+/// `u = 0` held on the boundary) for the least area-weighted variance of the linearised log
+/// scale factor `u` (Soliman–Slepčev–Crane 2018 with the positions fixed; the boundary's
+/// turning is free, so the cones need not add up to anything): `u = u₀ + Σ_c K̄_c g_c`, `g_c`
+/// the Dirichlet Green's function of cone `c`, `K̄` from the `k × k` normal equations. Cone
+/// angles are kept positive (`K̄ ≤ 2π − 0.05`). Returns `(vertex, K̄)` and the linearised
+/// area-weighted `σ(2u)`.
+pub fn free_boundary_least_squares(
+    mesh: &Mesh,
+    metric: &IntrinsicMetric,
+    cones: &[u32],
+) -> Result<(Vec<(u32, f64)>, f64)> {
+    let lap = laplacian(mesh, metric.lengths())?;
+    let n = lap.n;
+    let k0 = angle_defects(mesh, metric);
+    let held: Vec<bool> = (0..n as u32)
+        .map(|v| mesh.is_boundary_vertex(v) || mesh.is_isolated(v))
+        .collect();
+    if !held.iter().any(|&h| h) || !(0..n as u32).any(|v| mesh.is_boundary_vertex(v)) {
+        return Err(Error::input(
+            "free-boundary cone curvatures need a boundary",
+        ));
+    }
+    if let Some(&c) = cones.iter().find(|&&c| c as usize >= n || held[c as usize]) {
+        return Err(Error::input(format!(
+            "cone vertex {c} is not an interior vertex of the mesh"
+        )));
+    }
+    let mut solver = SymmetricSolver::new(LowerCsc {
+        n,
+        col_ptr: &lap.col_ptr,
+        row_idx: &lap.row_idx,
+    })?;
+    let scale = lap.diag.iter().map(|&i| lap.values[i]).fold(0.0, f64::max);
+    let mut vals = lap.values.clone();
+    for v in 0..n {
+        if held[v] {
+            vals[lap.diag[v]] += 1e10 * scale.max(1e-300);
+        }
+    }
+    if !solver.factor_llt(&vals) && !solver.factor_ldlt(&vals) {
+        return Err(Error::numerical(
+            "the cotangent Laplacian could not be factorized for the cone curvatures",
+        ));
+    }
+    let total: f64 = lap.area.iter().sum();
+    let centred = |mut x: Vec<f64>| -> Vec<f64> {
+        let m = (0..n).map(|v| x[v] * lap.area[v]).sum::<f64>() / total;
+        x.iter_mut().for_each(|y| *y -= m);
+        x
+    };
+    let mut u0: Vec<f64> = (0..n).map(|v| if held[v] { 0.0 } else { -k0[v] }).collect();
+    solver.solve(&mut u0);
+    let u0 = centred(u0);
+    let g: Vec<Vec<f64>> = cones
+        .iter()
+        .map(|&c| {
+            let mut x = vec![0.0; n];
+            x[c as usize] = 1.0;
+            solver.solve(&mut x);
+            centred(x)
+        })
+        .collect();
+    let k = cones.len();
+    let dot = |a: &[f64], b: &[f64]| (0..n).map(|v| lap.area[v] * a[v] * b[v]).sum::<f64>();
+    // Normal equations [GᵀAG | −GᵀAu₀], Gaussian elimination with partial pivoting.
+    let mut m: Vec<Vec<f64>> = (0..k)
+        .map(|i| {
+            let mut row: Vec<f64> = (0..k).map(|j| dot(&g[i], &g[j])).collect();
+            row.push(-dot(&g[i], &u0));
+            row
+        })
+        .collect();
+    for col in 0..k {
+        let p = (col..k)
+            .max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))
+            .unwrap_or(col);
+        m.swap(col, p);
+        let d = m[col][col];
+        if d.abs() < 1e-300 {
+            return Err(Error::numerical(
+                "cone curvatures: singular normal equations",
+            ));
+        }
+        let pivot = m[col].clone();
+        for (r, row) in m.iter_mut().enumerate() {
+            if r != col {
+                let f = row[col] / d;
+                for (x, y) in row[col..].iter_mut().zip(&pivot[col..]) {
+                    *x -= f * y;
+                }
+            }
+        }
+    }
+    let x: Vec<f64> = (0..k)
+        .map(|i| (m[i][k] / m[i][i]).min(2.0 * PI - 0.05))
+        .collect();
+    let mut u = u0;
+    for (gc, xc) in g.iter().zip(&x) {
+        for v in 0..n {
+            u[v] += xc * gc[v];
+        }
+    }
+    let sigma = 2.0 * (dot(&u, &u) / total).sqrt();
+    Ok((cones.iter().copied().zip(x).collect(), sigma))
+}
+
 /// The greedy with the boundary held at `u = 0`: one factorization per cone.
 fn greedy_with_boundary(
     lap: &Laplacian,

@@ -13,7 +13,10 @@
 //!      `2πχ − Σκ` moved to the boundary in proportion to the dual boundary lengths (BFF §4.2
 //!      "prescribed curvature").
 //!
-//!    Closed surfaces: cones `K̄_c` at given vertices, or placed by the greedy of
+//!    Closed surfaces of genus ≥ 1 with [`SeamMode::Free`] (`--seams free`): cut along the
+//!    homology generators into a disk, which is flattened as above with `free` (`u = 0` on
+//!    the cut) and cones inside placed by the greedy with the cut held (submodule `free`); the
+//!    homology seams are then not rigid. Otherwise closed surfaces: cones `K̄_c` at given vertices, or placed by the greedy of
 //!    [`cones`] (Ben-Chen–Gotsman–Bunin 2008), flat elsewhere; a torus may have none.
 //!    Greedy cones can be corrected on the nonlinear flow
 //!    ([`ParamOptions::cone_corrections`], [`cones::correct_cone_curvatures`]): the cone
@@ -48,6 +51,7 @@
 pub(crate) mod boundary;
 mod chart;
 pub mod cones;
+mod free;
 pub mod seamless;
 pub(crate) mod seams;
 pub mod sphere;
@@ -102,6 +106,40 @@ impl std::str::FromStr for BoundaryMode {
     }
 }
 
+/// How closed components of genus ≥ 1 are opened (`ricci param --seams`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SeamMode {
+    /// A flat metric with cones on the closed surface: every transition across a seam is a
+    /// rigid motion (a rotation by the holonomy), what seamless maps and quad meshing need.
+    #[default]
+    Rigid,
+    /// The homology seams are free (submodule `free`): the surface cut along its homology
+    /// generators is flattened as a disk with `u = 0` on the cut and cones inside (Boundary
+    /// First Flattening's kind of map on genus ≥ 1). Cone seams stay rigid.
+    Free,
+}
+
+impl std::str::FromStr for SeamMode {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "rigid" => Ok(SeamMode::Rigid),
+            "free" => Ok(SeamMode::Free),
+            _ => Err(format!("unknown seams '{s}' (expected rigid or free)")),
+        }
+    }
+}
+
+impl SeamMode {
+    pub fn name(self) -> &'static str {
+        match self {
+            SeamMode::Rigid => "rigid",
+            SeamMode::Free => "free",
+        }
+    }
+}
+
 /// Options of [`parametrize`].
 #[derive(Debug, Clone)]
 pub struct ParamOptions {
@@ -126,6 +164,11 @@ pub struct ParamOptions {
     /// Search of the automatic cone placement on closed surfaces (default
     /// [`cones::ConeSearch::Greedy`]; `Energy` is the wider, opt-in search).
     pub cone_search: cones::ConeSearch,
+    /// Rigid (default) or free homology seams on closed components of genus ≥ 1.
+    pub seams: SeamMode,
+    /// Curvatures of the greedy cones with free seams (default least squares: the least
+    /// linearised σ(2u) at the greedy's positions; `Dirichlet`: `u = 0` at the cones, BFF's).
+    pub free_cone_rule: cones::CurvatureRule,
 }
 
 impl Default for ParamOptions {
@@ -140,6 +183,8 @@ impl Default for ParamOptions {
             cone_corrections: 0,
             on_subdivision: false,
             cone_search: cones::ConeSearch::Greedy,
+            seams: SeamMode::Rigid,
+            free_cone_rule: cones::CurvatureRule::LeastSquares,
         }
     }
 }
@@ -164,6 +209,9 @@ pub struct Chart {
     pub genus: i64,
     pub boundary_loops: usize,
     pub target: String,
+    /// `"free"` when this chart's homology seams are free (closed, genus ≥ 1, `--seams
+    /// free`), else `"rigid"` (also charts with no homology seams).
+    pub seams: String,
     pub cones: Vec<Cone>,
     /// How the cones were chosen (`given`, `greedy`, `none`).
     pub cone_source: String,
