@@ -114,49 +114,66 @@ fn evaluate_angles<B: crate::metric::Background>(
     st.curvature.clear();
     st.curvature
         .extend((0..nv).map(|v| if tri.boundary_vertex[v] { PI } else { 2.0 * PI }));
+    // Per face in parallel (rayon): angles and their derivatives go to the face's own slots;
+    // the curvatures and the area are then summed in face order, as one loop would (the same
+    // numbers whatever the number of threads).
+    use rayon::prelude::*;
+    let per_face: Vec<(bool, f64)> = st
+        .angles
+        .par_chunks_mut(3)
+        .zip(st.jac.par_chunks_mut(9))
+        .enumerate()
+        .with_min_len(1024)
+        .map(|(f, (angles, jac))| {
+            let b = 3 * f;
+            // Side m is opposite corner m: the edge of half-edge 3f + (m+1)%3.
+            let mut l = [0.0; 3];
+            let mut ht = [0.0; 3];
+            for m in 0..3 {
+                let h = (b + (m + 1) % 3) as u32;
+                let lam = tri.lambda[tri.edge[h as usize] as usize]
+                    + u.get(tri.origin[h as usize] as usize)
+                        .copied()
+                        .unwrap_or(0.0)
+                    + u.get(tri.tip(h) as usize).copied().unwrap_or(0.0);
+                l[m] = length_of_lambda(geometry, lam);
+                ht[m] = B::half_tangent(l[m]);
+            }
+            let (th, d, deg) = angle_derivatives::<B>(l);
+            for m in 0..3 {
+                angles[m] = th[m];
+                for n in 0..3 {
+                    // ∂θ_m/∂u_n = Σ_{k ≠ n} ∂θ_m/∂l_k · ∂l_k/∂u (edge k has corners k+1, k+2).
+                    let mut s = 0.0;
+                    for k in 0..3 {
+                        if k != n {
+                            s += d[m][k] * ht[k];
+                        }
+                    }
+                    jac[3 * m + n] = s;
+                }
+            }
+            let a = match geometry {
+                Geometry::Euclidean => B::area(l[0], l[1], l[2]),
+                Geometry::Hyperbolic => (PI - th[0] - th[1] - th[2]).max(0.0),
+                Geometry::Spherical => (th[0] + th[1] + th[2] - PI).max(0.0),
+            };
+            (deg, a)
+        })
+        .collect();
     st.degenerate_faces = 0;
     let mut area = 0.0;
     let mut used = vec![false; nv];
-    for f in 0..nf {
-        let b = 3 * f;
-        // Side m is opposite corner m: the edge of half-edge 3f + (m+1)%3.
-        let mut l = [0.0; 3];
-        let mut ht = [0.0; 3];
-        for m in 0..3 {
-            let h = (b + (m + 1) % 3) as u32;
-            let lam = tri.lambda[tri.edge[h as usize] as usize]
-                + u.get(tri.origin[h as usize] as usize)
-                    .copied()
-                    .unwrap_or(0.0)
-                + u.get(tri.tip(h) as usize).copied().unwrap_or(0.0);
-            l[m] = length_of_lambda(geometry, lam);
-            ht[m] = B::half_tangent(l[m]);
-        }
-        let (th, d, deg) = angle_derivatives::<B>(l);
+    for (f, &(deg, a)) in per_face.iter().enumerate() {
         if deg {
             st.degenerate_faces += 1;
         }
         for m in 0..3 {
-            let v = tri.origin[b + m] as usize;
+            let v = tri.origin[3 * f + m] as usize;
             used[v] = true;
-            st.angles[b + m] = th[m];
-            st.curvature[v] -= th[m];
-            for n in 0..3 {
-                // ∂θ_m/∂u_n = Σ_{k ≠ n} ∂θ_m/∂l_k · ∂l_k/∂u (edge k has corners k+1, k+2).
-                let mut s = 0.0;
-                for k in 0..3 {
-                    if k != n {
-                        s += d[m][k] * ht[k];
-                    }
-                }
-                st.jac[9 * f + 3 * m + n] = s;
-            }
+            st.curvature[v] -= st.angles[3 * f + m];
         }
-        area += match geometry {
-            Geometry::Euclidean => B::area(l[0], l[1], l[2]),
-            Geometry::Hyperbolic => (PI - th[0] - th[1] - th[2]).max(0.0),
-            Geometry::Spherical => (th[0] + th[1] + th[2] - PI).max(0.0),
-        };
+        area += a;
     }
     for v in 0..nv {
         if !used[v] {

@@ -106,32 +106,40 @@ fn lengths_dd(
     eta_lo: Option<&[f64]>,
     u: &[Dd],
 ) -> Result<Vec<Dd>> {
+    use rayon::prelude::*;
     let cp = structure.scheme.is_circle_packing();
-    let vd: Vec<[Dd; 2]> = u
-        .iter()
+    // Per vertex, then per edge, in parallel (rayon): each value depends on its own inputs
+    // only, and the first error in index order is the one reported, as in one loop.
+    let vd: Vec<Result<[Dd; 2]>> = u
+        .par_iter()
+        .with_min_len(2048)
         .map(|&x| vertex_data(cp, x))
-        .collect::<Result<_>>()?;
+        .collect();
+    let vd: Vec<[Dd; 2]> = vd.into_iter().collect::<Result<_>>()?;
     let half = Dd::new(0.5);
-    let mut out = Vec::with_capacity(mesh.n_edges());
-    for e in 0..mesh.n_edges() {
-        let [a, b] = mesh.edge_vertices(e as u32);
-        let eta = Dd::new(structure.eta[e]) + Dd::new(eta_lo.map_or(0.0, |l| l[e]));
-        let (va, vb) = (vd[a as usize], vd[b as usize]);
-        let x = if cp {
-            let d = ((va[1] - vb[1]) * half).sinh();
-            let x2 = d.sqr() + half * va[0] * vb[0] * (Dd::ONE + eta);
-            if !(x2.hi > 0.0) {
-                return Err(Error::numerical(format!(
-                    "edge {e} ({a}, {b}) has no length at the polished variables"
-                )));
-            }
-            x2.sqrt()
-        } else {
-            va[0] * vb[0] * eta
-        };
-        out.push(Dd::new(2.0) * x.asinh());
-    }
-    Ok(out)
+    let out: Vec<Result<Dd>> = (0..mesh.n_edges())
+        .into_par_iter()
+        .with_min_len(2048)
+        .map(|e| {
+            let [a, b] = mesh.edge_vertices(e as u32);
+            let eta = Dd::new(structure.eta[e]) + Dd::new(eta_lo.map_or(0.0, |l| l[e]));
+            let (va, vb) = (vd[a as usize], vd[b as usize]);
+            let x = if cp {
+                let d = ((va[1] - vb[1]) * half).sinh();
+                let x2 = d.sqr() + half * va[0] * vb[0] * (Dd::ONE + eta);
+                if !(x2.hi > 0.0) {
+                    return Err(Error::numerical(format!(
+                        "edge {e} ({a}, {b}) has no length at the polished variables"
+                    )));
+                }
+                x2.sqrt()
+            } else {
+                va[0] * vb[0] * eta
+            };
+            Ok(Dd::new(2.0) * x.asinh())
+        })
+        .collect();
+    out.into_iter().collect()
 }
 
 /// A power of two within a factor 2 of `1/x` (`x > 0` finite; 1 otherwise): multiplying by
@@ -146,33 +154,52 @@ fn power_of_two_near_inverse(x: f64) -> f64 {
 }
 
 /// `K̄ − K` in double-double for target 0 (see the module docs), as doubles.
+///
+/// The three unit factors of each face are computed in parallel (rayon; the four double-double
+/// `sinh` per face are most of the cost) and multiplied into the vertex products in face
+/// order, as one loop would: the same numbers whatever the number of threads.
 fn residual_dd(mesh: &Mesh, lengths: &[Dd], residual: &mut [f64]) -> Result<()> {
+    use rayon::prelude::*;
     let nv = mesh.n_vertices();
     let mut prod = vec![Cdd::ONE; nv];
     let half = Dd::new(0.5);
-    for f in 0..mesh.n_faces() as u32 {
-        let l = mesh.face_edges_opposite(f).map(|e| lengths[e as usize]);
-        let sig = (l[0] + l[1] + l[2]) * half;
-        let d = [sig - l[0], sig - l[1], sig - l[2]];
-        if d.iter().any(|x| !(x.hi > 0.0)) {
+    let factors: Vec<Option<[Cdd; 3]>> = (0..mesh.n_faces() as u32)
+        .into_par_iter()
+        .with_min_len(2048)
+        .map(|f| {
+            let l = mesh.face_edges_opposite(f).map(|e| lengths[e as usize]);
+            let sig = (l[0] + l[1] + l[2]) * half;
+            let d = [sig - l[0], sig - l[1], sig - l[2]];
+            if d.iter().any(|x| !(x.hi > 0.0)) {
+                return None;
+            }
+            let s0 = sig.sinh();
+            let sd = d.map(|x| x.sinh());
+            // tan²(θ_i/2) = A/B with A = sinh d_j sinh d_k, B = sinh σ sinh d_i, so
+            // e^{iθ_i} = (1 − t² + 2it)/(1 + t²) is a positive multiple of (B − A) + 2i√(AB),
+            // and AB = sinh σ sinh d₀ sinh d₁ sinh d₂ is the same for the three corners: one
+            // square root per face and no division.
+            let p2 = Dd::new(2.0) * (s0 * sd[0] * sd[1] * sd[2]).sqrt();
+            Some([0, 1, 2].map(|i| {
+                let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+                Cdd {
+                    re: s0 * sd[i] - sd[j] * sd[k],
+                    im: p2,
+                }
+            }))
+        })
+        .collect();
+    for (f, w) in factors.iter().enumerate() {
+        let Some(w) = w else {
             return Err(Error::numerical(format!(
                 "face {f} violates the triangle inequality in the polished metric"
             )));
-        }
-        let s0 = sig.sinh();
-        let sd = d.map(|x| x.sinh());
-        // tan²(θ_i/2) = A/B with A = sinh d_j sinh d_k, B = sinh σ sinh d_i, so
-        // e^{iθ_i} = (1 − t² + 2it)/(1 + t²) is a positive multiple of (B − A) + 2i√(AB), and
-        // AB = sinh σ sinh d₀ sinh d₁ sinh d₂ is the same for the three corners: one square
-        // root per face and no division. The products around a vertex are rescaled by powers of
-        // two (exact) to stay near 1; only their argument is used.
-        let p2 = Dd::new(2.0) * (s0 * sd[0] * sd[1] * sd[2]).sqrt();
-        let fv = mesh.face(f);
+        };
+        // The products around a vertex are rescaled by powers of two (exact) to stay near 1;
+        // only their argument is used.
+        let fv = mesh.face(f as u32);
         for i in 0..3 {
-            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-            let a = sd[j] * sd[k];
-            let b = s0 * sd[i];
-            let z = prod[fv[i] as usize] * Cdd { re: b - a, im: p2 };
+            let z = prod[fv[i] as usize] * w[i];
             let scale = Dd::new(power_of_two_near_inverse(z.re.hi.abs() + z.im.hi.abs()));
             prod[fv[i] as usize] = z.scale(scale);
         }

@@ -22,6 +22,14 @@ pub struct CompactDomain {
     /// pairings, ball cover) and the search (tiles and classes, all rounds).
     pub seconds_domain: f64,
     pub seconds_search: f64,
+    /// The vertex the domain grows from; its copy in the seed face is the origin of the disk
+    /// and `radius` is measured from it.
+    pub centre: u32,
+    /// The developed domain in the Poincaré disk (rounded from double-double): its points,
+    /// the mesh vertex each point is a copy of, and its triangles (indices into `points`).
+    pub points: Vec<[f64; 2]>,
+    pub point_vertex: Vec<u32>,
+    pub triangles: Vec<[u32; 3]>,
 }
 
 /// A two-level cover of a fundamental domain `F` by hyperbolic balls, for the conservative
@@ -392,6 +400,10 @@ pub fn surface_spectrum(
         balls: cover.balls.len(),
         seconds_domain: clock.elapsed().as_secs_f64(),
         seconds_search: 0.0,
+        centre: o,
+        points: dom.positions.iter().map(|p| [p.re, p.im]).collect(),
+        point_vertex: dom.origin.clone(),
+        triangles: dom.faces.clone(),
     };
     let clock = std::time::Instant::now();
     let mut l = dom
@@ -523,6 +535,8 @@ struct DomainPairings {
     faces: Vec<[u32; 3]>,
     /// The copy of the centre vertex in the seed face.
     centre: Complex,
+    /// The mesh vertex of each point of `positions`.
+    origin: Vec<u32>,
     /// Distinct side pairings (a generating set of the deck group).
     generators: Vec<MobiusDd>,
     /// Boundary cycle: (position, generator of the side starting there).
@@ -624,6 +638,7 @@ impl DomainPairings {
             positions,
             faces,
             centre,
+            origin,
             generators,
             boundary,
             boundary_faces,
