@@ -222,7 +222,7 @@ fn outputs(args: &[String]) -> Vec<String> {
 const README_ALL_ONLY: &[(&str, &str)] = &[
     (
         "spline kitten.nf20k.off --degree 4",
-        "degree 4, r = 2 on 20 000 faces: ~900 CPU-s and 6 GB by its own estimate",
+        "degree 4 on 20 000 faces: ~25 CPU-s and 2.4 GB (session 11)",
     ),
     ("spline genus3.off", "20 CPU-s"),
     ("pou fertility.off", "22 CPU-s"),
