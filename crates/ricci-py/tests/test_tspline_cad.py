@@ -109,7 +109,11 @@ def check_genus_two(rep, samples, tol_percent):
 
 
 def test_generated_genus_two_step_and_iges_open_in_open_cascade(generated, tmp_path):
-    rep, samples = run_tspline(generated["genus"], tmp_path, "--tolerance", "1%")
+    # Since the knot-line tangent penalty (session 11: the strips no longer fold at the zeros'
+    # knot lines) this surface needs ~48k control points for 1 %, above the default 20 000.
+    rep, samples = run_tspline(
+        generated["genus"], tmp_path, "--tolerance", "1%", "--max-control-points", "80000"
+    )
     check_genus_two(rep, samples, 1.0)
     for name in ("tspline.step", "tspline.igs"):
         check_file(tmp_path / name, samples)
