@@ -116,6 +116,37 @@ def test_spectrum_equals_cli_on_shared_torus():
     assert_same(ricci.spectrum(path, count=8), want)
 
 
+def test_spectrum_of_a_bordered_surface_is_its_doubles_as_in_the_cli(generated, tmp_path):
+    """A surface with boundary (not a disk): the spectrum of its double, as `ricci spectrum`
+    gives it (spec11), from a path and from arrays. Values from elsewhere: the round annulus
+    0.5 < |z| < 1 is a cylinder of circumference 2π and height h = log 2, so its double is the
+    flat torus R²/(2πZ × 2hZ), whose closed geodesics have lengths |a·2π + i b·2h|."""
+    path = tmp_path / "annulus.off"
+    cli("generate", "annulus", "--inner", "0.5", "--outer", "1", "--resolution", "96",
+        "--out", path)
+    count = 6
+    _, want, _ = cli("spectrum", path, "--json", "--count", count)
+    got = ricci.spectrum(path, count=count)
+    assert_same(got, want)
+    assert got.spectrum_of == "double" and got.genus == 1
+    assert got.double["surface_genus"] == 0 and got.double["boundary_loops"] == 2
+    mesh = ricci.read_mesh(path)
+    assert_same(ricci.spectrum(mesh.vertices, mesh.faces, name=str(path), count=count), want)
+    h = np.log(2.0)
+    closed = sorted(
+        np.hypot(a * 2 * np.pi, b * 2 * h)
+        for a in range(0, 4)
+        for b in range(-20, 21)
+        if a > 0 or b > 0
+    )[:count]
+    closed = np.array(closed) / closed[0]
+    assert np.allclose(got.normalized, closed, rtol=5e-3, atol=0), (got.normalized, closed)
+    # A closed surface reports itself; a disk (whose double is a sphere) is refused.
+    assert ricci.spectrum(generated["torus"], count=2).spectrum_of == "surface"
+    with pytest.raises(ricci.RicciError, match="not a disk"):
+        ricci.spectrum(generated["disk"], count=2)
+
+
 def test_info_and_cut_equal_cli(generated, tmp_path):
     path = generated["genus"]
     _, want, _ = cli("info", path, "--json")

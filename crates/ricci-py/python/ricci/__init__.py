@@ -226,9 +226,14 @@ class LayoutResult(Report):
 
 
 class SpectrumResult(Report):
-    """``ricci spectrum``: the geodesic length spectrum (genus ≥ 1)."""
+    """``ricci spectrum``: the geodesic length spectrum of a closed surface of genus ≥ 1, or of
+    the double of a surface with boundary that is not a disk (``spectrum_of`` is
+    ``"surface"`` or ``"double"``; ``double`` then describes the double and ``genus`` is the
+    double's, ``2g + b − 1``)."""
 
     command = "spectrum"
+    spectrum_of: str
+    double: Optional[dict]
     genus: int
     lengths: list
     normalized: list
@@ -662,7 +667,9 @@ def spectrum(
     name: Optional[str] = None,
 ) -> SpectrumResult:
     """``ricci spectrum``: the ``count`` (default 8) shortest closed geodesics' lengths of a
-    closed surface of genus ≥ 1 (normalized by the shortest for genus 1)."""
+    closed surface of genus ≥ 1 (normalized by the shortest for genus 1), or, for a surface
+    with boundary that is not a disk, of its double (``spectrum_of == "double"``; the boundary
+    loops and doubled orthogeodesics are among them). ``metric`` is for closed surfaces only."""
     return run(  # type: ignore[return-value]
         "spectrum", mesh, faces, name=name, count=count, metric=metric, base=base
     )
