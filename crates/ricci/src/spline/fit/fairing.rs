@@ -2,7 +2,7 @@
 //! triangle's control points to its neighbours' blossoms, and the projection of control points
 //! onto them (see the parent module [`super`] for the formulas and the method).
 
-use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
+use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
 
 use crate::error::{Error, Result};
@@ -155,34 +155,13 @@ pub fn fair<S: SplineSpace + ?Sized>(
         return Ok((control.to_vec(), report(control, 0.0, 0)));
     }
     let sys = ConstraintSystem::new(&cons, nb, nc, control);
-    let (trip, diag_max) = penalty_triplets(&cons, nb, nc, space.n_triangles());
-    let mu = 1e8 / diag_max.max(1e-300);
-    let trip: Vec<Triplet<usize, usize, f64>> = trip
-        .into_iter()
-        .map(|t| {
-            let v = if t.row == t.col {
-                1.0 + mu * t.val
-            } else {
-                mu * t.val
-            };
-            Triplet::new(t.row, t.col, v)
-        })
-        .collect();
-    let h = SparseColMat::<usize, f64>::try_new_from_triplets(nc, nc, &trip)
-        .map_err(|e| Error::numerical(format!("fairing: could not assemble I + μAᵀA ({e:?})")))?;
-    drop(trip);
-    let llt = Cholesky::factor(h.as_ref()).map_err(|e| {
-        Error::numerical(format!(
-            "fairing: the Cholesky factorisation of I + μAᵀA failed ({e:?})"
-        ))
-    })?;
+    let pf = PenaltyFactor::new(&cons, nb, nc, space.n_triangles())?;
     let (mut x, mut worst, mut steps, lambda) =
-        sys.augmented_lagrangian(&llt, h.as_ref(), mu, control, dim, tolerance);
+        sys.augmented_lagrangian(&pf, control, dim, tolerance);
     if worst > 1e-2 * tolerance && worst.is_finite() {
         // The plain iteration is linear and slows down where `A` is ill-conditioned; conjugate
         // gradients on the dual, preconditioned by the same factorization, from its multipliers.
-        let (x2, worst2, steps2) =
-            sys.refine_by_dual_pcg(&llt, h.as_ref(), mu, control, dim, lambda, tolerance);
+        let (x2, worst2, steps2) = sys.refine_by_dual_pcg(&pf, control, dim, &lambda, tolerance);
         steps += steps2;
         if worst2 < worst {
             (x, worst) = (x2, worst2);
@@ -193,36 +172,79 @@ pub fn fair<S: SplineSpace + ?Sized>(
             "fairing: the constrained least-squares solve produced non-finite values",
         ));
     }
-    Ok((x.clone(), report(&x, worst, steps)))
+    let rep = report(&x, worst, steps);
+    Ok((x, rep))
 }
 
-/// `H⁻¹ b` for the columns of `b` (in place) with one step of iterative refinement,
-/// `x ← x + H⁻¹ (b − H x)`: `H = I + μAᵀA` has condition number about μ‖A‖², and without the
-/// step the solve's rounding (about ε·μ relative, mostly in the null space of `A`) moves the
-/// faired points off the closest feasible point by about 1e-8. `h` holds the lower triangle.
-fn solve_refined(llt: &Cholesky, h: SparseColMatRef<'_, usize, f64>, mut b: faer::MatMut<'_, f64>) {
-    let rhs = b.to_owned();
-    llt.solve_in_place(b.as_mut());
-    let (n, k) = (rhs.nrows(), rhs.ncols());
-    let sym = h.symbolic();
-    let (cp, ri, val) = (sym.col_ptr(), sym.row_idx(), h.val());
-    let mut r = rhs;
-    for c in 0..k {
-        for j in 0..n {
-            let xj = b[(j, c)];
-            for q in cp[j]..cp[j + 1] {
-                let i = ri[q];
-                r[(i, c)] -= val[q] * xj;
-                if i != j {
-                    r[(j, c)] -= val[q] * b[(i, c)];
+/// The penalty matrix `H = I + μ AᵀA` of [`fair`] (lower triangle) with its sparse Cholesky
+/// factorization and the weight `μ = 10⁸ / max diag(AᵀA)`.
+struct PenaltyFactor {
+    llt: Cholesky,
+    h: SparseColMat<usize, f64>,
+    mu: f64,
+}
+
+impl PenaltyFactor {
+    /// Assemble and factor `H` for the constraints `cons` (`nb` control points per triangle,
+    /// `nc` in all, `nf` triangles).
+    fn new(cons: &[Constraint], nb: usize, nc: usize, nf: usize) -> Result<Self> {
+        let (trip, diag_max) = penalty_triplets(cons, nb, nc, nf);
+        let mu = 1e8 / diag_max.max(1e-300);
+        let trip: Vec<Triplet<usize, usize, f64>> = trip
+            .into_iter()
+            .map(|t| {
+                let v = if t.row == t.col {
+                    1.0 + mu * t.val
+                } else {
+                    mu * t.val
+                };
+                Triplet::new(t.row, t.col, v)
+            })
+            .collect();
+        let h = SparseColMat::<usize, f64>::try_new_from_triplets(nc, nc, &trip).map_err(|e| {
+            Error::numerical(format!("fairing: could not assemble I + μAᵀA ({e:?})"))
+        })?;
+        drop(trip);
+        let llt = Cholesky::factor(h.as_ref()).map_err(|e| {
+            Error::numerical(format!(
+                "fairing: the Cholesky factorisation of I + μAᵀA failed ({e:?})"
+            ))
+        })?;
+        Ok(PenaltyFactor { llt, h, mu })
+    }
+
+    /// `H⁻¹ b` for the columns of `b` (in place) with one step of iterative refinement,
+    /// `x ← x + H⁻¹ (b − H x)`: `H = I + μAᵀA` has condition number about μ‖A‖², and without
+    /// the step the solve's rounding (about ε·μ relative, mostly in the null space of `A`) moves
+    /// the faired points off the closest feasible point by about 1e-8. `r` is scratch space
+    /// (reshaped to `b`'s shape when it differs).
+    fn solve_refined(&self, mut b: faer::MatMut<'_, f64>, r: &mut Mat<f64>) {
+        let (n, k) = (b.nrows(), b.ncols());
+        if r.nrows() != n || r.ncols() != k {
+            *r = Mat::zeros(n, k);
+        }
+        r.as_mut().copy_from(b.as_ref());
+        self.llt.solve_in_place(b.as_mut());
+        let h = self.h.as_ref();
+        let sym = h.symbolic();
+        let (cp, ri, val) = (sym.col_ptr(), sym.row_idx(), h.val());
+        for c in 0..k {
+            for j in 0..n {
+                let xj = b[(j, c)];
+                for q in cp[j]..cp[j + 1] {
+                    let i = ri[q];
+                    r[(i, c)] -= val[q] * xj;
+                    if i != j {
+                        r[(j, c)] -= val[q] * b[(i, c)];
+                    }
                 }
             }
         }
-    }
-    llt.solve_in_place(r.as_mut());
-    for c in 0..k {
-        for j in 0..n {
-            b[(j, c)] += r[(j, c)];
+        self.llt.solve_in_place(r.as_mut());
+        for c in 0..k {
+            for j in 0..n {
+                b[(j, c)] += r[(j, c)];
+            }
         }
     }
 }
@@ -345,23 +367,23 @@ impl<'a> ConstraintSystem<'a> {
     }
 
     /// The augmented-Lagrangian steps of [`fair`] (all coordinates at once): the iterate with
-    /// the smallest largest relative residual, that residual and the number of steps taken.
+    /// the smallest largest relative residual, that residual, the number of steps taken and
+    /// the multipliers.
     fn augmented_lagrangian(
         &self,
-        llt: &Cholesky,
-        h: SparseColMatRef<'_, usize, f64>,
-        mu: f64,
+        pf: &PenaltyFactor,
         control: &[f64],
         dim: usize,
         tolerance: f64,
     ) -> (Vec<f64>, f64, usize, Vec<f64>) {
-        let (m, nc) = (self.cons.len(), self.nc);
+        let (m, nc, mu) = (self.cons.len(), self.nc, pf.mu);
         let mut lambda = vec![0.0; m * dim];
         let mut best: (Vec<f64>, f64) = (control.to_vec(), f64::INFINITY);
         let mut history: Vec<f64> = Vec::new();
         let (mut tmp, mut col, mut res, mut lam) =
             (vec![0.0; nc], vec![0.0; nc], vec![0.0; m], vec![0.0; m]);
         let mut x = vec![0.0; nc * dim];
+        let (mut rhs, mut scratch) = (Mat::<f64>::zeros(nc, dim), Mat::<f64>::zeros(nc, dim));
         // `A c` per coordinate.
         let mut ac = vec![0.0; m * dim];
         for d in 0..dim {
@@ -379,7 +401,6 @@ impl<'a> ConstraintSystem<'a> {
             // In correction form, `c̃ = c − H⁻¹ Aᵀ (λ + μ A c)` (the same step as
             // `H c̃ = c − Aᵀ λ`): the solve's rounding is relative to the correction, so a
             // feasible `c` (r = 0, a polynomial) is left in place to the last bit.
-            let mut rhs = Mat::<f64>::zeros(nc, dim);
             for d in 0..dim {
                 for i in 0..m {
                     lam[i] = lambda[i * dim + d] + mu * ac[i * dim + d];
@@ -389,7 +410,7 @@ impl<'a> ConstraintSystem<'a> {
                     rhs[(k, d)] = tmp[k];
                 }
             }
-            solve_refined(llt, h, rhs.as_mut());
+            pf.solve_refined(rhs.as_mut(), &mut scratch);
             let mut worst: f64 = 0.0;
             for d in 0..dim {
                 for k in 0..nc {
@@ -406,7 +427,8 @@ impl<'a> ConstraintSystem<'a> {
                 break;
             }
             if worst < best.1 {
-                best = (x.clone(), worst);
+                best.0.copy_from_slice(&x);
+                best.1 = worst;
             }
             history.push(worst);
             // Go on to 1 % of the tolerance (steps are cheap next to the factorization): the
@@ -425,29 +447,27 @@ impl<'a> ConstraintSystem<'a> {
         (best.0, best.1, steps, lambda)
     }
 
-    /// [`Self::dual_pcg`] for every coordinate (budget 200 steps each): the projected points,
-    /// their largest relative residual and the most steps taken.
-    #[allow(clippy::too_many_arguments)]
+    /// [`Self::dual_pcg`] for every coordinate (budget 200 steps each) from the multipliers
+    /// `lambda`: the projected points, their largest relative residual and the most steps taken.
     fn refine_by_dual_pcg(
         &self,
-        llt: &Cholesky,
-        h: SparseColMatRef<'_, usize, f64>,
-        mu: f64,
+        pf: &PenaltyFactor,
         control: &[f64],
         dim: usize,
-        lambda: Vec<f64>,
+        lambda: &[f64],
         tolerance: f64,
     ) -> (Vec<f64>, f64, usize) {
         let (m, nc) = (self.cons.len(), self.nc);
         let mut x = control.to_vec();
         let (mut c, mut tmp, mut r) = (vec![0.0; nc], vec![0.0; nc], vec![0.0; m]);
+        let mut pre = Preconditioner::new(nc, m);
         let (mut worst, mut steps): (f64, usize) = (0.0, 0);
         for d in 0..dim {
             for k in 0..nc {
                 c[k] = control[k * dim + d];
             }
             let y0: Vec<f64> = (0..m).map(|i| lambda[i * dim + d]).collect();
-            let (y, it) = self.dual_pcg(llt, h, mu, &c, y0, tolerance, 200);
+            let (y, it) = self.dual_pcg(pf, &mut pre, &c, y0, tolerance, 200);
             steps = steps.max(it);
             self.apply_at(&y, &mut tmp);
             for k in 0..nc {
@@ -460,41 +480,51 @@ impl<'a> ConstraintSystem<'a> {
         (x, worst, steps)
     }
 
+    /// `out = μ (I − μ A H⁻¹ Aᵀ) r`, the preconditioner of [`Self::dual_pcg`] (Woodbury:
+    /// `(A Aᵀ + I/μ)⁻¹`), in the buffers of `pre`.
+    fn precondition(
+        &self,
+        pf: &PenaltyFactor,
+        pre: &mut Preconditioner,
+        r: &[f64],
+        out: &mut [f64],
+    ) {
+        let mu = pf.mu;
+        self.apply_at(r, &mut pre.t);
+        for (k, &t) in pre.t.iter().enumerate() {
+            pre.z[(k, 0)] = t;
+        }
+        pf.solve_refined(pre.z.as_mut(), &mut pre.scratch);
+        for (k, t) in pre.t.iter_mut().enumerate() {
+            *t = pre.z[(k, 0)];
+        }
+        self.apply_a(&pre.t, &mut pre.w);
+        for ((o, &ri), &wi) in out.iter_mut().zip(r).zip(&pre.w) {
+            *o = mu * (ri - mu * wi);
+        }
+    }
+
     /// Conjugate gradients on the dual `A Aᵀ y = A c` for one coordinate `c`, from `y`,
     /// preconditioned by `(A Aᵀ + I/μ)⁻¹ = μ (I − μ A H⁻¹ Aᵀ)` (Woodbury, through the primal
-    /// factorization of `H`), restarted with the true residual `A (c − Aᵀ y)` every 40 steps;
-    /// at most `budget` steps, and it stops when a round of 40 did not halve the residual. Returns `y` and the steps taken.
-    #[allow(clippy::too_many_arguments)]
+    /// factorization of `H`, [`Self::precondition`]), restarted with the true residual
+    /// `A (c − Aᵀ y)` every 40 steps; at most `budget` steps, and it stops when a round of 40
+    /// did not halve the residual. Returns `y` and the steps taken.
     fn dual_pcg(
         &self,
-        llt: &Cholesky,
-        h: SparseColMatRef<'_, usize, f64>,
-        mu: f64,
+        pf: &PenaltyFactor,
+        pre: &mut Preconditioner,
         c: &[f64],
         mut y: Vec<f64>,
         tolerance: f64,
         budget: usize,
     ) -> (Vec<f64>, usize) {
         let (m, nc) = (self.cons.len(), self.nc);
-        let precond = |r: &[f64]| -> Vec<f64> {
-            let mut t = vec![0.0; nc];
-            self.apply_at(r, &mut t);
-            let mut z = Mat::<f64>::zeros(nc, 1);
-            for k in 0..nc {
-                z[(k, 0)] = t[k];
-            }
-            solve_refined(llt, h, z.as_mut());
-            let zc: Vec<f64> = (0..nc).map(|k| z[(k, 0)]).collect();
-            let mut w = vec![0.0; m];
-            self.apply_a(&zc, &mut w);
-            (0..m).map(|i| mu * (r[i] - mu * w[i])).collect()
-        };
         let dotp = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();
         let mut tmp = vec![0.0; nc];
+        let (mut r, mut z, mut p, mut q) = (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
         let mut it = 0;
         let mut last_restart = f64::INFINITY;
         while it < budget {
-            let mut r = vec![0.0; m];
             self.apply_at(&y, &mut tmp);
             for k in 0..nc {
                 tmp[k] = c[k] - tmp[k];
@@ -506,10 +536,9 @@ impl<'a> ConstraintSystem<'a> {
                 break;
             }
             last_restart = rmax;
-            let mut z = precond(&r);
-            let mut p = z.clone();
+            self.precondition(pf, pre, &r, &mut z);
+            p.copy_from_slice(&z);
             let mut rz = dotp(&r, &z);
-            let mut q = vec![0.0; m];
             let mut inner = 0;
             while rmax > 1e-2 * tolerance && inner < 40 && it < budget {
                 inner += 1;
@@ -526,7 +555,7 @@ impl<'a> ConstraintSystem<'a> {
                     r[i] -= alpha * q[i];
                 }
                 rmax = self.rel_max(&r);
-                z = precond(&r);
+                self.precondition(pf, pre, &r, &mut z);
                 let rz_new = dotp(&r, &z);
                 let beta = rz_new / rz;
                 rz = rz_new;
@@ -539,5 +568,29 @@ impl<'a> ConstraintSystem<'a> {
             }
         }
         (y, it)
+    }
+}
+
+/// The buffers of [`ConstraintSystem::precondition`], allocated once per [`fair`] call (the
+/// preconditioner runs at every conjugate-gradient step).
+struct Preconditioner {
+    /// `Aᵀ r`, then `H⁻¹ Aᵀ r` (length `nc`).
+    t: Vec<f64>,
+    /// The right-hand side and solution of the solve (`nc × 1`).
+    z: Mat<f64>,
+    /// Scratch of [`PenaltyFactor::solve_refined`] (`nc × 1`).
+    scratch: Mat<f64>,
+    /// `A H⁻¹ Aᵀ r` (length `m`).
+    w: Vec<f64>,
+}
+
+impl Preconditioner {
+    fn new(nc: usize, m: usize) -> Self {
+        Preconditioner {
+            t: vec![0.0; nc],
+            z: Mat::zeros(nc, 1),
+            scratch: Mat::zeros(nc, 1),
+            w: vec![0.0; m],
+        }
     }
 }
