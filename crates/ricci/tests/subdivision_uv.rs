@@ -270,7 +270,13 @@ fn camelhead_free_boundary_through_the_double_agrees_with_the_surface_flow() {
     };
     let (s, _) = ricci::mesh::io::read_surface(&dir.join("camelhead.off")).unwrap();
     let f = conformal(&s, Geometry::Euclidean, TargetSpec::FreeBoundary);
-    let (r, _) = through_the_double("camelhead", &s, true);
+    let (r, h) = through_the_double("camelhead", &s, true);
+    // Precondition: the input metric's Delaunay triangulation of the double is a Δ-complex
+    // (pairs of vertices joined by two edges), so the overlay has to tell such edges apart.
+    assert!(
+        h.three_way.iso_multi_edges > 0,
+        "camelhead: T_iso has no doubled pair of vertices"
+    );
     assert_eq!(
         r.boundary_edges_flipped, 0,
         "precondition: no boundary edge flips on the double"
@@ -384,16 +390,13 @@ fn through_the_double(name: &str, s: &Surface, full: bool) -> (DoubleFlow, HalfM
         h.three_way.calibration_error
     );
     // Every crossing placed through T_iso (none left at the ideal-triangle map's places) —
-    // except on camelhead: its T_iso is a Δ-complex with 5 pairs of vertices joined twice;
-    // since session 11 the overlay takes such an input (edges told apart by their λ), but
-    // there two of them are mirror images under σ with the same λ (docs/notes/
-    // wave2-s11-half11.md, next step), so it still falls back.
-    if name != "camelhead" {
-        assert_eq!(
-            h.three_way.fallback, None,
-            "{name}: the three-way overlay fell back to the ideal-triangle map"
-        );
-    }
+    // camelhead too: its T_iso is a Δ-complex with pairs of vertices joined twice, two of them
+    // mirror images under σ with the same λ; they are told apart by side (session 12;
+    // docs/notes/wave2-s12-half12.md).
+    assert_eq!(
+        h.three_way.fallback, None,
+        "{name}: the three-way overlay fell back to the ideal-triangle map"
+    );
     assert!(h.layout_gap <= 1e-9 * scale, "{name}: gap {}", h.layout_gap);
     assert!(spread <= 1e-9 * scale, "{name}: UV spread {spread}");
     if r.boundary_edges_flipped > 0 {
