@@ -16,8 +16,12 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// The binary under test: `RICCI_BIN` if set (to sweep another build, e.g. main's, with this
+/// harness), else the one cargo built.
 fn bin() -> PathBuf {
-    PathBuf::from(env!("CARGO_BIN_EXE_ricci"))
+    std::env::var_os("RICCI_BIN")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_BIN_EXE_ricci")))
 }
 
 fn meshes() -> Option<PathBuf> {
@@ -40,6 +44,8 @@ struct Row {
     degenerate: i64,
     flips: i64,
     on: String,
+    /// The report's `route` ("surface" when absent, "double" through the double).
+    route: String,
     faces_written: usize,
     /// Flipped triangles of the OBJ, recomputed here.
     flipped: usize,
@@ -167,6 +173,7 @@ fn run(dir: &Path, mesh: &str, extra: &[&str]) -> Row {
         degenerate: -1,
         flips: -1,
         on: String::new(),
+        route: String::new(),
         faces_written: 0,
         flipped: 0,
         cpu,
@@ -196,6 +203,7 @@ fn run(dir: &Path, mesh: &str, extra: &[&str]) -> Row {
     row.degenerate = v["degenerate_faces"].as_i64().unwrap_or(-1);
     row.flips = flow["triangulation"]["flips"].as_i64().unwrap_or(-1);
     row.on = v["uv"]["on"].as_str().unwrap_or("").to_string();
+    row.route = v["route"].as_str().unwrap_or("surface").to_string();
     let text = std::fs::read_to_string(&obj).unwrap_or_default();
     let (flipped, faces) = flipped_in_obj(&text, &row.geometry);
     row.flipped = flipped;
@@ -217,23 +225,24 @@ fn cpu_children() -> f64 {
 
 fn print_table(rows: &[Row]) {
     println!(
-        "| case | geometry | converged | max abs(K − K̄) | degenerate (layout) | flips | uv on | faces written | flipped | CPU s |"
+        "| case | geometry | converged | max abs(K − K̄) | degenerate (layout) | flips | route | uv on | faces written | flipped | CPU s |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     for r in rows {
         match &r.refusal {
             Some(m) => println!(
-                "| {} | — | refused: {m} | | | | | | | {:.1} |",
+                "| {} | — | refused: {m} | | | | | | | | {:.1} |",
                 r.case, r.cpu
             ),
             None => println!(
-                "| {} | {} | {} | {:.1e} | {} | {} | {} | {} | {} | {:.1} |",
+                "| {} | {} | {} | {:.1e} | {} | {} | {} | {} | {} | {} | {:.1} |",
                 r.case,
                 r.geometry,
                 if r.converged { "yes" } else { "**no**" },
                 r.max_error,
                 r.degenerate,
                 r.flips,
+                r.route,
                 r.on,
                 r.faces_written,
                 r.flipped,

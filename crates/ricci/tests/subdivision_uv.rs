@@ -8,7 +8,7 @@
 
 mod ricci_meshes;
 use ricci::flow::double::{flow_on_double, DoubleFlow};
-use ricci::flow::target::resolve;
+use ricci::flow::target::{resolve, Target};
 use ricci::flow::{ricci_flow, FlowOptions, FlowResult, TargetSpec};
 use ricci::layout::double_half::{half_subdivision, HalfMap};
 use ricci::layout::place::layout;
@@ -270,7 +270,13 @@ fn camelhead_free_boundary_through_the_double_agrees_with_the_surface_flow() {
     };
     let (s, _) = ricci::mesh::io::read_surface(&dir.join("camelhead.off")).unwrap();
     let f = conformal(&s, Geometry::Euclidean, TargetSpec::FreeBoundary);
-    let (r, _) = through_the_double("camelhead", &s, true);
+    let (r, h) = through_the_double("camelhead", &s, true);
+    // Precondition: the input metric's Delaunay triangulation of the double is a Δ-complex
+    // (pairs of vertices joined by two edges), so the overlay has to tell such edges apart.
+    assert!(
+        h.three_way.iso_multi_edges > 0,
+        "camelhead: T_iso has no doubled pair of vertices"
+    );
     assert_eq!(
         r.boundary_edges_flipped, 0,
         "precondition: no boundary edge flips on the double"
@@ -284,6 +290,50 @@ fn camelhead_free_boundary_through_the_double_agrees_with_the_surface_flow() {
     assert!(d <= 1e-8, "u differs by {d}");
 }
 
+/// camelhead with a round boundary: the flow on the double takes fixed targets only (a round
+/// boundary's targets move with the metric), so the surface's own round-boundary solution gives
+/// them — its final boundary curvatures, no vertex held. The double's solution is then the same
+/// metric up to scale (the energy is strictly convex up to scale): `u` differs by a constant;
+/// and its map onto the surface goes through the three-way overlay with the full check.
+#[test]
+fn camelhead_round_boundary_through_the_double() {
+    let Some(dir) = ricci_meshes::ricci_meshes().filter(|d| d.is_dir()) else {
+        eprintln!("RICCI_MESHES unset: skipping camelhead");
+        return;
+    };
+    let (s, _) = ricci::mesh::io::read_surface(&dir.join("camelhead.off")).unwrap();
+    let f = conformal(&s, Geometry::Euclidean, TargetSpec::RoundBoundary);
+    let target = Target {
+        curvature: f.curvature.clone(),
+        fixed: vec![false; s.mesh.n_vertices()],
+        round_loops: Vec::new(),
+        description: "the round-boundary solution's curvature".into(),
+    };
+    let (r, h) = through_the_double_to("camelhead round", &s, &target, true);
+    assert!(
+        h.three_way.iso_multi_edges > 0,
+        "camelhead: T_iso has no doubled pair of vertices"
+    );
+    let shift: Vec<f64> = r.u.iter().zip(&f.u).map(|(a, b)| a - b).collect();
+    let (lo, hi) = shift
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
+            (l.min(x), h.max(x))
+        });
+    eprintln!(
+        "camelhead round: {} boundary edges flipped on the double; u_double − u_surface in \
+         [{lo:.6e}, {hi:.6e}]",
+        r.boundary_edges_flipped
+    );
+    if r.boundary_edges_flipped == 0 {
+        assert!(
+            hi - lo <= 1e-8,
+            "u differs by more than a constant: {}",
+            hi - lo
+        );
+    }
+}
+
 /// The E² free-boundary flow of `s` on its double, and the surface's map from it, checked as
 /// [`check_subdivision`] does; besides: the layout of the faces meeting the surface closes up
 /// (one UV per vertex: a disk is laid out without seams), and when boundary edges of the
@@ -291,11 +341,21 @@ fn camelhead_free_boundary_through_the_double_agrees_with_the_surface_flow() {
 /// All of [`check_subdivision`] when `full`, its area and topology checks only otherwise.
 fn through_the_double(name: &str, s: &Surface, full: bool) -> (DoubleFlow, HalfMap) {
     let target = resolve(&s.mesh, Geometry::Euclidean, &TargetSpec::FreeBoundary).unwrap();
+    through_the_double_to(name, s, &target, full)
+}
+
+/// [`through_the_double`] with a given (fixed) target.
+fn through_the_double_to(
+    name: &str,
+    s: &Surface,
+    target: &Target,
+    full: bool,
+) -> (DoubleFlow, HalfMap) {
     let r = flow_on_double(
         &s.mesh,
         &s.edge_lengths(),
         Geometry::Euclidean,
-        &target,
+        target,
         1e-10,
         &mut NoProgress,
     )
@@ -384,16 +444,13 @@ fn through_the_double(name: &str, s: &Surface, full: bool) -> (DoubleFlow, HalfM
         h.three_way.calibration_error
     );
     // Every crossing placed through T_iso (none left at the ideal-triangle map's places) —
-    // except on camelhead: its T_iso is a Δ-complex with 5 pairs of vertices joined twice;
-    // since session 11 the overlay takes such an input (edges told apart by their λ), but
-    // there two of them are mirror images under σ with the same λ (docs/notes/
-    // wave2-s11-half11.md, next step), so it still falls back.
-    if name != "camelhead" {
-        assert_eq!(
-            h.three_way.fallback, None,
-            "{name}: the three-way overlay fell back to the ideal-triangle map"
-        );
-    }
+    // camelhead too: its T_iso is a Δ-complex with pairs of vertices joined twice, two of them
+    // mirror images under σ with the same λ; they are told apart by side (session 12;
+    // docs/notes/wave2-s12-half12.md).
+    assert_eq!(
+        h.three_way.fallback, None,
+        "{name}: the three-way overlay fell back to the ideal-triangle map"
+    );
     assert!(h.layout_gap <= 1e-9 * scale, "{name}: gap {}", h.layout_gap);
     assert!(spread <= 1e-9 * scale, "{name}: UV spread {spread}");
     if r.boundary_edges_flipped > 0 {

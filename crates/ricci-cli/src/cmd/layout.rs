@@ -41,6 +41,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 mod double;
+pub mod file_metric;
 mod json;
 mod text;
 use json::deck_json;
@@ -259,6 +260,7 @@ fn metric_and_flow(
             geometry: g,
             lengths: l,
             mesh: own,
+            converged,
             ..
         } = read_metric(path, surface)?;
         if let Some(want) = geometry {
@@ -270,6 +272,8 @@ fn metric_and_flow(
             }
         }
         let mut report = json!({"source": path.display().to_string()});
+        let k = file_metric::interior_curvature(own.as_ref().unwrap_or(&surface.mesh), g, &l);
+        file_metric::report(&mut report, converged, k);
         if let Some(m) = &own {
             report["triangulation"] = json!({
                 "kind": "intrinsic", "vertices": m.n_vertices(), "faces": m.n_faces(),
@@ -789,6 +793,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         Err(e) => anyhow::bail!("{}: {}", a.mesh.display(), crate::util::sentence(&e)),
     };
+    let mut metric_report = metric_report;
+    if let Some(w) = file_metric::layout_warning(&metric_report) {
+        eprintln!("warning: {}: {w}", a.mesh.display());
+        metric_report["warning"] = json!(w);
+    }
     let geometry = metric.geometry();
     // The triangulation the metric lives on, and the input's positions when it is the input.
     let work: &Mesh = own_mesh.as_ref().unwrap_or(&surface.mesh);

@@ -92,6 +92,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         polish: polish_report,
         ..
     } = first;
+    if let Some(why) = super::layout::file_metric::spectrum_refusal(&metric_report) {
+        anyhow::bail!("{}: {why}", a.mesh.display());
+    }
     let work = own_mesh.as_ref().unwrap_or(&surface.mesh);
     let geometry = metric.geometry();
     // Wall seconds of the compact domain and of the search (in `timings_wall`).

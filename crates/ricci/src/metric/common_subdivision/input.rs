@@ -3,22 +3,32 @@
 //! input metric's Delaunay triangulation `T_iso` of the three-way overlay on camelhead's double).
 //!
 //! The overlay identifies a traced input edge by its two end vertices; in a Δ-complex that is
-//! not enough, so [`InputComplex::halfedge_between_near`] also takes the edge's log Penner
-//! coordinate in the input decoration, which the strip's Ptolemy development computes for the
-//! traced edge (the flips keep the hyperbolic structure, so it is the input edge's own `λ` up
-//! to rounding): among several input edges between the same two vertices the one with the
-//! nearest `λ` is taken, and a tie (two of them within [`LAMBDA_TIE`]) is refused. Loops (an
-//! edge from a vertex to itself, a face with a repeated vertex) are refused: a corner is found
-//! by its vertex.
-
+//! not enough: [`InputComplex::halfedges_between`] then gives all the candidates, and the
+//! tracer tells them apart by their **side** — where the traced edge leaves its first vertex,
+//! in the cyclic order of the input edges there ([`super::sides`]) — and checks that the edge
+//! found has the log Penner coordinate the strip's Ptolemy development recomputes (the flips
+//! keep the hyperbolic structure, so it is the input edge's own `λ` up to rounding; two σ-mirror
+//! edges of a double have the same `λ`, so `λ` alone cannot choose). Loops (an edge from a
+//! vertex to itself, a face with a repeated vertex) are refused: a corner is found by its
+//! vertex.
 use super::Tri;
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, NONE};
 use std::collections::HashMap;
 
-/// Two input edges between the same vertices whose log Penner coordinates differ by less than
-/// this are not told apart by their `λ` (refused).
+/// The edge chosen by side among several between the same vertices must have a log Penner
+/// coordinate within this of the nearest one to the traced `λ` (else refused: side and `λ`
+/// disagree).
 pub(super) const LAMBDA_TIE: f64 = 1e-6;
+
+/// The input half-edges from one vertex to another.
+pub(super) enum Between<'a> {
+    /// Not adjacent.
+    None,
+    One(u32),
+    /// Several (a Δ-complex): told apart by side.
+    Many(&'a [u32]),
+}
 
 /// What the overlay needs of its input triangulation (half-edges `3f + i` of face `f`).
 pub(super) trait InputComplex {
@@ -32,9 +42,13 @@ pub(super) trait InputComplex {
     fn he_edge(&self, h: u32) -> u32;
     fn edge_halfedge(&self, e: u32) -> u32;
     fn edge_vertices(&self, e: u32) -> [u32; 2];
-    /// The half-edge from `a` to `b`; among several (a Δ-complex), the one whose edge's log
-    /// Penner coordinate is nearest `lambda` (module docs).
-    fn halfedge_between_near(&self, a: u32, b: u32, lambda: f64) -> Result<Option<u32>>;
+    /// The half-edges from `a` to `b` (module docs).
+    fn halfedges_between(&self, a: u32, b: u32) -> Between<'_>;
+    /// The log Penner coordinate of edge `e` (NaN where the input has none: a [`Mesh`]).
+    fn edge_lambda(&self, e: u32) -> f64;
+    /// The half-edges leaving vertex `a`, `h, twin(prev(h)), …` (the rotation the overlay's
+    /// faces turn in); an error at a boundary vertex or where the input has no rotation.
+    fn rotation(&self, a: u32) -> Result<Vec<u32>>;
 }
 
 impl InputComplex for Mesh {
@@ -65,8 +79,20 @@ impl InputComplex for Mesh {
     fn edge_vertices(&self, e: u32) -> [u32; 2] {
         Mesh::edge_vertices(self, e)
     }
-    fn halfedge_between_near(&self, a: u32, b: u32, _lambda: f64) -> Result<Option<u32>> {
-        Ok(self.halfedge_between(a, b))
+    fn halfedges_between(&self, a: u32, b: u32) -> Between<'_> {
+        match self.halfedge_between(a, b) {
+            Some(h) => Between::One(h),
+            None => Between::None,
+        }
+    }
+    fn edge_lambda(&self, _e: u32) -> f64 {
+        f64::NAN
+    }
+    fn rotation(&self, a: u32) -> Result<Vec<u32>> {
+        // A simplicial mesh never has two edges between the same vertices: not needed.
+        Err(Error::numerical(format!(
+            "no rotation at vertex {a} of a simplicial input"
+        )))
     }
 }
 
@@ -75,12 +101,15 @@ impl InputComplex for Mesh {
 pub(super) struct DeltaInput<'a> {
     tri: &'a Tri,
     by_ends: HashMap<(u32, u32), Vec<u32>>,
+    /// A half-edge leaving every vertex (`NONE` for a vertex without one).
+    out: Vec<u32>,
 }
 
 impl<'a> DeltaInput<'a> {
     /// `tri` as an overlay's input; loops are refused (module docs).
     pub(super) fn new(tri: &'a Tri) -> Result<DeltaInput<'a>> {
         let mut by_ends: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+        let mut out = vec![NONE; tri.n_vertices];
         for h in 0..tri.n_halfedges() as u32 {
             let (a, b) = (tri.origin[h as usize], tri.tip(h));
             if a == b {
@@ -90,8 +119,9 @@ impl<'a> DeltaInput<'a> {
                 )));
             }
             by_ends.entry((a, b)).or_default().push(h);
+            out[a as usize] = h;
         }
-        Ok(DeltaInput { tri, by_ends })
+        Ok(DeltaInput { tri, by_ends, out })
     }
 
     /// Pairs of vertices joined by more than one edge.
@@ -135,23 +165,38 @@ impl InputComplex for DeltaInput<'_> {
     fn edge_vertices(&self, e: u32) -> [u32; 2] {
         self.tri.edge_vertices(e)
     }
-    fn halfedge_between_near(&self, a: u32, b: u32, lambda: f64) -> Result<Option<u32>> {
-        let Some(hs) = self.by_ends.get(&(a, b)) else {
-            return Ok(None);
-        };
-        if hs.len() == 1 {
-            return Ok(Some(hs[0]));
+    fn halfedges_between(&self, a: u32, b: u32) -> Between<'_> {
+        match self.by_ends.get(&(a, b)).map(|hs| &hs[..]) {
+            None | Some([]) => Between::None,
+            Some([h]) => Between::One(*h),
+            Some(hs) => Between::Many(hs),
         }
-        let dist = |h: u32| (self.tri.lambda[self.tri.edge[h as usize] as usize] - lambda).abs();
-        let mut sorted = hs.clone();
-        sorted.sort_by(|&x, &y| dist(x).total_cmp(&dist(y)));
-        if !(dist(sorted[1]) - dist(sorted[0]) > LAMBDA_TIE) {
-            return Err(Error::numerical(format!(
-                "{} input edges join vertices {a} and {b} with log Penner coordinates within \
-                 {LAMBDA_TIE:e} of the traced one ({lambda}); they are not told apart",
-                hs.len()
-            )));
+    }
+    fn edge_lambda(&self, e: u32) -> f64 {
+        self.tri.lambda[e as usize]
+    }
+    fn rotation(&self, a: u32) -> Result<Vec<u32>> {
+        let tri = self.tri;
+        let h0 = self.out[a as usize];
+        if h0 == NONE {
+            return Err(Error::numerical(format!("vertex {a} has no edge")));
         }
-        Ok(Some(sorted[0]))
+        let mut hs = vec![h0];
+        let mut h = h0;
+        for _ in 0..tri.n_halfedges() {
+            h = tri.twin[Tri::prev(h) as usize];
+            if h == NONE {
+                return Err(Error::numerical(format!(
+                    "vertex {a} is on the boundary of the input"
+                )));
+            }
+            if h == h0 {
+                return Ok(hs);
+            }
+            hs.push(h);
+        }
+        Err(Error::numerical(format!(
+            "the half-edges around vertex {a} do not close up"
+        )))
     }
 }

@@ -28,8 +28,9 @@
 //! the flip formula of Gillespie–Sharp–Crane. No roundabouts are kept: an input edge is
 //! identified by its two end vertices, and where the input is a Δ-complex with two edges
 //! between the same vertices — the input metric's Delaunay triangulation in the three-way
-//! overlay — by its log Penner coordinate as well, which the strip's development recomputes;
-//! see [`input`].)
+//! overlay — by where it leaves its first vertex in the cyclic order of the input edges there,
+//! recomputed from the normal coordinates at the vertices that need it, and checked against its
+//! log Penner coordinate, which the strip's development recomputes; see [`input`], [`sides`].)
 //!
 //! **Geometry: λ-lengths along a strip.** Tracing an input edge `ab` through `T` gives the
 //! strip of triangles it crosses. Developing the strip, the λ-length from the cusp `a` to every
@@ -67,6 +68,7 @@ mod monotone;
 mod normal;
 mod polygons;
 mod rounding;
+mod sides;
 mod three_way;
 mod trace;
 
@@ -137,6 +139,9 @@ pub struct CommonSubdivision {
     /// `crossing_offset[e] .. crossing_offset[e+1]`, in order along the edge).
     pub crossing_offset: Vec<u32>,
     pub crossings: Vec<Crossing>,
+    /// The input half-edge along `triangulation.edge_he[e]` of every edge `e` of `T` that is an
+    /// input edge (normal coordinate −1), `NONE` for the others.
+    pub(crate) shared_input: Vec<u32>,
     /// Number of input vertices.
     pub n_input_vertices: usize,
     /// Triangles of the common subdivision (counter-clockwise).

@@ -202,15 +202,21 @@ fn side_input_face<M: InputComplex>(
         if sub.normal[tri.edge[h as usize] as usize] != -1 {
             return Ok(None);
         }
-        let lambda = tri.lambda[tri.edge[h as usize] as usize];
-        let h0 = mesh
-            .halfedge_between_near(pa.vertex, pb.vertex, lambda)?
-            .ok_or_else(|| {
-                Error::numerical(format!(
-                    "face {f} of T: side {j} is marked as an input edge, but its ends are not \
-                 adjacent in the input"
-                ))
-            })?;
+        let e = tri.edge[h as usize];
+        let h_in = sub.shared_input[e as usize];
+        let h0 = if h_in == NONE {
+            NONE
+        } else if tri.edge_he[e as usize] == h {
+            h_in
+        } else {
+            mesh.he_twin(h_in)
+        };
+        if h0 == NONE {
+            return Err(Error::numerical(format!(
+                "face {f} of T: side {j} is marked as an input edge, but no input half-edge \
+                 runs along it"
+            )));
+        }
         return left_of(h0);
     }
     // A chord: a piece of one input edge.

@@ -2,12 +2,14 @@
 //! coordinates, with the λ-lengths along each strip that place the crossings (see the parent
 //! module, "Geometry: λ-lengths along a strip").
 
-use super::input::InputComplex;
+use super::input::{Between, InputComplex, LAMBDA_TIE};
 use super::normal::{arc_end, face_counts, ArcEnd, TriangleArcs};
 use super::polygons::face_polygons;
+use super::sides::{leaving_corner, match_at_vertex, Leaving};
 use super::{CommonSubdivision, Crossing, SubdivisionReport, Tri};
 use crate::error::{Error, Result};
 use crate::mesh::NONE;
+use std::collections::HashMap;
 
 /// `log(e^a + e^b)` without overflow.
 #[inline]
@@ -75,6 +77,11 @@ struct Tracer<'a, M: InputComplex> {
     crossings: Vec<Option<Crossing>>,
     /// Input edges found (as an edge of `T` or traced).
     input_seen: Vec<bool>,
+    /// The input half-edge along `edge_he[e]` of every edge `e` of `T` that is an input edge.
+    shared_input: Vec<u32>,
+    /// At the vertices where two input edges join the same vertices: the input half-edges by
+    /// where they leave the vertex in `T` ([`super::sides`]).
+    sides: HashMap<u32, HashMap<Leaving, u32>>,
     order_violations: usize,
 }
 
@@ -112,6 +119,8 @@ pub(super) fn build<M: InputComplex>(
         offset,
         crossings: vec![None; n_cross],
         input_seen: vec![false; mesh.n_edges()],
+        shared_input: vec![NONE; ne],
+        sides: HashMap::new(),
         order_violations: 0,
     };
     let shared_edges = tracer.mark_shared_edges()?;
@@ -134,6 +143,7 @@ pub(super) fn build<M: InputComplex>(
         arcs,
         offset,
         crossings,
+        shared_input,
         mut order_violations,
         ..
     } = tracer;
@@ -154,6 +164,7 @@ pub(super) fn build<M: InputComplex>(
         normal,
         crossing_offset: offset,
         crossings,
+        shared_input,
         n_input_vertices: mesh.n_vertices(),
         triangles: Vec::new(),
         input_face: Vec::new(),
@@ -183,9 +194,9 @@ impl<M: InputComplex> Tracer<'_, M> {
                 shared += 1;
                 let [a, b] = self.tri.edge_vertices(e);
                 let lambda = self.tri.lambda[e as usize];
+                let along = Leaving::Along(self.tri.edge_he[e as usize]);
                 let h0 = self
-                    .mesh
-                    .halfedge_between_near(a, b, lambda)?
+                    .input_halfedge(a, b, lambda, |_| Ok(along))?
                     .ok_or_else(|| {
                         Error::numerical(format!(
                             "edge {e} of the intrinsic triangulation is marked as an input edge, \
@@ -193,9 +204,55 @@ impl<M: InputComplex> Tracer<'_, M> {
                         ))
                     })?;
                 self.input_seen[self.mesh.he_edge(h0) as usize] = true;
+                self.shared_input[e as usize] = h0;
             }
         }
         Ok(shared)
+    }
+
+    /// The input half-edge from `a` to `b` whose log Penner coordinate is `lambda` up to
+    /// rounding; where several join `a` and `b`, the one leaving `a` at `leaving()` in `T`
+    /// ([`super::sides`]), checked against `lambda`. `None` when `a` and `b` are not adjacent.
+    fn input_halfedge(
+        &mut self,
+        a: u32,
+        b: u32,
+        lambda: f64,
+        leaving: impl FnOnce(&[TriangleArcs]) -> Result<Leaving>,
+    ) -> Result<Option<u32>> {
+        let mesh = self.mesh;
+        let hs = match mesh.halfedges_between(a, b) {
+            Between::None => return Ok(None),
+            Between::One(h) => return Ok(Some(h)),
+            Between::Many(hs) => hs,
+        };
+        let at = leaving(&self.arcs)?;
+        if !self.sides.contains_key(&a) {
+            let out = (0..self.tri.n_halfedges() as u32)
+                .find(|&h| self.tri.origin[h as usize] == a)
+                .ok_or_else(|| Error::numerical(format!("vertex {a} of T has no edge")))?;
+            let m = match_at_vertex(mesh, self.tri, self.normal, &self.arcs, a, out)?;
+            self.sides.insert(a, m);
+        }
+        let h = *self.sides[&a].get(&at).ok_or_else(|| {
+            Error::numerical(format!(
+                "an input edge leaving vertex {a} was not found around it in T"
+            ))
+        })?;
+        if !hs.contains(&h) {
+            return Err(Error::numerical(format!(
+                "the input edge leaving vertex {a} there does not end at vertex {b}"
+            )));
+        }
+        let dist = |x: u32| (mesh.edge_lambda(mesh.he_edge(x)) - lambda).abs();
+        let nearest = hs.iter().map(|&x| dist(x)).fold(f64::INFINITY, f64::min);
+        if !(dist(h) <= nearest + LAMBDA_TIE) {
+            return Err(Error::numerical(format!(
+                "the input edge from vertex {a} to {b} found by side has log Penner coordinate                  {}, another one {lambda}'s nearer",
+                mesh.edge_lambda(mesh.he_edge(h))
+            )));
+        }
+        Ok(Some(h))
     }
 
     /// The whole strip of the input edge through crossing `pc` of edge `e` of `T`: its steps
@@ -229,8 +286,10 @@ impl<M: InputComplex> Tracer<'_, M> {
         let b = tri.origin[end as usize];
         let (la, lb) = strip_lambdas(tri, &path);
         let lambda_ab = strip_end_lambda(tri, &path, &la);
-        let h0 = mesh
-            .halfedge_between_near(a, b, lambda_ab)?
+        let h0 = self
+            .input_halfedge(a, b, lambda_ab, |arcs| {
+                leaving_corner(tri, normal, arcs, start, path[0])
+            })?
             .ok_or_else(|| {
                 Error::numerical(format!(
                     "an input edge traced through the intrinsic triangulation joins vertices {a} \
