@@ -37,6 +37,7 @@ pub mod curves;
 pub mod cylinder_fit;
 pub mod cylinder_jumps;
 pub mod cylinders;
+pub mod domain_mesh;
 pub mod export;
 pub mod fit;
 pub mod genus0;
