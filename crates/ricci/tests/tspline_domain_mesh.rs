@@ -423,3 +423,75 @@ fn per_cylinder_fit_is_only_c0_across_knot_lines_and_trajectories() {
         assert!(t[1] > 1e-4 || t[2] > 1e-4, "{name}: {}", e3(t));
     }
 }
+
+/// The fit on the domain mesh (option, not the default): errors recomputed here from the
+/// patches against the input vertices; compared with the per-cylinder fit.
+#[test]
+fn domain_mesh_fit_errors_and_control_points() {
+    use ricci::spline::tspline::cylinder_fit::{fit_cylinders, GenusFitOptions};
+    use ricci::spline::tspline::domain_fit::{fit_domain_mesh, DomainFitOptions};
+    for (name, s) in cases() {
+        let h = forms(&s);
+        let d = best_genus_domain(&h, s.positions.len()).unwrap();
+        let g = gluing(&d).unwrap();
+        let side = {
+            let mut lo = [f64::INFINITY; 3];
+            let mut hi = [f64::NEG_INFINITY; 3];
+            for p in &s.positions {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+            (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)
+        };
+        for tolerance in [0.01, 0.005] {
+            let opts = DomainFitOptions {
+                tolerance,
+                ..DomainFitOptions::default()
+            };
+            let f = fit_domain_mesh(&d, &g, &s.positions, &opts).unwrap();
+            let mut max = 0.0f64;
+            for (p, &(c, a, b)) in d.points.iter().zip(&f.located) {
+                let q = f.mesh.patch(c, &f.control, 0.0, 0.0);
+                let x = q.point(q.u0 + a * (q.u1 - q.u0), q.v0 + b * (q.v1 - q.v0));
+                let y = s.positions[p.vertex as usize];
+                let e =
+                    ((x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + (x[2] - y[2]).powi(2)).sqrt();
+                max = max.max(e);
+            }
+            let old = fit_cylinders(
+                &d,
+                &s.positions,
+                &GenusFitOptions {
+                    tolerance,
+                    ..GenusFitOptions::default()
+                },
+            )
+            .unwrap();
+            let last = old.steps.last().unwrap();
+            eprintln!(
+                "{name} at {:.1} %: domain mesh {} control points, L∞ {:.4} % (recomputed {:.4} %), rms {:.4} %, converged {}, steps {:?}; per-cylinder fit {} control points, L∞ {:.4} %, converged {}",
+                100.0 * tolerance,
+                f.mesh.n_vertices(),
+                f.steps.last().unwrap().max_error_percent,
+                100.0 * max / side,
+                f.steps.last().unwrap().rms_error_percent,
+                f.converged,
+                f.steps.iter().map(|s| (s.control_points, s.max_error_percent)).collect::<Vec<_>>(),
+                old.control_points(),
+                last.max_error_percent,
+                old.converged
+            );
+            assert!(
+                (100.0 * max / side - f.steps.last().unwrap().max_error_percent).abs() < 1e-9,
+                "{name}"
+            );
+            // issue 18's budget: within 20 000 control points at 1 % and 0.5 %
+            assert!(
+                f.converged && f.mesh.n_vertices() <= 20_000,
+                "{name} at {tolerance}"
+            );
+        }
+    }
+}
