@@ -23,9 +23,13 @@
 //! * [`half`] — that half (the strip between the seams): the control points that influence
 //!   the surface, the Bézier patches clipped to it for export.
 //!
-//! What is not here yet: for genus ≥ 2 a T-mesh (with T-junctions) over the cylinders; the
-//! cylinders carry tensor-product splines ([`cylinder_fit`]); surfaces of genus ≥ 1 with
-//! boundary.
+//! * [`domain_mesh`] — genus ≥ 2: one conforming quad mesh of knot intervals over all the
+//!   strips glued by translations (the zeros its only irregular vertices) and its spline,
+//!   C² two knot intervals from the zeros; [`domain_fit`] fits on it (an option: the
+//!   per-cylinder [`cylinder_fit`] stays the default).
+//!
+//! What is not here yet: for genus ≥ 2 T-junctions and local refinement on the domain mesh,
+//! C² one interval from the zeros; surfaces of genus ≥ 2 with boundary.
 
 #![allow(clippy::needless_range_loop)]
 
@@ -37,6 +41,8 @@ pub mod curves;
 pub mod cylinder_fit;
 pub mod cylinder_jumps;
 pub mod cylinders;
+pub mod domain_fit;
+pub mod domain_mesh;
 pub mod export;
 pub mod fit;
 pub mod genus0;

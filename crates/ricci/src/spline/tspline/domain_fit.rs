@@ -1,0 +1,245 @@
+//! Genus ≥ 2: least squares on the spline of the domain manifold's quad mesh
+//! ([`super::domain_mesh`]), behind an option (the per-cylinder fit of [`super::cylinder_fit`]
+//! stays the default). The data points are located in the cells from their cylinder
+//! coordinates and the gluing's sheared coordinate; the fairness term is the squared second
+//! differences of the control net along the mesh lines through every regular vertex (as the
+//! per-cylinder fit's), the umbrella operator at the zeros; refinement shrinks the spacing
+//! (by 1/√2, uniformly: the mesh is conforming) until the largest error is below the tolerance or the
+//! budget of control points is spent.
+
+use super::cylinder_fit::GenusStep;
+use super::domain_mesh::DomainMesh;
+use super::fit::bbox_scale;
+use super::genus_domain::GenusDomain;
+use super::glue::Gluing;
+use crate::error::{Error, Result};
+use crate::numeric::sparse::Cholesky;
+use faer::sparse::{SparseColMat, Triplet};
+use faer::Mat;
+
+/// The fitted spline on the domain mesh.
+#[derive(Debug, Clone)]
+pub struct DomainFit {
+    pub mesh: DomainMesh,
+    pub control: Vec<[f64; 3]>,
+    /// Per data point (`GenusDomain::points` order): cell, local `(s, t) ∈ [0, 1]²`, error.
+    pub located: Vec<(u32, f64, f64)>,
+    pub errors: Vec<f64>,
+    pub steps: Vec<GenusStep>,
+    pub converged: bool,
+    /// Longest bounding-box side (errors in percent are relative to it).
+    pub scale: f64,
+}
+
+/// Options of [`fit_domain_mesh`].
+#[derive(Debug, Clone, Copy)]
+pub struct DomainFitOptions {
+    /// L∞ tolerance as a fraction of the longest bounding-box side.
+    pub tolerance: f64,
+    /// Weight of the fairness term (relative to the data term per control point).
+    pub smoothing: f64,
+    /// Initial spacing as a fraction of the longest circumference.
+    pub initial: f64,
+    /// Factor of the spacing per refinement (the control points grow by about its inverse
+    /// square).
+    pub refine: f64,
+    pub max_iterations: usize,
+    pub max_control_points: usize,
+}
+
+impl Default for DomainFitOptions {
+    fn default() -> Self {
+        DomainFitOptions {
+            tolerance: 0.005,
+            smoothing: 1e-4,
+            initial: 0.125,
+            refine: std::f64::consts::FRAC_1_SQRT_2,
+            max_iterations: 16,
+            max_control_points: 20_000,
+        }
+    }
+}
+
+/// Cell and local coordinates of the cylinder point `(u, v)` of cylinder `c`.
+pub fn locate(
+    mesh: &DomainMesh,
+    gluing: &Gluing,
+    domain: &GenusDomain,
+    c: usize,
+    u: f64,
+    v: f64,
+) -> Option<(u32, f64, f64)> {
+    let lay = gluing.layouts.get(c)?;
+    let ch = &domain.cylinders[c];
+    let up = (u - lay.shift - lay.shear * v / ch.height).rem_euclid(ch.circumference);
+    let s = lay.strip(up);
+    let r = mesh
+        .rects
+        .iter()
+        .position(|r| r.cylinder == c && r.strip == s)?;
+    let rc = &mesh.rects[r];
+    let (w, h) = (rc.length / rc.m as f64, rc.height / rc.n as f64);
+    let x = ((up - lay.lines[s]) / w).clamp(0.0, rc.m as f64);
+    let y = (v / h).clamp(0.0, rc.n as f64);
+    let (i, j) = (
+        (x.floor() as usize).min(rc.m - 1),
+        (y.floor() as usize).min(rc.n - 1),
+    );
+    let cell = (rc.first_cell + j * rc.m + i) as u32;
+    Some((cell, x - i as f64, y - j as f64))
+}
+
+/// One least-squares solve on `mesh`.
+fn solve(
+    mesh: &DomainMesh,
+    located: &[(u32, f64, f64)],
+    targets: &[[f64; 3]],
+    smoothing: f64,
+) -> Result<Vec<[f64; 3]>> {
+    let n = mesh.n_vertices();
+    let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::new();
+    let mut b = Mat::<f64>::zeros(n, 3);
+    for (&(c, s, t), p) in located.iter().zip(targets) {
+        let row = mesh.blending(c, s, t);
+        for &(r, x) in &row {
+            for &(q, y) in &row {
+                trip.push(Triplet::new(r as usize, q as usize, x * y));
+            }
+            for d in 0..3 {
+                b[(r as usize, d)] += x * p[d];
+            }
+        }
+    }
+    let w = smoothing * (located.len() as f64 / n as f64).max(1.0);
+    let mut push = |row: &[(u32, f64)]| {
+        for &(r, x) in row {
+            for &(q, y) in row {
+                trip.push(Triplet::new(r as usize, q as usize, w * x * y));
+            }
+        }
+    };
+    for c in 0..mesh.n_cells() as u32 {
+        let a = mesh.corners[c as usize][0];
+        let (l, bt) = (mesh.across(c, 2), mesh.across(c, 3));
+        if mesh.is_zero(a) {
+            continue;
+        }
+        let q = mesh.corners[c as usize];
+        push(&[(mesh.corners[l as usize][0], 1.0), (a, -2.0), (q[1], 1.0)]);
+        push(&[(mesh.corners[bt as usize][0], 1.0), (a, -2.0), (q[3], 1.0)]);
+    }
+    for z in (0..n as u32).filter(|&z| mesh.is_zero(z)) {
+        let mut nb: Vec<u32> = Vec::new();
+        for q in &mesh.corners {
+            for k in 0..4 {
+                if q[k] == z {
+                    for x in [q[(k + 1) % 4], q[(k + 3) % 4]] {
+                        if !nb.contains(&x) {
+                            nb.push(x);
+                        }
+                    }
+                }
+            }
+        }
+        let k = nb.len() as f64;
+        let mut row: Vec<(u32, f64)> = nb.iter().map(|&x| (x, 1.0 / k)).collect();
+        row.push((z, -1.0));
+        push(&row);
+    }
+    // a tiny ridge keeps vertices without data determined by the fairness alone
+    for i in 0..n {
+        trip.push(Triplet::new(i, i, 1e-12));
+    }
+    let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip).map_err(|e| {
+        Error::numerical(format!(
+            "domain mesh fit: the normal equations ({n} unknowns) cannot be assembled: {e:?}"
+        ))
+    })?;
+    let chol = Cholesky::factor(a.as_ref()).map_err(|e| {
+        Error::numerical(format!(
+            "domain mesh fit: the normal equations ({n} unknowns, {} points) are not positive definite: {e:?}",
+            located.len()
+        ))
+    })?;
+    chol.solve_in_place(b.as_mut());
+    let out: Vec<[f64; 3]> = (0..n).map(|i| [b[(i, 0)], b[(i, 1)], b[(i, 2)]]).collect();
+    if out.iter().flatten().any(|x| !x.is_finite()) {
+        return Err(Error::numerical(
+            "domain mesh fit: the solve gave non-finite control points",
+        ));
+    }
+    Ok(out)
+}
+
+/// Fit the data points of `domain` (positions by vertex) on the domain mesh, refining
+/// uniformly until `L∞ ≤ tolerance` or the budget is spent.
+pub fn fit_domain_mesh(
+    domain: &GenusDomain,
+    gluing: &Gluing,
+    positions: &[[f64; 3]],
+    opts: &DomainFitOptions,
+) -> Result<DomainFit> {
+    let scale = bbox_scale(positions);
+    let l = domain
+        .cylinders
+        .iter()
+        .map(|c| c.circumference)
+        .fold(0.0, f64::max);
+    let targets: Vec<[f64; 3]> = domain
+        .points
+        .iter()
+        .map(|p| positions[p.vertex as usize])
+        .collect();
+    let mut spacing = opts.initial * l;
+    let mut steps = Vec::new();
+    let mut last: Option<DomainFit> = None;
+    for _ in 0..opts.max_iterations.max(1) {
+        let mesh = DomainMesh::new(domain, gluing, spacing).map_err(Error::numerical)?;
+        if last.is_some() && mesh.n_vertices() > opts.max_control_points {
+            break;
+        }
+        let mut located = Vec::with_capacity(targets.len());
+        for p in &domain.points {
+            let x = locate(&mesh, gluing, domain, p.cylinder, p.u, p.v).ok_or_else(|| {
+                Error::numerical(format!(
+                    "domain mesh fit: vertex {} (cylinder {}) is in no strip",
+                    p.vertex, p.cylinder
+                ))
+            })?;
+            located.push(x);
+        }
+        let control = solve(&mesh, &located, &targets, opts.smoothing)?;
+        let errors: Vec<f64> = located
+            .iter()
+            .zip(&targets)
+            .map(|(&(c, s, t), q)| {
+                let p = mesh.patch(c, &control, 0.0, 0.0);
+                let [u0, u1, v0, v1] = [p.u0, p.u1, p.v0, p.v1];
+                let x = p.point(u0 + s * (u1 - u0), v0 + t * (v1 - v0));
+                ((x[0] - q[0]).powi(2) + (x[1] - q[1]).powi(2) + (x[2] - q[2]).powi(2)).sqrt()
+            })
+            .collect();
+        let max = errors.iter().fold(0.0f64, |a, &b| a.max(b));
+        let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len().max(1) as f64).sqrt();
+        steps.push(GenusStep {
+            control_points: mesh.n_vertices(),
+            rms_error_percent: 100.0 * rms / scale,
+            max_error_percent: 100.0 * max / scale,
+        });
+        let converged = max <= opts.tolerance * scale;
+        last = Some(DomainFit {
+            mesh,
+            control,
+            located,
+            errors,
+            steps: steps.clone(),
+            converged,
+            scale,
+        });
+        if converged {
+            break;
+        }
+        spacing *= opts.refine.clamp(0.1, 0.95);
+    }
+    last.ok_or_else(|| Error::numerical("domain mesh fit: no iteration ran"))
+}

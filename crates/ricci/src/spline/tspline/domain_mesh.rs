@@ -1,0 +1,549 @@
+//! Genus ≥ 2, the spline space of the domain manifold itself (issue 18, paper 003 §2–3): one
+//! mesh of knot intervals over all the cylinders' strips, glued by the translations of
+//! [`super::glue`], instead of one spline per cylinder.
+//!
+//! The strips of [`super::glue::Gluing`] are rectangles `[0, length] × [0, H]` whose sides are
+//! glued **whole** by translations: the right side of strip `s` to the left side of strip
+//! `s + 1` of the same cylinder, the top to the bottom of one strip of the next band (equal
+//! lengths). Every rectangle corner is a zero of the form. Cutting every strip into `m × n`
+//! cells, with `m` the same along every chain of strips glued top to bottom and `n` the same
+//! in every cylinder, gives a conforming quad mesh of the closed surface (no T-junctions) whose
+//! only vertices of valence ≠ 4 are the zeros (valence `4 (k + 1)` at a zero of order `k`).
+//! A ray from a vertex continues across a gluing by the translation: walking from cell to
+//! cell over a side is always defined; only walking *through* a zero is not.
+//!
+//! **The spline.** One control point per vertex. Every cell is a bicubic Bézier patch whose 16
+//! points are affine combinations of control points, each computed **once** per mesh entity
+//! from the knot intervals (cell widths and heights) by blossoming the cubic B-spline:
+//! * the 4 inner points of a cell: from its 4 corners, with the intervals of the cell and of
+//!   its 4 side neighbours;
+//! * the 2 points on a side: from the 6 corners of the two cells sharing it; an interval
+//!   needed beyond an end of the side that is a zero is replaced by the side's own;
+//! * the point at a vertex of valence 4: the B-spline's value there (3 × 3 neighbours, the
+//!   same replacement for an interval beyond a neighbouring zero); at a zero of valence `n`:
+//!   the Catmull–Clark limit point `(n² P + 4 Σ eᵢ + Σ fᵢ) / (n (n + 5))` (edge and face
+//!   neighbours), which is the B-spline's rule for `n = 4` and uniform intervals.
+//!
+//! Hence: partition of unity (every combination is affine), chart independence (every point
+//! shared by two patches is one value), C⁰ everywhere; on every cell side **not incident to a
+//! zero** the two patches are pieces of one tensor-product B-spline row by row (the points
+//! that the replacements change are only the zero's corner point and points of rows/columns
+//! that the C² conditions across such a side do not involve), so the surface is **C²** there;
+//! on the sides incident to a zero it is C⁰ (C¹ defect vanishing to third order at the
+//! side's other end). So C² at every point at least one knot interval from the zeros.
+
+use super::bezier::BezierPatch;
+use super::genus_domain::GenusDomain;
+use super::glue::Gluing;
+
+/// A sparse affine combination of control points: `(vertex, weight)`.
+pub type Combination = Vec<(u32, f64)>;
+
+/// The quad mesh of knot intervals over the domain manifold and its Bézier extraction.
+#[derive(Debug, Clone)]
+pub struct DomainMesh {
+    /// Per strip (rectangle): cylinder, strip index, length, height, cells `m × n`, and the
+    /// index of its first cell.
+    pub rects: Vec<Rect>,
+    /// Per cell: `[right, top, left, bottom]` neighbour cells.
+    pub neighbours: Vec<[u32; 4]>,
+    /// Per cell: corners `[lower left, lower right, upper right, upper left]` (vertex ids).
+    pub corners: Vec<[u32; 4]>,
+    /// Per cell: its rectangle and `(i, j)` in it.
+    pub cell_at: Vec<(u32, u32, u32)>,
+    /// Per vertex: the number of cell corners there (4 = regular; a zero otherwise).
+    pub valence: Vec<u32>,
+    /// Per cell: its 16 Bézier points as combinations, `bezier[cell][i][j]`, `i` along `u`.
+    pub bezier: Vec<[[Combination; 4]; 4]>,
+}
+
+/// One strip of one cylinder.
+#[derive(Debug, Clone, Copy)]
+pub struct Rect {
+    pub cylinder: usize,
+    pub strip: usize,
+    pub length: f64,
+    pub height: f64,
+    pub m: usize,
+    pub n: usize,
+    pub first_cell: usize,
+}
+
+const RIGHT: usize = 0;
+const TOP: usize = 1;
+const LEFT: usize = 2;
+const BOTTOM: usize = 3;
+
+/// Weights on `(P₋₁, P₀, P₁)` of the point at vertex 0 of a cubic B-spline whose anchors sit
+/// at the vertices, with intervals `d` = `(d₋₂, d₋₁, d₀, d₁)` around it (blossom `f(0,0,0)`).
+pub fn corner_weights(d: [f64; 4]) -> [f64; 3] {
+    let [dm2, dm1, d0, d1] = d;
+    // vertex positions x₋₂ … x₂ with x₀ = 0; P_j = f(x_{j−1}, x_j, x_{j+1})
+    let (xm2, xm1, x1, x2) = (-dm1 - dm2, -dm1, d0, d0 + d1);
+    // f(x₋₁, 0, 0) on P₋₁ … P₀: parameter 0 between x₋₂ and x₁
+    let a = (0.0 - xm2) / (x1 - xm2);
+    // f(0, 0, x₁) on P₀ … P₁: parameter 0 between x₋₁ and x₂
+    let b = (0.0 - xm1) / (x2 - xm1);
+    // f(0, 0, 0) on f(x₋₁, 0, 0) … f(0, 0, x₁): parameter 0 between x₋₁ and x₁
+    let c = (0.0 - xm1) / (x1 - xm1);
+    [(1.0 - c) * (1.0 - a), (1.0 - c) * a + c * (1.0 - b), c * b]
+}
+
+/// Weights on `(P₀, P₁)` of the two inner Bézier points of span `[x₀, x₁]` (intervals
+/// `(d₋₁, d₀, d₁)`): `f(0, 0, x₁)` and `f(0, x₁, x₁)`.
+pub fn inner_weights(d: [f64; 3]) -> [[f64; 2]; 2] {
+    let [dm1, d0, d1] = d;
+    let s = dm1 + d0 + d1;
+    let (t1, t2) = (dm1 / s, (dm1 + d0) / s);
+    [[1.0 - t1, t1], [1.0 - t2, t2]]
+}
+
+fn add(out: &mut Combination, v: u32, w: f64) {
+    if w == 0.0 {
+        return;
+    }
+    match out.iter_mut().find(|x| x.0 == v) {
+        Some(x) => x.1 += w,
+        None => out.push((v, w)),
+    }
+}
+
+fn find(p: &mut [u32], mut x: u32) -> u32 {
+    while p[x as usize] != x {
+        p[x as usize] = p[p[x as usize] as usize];
+        x = p[x as usize];
+    }
+    x
+}
+
+impl DomainMesh {
+    /// The mesh with cells of size about `spacing` (at least 2 × 2 per strip), or why not.
+    pub fn new(domain: &GenusDomain, gluing: &Gluing, spacing: f64) -> Result<Self, String> {
+        if !(spacing > 0.0) {
+            return Err(format!("spacing {spacing} must be positive"));
+        }
+        // rectangles and their top neighbours
+        let mut rects = Vec::new();
+        let mut index = std::collections::HashMap::new();
+        for (c, lay) in gluing.layouts.iter().enumerate() {
+            let ch = &domain.cylinders[c];
+            let n = ((ch.height / spacing).ceil() as usize).max(2);
+            for s in 0..lay.lines.len() {
+                index.insert((c, s), rects.len());
+                rects.push(Rect {
+                    cylinder: c,
+                    strip: s,
+                    length: lay.strip_length(s, ch.circumference),
+                    height: ch.height,
+                    m: 0,
+                    n,
+                    first_cell: 0,
+                });
+            }
+        }
+        let nr = rects.len();
+        let mut top = vec![usize::MAX; nr];
+        for g in &gluing.glues {
+            let (Some(&a), Some(&b)) = (
+                index.get(&(g.lower, g.lower_strip)),
+                index.get(&(g.upper, g.upper_strip)),
+            ) else {
+                return Err(format!("glue {g:?} names a strip that does not exist"));
+            };
+            top[a] = b;
+        }
+        if let Some(r) = top.iter().position(|&t| t == usize::MAX) {
+            return Err(format!(
+                "the top of strip {} of cylinder {} is glued to nothing",
+                rects[r].strip, rects[r].cylinder
+            ));
+        }
+        // m per chain of strips glued top to bottom (a cycle of the permutation `top`)
+        let mut done = vec![false; nr];
+        for r0 in 0..nr {
+            if done[r0] {
+                continue;
+            }
+            let mut chain = vec![r0];
+            let mut r = top[r0];
+            while r != r0 {
+                if chain.len() > nr {
+                    return Err("the glues of the strips' tops are not a permutation".into());
+                }
+                chain.push(r);
+                r = top[r];
+            }
+            let len = chain.iter().map(|&r| rects[r].length).fold(0.0, f64::max);
+            let m = ((len / spacing).ceil() as usize).max(2);
+            for &r in &chain {
+                rects[r].m = m;
+                done[r] = true;
+            }
+        }
+        let mut cells = 0;
+        for r in rects.iter_mut() {
+            r.first_cell = cells;
+            cells += r.m * r.n;
+        }
+        let right_rect = |r: usize| {
+            let (c, s) = (rects[r].cylinder, rects[r].strip);
+            let k = gluing.layouts[c].lines.len();
+            index[&(c, (s + 1) % k)]
+        };
+        let cell = |r: usize, i: usize, j: usize| (rects[r].first_cell + j * rects[r].m + i) as u32;
+        let mut neighbours = vec![[u32::MAX; 4]; cells];
+        let mut cell_at = Vec::with_capacity(cells);
+        for (r, rc) in rects.iter().enumerate() {
+            for j in 0..rc.n {
+                for i in 0..rc.m {
+                    cell_at.push((r as u32, i as u32, j as u32));
+                    let me = cell(r, i, j);
+                    let right = if i + 1 < rc.m {
+                        cell(r, i + 1, j)
+                    } else {
+                        cell(right_rect(r), 0, j)
+                    };
+                    let up = if j + 1 < rc.n {
+                        cell(r, i, j + 1)
+                    } else {
+                        cell(top[r], i, 0)
+                    };
+                    neighbours[me as usize][RIGHT] = right;
+                    neighbours[me as usize][TOP] = up;
+                    neighbours[right as usize][LEFT] = me;
+                    neighbours[up as usize][BOTTOM] = me;
+                }
+            }
+        }
+        if neighbours.iter().any(|n| n.contains(&u32::MAX)) {
+            return Err("a cell has no neighbour across one of its sides".into());
+        }
+        // vertices: the lower-left corners of the cells, identified across the sides
+        let mut parent: Vec<u32> = (0..cells as u32).collect();
+        // c.lr = right(c).ll; c.ul = top(c).ll; c.ur = top(right(c)).ll = right(top(c)).ll
+        let mut corners_key = vec![[0u32; 4]; cells];
+        for c in 0..cells {
+            let [r, t, _, _] = neighbours[c];
+            let tr = neighbours[r as usize][TOP];
+            let rt = neighbours[t as usize][RIGHT];
+            let (a, b) = (find(&mut parent, tr), find(&mut parent, rt));
+            parent[a as usize] = b;
+            corners_key[c] = [c as u32, r, tr, t];
+        }
+        let mut id = vec![u32::MAX; cells];
+        let mut nv = 0u32;
+        for c in 0..cells as u32 {
+            let root = find(&mut parent, c);
+            if id[root as usize] == u32::MAX {
+                id[root as usize] = nv;
+                nv += 1;
+            }
+        }
+        let mut corners = vec![[0u32; 4]; cells];
+        let mut valence = vec![0u32; nv as usize];
+        for c in 0..cells {
+            for k in 0..4 {
+                let v = id[find(&mut parent, corners_key[c][k]) as usize];
+                corners[c][k] = v;
+                valence[v as usize] += 1;
+            }
+        }
+        let mut mesh = DomainMesh {
+            rects,
+            neighbours,
+            corners,
+            cell_at,
+            valence,
+            bezier: Vec::new(),
+        };
+        mesh.bezier = (0..cells).map(|c| mesh.extract(c)).collect();
+        Ok(mesh)
+    }
+
+    pub fn n_cells(&self) -> usize {
+        self.corners.len()
+    }
+
+    pub fn n_vertices(&self) -> usize {
+        self.valence.len()
+    }
+
+    /// Whether vertex `v` is a zero (valence ≠ 4).
+    pub fn is_zero(&self, v: u32) -> bool {
+        self.valence[v as usize] != 4
+    }
+
+    fn nb(&self, c: u32, side: usize) -> u32 {
+        self.neighbours[c as usize][side]
+    }
+
+    /// Width and height of a cell.
+    pub fn size(&self, c: u32) -> (f64, f64) {
+        let r = &self.rects[self.cell_at[c as usize].0 as usize];
+        (r.length / r.m as f64, r.height / r.n as f64)
+    }
+
+    fn w(&self, c: u32) -> f64 {
+        self.size(c).0
+    }
+
+    fn h(&self, c: u32) -> f64 {
+        self.size(c).1
+    }
+
+    /// The Bézier point at the lower-left corner of cell `c`.
+    fn vertex_point(&self, c: u32) -> Combination {
+        let a = self.corners[c as usize][0];
+        let mut out = Combination::new();
+        if self.is_zero(a) {
+            // Catmull–Clark limit point over every cell with a corner at a
+            let n = self.valence[a as usize] as f64;
+            let norm = n * (n + 5.0);
+            add(&mut out, a, n * n / norm);
+            for q in &self.corners {
+                for k in 0..4 {
+                    if q[k] == a {
+                        add(&mut out, q[(k + 1) % 4], 2.0 / norm);
+                        add(&mut out, q[(k + 3) % 4], 2.0 / norm);
+                        add(&mut out, q[(k + 2) % 4], 1.0 / norm);
+                    }
+                }
+            }
+            return out;
+        }
+        let (l, b) = (self.nb(c, LEFT), self.nb(c, BOTTOM));
+        let bl = self.nb(b, LEFT);
+        let right = self.corners[c as usize][1];
+        let left = self.corners[l as usize][0];
+        let up = self.corners[c as usize][3];
+        let down = self.corners[b as usize][0];
+        let wl2 = if self.is_zero(left) {
+            self.w(l)
+        } else {
+            self.w(self.nb(l, LEFT))
+        };
+        let wr2 = if self.is_zero(right) {
+            self.w(c)
+        } else {
+            self.w(self.nb(c, RIGHT))
+        };
+        let hb2 = if self.is_zero(down) {
+            self.h(b)
+        } else {
+            self.h(self.nb(b, BOTTOM))
+        };
+        let ht2 = if self.is_zero(up) {
+            self.h(c)
+        } else {
+            self.h(self.nb(c, TOP))
+        };
+        let uw = corner_weights([wl2, self.w(l), self.w(c), wr2]);
+        let vw = corner_weights([hb2, self.h(b), self.h(c), ht2]);
+        let k = |x: u32| self.corners[x as usize];
+        // 3 × 3 vertices, [column][row]
+        let grid = [
+            [k(bl)[0], k(l)[0], k(l)[3]],
+            [k(b)[0], a, k(c)[3]],
+            [k(b)[1], k(c)[1], k(c)[2]],
+        ];
+        for x in 0..3 {
+            for y in 0..3 {
+                add(&mut out, grid[x][y], uw[x] * vw[y]);
+            }
+        }
+        out
+    }
+
+    /// The two points on the bottom side of cell `c` (`b₁₀`, `b₂₀`).
+    fn bottom_points(&self, c: u32) -> [Combination; 2] {
+        let b = self.nb(c, BOTTOM);
+        let [a0, a1, u1, u0] = self.corners[c as usize];
+        let (d0, d1) = (self.corners[b as usize][0], self.corners[b as usize][1]);
+        let dprev = if self.is_zero(a0) {
+            self.w(c)
+        } else {
+            self.w(self.nb(c, LEFT))
+        };
+        let dnext = if self.is_zero(a1) {
+            self.w(c)
+        } else {
+            self.w(self.nb(c, RIGHT))
+        };
+        let uw = inner_weights([dprev, self.w(c), dnext]);
+        let column = |below: u32, up: u32| {
+            let hb2 = if self.is_zero(below) {
+                self.h(b)
+            } else {
+                self.h(self.nb(b, BOTTOM))
+            };
+            let ht2 = if self.is_zero(up) {
+                self.h(c)
+            } else {
+                self.h(self.nb(c, TOP))
+            };
+            corner_weights([hb2, self.h(b), self.h(c), ht2])
+        };
+        let cols = [(d0, a0, u0), (d1, a1, u1)];
+        let vws = [column(d0, u0), column(d1, u1)];
+        std::array::from_fn(|p| {
+            let mut out = Combination::new();
+            for k in 0..2 {
+                let (x, y, z) = cols[k];
+                for (v, w) in [(x, vws[k][0]), (y, vws[k][1]), (z, vws[k][2])] {
+                    add(&mut out, v, uw[p][k] * w);
+                }
+            }
+            out
+        })
+    }
+
+    /// The two points on the left side of cell `c` (`b₀₁`, `b₀₂`).
+    fn left_points(&self, c: u32) -> [Combination; 2] {
+        let l = self.nb(c, LEFT);
+        let [a0, r0, r1, a1] = self.corners[c as usize];
+        let (l0, l1) = (self.corners[l as usize][0], self.corners[l as usize][3]);
+        let dprev = if self.is_zero(a0) {
+            self.h(c)
+        } else {
+            self.h(self.nb(c, BOTTOM))
+        };
+        let dnext = if self.is_zero(a1) {
+            self.h(c)
+        } else {
+            self.h(self.nb(c, TOP))
+        };
+        let vw = inner_weights([dprev, self.h(c), dnext]);
+        let row = |left: u32, right: u32| {
+            let wl2 = if self.is_zero(left) {
+                self.w(l)
+            } else {
+                self.w(self.nb(l, LEFT))
+            };
+            let wr2 = if self.is_zero(right) {
+                self.w(c)
+            } else {
+                self.w(self.nb(c, RIGHT))
+            };
+            corner_weights([wl2, self.w(l), self.w(c), wr2])
+        };
+        let rows = [(l0, a0, r0), (l1, a1, r1)];
+        let uws = [row(l0, r0), row(l1, r1)];
+        std::array::from_fn(|q| {
+            let mut out = Combination::new();
+            for k in 0..2 {
+                let (x, y, z) = rows[k];
+                for (v, w) in [(x, uws[k][0]), (y, uws[k][1]), (z, uws[k][2])] {
+                    add(&mut out, v, vw[q][k] * w);
+                }
+            }
+            out
+        })
+    }
+
+    /// The 16 Bézier points of cell `c`.
+    fn extract(&self, c: usize) -> [[Combination; 4]; 4] {
+        let cu = c as u32;
+        let (r, t) = (self.nb(cu, RIGHT), self.nb(cu, TOP));
+        let tr = self.nb(r, TOP);
+        let mut out: [[Combination; 4]; 4] = Default::default();
+        out[0][0] = self.vertex_point(cu);
+        out[3][0] = self.vertex_point(r);
+        out[0][3] = self.vertex_point(t);
+        out[3][3] = self.vertex_point(tr);
+        let [b1, b2] = self.bottom_points(cu);
+        out[1][0] = b1;
+        out[2][0] = b2;
+        let [t1, t2] = self.bottom_points(t);
+        out[1][3] = t1;
+        out[2][3] = t2;
+        let [l1, l2] = self.left_points(cu);
+        out[0][1] = l1;
+        out[0][2] = l2;
+        let [r1, r2] = self.left_points(r);
+        out[3][1] = r1;
+        out[3][2] = r2;
+        let uw = inner_weights([self.w(self.nb(cu, LEFT)), self.w(cu), self.w(r)]);
+        let vw = inner_weights([self.h(self.nb(cu, BOTTOM)), self.h(cu), self.h(t)]);
+        let q = self.corners[c];
+        let grid = [[q[0], q[3]], [q[1], q[2]]];
+        for p in 0..2 {
+            for s in 0..2 {
+                let mut comb = Combination::new();
+                for x in 0..2 {
+                    for y in 0..2 {
+                        add(&mut comb, grid[x][y], uw[p][x] * vw[s][y]);
+                    }
+                }
+                out[p + 1][s + 1] = comb;
+            }
+        }
+        out
+    }
+
+    /// The cell's rectangle in its strip's coordinates `[u0, u1] × [v0, v1]`.
+    pub fn cell_box(&self, c: u32) -> [f64; 4] {
+        let (_, i, j) = self.cell_at[c as usize];
+        let (w, h) = self.size(c);
+        let (u0, v0) = (i as f64 * w, j as f64 * h);
+        [u0, u0 + w, v0, v0 + h]
+    }
+
+    /// The Bézier patch of cell `c` for control points `control` (one per vertex), over its
+    /// box translated by `(du, dv)`.
+    pub fn patch(&self, c: u32, control: &[[f64; 3]], du: f64, dv: f64) -> BezierPatch {
+        let [u0, u1, v0, v1] = self.cell_box(c);
+        let mut p = [[[0.0; 3]; 4]; 4];
+        for i in 0..4 {
+            for j in 0..4 {
+                for &(v, w) in &self.bezier[c as usize][i][j] {
+                    for d in 0..3 {
+                        p[i][j][d] += w * control[v as usize][d];
+                    }
+                }
+            }
+        }
+        BezierPatch {
+            u0: u0 + du,
+            u1: u1 + du,
+            v0: v0 + dv,
+            v1: v1 + dv,
+            control: p,
+        }
+    }
+
+    /// The blending functions non-zero at `(s, t) ∈ [0, 1]²` of cell `c`: vertex and value
+    /// (summed over the Bézier points; a vertex may appear once).
+    pub fn blending(&self, c: u32, s: f64, t: f64) -> Combination {
+        let bern = |x: f64| {
+            let y = 1.0 - x;
+            [y * y * y, 3.0 * x * y * y, 3.0 * x * x * y, x * x * x]
+        };
+        let (bu, bv) = (bern(s), bern(t));
+        let mut out = Combination::new();
+        for i in 0..4 {
+            for j in 0..4 {
+                for &(v, w) in &self.bezier[c as usize][i][j] {
+                    add(&mut out, v, bu[i] * bv[j] * w);
+                }
+            }
+        }
+        out
+    }
+
+    /// Sides: `(cell, side)` for `side ∈ {RIGHT = 0, TOP = 1}` of every cell, and whether
+    /// the side has a zero at an end.
+    pub fn sides(&self) -> Vec<(u32, usize, bool)> {
+        let mut out = Vec::with_capacity(2 * self.n_cells());
+        for c in 0..self.n_cells() as u32 {
+            let q = self.corners[c as usize];
+            out.push((c, RIGHT, self.is_zero(q[1]) || self.is_zero(q[2])));
+            out.push((c, TOP, self.is_zero(q[2]) || self.is_zero(q[3])));
+        }
+        out
+    }
+
+    /// The neighbour across `side` of `c`.
+    pub fn across(&self, c: u32, side: usize) -> u32 {
+        self.nb(c, side)
+    }
+}
