@@ -9,12 +9,13 @@ use super::cones::{
     correct_cone_curvatures, greedy_cones_with, round_to_quarter_turns, ConeBudget,
 };
 use super::free::{free_seam_target, homology_disk, HomologyDisk};
+use super::harmonic::{harmonic_interior, repair_folds};
 use super::transfer::{
     folded_faces, input_route, scale_to_area, seam_edges, seam_report, subdivision_route,
     SubdivisionChart,
 };
 use super::{log_scale_sigma, BoundaryMode, Chart, Cone, ConeSpec};
-use super::{ParamOptions, Piece, SeamMode};
+use super::{Interior, ParamOptions, Piece, SeamMode};
 use crate::error::{Error, Result};
 use crate::flow::{flow_with_fallback, FlowResult, TargetSpec, UniformizationOptions};
 use crate::mesh::{topology, Mesh};
@@ -342,10 +343,7 @@ pub(super) fn chart_uv(
     progress.report("cut", None, "cut graph through the cones and the handles");
     let faces = mesh.faces();
     let on_input = input_route(s, &lengths, r, &cone_vertices, needs_cut);
-    let input_folds = match &on_input {
-        Ok((_, uv)) => folded_faces(faces, uv),
-        Err(_) => faces.len(),
-    };
+    let (on_input, input_folds, interior) = with_interior(mesh, &lengths, on_input, opts.interior);
     let (cut, mut corner_uv, mut subdivision) = match on_input {
         Ok((cut, uv)) if input_folds == 0 && !opts.on_subdivision => (cut, uv, None),
         first => {
@@ -413,6 +411,7 @@ pub(super) fn chart_uv(
         } else {
             "input".into()
         },
+        interior: interior.name().into(),
         input_flipped_faces: input_folds,
         moved_cones: 0,
         seam_edges: seams.edges,
@@ -436,6 +435,37 @@ pub(super) fn chart_uv(
         subdivision,
         chart,
     })
+}
+
+/// The input route's result: the cut on input edges and one UV per input corner.
+type InputRoute = Result<(Vec<bool>, Vec<[f64; 2]>)>;
+
+/// The input route's UVs with the opt-in interior `want` ([`Interior`]), kept when it folds
+/// no input face, else the exact UVs; the input faces that fold (all when the route failed)
+/// and the interior used.
+fn with_interior(
+    mesh: &Mesh,
+    lengths: &[f64],
+    on_input: InputRoute,
+    want: Interior,
+) -> (InputRoute, usize, Interior) {
+    let faces = mesh.faces();
+    let (cut, uv) = match on_input {
+        Ok(x) => x,
+        Err(e) => return (Err(e), faces.len(), Interior::Exact),
+    };
+    let folds = folded_faces(faces, &uv);
+    let other = match want {
+        Interior::Harmonic => harmonic_interior(mesh, lengths, &cut, &uv)
+            .ok()
+            .filter(|h| folded_faces(faces, h) == 0),
+        Interior::Repair if folds > 0 => repair_folds(mesh, lengths, &cut, &uv).map(|r| r.0),
+        _ => None,
+    };
+    match other {
+        Some(x) => (Ok((cut, x)), 0, want),
+        None => (Ok((cut, uv)), folds, Interior::Exact),
+    }
 }
 
 /// UV per corner of the input's faces from the common subdivision: the corner of the piece

@@ -20,20 +20,22 @@
 //! angle defect when `χ < 0`) or the extremum of the smooth solution with the total curvature
 //! spread by area, whichever greedy ends with the smaller area-weighted `σ(2u)`; then the
 //! cones are moved one at a time while `σ(2u)` drops. Every solve uses one factorization of
-//! the Laplacian and the cones' Green's functions (submodule `green`). With a boundary, each solve is
-//! one numeric Cholesky factorization of `L + P` (`P` a large diagonal penalty holding
-//! `u = 0` on the boundary and the cones). With a count `N` the greedy stops after `N`
+//! the Laplacian and the cones' Green's functions (submodule `green`). With a boundary, every
+//! solve is the system `L + P` (`P` a large diagonal penalty holding `u = 0` on the boundary
+//! and the cones), solved from one factorization of `L + P_boundary` and one column per cone
+//! by the Woodbury identity (submodule `held`). With a count `N` the greedy stops after `N`
 //! cones; with a bound `D` on the area distortion it stops at the first cone set whose
 //! linearised `max |2u − mean(2u)| ≤ D` (at most `max_cones` cones).
 
 mod closed;
 mod green;
+mod held;
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::metric::IntrinsicMetric;
-use crate::numeric::sparse::{LowerCsc, SymmetricSolver};
 use green::GreenBasis;
+use held::HeldBasis;
 use std::f64::consts::PI;
 
 /// How many cones the greedy places.
@@ -202,7 +204,7 @@ pub fn greedy_cones_with(
         keep_angles_positive(&mut p.cones, 2.0 * PI * chi);
         return Ok(p);
     }
-    greedy_with_boundary(&lap, &k0, &boundary, &used, budget)
+    HeldBasis::new(&lap, &k0, &boundary, &used)?.greedy(budget)
 }
 
 /// How cones at given positions get their curvatures (see [`cone_curvatures_at`]).
@@ -260,186 +262,43 @@ pub fn free_boundary_least_squares(
     cones: &[u32],
 ) -> Result<(Vec<(u32, f64)>, f64)> {
     let lap = laplacian(mesh, metric.lengths())?;
-    let n = lap.n;
     let k0 = angle_defects(mesh, metric);
-    let held: Vec<bool> = (0..n as u32)
-        .map(|v| mesh.is_boundary_vertex(v) || mesh.is_isolated(v))
-        .collect();
-    if !held.iter().any(|&h| h) || !(0..n as u32).any(|v| mesh.is_boundary_vertex(v)) {
+    let mut basis = held_basis(mesh, &lap, &k0)?;
+    basis.least_squares(cones)
+}
+
+/// The greedy with the boundary held ([`greedy_cones`] on a surface with boundary) and the
+/// curvatures at its positions by `rule` (`Dirichlet`: the greedy's own, `u = 0` at the
+/// cones; `LeastSquares`: [`free_boundary_least_squares`]), from one factorization of the
+/// Laplacian (submodule `held`) — what `--seams free` places on its disk.
+pub fn free_boundary_cones(
+    mesh: &Mesh,
+    metric: &IntrinsicMetric,
+    budget: ConeBudget,
+    rule: CurvatureRule,
+) -> Result<ConePlacement> {
+    let lap = laplacian(mesh, metric.lengths())?;
+    let k0 = angle_defects(mesh, metric);
+    let mut basis = held_basis(mesh, &lap, &k0)?;
+    let mut p = basis.greedy(budget)?;
+    if rule == CurvatureRule::LeastSquares {
+        let at: Vec<u32> = p.cones.iter().map(|c| c.0).collect();
+        p.cones = basis.least_squares(&at)?.0;
+    }
+    Ok(p)
+}
+
+/// [`HeldBasis`] of a mesh with boundary (boundary and isolated vertices held at `u = 0`).
+fn held_basis<'a>(mesh: &Mesh, lap: &'a Laplacian, k0: &'a [f64]) -> Result<HeldBasis<'a>> {
+    let n = lap.n;
+    let boundary: Vec<bool> = (0..n as u32).map(|v| mesh.is_boundary_vertex(v)).collect();
+    if !boundary.iter().any(|&b| b) {
         return Err(Error::input(
             "free-boundary cone curvatures need a boundary",
         ));
     }
-    if let Some(&c) = cones.iter().find(|&&c| c as usize >= n || held[c as usize]) {
-        return Err(Error::input(format!(
-            "cone vertex {c} is not an interior vertex of the mesh"
-        )));
-    }
-    let mut solver = SymmetricSolver::new(LowerCsc {
-        n,
-        col_ptr: &lap.col_ptr,
-        row_idx: &lap.row_idx,
-    })?;
-    let scale = lap.diag.iter().map(|&i| lap.values[i]).fold(0.0, f64::max);
-    let mut vals = lap.values.clone();
-    for v in 0..n {
-        if held[v] {
-            vals[lap.diag[v]] += 1e10 * scale.max(1e-300);
-        }
-    }
-    if !solver.factor_llt(&vals) && !solver.factor_ldlt(&vals) {
-        return Err(Error::numerical(
-            "the cotangent Laplacian could not be factorized for the cone curvatures",
-        ));
-    }
-    let total: f64 = lap.area.iter().sum();
-    let centred = |mut x: Vec<f64>| -> Vec<f64> {
-        let m = (0..n).map(|v| x[v] * lap.area[v]).sum::<f64>() / total;
-        x.iter_mut().for_each(|y| *y -= m);
-        x
-    };
-    let mut u0: Vec<f64> = (0..n).map(|v| if held[v] { 0.0 } else { -k0[v] }).collect();
-    solver.solve(&mut u0);
-    let u0 = centred(u0);
-    let g: Vec<Vec<f64>> = cones
-        .iter()
-        .map(|&c| {
-            let mut x = vec![0.0; n];
-            x[c as usize] = 1.0;
-            solver.solve(&mut x);
-            centred(x)
-        })
-        .collect();
-    let k = cones.len();
-    let dot = |a: &[f64], b: &[f64]| (0..n).map(|v| lap.area[v] * a[v] * b[v]).sum::<f64>();
-    // Normal equations [GᵀAG | −GᵀAu₀], Gaussian elimination with partial pivoting.
-    let mut m: Vec<Vec<f64>> = (0..k)
-        .map(|i| {
-            let mut row: Vec<f64> = (0..k).map(|j| dot(&g[i], &g[j])).collect();
-            row.push(-dot(&g[i], &u0));
-            row
-        })
-        .collect();
-    for col in 0..k {
-        let p = (col..k)
-            .max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))
-            .unwrap_or(col);
-        m.swap(col, p);
-        let d = m[col][col];
-        if d.abs() < 1e-300 {
-            return Err(Error::numerical(
-                "cone curvatures: singular normal equations",
-            ));
-        }
-        let pivot = m[col].clone();
-        for (r, row) in m.iter_mut().enumerate() {
-            if r != col {
-                let f = row[col] / d;
-                for (x, y) in row[col..].iter_mut().zip(&pivot[col..]) {
-                    *x -= f * y;
-                }
-            }
-        }
-    }
-    let x: Vec<f64> = (0..k)
-        .map(|i| (m[i][k] / m[i][i]).min(2.0 * PI - 0.05))
-        .collect();
-    let mut u = u0;
-    for (gc, xc) in g.iter().zip(&x) {
-        for v in 0..n {
-            u[v] += xc * gc[v];
-        }
-    }
-    let sigma = 2.0 * (dot(&u, &u) / total).sqrt();
-    Ok((cones.iter().copied().zip(x).collect(), sigma))
-}
-
-/// The greedy with the boundary held at `u = 0`: one factorization per cone.
-fn greedy_with_boundary(
-    lap: &Laplacian,
-    k0: &[f64],
-    boundary: &[bool],
-    used: &[bool],
-    budget: ConeBudget,
-) -> Result<ConePlacement> {
-    let n = lap.n;
-    let pattern = LowerCsc {
-        n,
-        col_ptr: &lap.col_ptr,
-        row_idx: &lap.row_idx,
-    };
-    let mut solver = SymmetricSolver::new(pattern)?;
-    let total_area: f64 = lap.area.iter().sum();
-    let scale = lap.diag.iter().map(|&i| lap.values[i]).fold(0.0, f64::max);
-    let penalty = 1e10 * scale.max(1e-300);
-    // Solve with u held at 0 on `held` (penalty); `rhs` per vertex.
-    let mut solve = |held: &[bool], rhs: &[f64]| -> Result<Vec<f64>> {
-        let mut vals = lap.values.clone();
-        for v in 0..n {
-            if held[v] || !used[v] {
-                vals[lap.diag[v]] += penalty;
-            }
-        }
-        if !solver.factor_llt(&vals) && !solver.factor_ldlt(&vals) {
-            return Err(Error::numerical(
-                "the cotangent Laplacian could not be factorized for cone placement",
-            ));
-        }
-        let mut x: Vec<f64> = (0..n)
-            .map(|v| if held[v] || !used[v] { 0.0 } else { rhs[v] })
-            .collect();
-        solver.solve(&mut x);
-        Ok(x)
-    };
-    let spread = |u: &[f64]| -> f64 {
-        let m: f64 = (0..n).map(|v| 2.0 * u[v] * lap.area[v]).sum::<f64>() / total_area;
-        (0..n)
-            .filter(|&v| used[v])
-            .map(|v| (2.0 * u[v] - m).abs())
-            .fold(0.0, f64::max)
-    };
-    let mut held = boundary.to_vec();
-    let mut cones: Vec<u32> = Vec::new();
-    let mut history = Vec::new();
-    let (max_cones, bound) = match budget {
-        ConeBudget::Count(c) => (c, -1.0),
-        ConeBudget::AreaDistortion { bound, max_cones } => (max_cones, bound),
-    };
-    let rhs: Vec<f64> = k0.iter().map(|&k| -k).collect();
-    let mut u = solve(&held, &rhs)?;
-    while cones.len() < max_cones {
-        if bound >= 0.0 && !cones.is_empty() && spread(&u) <= bound {
-            break;
-        }
-        let mean: f64 = (0..n).map(|v| u[v] * lap.area[v]).sum::<f64>() / total_area;
-        let next = (0..n)
-            .filter(|&v| used[v] && !held[v])
-            .max_by(|&a, &b| (u[a] - mean).abs().total_cmp(&(u[b] - mean).abs()));
-        let Some(c) = next else { break };
-        cones.push(c as u32);
-        held[c] = true;
-        u = solve(&held, &rhs)?;
-        history.push(spread(&u));
-    }
-    // Curvature left at the cones: K̄_c = K⁰_c + (L u)_c.
-    let mut lu = vec![0.0; n];
-    for j in 0..n {
-        for p in lap.col_ptr[j] as usize..lap.col_ptr[j + 1] as usize {
-            let i = lap.row_idx[p] as usize;
-            let v = lap.values[p];
-            lu[i] += v * u[j];
-            if i != j {
-                lu[j] += v * u[i];
-            }
-        }
-    }
-    Ok(ConePlacement {
-        cones: cones
-            .iter()
-            .map(|&c| (c, k0[c as usize] + lu[c as usize]))
-            .collect(),
-        distortion_history: history,
-    })
+    let used: Vec<bool> = (0..n as u32).map(|v| !mesh.is_isolated(v)).collect();
+    HeldBasis::new(lap, k0, &boundary, &used)
 }
 
 /// One Newton-type correction of cone curvatures on the *nonlinear* flow towards the least

@@ -14,7 +14,7 @@
 //! (no Gauss–Bonnet constraint on the cones alone); the disk's boundary turns by
 //! `2π − Σ K̄_cones` in total.
 
-use super::cones::{free_boundary_least_squares, greedy_cones, ConeBudget, CurvatureRule};
+use super::cones::{free_boundary_cones, ConeBudget};
 use super::{ConeSpec, ParamOptions, Piece};
 use crate::error::{Error, Result};
 use crate::flow::TargetSpec;
@@ -162,15 +162,11 @@ pub(super) fn free_seam_target(
             progress.report("cones", None, "greedy cone placement, seams held");
             let lengths = disk.piece.surface.edge_lengths();
             let metric = IntrinsicMetric::euclidean(lengths);
-            let p = greedy_cones(mesh, &metric, b)?;
-            // The greedy's positions; curvatures for the least linearised σ(2u) (the
-            // greedy's own, u = 0 at the cones, are one candidate of that least-squares
+            // The greedy's positions; curvatures for the least linearised σ(2u) by default
+            // (the greedy's own, u = 0 at the cones, are one candidate of that least-squares
             // problem, so this is never worse in the linear model).
-            let at: Vec<u32> = p.cones.iter().map(|c| c.0).collect();
-            let cones = match opts.free_cone_rule {
-                CurvatureRule::LeastSquares => free_boundary_least_squares(mesh, &metric, &at)?.0,
-                CurvatureRule::Dirichlet => p.cones,
-            };
+            let p = free_boundary_cones(mesh, &metric, b, opts.free_cone_rule)?;
+            let cones = p.cones;
             (cones, p.distortion_history)
         }
         None => (Vec::new(), Vec::new()),

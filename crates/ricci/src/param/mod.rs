@@ -52,6 +52,7 @@ pub(crate) mod boundary;
 mod chart;
 pub mod cones;
 mod free;
+mod harmonic;
 pub mod seamless;
 pub(crate) mod seams;
 pub mod sphere;
@@ -140,6 +141,52 @@ impl SeamMode {
     }
 }
 
+/// Where the UVs of the vertices off the seams come from ([`ParamOptions::interior`];
+/// library only, not on the CLI: neither opt-in interior helps yet, BENCHMARKS session 12).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Interior {
+    /// The flat layout itself at every vertex: the discrete conformal map, exact at the
+    /// vertices (on the common subdivision when the input's faces would fold).
+    #[default]
+    Exact,
+    /// The seam (and boundary) vertices from the flat layout, the others by the
+    /// cotangent-harmonic extension of them on the input's faces (submodule `harmonic`;
+    /// Boundary First Flattening's interior): least conformal energy with that boundary, same
+    /// cones and seams. Used only when it folds no input face; otherwise the exact map.
+    Harmonic,
+    /// The exact layout, except where an input face would fold: the vertices of those faces
+    /// and a few rings around them (off the seams) move to the mean-value average of their
+    /// neighbours (submodule `harmonic`, `repair_folds`), so that the map stays on the
+    /// input's faces instead of the common subdivision. Falls back to the exact map (on the
+    /// subdivision) when that does not unfold every face.
+    Repair,
+}
+
+impl std::str::FromStr for Interior {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "exact" => Ok(Interior::Exact),
+            "harmonic" => Ok(Interior::Harmonic),
+            "repair" => Ok(Interior::Repair),
+            _ => Err(format!(
+                "unknown interior '{s}' (expected exact, harmonic or repair)"
+            )),
+        }
+    }
+}
+
+impl Interior {
+    pub fn name(self) -> &'static str {
+        match self {
+            Interior::Exact => "exact",
+            Interior::Harmonic => "harmonic",
+            Interior::Repair => "repair",
+        }
+    }
+}
+
 /// Options of [`parametrize`].
 #[derive(Debug, Clone)]
 pub struct ParamOptions {
@@ -169,6 +216,8 @@ pub struct ParamOptions {
     /// Curvatures of the greedy cones with free seams (default least squares: the least
     /// linearised σ(2u) at the greedy's positions; `Dirichlet`: `u = 0` at the cones, BFF's).
     pub free_cone_rule: cones::CurvatureRule,
+    /// Exact layout at every vertex (default) or the harmonic interior ([`Interior`]).
+    pub interior: Interior,
 }
 
 impl Default for ParamOptions {
@@ -185,6 +234,7 @@ impl Default for ParamOptions {
             cone_search: cones::ConeSearch::Greedy,
             seams: SeamMode::Rigid,
             free_cone_rule: cones::CurvatureRule::LeastSquares,
+            interior: Interior::Exact,
         }
     }
 }
@@ -227,6 +277,10 @@ pub struct Chart {
     /// `"common_subdivision"` (the input's faces would fold, or the cut needs edges the flow
     /// flipped; [`Parametrization::subdivision`]).
     pub uv_faces: String,
+    /// `"harmonic"` when the vertices off the seams were moved to the harmonic extension
+    /// ([`Interior::Harmonic`]), `"repair"` when the vertices around input faces that would
+    /// fold were moved ([`Interior::Repair`]), else `"exact"`.
+    pub interior: String,
     /// Input faces whose own UV triangle is not positive (with the cut on input edges; all
     /// faces when no such cut exists) — the reason for `common_subdivision`.
     pub input_flipped_faces: usize,
