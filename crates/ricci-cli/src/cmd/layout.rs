@@ -40,7 +40,7 @@ use serde_json::{json, Value};
 use std::path::PathBuf;
 use std::time::Instant;
 
-mod double;
+pub(crate) mod double;
 pub mod file_metric;
 mod json;
 mod text;

@@ -29,6 +29,38 @@ pub fn applies(a: &Args, geometry: Option<Geometry>, mesh: &Mesh) -> bool {
 /// The layout through the double (module docs): fills `out` like the surface's own route
 /// (`flipped_faces`, `uv`, no deck group) plus `route`, `route_reason` and the double's flow;
 /// writes `--out` (the common subdivision with its UVs) and `--svg`.
+/// The E² flow of `surface` (one disk) on its double to `target` at the layout tolerance, with
+/// the input's Euclidean metric; refused with one sentence when it does not converge or ends
+/// with degenerate faces. Shared by `ricci layout` and `ricci param` (their route through the
+/// double).
+pub fn converged_double_flow(
+    surface: &Surface,
+    target: &ricci::flow::Target,
+    progress: &mut dyn ricci::progress::Progress,
+) -> anyhow::Result<(ricci::flow::double::DoubleFlow, IntrinsicMetric)> {
+    let g = Geometry::Euclidean;
+    let tolerance = ricci::flow::uniformize::layout_tolerance(g);
+    let metric = IntrinsicMetric::euclidean(surface.edge_lengths());
+    let flow = flow_on_double(
+        &surface.mesh,
+        metric.lengths(),
+        g,
+        target,
+        tolerance,
+        progress,
+    )?;
+    if !flow.converged || flow.degenerate_faces > 0 {
+        anyhow::bail!(
+            "the flow on the double did not converge either (max |K − K̄| = {:.3e} after {} \
+             iterations, {} degenerate faces)",
+            flow.max_error,
+            flow.iterations,
+            flow.degenerate_faces
+        );
+    }
+    Ok((flow, metric))
+}
+
 pub fn layout_through_double(
     a: &Args,
     surface: &Surface,
@@ -42,26 +74,9 @@ pub fn layout_through_double(
         None => TargetPolicy::Topology,
     };
     let target = resolve(&surface.mesh, g, &policy.resolve(&surface.mesh, g))?;
-    let tolerance = ricci::flow::uniformize::layout_tolerance(g);
-    let metric = IntrinsicMetric::euclidean(surface.edge_lengths());
-    let flow = flow_on_double(
-        &surface.mesh,
-        metric.lengths(),
-        g,
-        &target,
-        tolerance,
-        progress,
-    )?;
+    let (flow, metric) = converged_double_flow(surface, &target, progress)
+        .map_err(|e| anyhow::anyhow!("{e}; no layout computed"))?;
     crate::util::stage_done("flow");
-    if !flow.converged || flow.degenerate_faces > 0 {
-        anyhow::bail!(
-            "the flow on the double did not converge either (max |K − K̄| = {:.3e} after {} \
-             iterations, {} degenerate faces); no layout computed",
-            flow.max_error,
-            flow.iterations,
-            flow.degenerate_faces
-        );
-    }
     let h = half_subdivision(&surface.mesh, &surface.positions, &metric, &flow)?;
     crate::util::stage_done("layout");
     let s = &h.subdivision;

@@ -8,13 +8,12 @@
 use super::Args;
 use crate::util::{print_json, write_atomic};
 use ricci::analysis::distortion::uv_stats;
-use ricci::flow::double::flow_on_double;
 use ricci::flow::target::resolve;
 use ricci::flow::TargetSpec;
 use ricci::layout::double_half::half_subdivision;
 use ricci::layout::export::obj_with_corner_uv;
 use ricci::mesh::{Mesh, Surface};
-use ricci::metric::{Geometry, IntrinsicMetric};
+use ricci::metric::Geometry;
 use ricci::param::BoundaryMode;
 use serde_json::json;
 use std::time::Instant;
@@ -63,25 +62,8 @@ pub fn run_double(
     let mut inner = || -> anyhow::Result<serde_json::Value> {
         let g = Geometry::Euclidean;
         let target = resolve(&surface.mesh, g, &TargetSpec::FreeBoundary)?;
-        let tolerance = ricci::flow::uniformize::layout_tolerance(g);
-        let metric = IntrinsicMetric::euclidean(surface.edge_lengths());
-        let flow = flow_on_double(
-            &surface.mesh,
-            metric.lengths(),
-            g,
-            &target,
-            tolerance,
-            progress,
-        )?;
-        if !flow.converged || flow.degenerate_faces > 0 {
-            anyhow::bail!(
-                "the flow on the double did not converge either (max |K − K̄| = {:.3e} after {} \
-                 iterations, {} degenerate faces)",
-                flow.max_error,
-                flow.iterations,
-                flow.degenerate_faces
-            );
-        }
+        let (flow, metric) =
+            crate::cmd::layout::double::converged_double_flow(surface, &target, progress)?;
         let h = half_subdivision(&surface.mesh, &surface.positions, &metric, &flow)?;
         let s = &h.subdivision;
         let uv = pack(&s.corner_uv, a.margin);
