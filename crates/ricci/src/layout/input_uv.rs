@@ -260,14 +260,17 @@ type Choice<P> = (f64, [P; 3], [(u32, u32); 3]);
 /// Both searches return what an exhaustive search over (copy, map) in that order with
 /// [`Space::distance`] returns, but skip work: candidates are ranked by
 /// [`Space::distance_key`] and only those within 1e-9 (relative) of the best are measured
-/// exactly; where distances are accurate ([`Space::resolved`]), a map `g` whose displacement
-/// bound `ℓ_g` gives `d(g q, p) ≥ ℓ_g − d(q, p)` beyond the best found (plus 1e-6) is skipped.
+/// exactly; where distances are accurate ([`Space::resolved`]), the maps are visited by
+/// increasing displacement bound `ℓ_g` and the visit stops where `d(g q, p) ≥ ℓ_g − d(q, p)`
+/// exceeds the best found (plus 1e-6).
 struct Images<'a, S: Space> {
     positions: &'a [S::Point],
     copies: &'a [Vec<u32>],
     cands: &'a [S::Iso],
     /// Per candidate map: [`Isometry::displacement_bound`].
     disp: Vec<f64>,
+    /// The candidate maps but the first, by increasing `disp` (ties by index).
+    by_disp: Vec<u32>,
 }
 
 /// Rounding allowance of the pruning bounds of [`Images`].
@@ -280,12 +283,15 @@ where
     S::Iso: Isometry<Point = S::Point>,
 {
     fn new(positions: &'a [S::Point], copies: &'a [Vec<u32>], cands: &'a [S::Iso]) -> Self {
-        let disp = cands.iter().map(|g| g.displacement_bound()).collect();
+        let disp: Vec<f64> = cands.iter().map(|g| g.displacement_bound()).collect();
+        let mut by_disp: Vec<u32> = (1..cands.len() as u32).collect();
+        by_disp.sort_by(|&a, &b| disp[a as usize].total_cmp(&disp[b as usize]));
         Images {
             positions,
             copies,
             cands,
             disp,
+            by_disp,
         }
     }
 
@@ -304,21 +310,36 @@ where
         let prune_p = S::resolved(p);
         for &c in &self.copies[w as usize] {
             let q = self.positions[c as usize];
-            let prune = prune_p && S::resolved(q);
-            let dq = if prune { S::distance(q, p) } else { 0.0 };
-            for (k, g) in self.cands[..n].iter().enumerate() {
-                if k > 0 && prune && self.disp[k] - dq > upper + slack(upper + dq) {
-                    continue;
-                }
-                let gq = g.apply(q);
-                if k == 0 {
-                    upper = upper.min(S::distance(gq, p));
-                }
+            let start = buf.len();
+            let mut visit = |k: usize, buf: &mut Vec<(f64, u32, u32)>| {
+                let gq = self.cands[k].apply(q);
                 let key = S::distance_key(gq, p);
                 if key < kmin {
                     kmin = key;
                 }
                 buf.push((key, c, k as u32));
+                gq
+            };
+            if n == 0 {
+                continue;
+            }
+            let gq = visit(0, buf);
+            upper = upper.min(S::distance(gq, p));
+            if n > 1 && prune_p && S::resolved(q) {
+                let dq = S::distance(q, p);
+                for &k in &self.by_disp {
+                    if self.disp[k as usize] - dq > upper + slack(upper + dq) {
+                        break;
+                    }
+                    if (k as usize) < n {
+                        visit(k as usize, buf);
+                    }
+                }
+                buf[start..].sort_unstable_by_key(|e| e.2);
+            } else {
+                for k in 1..n {
+                    visit(k, buf);
+                }
             }
         }
         let band = kmin + 1e-9 * kmin + 1e-200;
@@ -336,7 +357,7 @@ where
     }
 
     /// The `keep` images of vertex `w` whose distance from `p` is nearest to `want`:
-    /// (mismatch, point, (copy, map)), sorted by mismatch (stable in (copy, map) order).
+    /// (mismatch, point, (copy, map)), sorted by mismatch, ties in (copy, map) order.
     fn matching(
         &self,
         w: u32,
@@ -352,14 +373,16 @@ where
             let q = self.positions[c as usize];
             let prune = prune_p && S::resolved(q);
             let dq = if prune { S::distance(q, p) } else { 0.0 };
-            for (k, g) in self.cands.iter().enumerate() {
-                if prune && top.len() == keep {
+            let order = std::iter::once(0).chain(self.by_disp.iter().copied());
+            for k in order.take(self.cands.len()) {
+                let k = k as usize;
+                if prune && top.len() == keep && keep > 0 {
                     let worst = top[keep - 1];
                     if self.disp[k] - dq - want > worst + slack(worst + want + dq) {
-                        continue;
+                        break;
                     }
                 }
-                let gq = g.apply(q);
+                let gq = self.cands[k].apply(q);
                 let m = (S::distance(gq, p) - want).abs();
                 v.push((m, gq, (c, k as u32)));
                 if keep > 0 && (top.len() < keep || m < top[keep - 1]) {
@@ -369,7 +392,7 @@ where
                 }
             }
         }
-        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
         v.truncate(keep);
         v
     }
