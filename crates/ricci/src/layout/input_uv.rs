@@ -184,21 +184,9 @@ where
     // Searched in three levels (identity; pairings; products), the next only when the
     // previous leaves the face spread out or flipped.
     let (cands, level_end) = candidate_maps(group);
-    // Nearest image of vertex `w` to point `p`: (distance, point, (copy, map)).
-    let nearest = |w: u32, p: S::Point, n: usize| -> (f64, S::Point, (u32, u32)) {
-        let mut best = (f64::INFINITY, p, (u32::MAX, 0));
-        for &c in &copies[w as usize] {
-            let q = positions[c as usize];
-            for (k, g) in cands[..n].iter().enumerate() {
-                let gq = g.apply(q);
-                let d = S::distance(gq, p);
-                if d < best.0 {
-                    best = (d, gq, (c, k as u32));
-                }
-            }
-        }
-        best
-    };
+    let images = Images::<S>::new(positions, &copies, &cands);
+    let mut buf = Vec::new();
+    let mut nearest = |w: u32, p: S::Point, n: usize| images.nearest(w, p, n, &mut buf);
     // First pass with the identity only: the typical size of a face in the layout.
     let mut spread = vec![0.0f64; faces.len()];
     let mut corner = Vec::with_capacity(3 * faces.len());
@@ -250,11 +238,6 @@ where
         }
     }
     if let (Some(l), Some(_)) = (side_lengths, group) {
-        let images = Images::<S> {
-            positions,
-            copies: &copies,
-            cands: &cands,
-        };
         seam_faces += images.match_side_lengths(faces, l, &mut corner, &mut source);
     }
     let flipped_faces = (0..faces.len())
@@ -273,18 +256,108 @@ where
 type Choice<P> = (f64, [P; 3], [(u32, u32); 3]);
 
 /// The images of the surface's vertices under the candidate deck maps.
+///
+/// Both searches return what an exhaustive search over (copy, map) in that order with
+/// [`Space::distance`] returns, but skip work: candidates are ranked by
+/// [`Space::distance_key`] and only those within 1e-9 (relative) of the best are measured
+/// exactly; where distances are accurate ([`Space::resolved`]), the maps are visited by
+/// increasing displacement bound `ℓ_g` and the visit stops where `d(g q, p) ≥ ℓ_g − d(q, p)`
+/// exceeds the best found (plus 1e-6).
 struct Images<'a, S: Space> {
     positions: &'a [S::Point],
     copies: &'a [Vec<u32>],
     cands: &'a [S::Iso],
+    /// Per candidate map: [`Isometry::displacement_bound`].
+    disp: Vec<f64>,
+    /// The candidate maps but the first, by increasing `disp` (ties by index).
+    by_disp: Vec<u32>,
 }
 
-impl<S: Space> Images<'_, S>
+/// Rounding allowance of the pruning bounds of [`Images`].
+fn slack(x: f64) -> f64 {
+    1e-6 * (1.0 + x)
+}
+
+impl<'a, S: Space> Images<'a, S>
 where
     S::Iso: Isometry<Point = S::Point>,
 {
+    fn new(positions: &'a [S::Point], copies: &'a [Vec<u32>], cands: &'a [S::Iso]) -> Self {
+        let disp: Vec<f64> = cands.iter().map(|g| g.displacement_bound()).collect();
+        let mut by_disp: Vec<u32> = (1..cands.len() as u32).collect();
+        by_disp.sort_by(|&a, &b| disp[a as usize].total_cmp(&disp[b as usize]));
+        Images {
+            positions,
+            copies,
+            cands,
+            disp,
+            by_disp,
+        }
+    }
+
+    /// Nearest image of vertex `w` to `p` under the first `n` candidate maps: (distance,
+    /// point, (copy, map)), the first in (copy, map) order among equal distances. `buf`:
+    /// scratch space.
+    fn nearest(
+        &self,
+        w: u32,
+        p: S::Point,
+        n: usize,
+        buf: &mut Vec<(f64, u32, u32)>,
+    ) -> (f64, S::Point, (u32, u32)) {
+        buf.clear();
+        let (mut kmin, mut upper) = (f64::INFINITY, f64::INFINITY);
+        let prune_p = S::resolved(p);
+        for &c in &self.copies[w as usize] {
+            let q = self.positions[c as usize];
+            let start = buf.len();
+            let mut visit = |k: usize, buf: &mut Vec<(f64, u32, u32)>| {
+                let gq = self.cands[k].apply(q);
+                let key = S::distance_key(gq, p);
+                if key < kmin {
+                    kmin = key;
+                }
+                buf.push((key, c, k as u32));
+                gq
+            };
+            if n == 0 {
+                continue;
+            }
+            let gq = visit(0, buf);
+            upper = upper.min(S::distance(gq, p));
+            if n > 1 && prune_p && S::resolved(q) {
+                let dq = S::distance(q, p);
+                for &k in &self.by_disp {
+                    if self.disp[k as usize] - dq > upper + slack(upper + dq) {
+                        break;
+                    }
+                    if (k as usize) < n {
+                        visit(k as usize, buf);
+                    }
+                }
+                buf[start..].sort_unstable_by_key(|e| e.2);
+            } else {
+                for k in 1..n {
+                    visit(k, buf);
+                }
+            }
+        }
+        let band = kmin + 1e-9 * kmin + 1e-200;
+        let mut best = (f64::INFINITY, p, (u32::MAX, 0));
+        for &(key, c, k) in buf.iter() {
+            if key <= band {
+                let gq = self.cands[k as usize].apply(self.positions[c as usize]);
+                let d = S::distance(gq, p);
+                if d < best.0 {
+                    best = (d, gq, (c, k));
+                }
+            }
+        }
+        best
+    }
+
     /// The `keep` images of vertex `w` whose distance from `p` is nearest to `want`:
-    /// (mismatch, point, (copy, map)).
+    /// (mismatch, point, (copy, map)), sorted by mismatch, ties in (copy, map) order.
     fn matching(
         &self,
         w: u32,
@@ -293,14 +366,33 @@ where
         keep: usize,
     ) -> Vec<(f64, S::Point, (u32, u32))> {
         let mut v = Vec::new();
+        // The `keep` smallest mismatches so far (ascending).
+        let mut top: Vec<f64> = Vec::with_capacity(keep + 1);
+        let prune_p = S::resolved(p);
         for &c in &self.copies[w as usize] {
             let q = self.positions[c as usize];
-            for (k, g) in self.cands.iter().enumerate() {
-                let gq = g.apply(q);
-                v.push(((S::distance(gq, p) - want).abs(), gq, (c, k as u32)));
+            let prune = prune_p && S::resolved(q);
+            let dq = if prune { S::distance(q, p) } else { 0.0 };
+            let order = std::iter::once(0).chain(self.by_disp.iter().copied());
+            for k in order.take(self.cands.len()) {
+                let k = k as usize;
+                if prune && top.len() == keep && keep > 0 {
+                    let worst = top[keep - 1];
+                    if self.disp[k] - dq - want > worst + slack(worst + want + dq) {
+                        break;
+                    }
+                }
+                let gq = self.cands[k].apply(q);
+                let m = (S::distance(gq, p) - want).abs();
+                v.push((m, gq, (c, k as u32)));
+                if keep > 0 && (top.len() < keep || m < top[keep - 1]) {
+                    let at = top.partition_point(|&x| x <= m);
+                    top.insert(at, m);
+                    top.truncate(keep);
+                }
             }
         }
-        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
         v.truncate(keep);
         v
     }

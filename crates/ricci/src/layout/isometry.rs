@@ -49,6 +49,10 @@ pub trait Isometry: Copy + Clone + std::fmt::Debug + Send + Sync + 'static {
     fn distance(&self, other: &Self) -> f64;
     /// Re-project onto the group (remove accumulated rounding).
     fn normalized(&self) -> Self;
+    /// A lower bound of the displacement `d(g(x), x)` over all points `x` (0 if unknown).
+    fn displacement_bound(&self) -> f64 {
+        0.0
+    }
     /// Size of the isometry as a matrix (Frobenius norm for Möbius maps and rotations,
     /// `1 + |t|` for rigid motions): rounding in a product of isometries is bounded by the
     /// machine epsilon times the product of these sizes.
@@ -290,8 +294,33 @@ pub fn disk_distance(p: C, q: C) -> f64 {
     2.0 * ((p - q).norm() / den).asinh()
 }
 
+/// `|p − q|² / ((1 − |p|²)(1 − |q|²))` (∞ outside the disk), `sinh²` of half the
+/// [`disk_distance`] with the same denominator: ordering by it orders by that distance.
+#[inline]
+pub fn disk_distance_key(p: C, q: C) -> f64 {
+    let den = ((1.0 - p.norm_sqr()) * (1.0 - q.norm_sqr())).max(0.0);
+    if den <= 0.0 {
+        return f64::INFINITY;
+    }
+    (p - q).norm_sqr() / den
+}
+
 impl Isometry for Mobius {
     type Point = C;
+    /// The translation length `2 acosh(|Re a| / √(|a|² − |b|²))` of a hyperbolic map (0 for
+    /// elliptic and parabolic ones): no point of the disk moves less.
+    fn displacement_bound(&self) -> f64 {
+        let det = self.a.norm_sqr() - self.b.norm_sqr();
+        if !(det > 0.0) {
+            return 0.0;
+        }
+        let t = self.a.re.abs() / det.sqrt();
+        if t > 1.0 {
+            2.0 * t.acosh()
+        } else {
+            0.0
+        }
+    }
     fn identity() -> Self {
         Mobius {
             a: C::new(1.0, 0.0),

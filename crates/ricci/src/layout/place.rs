@@ -45,8 +45,8 @@ use super::dd::MobiusDd;
 use super::error::LayoutError;
 pub use super::frame::{Frame, IsoPoint};
 use super::isometry::{
-    cross3, det3, disk_distance, dot3, normalize3, sphere_distance, Complex, Isometry, Mobius,
-    RigidMotion, Rotation,
+    cross3, det3, disk_distance, disk_distance_key, dot3, normalize3, sphere_distance, Complex,
+    Isometry, Mobius, RigidMotion, Rotation,
 };
 use crate::error::{Error, Result};
 use crate::mesh::{topology, Mesh, NONE};
@@ -82,6 +82,18 @@ pub trait Space: Background {
     fn orientation(a: Self::Point, b: Self::Point, c: Self::Point) -> f64;
     /// Geodesic distance.
     fn distance(a: Self::Point, b: Self::Point) -> f64;
+    /// A cheaper key that increases with [`Space::distance`] (to a few ulps, relative).
+    #[inline]
+    fn distance_key(a: Self::Point, b: Self::Point) -> f64 {
+        Self::distance(a, b)
+    }
+    /// Whether [`Space::distance`] from `p` is accurate to 1e-9, so that searches may be
+    /// pruned there with [`Isometry::displacement_bound`].
+    #[inline]
+    fn resolved(p: Self::Point) -> bool {
+        let _ = p;
+        false
+    }
     /// The point at fraction `t` of the geodesic from `a` to `b`.
     fn toward(a: Self::Point, b: Self::Point, t: f64) -> Self::Point;
     /// [`Space::seed`] in the working precision, for side lengths `l[m] + lo[m]`
@@ -156,6 +168,10 @@ impl Space for Euclidean {
     fn distance(a: Complex, b: Complex) -> f64 {
         (a - b).norm()
     }
+    #[inline]
+    fn distance_key(a: Complex, b: Complex) -> f64 {
+        (a - b).norm_sqr()
+    }
     fn toward(a: Complex, b: Complex, t: f64) -> Complex {
         a + (b - a) * t
     }
@@ -195,6 +211,14 @@ impl Space for Hyperbolic {
     #[inline]
     fn distance(a: Complex, b: Complex) -> f64 {
         disk_distance(a, b)
+    }
+    #[inline]
+    fn distance_key(a: Complex, b: Complex) -> f64 {
+        disk_distance_key(a, b)
+    }
+    #[inline]
+    fn resolved(p: Complex) -> bool {
+        1.0 - p.norm_sqr() >= 1e-8
     }
     /// The canonical triangle in double-double: `p0 = 0`, `p1 = tanh(l01/2)`,
     /// `p2 = e^{iθ} tanh(l20/2)` with `e^{iθ} = (1 − t² + 2it)/(1 + t²)` from the half-angle
