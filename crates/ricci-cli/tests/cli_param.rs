@@ -3,6 +3,9 @@
 use std::path::PathBuf;
 use std::process::Command;
 
+#[path = "../../ricci/tests/ricci_meshes/mod.rs"]
+mod ricci_meshes;
+
 fn bin() -> PathBuf {
     PathBuf::from(env!("CARGO_BIN_EXE_ricci"))
 }
@@ -161,4 +164,40 @@ fn free_seams_are_reported_and_written_on_the_input_faces() {
         .unwrap();
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown seams 'loose'"));
+}
+
+/// A map with flipped triangles is never written silently: stderr warns exactly when the
+/// report counts flipped faces (camel with three cones and free seams has had some: its scale
+/// factors span ~e^±10), and says nothing of flips otherwise.
+#[test]
+fn flipped_triangles_are_warned_on_stderr() {
+    let Some(meshes) = ricci_meshes::ricci_meshes() else {
+        eprintln!("RICCI_MESHES not set: skipped");
+        return;
+    };
+    let mesh = meshes.join("camel.off");
+    if !mesh.exists() {
+        eprintln!("{} missing: skipped", mesh.display());
+        return;
+    }
+    for (cones, seams) in [("3", "free"), ("8", "rigid")] {
+        let out = tmp(&format!("camel-{cones}-{seams}.obj"));
+        let o = Command::new(bin())
+            .arg("param")
+            .arg(&mesh)
+            .args(["--cones", cones, "--seams", seams, "--json", "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let flipped = v["flipped_faces"].as_u64().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        let warned = err.contains("flipped triangle");
+        assert_eq!(
+            warned,
+            flipped > 0,
+            "{cones} cones, {seams} seams: {flipped} flipped, stderr: {err}"
+        );
+    }
 }

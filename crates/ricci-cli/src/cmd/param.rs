@@ -301,6 +301,18 @@ fn sphere_obj(name: &str, surface: &ricci::mesh::Surface, m: &SphereMap) -> Stri
 }
 
 fn report(a: &Args, out: &serde_json::Value) -> anyhow::Result<()> {
+    let flipped = out["flipped_faces"].as_u64().unwrap_or(0);
+    if flipped > 0 {
+        // Issue 16 asks for 0 flipped faces every time; when the map has some (e.g. very few
+        // cones with free seams: scale factors beyond what the layout resolves), say so on
+        // stderr as well as in the report, so that scripts do not take the UVs on trust.
+        eprintln!(
+            "warning: {}: the UV map has {flipped} flipped triangle(s) (σ(log area ratio) {:.3}); \
+             try more cones (--cones N) or --seams rigid",
+            a.mesh.display(),
+            out["log_area_sigma"].as_f64().unwrap_or(f64::NAN)
+        );
+    }
     if a.json {
         print_json(out);
     } else {
