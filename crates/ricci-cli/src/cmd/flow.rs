@@ -286,6 +286,7 @@ fn report_json(
         "clamped_edges": r.clamped_edges,
         "initial_length_error": r.initial_length_error,
         "degenerate_faces": r.degenerate_faces,
+        "stop_reason": r.stop_reason,
         "flips": r.triangulation.as_ref().map(|t| t.initial_flips + t.flips),
         "triangulation": r.triangulation.as_ref().map(|t| json!({
             "kind": "intrinsic",

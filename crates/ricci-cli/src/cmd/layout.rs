@@ -86,9 +86,21 @@ pub struct Args {
     /// polishing it to double-double first.
     #[arg(long)]
     pub no_polish: bool,
+    /// Newton iteration budget of the flow (default: the scheme's, e.g. 30 for vertex scaling
+    /// with flips); a flow that runs out of it is refused with the reason. Ignored with --metric.
+    #[arg(long)]
+    pub max_iterations: Option<usize>,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+}
+
+/// How far the flow behind a layout or a spectrum may go: its tolerance (default
+/// `layout_tolerance` of the geometry) and its iteration budget (default the scheme's).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FlowLimits {
+    pub tolerance: Option<f64>,
+    pub max_iterations: Option<usize>,
 }
 
 /// Per-edge lengths from a metric file (`ricci flow --out`): `lengths` by edge id, matched by
@@ -163,7 +175,7 @@ pub fn polished_metric(
     scheme: Option<Scheme>,
     metric_file: Option<&PathBuf>,
     polish: Polish,
-    flow_tolerance: Option<f64>,
+    limits: FlowLimits,
     progress: &mut dyn ricci::progress::Progress,
 ) -> anyhow::Result<PolishedLengths> {
     use ricci::layout::pipeline::{polish_lengths, polish_uniformization};
@@ -173,10 +185,10 @@ pub fn polished_metric(
         target,
         scheme,
         metric_file,
-        flow_tolerance,
+        limits,
         progress,
     )?;
-    if let Some(t) = flow_tolerance {
+    if let Some(t) = limits.tolerance {
         report["flow_tolerance"] = json!(t);
     }
     crate::util::stage_done("flow");
@@ -252,7 +264,7 @@ fn metric_and_flow(
     target: Option<&str>,
     scheme: Option<Scheme>,
     metric_file: Option<&PathBuf>,
-    tolerance: Option<f64>,
+    limits: FlowLimits,
     progress: &mut dyn ricci::progress::Progress,
 ) -> anyhow::Result<MetricAndFlow> {
     if let Some(path) = metric_file {
@@ -291,7 +303,9 @@ fn metric_and_flow(
     let mut uniformization = ricci::flow::UniformizationOptions::single(
         Some(g),
         scheme,
-        tolerance.unwrap_or_else(|| ricci::flow::uniformize::layout_tolerance(g)),
+        limits
+            .tolerance
+            .unwrap_or_else(|| ricci::flow::uniformize::layout_tolerance(g)),
     );
     if let Some(t) = target {
         uniformization.target = ricci::flow::TargetPolicy::Given(
@@ -299,7 +313,7 @@ fn metric_and_flow(
                 .map_err(|e: String| UsageError(format!("--target: {e}")))?,
         );
     }
-    let opts = uniformization.flow_options(&surface.mesh, scheme, None)?;
+    let opts = uniformization.flow_options(&surface.mesh, scheme, limits.max_iterations)?;
     let r = ricci::flow::ricci_flow(&surface.mesh, &surface.edge_lengths(), &opts, progress)?;
     let mut report = json!({
         "source": "flow", "scheme": r.scheme, "target": r.target_description,
@@ -772,7 +786,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             (false, true) => Polish::Now,
             (false, false) => Polish::AfterCut,
         },
-        None,
+        FlowLimits {
+            tolerance: None,
+            max_iterations: a.max_iterations,
+        },
         &mut bar,
     );
     let PolishedLengths {

@@ -16,7 +16,7 @@
 
 mod double;
 
-use super::layout::{polished_metric, Polish, PolishedLengths};
+use super::layout::{polished_metric, FlowLimits, Polish, PolishedLengths};
 use crate::util::read_surface;
 use crate::util::Reporter;
 use crate::util::{print_json, UsageError};
@@ -48,6 +48,10 @@ pub struct Args {
     /// domain (genus ≥ 2).
     #[arg(long)]
     pub base: Option<u32>,
+    /// Newton iteration budget of the flow (default: the scheme's); a flow that runs out of
+    /// it is refused with the reason. Ignored with --metric.
+    #[arg(long)]
+    pub max_iterations: Option<usize>,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
@@ -208,7 +212,10 @@ fn flowed_metric(
             a.scheme,
             a.metric.as_ref(),
             Polish::Now,
-            tol,
+            FlowLimits {
+                tolerance: tol,
+                max_iterations: a.max_iterations,
+            },
             bar,
         )
         .map_err(|e| anyhow::anyhow!("{}: {}", a.mesh.display(), crate::util::sentence(&e)))

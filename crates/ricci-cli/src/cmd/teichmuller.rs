@@ -37,8 +37,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let n = a.meshes.len();
     for (i, path) in a.meshes.iter().enumerate() {
         rep.line(&format!("teichmuller: {} ({}/{n})", path.display(), i + 1));
-        let (surface, _) =
-            read_surface(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let (surface, _) = read_surface(path)?; // its errors name the file
         if let Some(b) = a.base {
             crate::util::check_vertex("--base", b, surface.mesh.n_vertices())?;
         }

@@ -341,6 +341,8 @@ pub struct ConformalOutcome {
     pub symbolic_factorizations: usize,
     pub state: ConformalState,
     pub notes: Vec<String>,
+    /// Why the solve stopped short of the tolerance ([`super::newton::stop_reason`]).
+    pub stop_reason: Option<String>,
 }
 
 /// Newton's method for the target `target` on `tri` (already Delaunay for its base metric),
@@ -456,6 +458,8 @@ pub fn solve(
             update_round(cn.tri, &cn.u, target);
         }
     }
+    let stop_reason =
+        super::newton::stop_reason(converged, it, settings.max_iterations, err, &notes);
     if dynamic {
         notes.push(format!(
             "round boundary: {exact_steps} exact Newton step(s) (Jacobian H − ∂K̄/∂u), \
@@ -477,6 +481,7 @@ pub fn solve(
         symbolic_factorizations: cn.pattern.symbolic_count,
         state: cn.st,
         notes,
+        stop_reason,
     })
 }
 

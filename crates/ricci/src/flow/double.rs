@@ -62,6 +62,8 @@ pub struct DoubleFlow {
     /// max |u(v) − u(σ(v))|: the solution's distance from σ-symmetry (rounding only).
     pub asymmetry: f64,
     pub notes: Vec<String>,
+    /// Why the solve stopped short of the tolerance ([`super::newton::stop_reason`]).
+    pub stop_reason: Option<String>,
 }
 
 /// The target of the double from the surface's `target` (module docs): `K̄` mirrored and
@@ -186,6 +188,7 @@ pub fn flow_on_double(
         boundary_edges_flipped,
         asymmetry,
         notes: out.notes,
+        stop_reason: out.stop_reason,
         triangulation: tri,
         edge_origin,
         sigma,

@@ -24,6 +24,9 @@ pub enum FlowError {
         tolerance: f64,
         iterations: usize,
         degenerate_faces: usize,
+        /// Why the iteration stopped ([`FlowResult::stop_reason`]): the iteration budget, the
+        /// line search, the flip budget, …
+        reason: Option<String>,
     },
     /// Σ K̄ (`curvature_sum`) is not what Gauss–Bonnet asks of a metric of `geometry` on a
     /// surface of Euler characteristic `euler_characteristic` (E²: 2πχ; H² and S²: a positive
@@ -60,6 +63,7 @@ impl FlowError {
             tolerance: r.tolerance,
             iterations: r.iterations,
             degenerate_faces: r.degenerate_faces,
+            reason: r.stop_reason.clone(),
         }
     }
 
@@ -82,13 +86,26 @@ impl fmt::Display for FlowError {
                 tolerance,
                 iterations,
                 degenerate_faces,
+                reason,
             } => {
+                let reason = reason
+                    .as_deref()
+                    .map(|r| format!(": {r}"))
+                    .unwrap_or_default();
                 if max_error > tolerance {
                     write!(
                         f,
                         "the flow did not converge (max |K − K̄| = {max_error:.3e} > \
-                         {tolerance:.1e} after {iterations} iterations)"
-                    )
+                         {tolerance:.1e} after {iterations} iterations){reason}"
+                    )?;
+                    if *degenerate_faces > 0 {
+                        write!(
+                            f,
+                            "; {degenerate_faces} face(s) violate the triangle inequality in \
+                             the final metric"
+                        )?;
+                    }
+                    Ok(())
                 } else if *degenerate_faces > 0 {
                     write!(
                         f,
@@ -102,7 +119,7 @@ impl fmt::Display for FlowError {
                     write!(
                         f,
                         "the flow did not converge (max |K − K̄| = {max_error:.3e}, tolerance \
-                         {tolerance:.1e}, {iterations} iterations)"
+                         {tolerance:.1e}, {iterations} iterations){reason}"
                     )
                 }
             }

@@ -202,6 +202,10 @@ pub struct FlowResult {
     pub pinned: Vec<u32>,
     pub seconds: f64,
     pub notes: Vec<String>,
+    /// Why the flow stopped short of its target when it did not converge (the iteration
+    /// budget, the line search, the flip budget, …; faces violating the triangle inequality
+    /// are counted in `degenerate_faces`), for the sentence of [`FlowError::not_converged`].
+    pub stop_reason: Option<String>,
     /// [`Scheme::Conformal`] only: the final intrinsic triangulation (then `lengths` belong to
     /// its simplicial mesh `triangulation.simplicial.mesh`, not to the input mesh).
     pub triangulation: Option<IntrinsicResult>,
@@ -559,23 +563,26 @@ pub fn ricci_flow(
     let ksum: f64 = ev.ws.curvature.iter().sum();
     let gb = (ksum + geometry.curvature() * ev.ws.area - 2.0 * PI * chi as f64).abs();
     let converged = outcome.converged && max_err <= options.tolerance;
+    let mut stop_reason = (!converged).then(|| outcome.stop_reason.clone()).flatten();
     if !converged && (target.is_dynamic() || matches!(options.target, TargetSpec::GeodesicBoundary))
     {
         let ears = (0..mesh.n_vertices() as u32)
             .filter(|&v| mesh.is_boundary_vertex(v) && mesh.vertex_faces(v).count() == 1)
             .count();
         if ears > 0 {
-            notes.push(format!(
+            let why = format!(
                 "{ears} boundary vertices have a single face (ears): a round or geodesic \
                  boundary needs their one corner to open to nearly π, which degenerates the \
                  triangle; split the edges opposite the ears first"
-            ));
+            );
+            add_reason(&mut stop_reason, &why);
+            notes.push(why);
         }
     }
     if outcome.converged && !converged {
-        notes.push(format!(
-            "after rescaling, max |K − K̄| = {max_err:.3e} exceeds the tolerance"
-        ));
+        let why = format!("after rescaling, max |K − K̄| = {max_err:.3e} exceeds the tolerance");
+        add_reason(&mut stop_reason, &why);
+        notes.push(why);
     }
     // A curvature reached with faces that violate the triangle inequality (their angles
     // extended by 0, 0, π) is not a polyhedral metric on this triangulation: not converged.
@@ -613,8 +620,17 @@ pub fn ricci_flow(
         pinned,
         seconds: t0.elapsed().as_secs_f64(),
         notes,
+        stop_reason,
         triangulation: None,
     })
+}
+
+/// Append `why` to the reasons a flow stopped short (`"; "`-separated).
+fn add_reason(reason: &mut Option<String>, why: &str) {
+    *reason = Some(match reason.take() {
+        Some(r) => format!("{r}; {why}"),
+        None => why.to_string(),
+    });
 }
 
 /// [`ricci_flow`] for [`Scheme::Conformal`]: isometric flips to the input metric's intrinsic
@@ -708,10 +724,11 @@ fn conformal_flow(
     let gb = (ksum + geometry.curvature() * state.area - 2.0 * PI * chi as f64).abs();
     let degenerate = state.degenerate_faces;
     let converged = out.converged && max_err <= options.tolerance && degenerate == 0;
+    let mut stop_reason = (!converged).then(|| out.stop_reason.clone()).flatten();
     if out.converged && max_err > options.tolerance {
-        notes.push(format!(
-            "after rescaling, max |K − K̄| = {max_err:.3e} exceeds the tolerance"
-        ));
+        let why = format!("after rescaling, max |K − K̄| = {max_err:.3e} exceeds the tolerance");
+        add_reason(&mut stop_reason, &why);
+        notes.push(why);
     }
     if degenerate > 0 {
         notes.push(format!(
@@ -760,6 +777,7 @@ fn conformal_flow(
         pinned,
         seconds: t0.elapsed().as_secs_f64(),
         notes,
+        stop_reason,
         triangulation: Some(triangulation),
     })
 }
@@ -881,6 +899,7 @@ fn conformal_sphere_flow(
         pinned: Vec::new(),
         seconds: t0.elapsed().as_secs_f64(),
         notes,
+        stop_reason: None,
         triangulation: Some(triangulation),
     })
 }

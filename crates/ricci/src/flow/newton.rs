@@ -74,6 +74,36 @@ pub struct SolveOutcome {
     pub converged: bool,
     pub max_error: f64,
     pub notes: Vec<String>,
+    /// Why the solve stopped short of the tolerance (see [`stop_reason`]); `None` when it
+    /// converged.
+    pub stop_reason: Option<String>,
+}
+
+/// Why an iteration stopped short of its tolerance, for the non-convergence sentence the
+/// caller prints: the iteration budget when it ran out, a non-finite curvature, else the
+/// note the loop wrote when it broke off (every other early exit writes one: `loop_notes`
+/// are the notes written since the loop started). `None` when it converged.
+pub fn stop_reason(
+    converged: bool,
+    iterations: usize,
+    max_iterations: usize,
+    err: f64,
+    loop_notes: &[String],
+) -> Option<String> {
+    if converged {
+        None
+    } else if !err.is_finite() {
+        Some("the curvature became non-finite".into())
+    } else if iterations >= max_iterations {
+        Some(format!("the budget of {max_iterations} iterations ran out"))
+    } else {
+        Some(
+            loop_notes
+                .last()
+                .cloned()
+                .unwrap_or_else(|| "the iteration stopped without a reason".into()),
+        )
+    }
 }
 
 /// Largest |K − K̄| over the vertices with a prescribed curvature.
@@ -124,6 +154,7 @@ pub fn newton(
     let mut counts = StepCounts::default();
     let mut exact_failed = false;
     let dynamic = target.is_dynamic();
+    let notes_before_loop = notes.len();
     loop {
         if !ev.evaluate_with_hessian(&u, &sys.pattern, &mut sys.values) {
             notes.push("the metric left the domain of the scheme".into());
@@ -229,6 +260,13 @@ pub fn newton(
         }
         last_step = t * delta.iter().fold(0.0f64, |m, d| m.max(d.abs()));
     }
+    let stop_reason = stop_reason(
+        converged,
+        it,
+        settings.max_iterations,
+        err,
+        &notes[notes_before_loop..],
+    );
     counts.shifted = sys.shifted_steps;
     counts.push_notes(settings.indefinite && it > 0, &mut notes);
     Ok(SolveOutcome {
@@ -238,6 +276,7 @@ pub fn newton(
         converged,
         max_error: err,
         notes,
+        stop_reason,
     })
 }
 
@@ -732,6 +771,7 @@ pub fn gradient_flow(
             r[i] = target.curvature[i] - ev.ws.curvature[i];
         }
     }
+    let stop_reason = stop_reason(converged, it, settings.max_iterations, err, &notes);
     if eps < settings.step {
         notes.push(format!("step length reduced to ε = {eps:.3e}"));
     }
@@ -742,6 +782,7 @@ pub fn gradient_flow(
         converged,
         max_error: err,
         notes,
+        stop_reason,
     })
 }
 

@@ -52,10 +52,14 @@ pub fn converged_double_flow(
     if !flow.converged || flow.degenerate_faces > 0 {
         anyhow::bail!(
             "the flow on the double did not converge either (max |K − K̄| = {:.3e} after {} \
-             iterations, {} degenerate faces)",
+             iterations, {} degenerate faces){}",
             flow.max_error,
             flow.iterations,
-            flow.degenerate_faces
+            flow.degenerate_faces,
+            flow.stop_reason
+                .as_deref()
+                .map(|r| format!(": {r}"))
+                .unwrap_or_default()
         );
     }
     Ok((flow, metric))
