@@ -48,6 +48,34 @@ fn torus_spectrum_from_layout_matches_the_lattice() {
     }
 }
 
+/// Long thin tori: the enumeration's work follows the vectors it finds, not the square of
+/// side l/|a| (τ = 10⁶ i took ~10¹³ steps — a hang — before). Closed form: when |b| is far
+/// above count·|a|, the first `count` lengths are |a|, 2|a|, …; a moderately thin skewed torus
+/// against the brute-force enumeration.
+#[test]
+fn thin_tori_spectrum_is_quick_and_exact() {
+    let t0 = std::time::Instant::now();
+    for (w1, w2) in [
+        (C::new(1.0, 0.0), C::new(0.0, 1e6)),
+        (C::new(0.0, 2.0), C::new(-3e5, 0.7)),
+        (C::new(1.0, 0.0), C::new(0.5, 1e4)),
+    ] {
+        let got = lattice_spectrum(w1, w2, 20).unwrap();
+        let a = w1.norm().min(w2.norm());
+        for (k, x) in got.iter().enumerate() {
+            let want = a * (k + 1) as f64;
+            assert!((x - want).abs() < 1e-9 * want, "{w1} {w2}: {got:?}");
+        }
+    }
+    let (w1, w2) = (C::new(1.0, 0.0), C::new(0.37, 6.5));
+    let got = lattice_spectrum(w1, w2, 30).unwrap();
+    let want = brute_lattice(w1, w2, 30);
+    for (a, b) in got.iter().zip(&want) {
+        assert!((a - b).abs() < 1e-12, "{got:?} vs {want:?}");
+    }
+    assert!(t0.elapsed().as_secs_f64() < 5.0, "{:?}", t0.elapsed());
+}
+
 #[test]
 fn bolza_surface_has_twelve_systoles() {
     // The Bolza surface (regular octagon, angles π/4, opposite sides glued) has exactly 12

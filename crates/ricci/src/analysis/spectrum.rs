@@ -91,36 +91,44 @@ pub fn lattice_spectrum(w1: Complex, w2: Complex, count: usize) -> Result<Vec<f6
     if b.norm_sqr() < a.norm_sqr() {
         std::mem::swap(&mut a, &mut b);
     }
-    // Smallest eigenvalue of the Gram matrix [[|a|², a·b], [a·b, |b|²]].
-    let (g11, g22, g12) = (a.norm_sqr(), b.norm_sqr(), (a * b.conj()).re);
-    let tr = g11 + g22;
-    let det = g11 * g22 - g12 * g12;
-    let lmin = det / (0.5 * tr + (0.25 * tr * tr - det).max(0.0).sqrt());
-    if lmin.is_nan() || lmin <= 0.0 {
+    // Enumerate m·a + n·b (n ≥ 0, m > 0 when n = 0) with norm ≤ l, row by row: row n lies at
+    // distance n·h from the line through a (h = |a ∧ b| / |a|), and |m·a + n·b| ≤ l exactly
+    // for m in an interval around −n (a·b)/|a|² of half-width √(l² − n²h²)/|a|. So the work
+    // is the number of vectors found plus the rows, however long and thin the torus (the old
+    // square of side l/√λ_min did ~10¹³ steps for τ = 10⁶ i).
+    let (g11, g12) = (a.norm_sqr(), (a * b.conj()).re);
+    let h = (a.re * b.im - a.im * b.re).abs() / a.norm();
+    if !(h > 0.0 && h.is_finite() && g11.is_finite()) {
         return Err(Error::numerical("degenerate translation lattice"));
     }
     let mut l = b.norm() * 2.0;
-    loop {
-        let k = (l / lmin.sqrt()).floor() as i64 + 1;
+    // Each round multiplies l by 1.5, so the count within l by 2.25: a budget of rounds far
+    // beyond any `count` (the CLI allows 10 000).
+    for _ in 0..200 {
         let mut out = Vec::new();
-        for n in 0..=k {
-            for m in -k..=k {
-                if n == 0 && m <= 0 {
-                    continue; // identify ±v, skip 0
-                }
+        let rows = (l / h).floor() as i64;
+        for n in 0..=rows {
+            let w = (l * l - (n as f64 * h).powi(2)).max(0.0).sqrt();
+            let c = -(n as f64) * g12 / g11;
+            let r = w / g11.sqrt();
+            let lo = if n == 0 { 1 } else { (c - r).floor() as i64 };
+            for m in lo..=(c + r).ceil() as i64 {
                 let v = (a * m as f64 + b * n as f64).norm();
                 if v <= l {
                     out.push(v);
                 }
             }
         }
-        if out.len() >= count || k > 100_000 {
+        if out.len() >= count {
             out.sort_by(f64::total_cmp);
             out.truncate(count);
             return Ok(out);
         }
         l *= 1.5;
     }
+    Err(Error::numerical(format!(
+        "the lattice enumeration found fewer than {count} vectors within 200 rounds"
+    )))
 }
 
 /// One free homotopy class of closed geodesics on a hyperbolic surface.
