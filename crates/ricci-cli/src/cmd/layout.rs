@@ -44,6 +44,7 @@ pub(crate) mod double;
 pub mod file_metric;
 mod json;
 mod text;
+mod tolerance;
 use json::deck_json;
 pub use json::JsonIso;
 use text::print_text;
@@ -761,18 +762,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .first()
         .is_some_and(|c| c.genus == 0 && c.boundary_loops == 1);
     let mut bar = spinner(a.json);
-    // The conformal flow's hyperbolic uniformization is polished to double-double after the
-    // cut: it needs the flow only within the polish's reach (`polished_layout_tolerance`).
-    let polished_flow = !a.no_polish
-        && a.metric.is_none()
-        && a.target.is_none()
-        && matches!(a.scheme, None | Some(Scheme::Conformal));
-    let flow_tolerance = match geometry.map_or_else(|| uniformization_geometry(&surface.mesh), Ok) {
-        Ok(g) if polished_flow && g == Geometry::Hyperbolic => {
-            Some(ricci::flow::uniformize::polished_layout_tolerance(g))
-        }
-        _ => None,
-    };
     let polished = polished_metric(
         &surface,
         geometry,
@@ -784,7 +773,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             (false, true) => Polish::Now,
             (false, false) => Polish::AfterCut,
         },
-        flow_tolerance,
+        tolerance::flow_tolerance(&a, &surface.mesh, geometry),
         &mut bar,
     );
     let PolishedLengths {
