@@ -44,6 +44,7 @@ pub(crate) mod double;
 pub mod file_metric;
 mod json;
 mod text;
+mod tolerance;
 use json::deck_json;
 pub use json::JsonIso;
 use text::print_text;
@@ -166,7 +167,7 @@ pub enum Polish {
 /// (`ricci::layout::pipeline::polish_uniformization` for the flow's metric,
 /// `polish_lengths` — vertex scaling in place — for a metric file). A polish that cannot be
 /// applied (a target other than 0, a metric with cone points) is reported, not an error.
-/// `flow_tolerance` replaces `layout_tolerance` for the flow (reported as `flow_tolerance`).
+/// `limits.tolerance` replaces `layout_tolerance` for the flow (reported as `flow_tolerance`).
 #[allow(clippy::too_many_arguments)]
 pub fn polished_metric(
     surface: &Surface,
@@ -787,7 +788,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             (false, false) => Polish::AfterCut,
         },
         FlowLimits {
-            tolerance: None,
+            tolerance: tolerance::flow_tolerance(&a, &surface.mesh, geometry),
             max_iterations: a.max_iterations,
         },
         &mut bar,

@@ -62,6 +62,21 @@ pub fn layout_tolerance(geometry: Geometry) -> f64 {
     }
 }
 
+/// The flow tolerance of the layout pipeline when the flow's hyperbolic metric is polished
+/// to double-double afterwards (`ricci layout` without `--no-polish`, `ricci spectrum`): 1e-10
+/// in H² (issue 15's convergence bound), else [`layout_tolerance`]. The polish
+/// ([`super::polish`]) multiplies the residual by ~1e-16·cond(H) per step, so from 1e-10 it
+/// reaches its 1e-26 in the same two steps as from 1e-12 — and a large mesh's flow cannot
+/// resolve 1e-12 reliably: seahorse2_100K's conformal flow reaches 1.1e-11 at iteration 9,
+/// then takes 18 steps of ~1e-13 at the rounding floor of `K = 2π − Σθ` (errors 1e-12 to
+/// 9e-11) before one lands below 1e-12 by chance (two thirds of its Newton steps).
+pub fn polished_layout_tolerance(geometry: Geometry) -> f64 {
+    match geometry {
+        Geometry::Hyperbolic => 1e-10,
+        g => layout_tolerance(g),
+    }
+}
+
 /// Where the target curvature comes from.
 #[derive(Debug, Clone, PartialEq)]
 pub enum TargetPolicy {
