@@ -74,6 +74,31 @@ const TOP: usize = 1;
 const LEFT: usize = 2;
 const BOTTOM: usize = 3;
 
+/// A direction of the mesh lines: `U` along the strips (cell widths), `V` across them (cell
+/// heights).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Axis {
+    U,
+    V,
+}
+
+impl Axis {
+    fn other(self) -> Axis {
+        match self {
+            Axis::U => Axis::V,
+            Axis::V => Axis::U,
+        }
+    }
+
+    /// The sides of a cell before and after it along this direction.
+    fn sides(self) -> (usize, usize) {
+        match self {
+            Axis::U => (LEFT, RIGHT),
+            Axis::V => (BOTTOM, TOP),
+        }
+    }
+}
+
 /// Weights on `(P₋₁, P₀, P₁)` of the point at vertex 0 of a cubic B-spline whose anchors sit
 /// at the vertices, with intervals `d` = `(d₋₂, d₋₁, d₀, d₁)` around it (blossom `f(0,0,0)`).
 pub fn corner_weights(d: [f64; 4]) -> [f64; 3] {
@@ -283,12 +308,20 @@ impl DomainMesh {
         (r.length / r.m as f64, r.height / r.n as f64)
     }
 
+    /// The size of cell `c` along `axis` (its knot interval in that direction).
+    fn len(&self, c: u32, axis: Axis) -> f64 {
+        match axis {
+            Axis::U => self.size(c).0,
+            Axis::V => self.size(c).1,
+        }
+    }
+
     fn w(&self, c: u32) -> f64 {
-        self.size(c).0
+        self.len(c, Axis::U)
     }
 
     fn h(&self, c: u32) -> f64 {
-        self.size(c).1
+        self.len(c, Axis::V)
     }
 
     /// The Bézier point at the lower-left corner of cell `c`.
@@ -317,26 +350,10 @@ impl DomainMesh {
         let left = self.corners[l as usize][0];
         let up = self.corners[c as usize][3];
         let down = self.corners[b as usize][0];
-        let wl2 = if self.is_zero(left) {
-            self.w(l)
-        } else {
-            self.w(self.nb(l, LEFT))
-        };
-        let wr2 = if self.is_zero(right) {
-            self.w(c)
-        } else {
-            self.w(self.nb(c, RIGHT))
-        };
-        let hb2 = if self.is_zero(down) {
-            self.h(b)
-        } else {
-            self.h(self.nb(b, BOTTOM))
-        };
-        let ht2 = if self.is_zero(up) {
-            self.h(c)
-        } else {
-            self.h(self.nb(c, TOP))
-        };
+        let wl2 = self.beyond(l, left, LEFT, Axis::U);
+        let wr2 = self.beyond(c, right, RIGHT, Axis::U);
+        let hb2 = self.beyond(b, down, BOTTOM, Axis::V);
+        let ht2 = self.beyond(c, up, TOP, Axis::V);
         let uw = corner_weights([wl2, self.w(l), self.w(c), wr2]);
         let vw = corner_weights([hb2, self.h(b), self.h(c), ht2]);
         let k = |x: u32| self.corners[x as usize];
@@ -354,86 +371,56 @@ impl DomainMesh {
         out
     }
 
-    /// The two points on the bottom side of cell `c` (`b₁₀`, `b₂₀`).
-    fn bottom_points(&self, c: u32) -> [Combination; 2] {
-        let b = self.nb(c, BOTTOM);
-        let [a0, a1, u1, u0] = self.corners[c as usize];
-        let (d0, d1) = (self.corners[b as usize][0], self.corners[b as usize][1]);
-        let dprev = if self.is_zero(a0) {
-            self.w(c)
+    /// The interval two steps from the cell before a vertex: the size along `axis` of the
+    /// neighbour of `c` across `side`, or `c`'s own when the vertex `v` between them is a zero
+    /// (no mesh line runs through a zero).
+    fn beyond(&self, c: u32, v: u32, side: usize, axis: Axis) -> f64 {
+        if self.is_zero(v) {
+            self.len(c, axis)
         } else {
-            self.w(self.nb(c, LEFT))
+            self.len(self.nb(c, side), axis)
+        }
+    }
+
+    /// The two Bézier points inside the side of cell `c` that runs along `along` from its
+    /// lower-left corner (the bottom side for `U`: `b₁₀`, `b₂₀`; the left side for `V`: `b₀₁`,
+    /// `b₀₂`): the blossom along the side (its interval and its two neighbours) of the
+    /// corner points of the mesh lines across it, each from the cell `c`, the cell before it
+    /// across the side, and the intervals beyond them.
+    fn side_points(&self, c: u32, along: Axis) -> [Combination; 2] {
+        let across = along.other();
+        let (prev, next) = along.sides();
+        let (before, after) = across.sides();
+        let b = self.nb(c, before);
+        // corner indices: the side's far end, and the start of the opposite side
+        let (end, far) = match along {
+            Axis::U => (1, 3),
+            Axis::V => (3, 1),
         };
-        let dnext = if self.is_zero(a1) {
-            self.w(c)
-        } else {
-            self.w(self.nb(c, RIGHT))
+        let q = self.corners[c as usize];
+        let (a0, a1, f0, f1) = (q[0], q[end], q[far], q[2]);
+        let (d0, d1) = (self.corners[b as usize][0], self.corners[b as usize][end]);
+        let aw = inner_weights([
+            self.beyond(c, a0, prev, along),
+            self.len(c, along),
+            self.beyond(c, a1, next, along),
+        ]);
+        let line = |lo: u32, hi: u32| {
+            corner_weights([
+                self.beyond(b, lo, before, across),
+                self.len(b, across),
+                self.len(c, across),
+                self.beyond(c, hi, after, across),
+            ])
         };
-        let uw = inner_weights([dprev, self.w(c), dnext]);
-        let column = |below: u32, up: u32| {
-            let hb2 = if self.is_zero(below) {
-                self.h(b)
-            } else {
-                self.h(self.nb(b, BOTTOM))
-            };
-            let ht2 = if self.is_zero(up) {
-                self.h(c)
-            } else {
-                self.h(self.nb(c, TOP))
-            };
-            corner_weights([hb2, self.h(b), self.h(c), ht2])
-        };
-        let cols = [(d0, a0, u0), (d1, a1, u1)];
-        let vws = [column(d0, u0), column(d1, u1)];
+        let lines = [(d0, a0, f0), (d1, a1, f1)];
+        let ws = [line(d0, f0), line(d1, f1)];
         std::array::from_fn(|p| {
             let mut out = Combination::new();
             for k in 0..2 {
-                let (x, y, z) = cols[k];
-                for (v, w) in [(x, vws[k][0]), (y, vws[k][1]), (z, vws[k][2])] {
-                    add(&mut out, v, uw[p][k] * w);
-                }
-            }
-            out
-        })
-    }
-
-    /// The two points on the left side of cell `c` (`b₀₁`, `b₀₂`).
-    fn left_points(&self, c: u32) -> [Combination; 2] {
-        let l = self.nb(c, LEFT);
-        let [a0, r0, r1, a1] = self.corners[c as usize];
-        let (l0, l1) = (self.corners[l as usize][0], self.corners[l as usize][3]);
-        let dprev = if self.is_zero(a0) {
-            self.h(c)
-        } else {
-            self.h(self.nb(c, BOTTOM))
-        };
-        let dnext = if self.is_zero(a1) {
-            self.h(c)
-        } else {
-            self.h(self.nb(c, TOP))
-        };
-        let vw = inner_weights([dprev, self.h(c), dnext]);
-        let row = |left: u32, right: u32| {
-            let wl2 = if self.is_zero(left) {
-                self.w(l)
-            } else {
-                self.w(self.nb(l, LEFT))
-            };
-            let wr2 = if self.is_zero(right) {
-                self.w(c)
-            } else {
-                self.w(self.nb(c, RIGHT))
-            };
-            corner_weights([wl2, self.w(l), self.w(c), wr2])
-        };
-        let rows = [(l0, a0, r0), (l1, a1, r1)];
-        let uws = [row(l0, r0), row(l1, r1)];
-        std::array::from_fn(|q| {
-            let mut out = Combination::new();
-            for k in 0..2 {
-                let (x, y, z) = rows[k];
-                for (v, w) in [(x, uws[k][0]), (y, uws[k][1]), (z, uws[k][2])] {
-                    add(&mut out, v, vw[q][k] * w);
+                let (x, y, z) = lines[k];
+                for (v, w) in [(x, ws[k][0]), (y, ws[k][1]), (z, ws[k][2])] {
+                    add(&mut out, v, aw[p][k] * w);
                 }
             }
             out
@@ -450,16 +437,16 @@ impl DomainMesh {
         out[3][0] = self.vertex_point(r);
         out[0][3] = self.vertex_point(t);
         out[3][3] = self.vertex_point(tr);
-        let [b1, b2] = self.bottom_points(cu);
+        let [b1, b2] = self.side_points(cu, Axis::U);
         out[1][0] = b1;
         out[2][0] = b2;
-        let [t1, t2] = self.bottom_points(t);
+        let [t1, t2] = self.side_points(t, Axis::U);
         out[1][3] = t1;
         out[2][3] = t2;
-        let [l1, l2] = self.left_points(cu);
+        let [l1, l2] = self.side_points(cu, Axis::V);
         out[0][1] = l1;
         out[0][2] = l2;
-        let [r1, r2] = self.left_points(r);
+        let [r1, r2] = self.side_points(r, Axis::V);
         out[3][1] = r1;
         out[3][2] = r2;
         let uw = inner_weights([self.w(self.nb(cu, LEFT)), self.w(cu), self.w(r)]);
@@ -509,6 +496,46 @@ impl DomainMesh {
             v1: v1 + dv,
             control: p,
         }
+    }
+
+    /// Per strip, the translation of its `u` coordinate in the exported parameter plane: the
+    /// strips side by side along `u`, a quarter of the longest strip apart, so that every
+    /// Bézier patch has a parameter rectangle of its own (as the per-cylinder fit's offsets).
+    pub fn export_offsets(&self) -> Vec<f64> {
+        let gap = 0.25 * self.rects.iter().map(|r| r.length).fold(0.0, f64::max);
+        let mut at = 0.0;
+        self.rects
+            .iter()
+            .map(|r| {
+                let off = at;
+                at += r.length + gap;
+                off
+            })
+            .collect()
+    }
+
+    /// Every cell's Bézier patch (cell order) over its box in the exported parameters
+    /// ([`Self::export_offsets`]): one bicubic patch per cell, for STEP, IGES and OBJ.
+    pub fn patches(&self, control: &[[f64; 3]]) -> Vec<BezierPatch> {
+        let offsets = self.export_offsets();
+        (0..self.n_cells() as u32)
+            .map(|c| {
+                let r = self.cell_at[c as usize].0 as usize;
+                self.patch(c, control, offsets[r], 0.0)
+            })
+            .collect()
+    }
+
+    /// The spline's point at `(s, t) ∈ [0, 1]²` of cell `c` from the blending functions (not
+    /// the patches).
+    pub fn point(&self, c: u32, s: f64, t: f64, control: &[[f64; 3]]) -> [f64; 3] {
+        let mut x = [0.0; 3];
+        for (v, w) in self.blending(c, s, t) {
+            for d in 0..3 {
+                x[d] += w * control[v as usize][d];
+            }
+        }
+        x
     }
 
     /// The blending functions non-zero at `(s, t) ∈ [0, 1]²` of cell `c`: vertex and value
