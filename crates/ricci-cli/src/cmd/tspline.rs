@@ -90,6 +90,12 @@ pub struct Args {
     /// Factor applied to the thin-plate weight after every refinement (1 = constant).
     #[arg(long, default_value_t = 1.0)]
     pub smoothing_decay: f64,
+    /// Genus ≥ 2: fit one tensor-product spline per cylinder of the holomorphic 1-form (C⁰
+    /// across the critical trajectories and the knot lines through the zeros) instead of the
+    /// default, one spline on the domain manifold's quad mesh (C² at least two knot intervals
+    /// from the zeros, C⁰ at them).
+    #[arg(long)]
+    pub per_cylinder: bool,
     /// Budget: refinement iterations.
     #[arg(long, default_value_t = 30)]
     pub max_iterations: usize,

@@ -226,7 +226,10 @@ pub fn fit_domain_mesh(
     let mut filled = false;
     for _ in 0..opts.max_iterations.max(1) {
         let mut mesh = DomainMesh::new(domain, gluing, spacing).map_err(Error::numerical)?;
-        if let Some(prev) = last.as_ref().filter(|_| mesh.n_vertices() > opts.max_control_points) {
+        if let Some(prev) = last
+            .as_ref()
+            .filter(|_| mesh.n_vertices() > opts.max_control_points)
+        {
             // the next refinement is over the budget: one last fit on the largest mesh within it
             match fill_budget(
                 domain,
