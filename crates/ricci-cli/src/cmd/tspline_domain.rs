@@ -13,7 +13,7 @@
 
 use crate::cmd::layout::Bar;
 use crate::cmd::tspline::Args;
-use crate::cmd::tspline_genus::{jumps_json, warn_not_converged, write_files};
+use crate::cmd::tspline_genus::{jumps_json, shared_keys, warn_not_converged, write_files};
 use crate::util::print_json;
 use ricci::analysis::forms::HolomorphicForms;
 use ricci::mesh::Surface;
@@ -110,34 +110,28 @@ pub fn run_domain(
                    "cells_u": r.m, "cells_v": r.n, "u_offset": off})
         })
         .collect();
-    let dec = &domain.decomposition;
     let mut out = json!({
-        "file": a.mesh.display().to_string(),
         "domain": format!("cylinders of a holomorphic 1-form with integer imaginary periods (genus {}), their strips glued by translations into one quad mesh of knot intervals", h.genus),
         "spline": "domain_mesh",
-        "form": {"imaginary_part": "sum of n_k times the harmonic form dual to loop k", "n": domain.combination, "saddle_levels": domain.levels},
-        "zeros": dec.zeros,
-        "critical_levels": dec.levels,
         "strips": strips,
         "cells": mesh.n_cells(),
         "control_points": mesh.n_vertices(),
-        "t_junctions": 0,
         "bezier_patches": patches.len(),
-        "rms_error_percent": rms,
-        "max_error_percent": max,
-        "tolerance_percent": 100.0 * tolerance,
-        "converged": fit.converged,
-        "iterations": fit.steps.len(),
-        "steps": fit.steps,
         "continuity": continuity,
-        "data_points": surface.positions.len(),
-        "unassigned_points": domain.unassigned.len(),
-        "holonomy_defect": domain.holonomy_defect,
         "gluing_mismatch": gluing.mismatch,
-        "scale": fit.scale,
-        "seconds_fit": fit_seconds,
-        "seconds": t0.elapsed().as_secs_f64(),
     });
+    shared_keys(
+        &mut out,
+        a,
+        surface,
+        domain,
+        &fit.steps,
+        fit.converged,
+        tolerance,
+        fit.scale,
+        fit_seconds,
+        t0,
+    );
     if !fit.converged {
         warn_not_converged(a, max, tolerance, opts.max_iterations);
     }

@@ -19,10 +19,9 @@ use crate::util::{print_json, write_atomic};
 use ricci::analysis::forms::{holomorphic_forms, FormsOptions};
 use ricci::mesh::Surface;
 use ricci::metric::IntrinsicMetric;
-use ricci::spline::tspline::cylinder_fit::{fit_cylinders, GenusFit, GenusFitOptions};
+use ricci::spline::tspline::cylinder_fit::{fit_cylinders, GenusFit, GenusFitOptions, GenusStep};
 use ricci::spline::tspline::cylinder_jumps::{AtZero, GluedSeams, Seam};
-use ricci::spline::tspline::export::{iges, obj, step};
-use ricci::spline::tspline::genus_domain::best_genus_domain;
+use ricci::spline::tspline::genus_domain::{best_genus_domain, GenusDomain};
 use ricci::spline::tspline::glue::gluing;
 use ricci::spline::tspline::{BezierPatch, Continuity};
 use serde_json::json;
@@ -148,18 +147,7 @@ pub(crate) fn write_files(
     let Some(dir) = &a.out else {
         return Ok(());
     };
-    write_atomic(
-        &dir.join("tspline.step"),
-        step(patches, "tspline").as_bytes(),
-    )?;
-    write_atomic(
-        &dir.join("tspline.igs"),
-        iges(patches, "tspline").as_bytes(),
-    )?;
-    write_atomic(
-        &dir.join("surface.obj"),
-        obj(patches, a.tessellation).as_bytes(),
-    )?;
+    crate::cmd::tspline::write_patch_files(dir, a, patches)?;
     write_atomic(
         &dir.join("samples.json"),
         serde_json::to_string(&samples())?.as_bytes(),
@@ -171,6 +159,51 @@ pub(crate) fn write_files(
         serde_json::to_string_pretty(out)?.as_bytes(),
     )?;
     Ok(())
+}
+
+/// The report keys both genus ≥ 2 fits share: the input, the form and its zeros, the errors of
+/// the last step, the budget's outcome, the data and the times.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn shared_keys(
+    out: &mut serde_json::Value,
+    a: &Args,
+    surface: &Surface,
+    domain: &GenusDomain,
+    steps: &[GenusStep],
+    converged: bool,
+    tolerance: f64,
+    scale: f64,
+    fit_seconds: f64,
+    t0: Instant,
+) {
+    let (rms, max) = steps.last().map_or((f64::NAN, f64::NAN), |s| {
+        (s.rms_error_percent, s.max_error_percent)
+    });
+    let dec = &domain.decomposition;
+    for (k, v) in [
+        ("file", json!(a.mesh.display().to_string())),
+        (
+            "form",
+            json!({"imaginary_part": "sum of n_k times the harmonic form dual to loop k", "n": domain.combination, "saddle_levels": domain.levels}),
+        ),
+        ("zeros", json!(dec.zeros)),
+        ("critical_levels", json!(dec.levels)),
+        ("t_junctions", json!(0)),
+        ("rms_error_percent", json!(rms)),
+        ("max_error_percent", json!(max)),
+        ("tolerance_percent", json!(100.0 * tolerance)),
+        ("converged", json!(converged)),
+        ("iterations", json!(steps.len())),
+        ("steps", json!(steps)),
+        ("data_points", json!(surface.positions.len())),
+        ("unassigned_points", json!(domain.unassigned.len())),
+        ("holonomy_defect", json!(domain.holonomy_defect)),
+        ("scale", json!(scale)),
+        ("seconds_fit", json!(fit_seconds)),
+        ("seconds", json!(t0.elapsed().as_secs_f64())),
+    ] {
+        out[k] = v;
+    }
 }
 
 pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> anyhow::Result<()> {
@@ -230,7 +263,6 @@ pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> an
     let (rms, max) = last.as_ref().map_or((f64::NAN, f64::NAN), |s| {
         (s.rms_error_percent, s.max_error_percent)
     });
-    let dec = &domain.decomposition;
     let cylinders: Vec<_> = domain
         .cylinders
         .iter()
@@ -244,31 +276,26 @@ pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> an
         })
         .collect();
     let mut out = json!({
-        "file": a.mesh.display().to_string(),
         "domain": format!("cylinders of a holomorphic 1-form with integer imaginary periods (genus {})", h.genus),
         "spline": "per_cylinder",
         "domain_mesh_refused": refused,
-        "form": {"imaginary_part": "sum of n_k times the harmonic form dual to loop k", "n": domain.combination, "saddle_levels": domain.levels},
-        "zeros": dec.zeros,
-        "critical_levels": dec.levels,
         "cylinders": cylinders,
         "control_points": fit.control_points(),
-        "t_junctions": 0,
         "bezier_patches": patches.len(),
-        "rms_error_percent": rms,
-        "max_error_percent": max,
-        "tolerance_percent": 100.0 * tolerance,
-        "converged": fit.converged,
-        "iterations": fit.steps.len(),
-        "steps": fit.steps,
         "continuity": continuity,
-        "data_points": surface.positions.len(),
-        "unassigned_points": domain.unassigned.len(),
-        "holonomy_defect": domain.holonomy_defect,
-        "scale": fit.scale,
-        "seconds_fit": fit_seconds,
-        "seconds": t0.elapsed().as_secs_f64(),
     });
+    shared_keys(
+        &mut out,
+        a,
+        surface,
+        &domain,
+        &fit.steps,
+        fit.converged,
+        tolerance,
+        fit.scale,
+        fit_seconds,
+        t0,
+    );
     if !fit.converged {
         warn_not_converged(a, max, tolerance, opts.max_iterations);
     }
