@@ -173,7 +173,7 @@ fn e3(x: [f64; 3]) -> String {
 }
 
 #[test]
-fn domain_mesh_spline_is_chart_independent_and_c2_two_knot_intervals_from_the_zeros() {
+fn domain_mesh_spline_is_chart_independent_and_c2_one_knot_interval_from_the_zeros() {
     let mut rng = Rng(0x2545f4914f6cdd1d);
     for (name, _, m) in meshes() {
         let control: Vec<[f64; 3]> = (0..m.n_vertices())
@@ -243,7 +243,11 @@ fn domain_mesh_spline_is_chart_independent_and_c2_two_knot_intervals_from_the_ze
             "{name}: {:?}",
             lib.at_zeros
         );
-        assert!(lib.one_interval_from_zeros.relative()[1] > 1e-6, "{name}");
+        assert!(
+            lib.one_interval_from_zeros.class(1e-8) >= Some(2),
+            "{name}: {:?}",
+            lib.one_interval_from_zeros
+        );
         assert!(
             lib.elsewhere.class(1e-8) >= Some(2),
             "{name}: {:?}",
@@ -257,12 +261,11 @@ fn domain_mesh_spline_is_chart_independent_and_c2_two_knot_intervals_from_the_ze
         for w in &worst {
             assert!(w[0] <= 1e-10, "{name}: {}", e3(*w));
         }
-        // C² two intervals from the zeros
-        assert!(
-            worst[2][1] <= 1e-9 && worst[2][2] <= 1e-9,
-            "{name}: {}",
-            e3(worst[2])
-        );
+        // C² on every side not incident to a zero: one interval from a zero (the cells there
+        // all have the edge size) and farther
+        for w in &worst[1..] {
+            assert!(w[1] <= 1e-9 && w[2] <= 1e-9, "{name}: {}", e3(*w));
+        }
         // at the zeros the measure sees the kink (the test can fail)
         assert!(worst[0][1] > 1e-6, "{name}: {}", e3(worst[0]));
     }

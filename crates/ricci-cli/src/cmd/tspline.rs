@@ -92,8 +92,8 @@ pub struct Args {
     pub smoothing_decay: f64,
     /// Genus ≥ 2: fit one tensor-product spline per cylinder of the holomorphic 1-form (C⁰
     /// across the critical trajectories and the knot lines through the zeros) instead of the
-    /// default, one spline on the domain manifold's quad mesh (C² at least two knot intervals
-    /// from the zeros, C⁰ at them).
+    /// default, one spline on the domain manifold's quad mesh (C² on every cell side not at a
+    /// zero, C⁰ at the zeros).
     #[arg(long)]
     pub per_cylinder: bool,
     /// Budget: refinement iterations.

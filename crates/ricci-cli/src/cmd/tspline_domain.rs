@@ -3,9 +3,8 @@
 //! holomorphic 1-form glued by translations; `ricci::spline::tspline::{domain_mesh,
 //! domain_fit, domain_continuity}`, paper 003 §2–3), fitted by least squares with uniform
 //! refinement. Continuity, measured across every cell side (JSON `continuity`): C⁰ at the
-//! zeros (the extraordinary points), C² on every side whose ends are at least two knot
-//! intervals from every zero, and what the sides one interval from a zero show (order-1
-//! jumps of about a tenth of the derivatives when the cells around a zero differ in size).
+//! zeros (the extraordinary points), C² on every other side — reported apart for the sides
+//! one knot interval from a zero and the sides farther.
 //!
 //! Writes `tspline.step`, `tspline.igs` (one Bézier patch per cell, the strips side by side in
 //! the parameter plane), `surface.obj` (per-patch tessellation), `samples.json` (our
@@ -47,7 +46,7 @@ fn continuity_json(s: &SideContinuity, zeros: usize, scale: f64) -> serde_json::
         ),
         "measured": format!("jumps of every partial derivative of orders 0-3 between the two Bézier patches of every cell side at {SIDE_SAMPLES} points per side, relative to the largest partial of that order; C^k = relative jumps of orders <= k below {CONTINUOUS:e}"),
         "at_zeros": group(&s.at_zeros, s.sides[0], "sides with a zero at an end: C0 by construction (the Catmull-Clark limit point at the zero), not G1"),
-        "one_interval_from_zeros": group(&s.one_interval_from_zeros, s.sides[1], "sides with an end one knot interval from a zero: the blossoms there use the intervals that replace those beyond the zero"),
+        "one_interval_from_zeros": group(&s.one_interval_from_zeros, s.sides[1], "sides with an end one knot interval from a zero: C2 by construction (every cell within two intervals of a zero has the same size)"),
         "elsewhere": group(&s.elsewhere, s.sides[2], "all other sides, on the critical trajectories and the former knot lines included: C2 by construction"),
         "chart_independence_percent": 100.0 * gap / scale,
         "extraordinary_points": zeros,

@@ -1,8 +1,8 @@
 //! `ricci tspline` on closed surfaces of genus ≥ 2: the domain manifold is the cylinder
 //! decomposition of a holomorphic 1-form with integer imaginary periods
 //! (`ricci::spline::tspline::{cylinders, genus_domain}`). By default its strips, glued by
-//! translations, carry one spline on one quad mesh (`tspline_domain`, C² at least two knot
-//! intervals from the zeros); when they cannot be glued, or with `--per-cylinder`, each
+//! translations, carry one spline on one quad mesh (`tspline_domain`, C² on every cell side
+//! not at a zero); when they cannot be glued, or with `--per-cylinder`, each
 //! cylinder carries its own tensor-product cubic spline (`cylinder_fit`: C² inside a cylinder except C⁰ along the knot
 //! lines through the zero copies, pulled towards C¹ by a tangent penalty; the glued boundary
 //! rows are shared, so C⁰ across the critical trajectories — the JSON `continuity` reports the

@@ -5,9 +5,8 @@
 //! The sides fall into three classes by the distance of their ends to the zeros (paper 003
 //! §2's extraordinary points, the mesh's only irregular vertices): sides with a zero at an end
 //! (C⁰ by construction: the Catmull–Clark point there), sides with an end one knot interval
-//! from a zero (a corner of a cell that has a zero as a corner: the per-entity blossoms there
-//! use the replaced intervals, so the two patches need not be pieces of one B-spline), and all
-//! the other sides (C² by construction). Both patches of a side are evaluated at the same
+//! from a zero (a corner of a cell that has a zero as a corner: C² since the cells near the
+//! zeros have one size, see [`super::domain_mesh`]), and all the other sides (C²). Both patches of a side are evaluated at the same
 //! surface points in their own cells' coordinates: the neighbour across a side is a
 //! translation away (the gluing), so its partial derivatives are those of the same chart.
 

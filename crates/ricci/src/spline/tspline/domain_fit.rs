@@ -79,15 +79,10 @@ pub fn locate(
         .iter()
         .position(|r| r.cylinder == c && r.strip == s)?;
     let rc = &mesh.rects[r];
-    let (w, h) = (rc.length / rc.m as f64, rc.height / rc.n as f64);
-    let x = ((up - lay.lines[s]) / w).clamp(0.0, rc.m as f64);
-    let y = (v / h).clamp(0.0, rc.n as f64);
-    let (i, j) = (
-        (x.floor() as usize).min(rc.m - 1),
-        (y.floor() as usize).min(rc.n - 1),
-    );
+    let (i, x) = rc.column(up - lay.lines[s]);
+    let (j, y) = rc.row(v);
     let cell = (rc.first_cell + j * rc.m + i) as u32;
-    Some((cell, x - i as f64, y - j as f64))
+    Some((cell, x, y))
 }
 
 /// One least-squares solve on `mesh`.

@@ -7,10 +7,13 @@
 //! `s + 1` of the same cylinder, the top to the bottom of one strip of the next band (equal
 //! lengths). Every rectangle corner is a zero of the form. Cutting every strip into `m × n`
 //! cells, with `m` the same along every chain of strips glued top to bottom and `n` the same
-//! in every cylinder, gives a conforming quad mesh of the closed surface (no T-junctions) whose
+//! in every cylinder (at least 5 each), gives a conforming quad mesh of the closed surface (no T-junctions) whose
 //! only vertices of valence ≠ 4 are the zeros (valence `4 (k + 1)` at a zero of order `k`).
 //! A ray from a vertex continues across a gluing by the translation: walking from cell to
-//! cell over a side is always defined; only walking *through* a zero is not.
+//! cell over a side is always defined; only walking *through* a zero is not. The two first and
+//! two last columns of every strip have one width `edge_u` and the two first and two last rows
+//! one height `edge_v` (the smallest uniform cell size of any strip; the middle cells share
+//! the rest): every cell within two knot intervals of a zero has the same size.
 //!
 //! **The spline.** One control point per vertex. Every cell is a bicubic Bézier patch whose 16
 //! points are affine combinations of control points, each computed **once** per mesh entity
@@ -26,11 +29,14 @@
 //!
 //! Hence: partition of unity (every combination is affine), chart independence (every point
 //! shared by two patches is one value), C⁰ everywhere; on every cell side **not incident to a
-//! zero** the two patches are pieces of one tensor-product B-spline row by row (the points
-//! that the replacements change are only the zero's corner point and points of rows/columns
-//! that the C² conditions across such a side do not involve), so the surface is **C²** there;
-//! on the sides incident to a zero it is C⁰ (C¹ defect vanishing to third order at the
-//! side's other end). So C² at every point at least one knot interval from the zeros.
+//! zero** the two patches are pieces of one tensor-product B-spline row by row: the replaced
+//! intervals equal the true ones (all cells near a zero have the edge size), so the only
+//! point no B-spline rule gives is the zero's own corner point, which the C² conditions across
+//! such a side do not involve — the surface is **C²** there (measured: relative jumps of
+//! orders 1 and 2 ≤ 1e-14, test `tspline_domain_mesh.rs`); on the sides incident to a zero it
+//! is C⁰ (C¹ defect vanishing to third order at the side's other end). So C² at every point
+//! of the surface but the sides at the zeros. (With uniform cells per strip the sides one
+//! interval from a zero jumped in the first derivative by ~0.1 of its size: session 12.)
 
 use super::bezier::BezierPatch;
 use super::genus_domain::GenusDomain;
@@ -57,7 +63,10 @@ pub struct DomainMesh {
     pub bezier: Vec<[[Combination; 4]; 4]>,
 }
 
-/// One strip of one cylinder.
+/// One strip of one cylinder, cut into `m × n` cells: the two first and the two last columns
+/// are `edge_u` wide, the two first and two last rows `edge_v` high (the same in every strip:
+/// every cell within two knot intervals of a zero has the same size, so the blossoms there
+/// need no replaced interval), the others share the rest equally.
 #[derive(Debug, Clone, Copy)]
 pub struct Rect {
     pub cylinder: usize,
@@ -66,7 +75,61 @@ pub struct Rect {
     pub height: f64,
     pub m: usize,
     pub n: usize,
+    pub edge_u: f64,
+    pub edge_v: f64,
     pub first_cell: usize,
+}
+
+/// The least number of cells along a strip side: two edge cells at each end and one between.
+pub const MIN_CELLS: usize = 5;
+
+/// Knot `i` (0..=k) of `k` intervals over `[0, len]`, the two at each end `e` long.
+fn knot(len: f64, k: usize, e: f64, i: usize) -> f64 {
+    if i <= 2 {
+        i as f64 * e
+    } else if i + 2 >= k {
+        len - (k - i) as f64 * e
+    } else {
+        2.0 * e + (i - 2) as f64 * (len - 4.0 * e) / (k - 4) as f64
+    }
+}
+
+/// The interval of `x` (clamped to `[0, len]`) and the local coordinate in it.
+fn interval(len: f64, k: usize, e: f64, x: f64) -> (usize, f64) {
+    let x = x.clamp(0.0, len);
+    let (mut lo, mut hi) = (0, k);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if knot(len, k, e, mid) <= x {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let (a, b) = (knot(len, k, e, lo), knot(len, k, e, lo + 1));
+    (lo, ((x - a) / (b - a)).clamp(0.0, 1.0))
+}
+
+impl Rect {
+    /// The start of column `i` (`i = m`: the strip's length).
+    pub fn x(&self, i: usize) -> f64 {
+        knot(self.length, self.m, self.edge_u, i)
+    }
+
+    /// The start of row `j` (`j = n`: the height).
+    pub fn y(&self, j: usize) -> f64 {
+        knot(self.height, self.n, self.edge_v, j)
+    }
+
+    /// The column of `x` along the strip and the local coordinate in it.
+    pub fn column(&self, x: f64) -> (usize, f64) {
+        interval(self.length, self.m, self.edge_u, x)
+    }
+
+    /// The row of `y` and the local coordinate in it.
+    pub fn row(&self, y: f64) -> (usize, f64) {
+        interval(self.height, self.n, self.edge_v, y)
+    }
 }
 
 const RIGHT: usize = 0;
@@ -142,7 +205,8 @@ fn find(p: &mut [u32], mut x: u32) -> u32 {
 }
 
 impl DomainMesh {
-    /// The mesh with cells of size about `spacing` (at least 2 × 2 per strip), or why not.
+    /// The mesh with cells of size about `spacing` (at least [`MIN_CELLS`] along every strip
+    /// side), or why not.
     pub fn new(domain: &GenusDomain, gluing: &Gluing, spacing: f64) -> Result<Self, String> {
         if !(spacing > 0.0) {
             return Err(format!("spacing {spacing} must be positive"));
@@ -152,7 +216,7 @@ impl DomainMesh {
         let mut index = std::collections::HashMap::new();
         for (c, lay) in gluing.layouts.iter().enumerate() {
             let ch = &domain.cylinders[c];
-            let n = ((ch.height / spacing).ceil() as usize).max(2);
+            let n = ((ch.height / spacing).ceil() as usize).max(MIN_CELLS);
             for s in 0..lay.lines.len() {
                 index.insert((c, s), rects.len());
                 rects.push(Rect {
@@ -162,6 +226,8 @@ impl DomainMesh {
                     height: ch.height,
                     m: 0,
                     n,
+                    edge_u: 0.0,
+                    edge_v: 0.0,
                     first_cell: 0,
                 });
             }
@@ -199,14 +265,31 @@ impl DomainMesh {
                 r = top[r];
             }
             let len = chain.iter().map(|&r| rects[r].length).fold(0.0, f64::max);
-            let m = ((len / spacing).ceil() as usize).max(2);
+            let m = ((len / spacing).ceil() as usize).max(MIN_CELLS);
             for &r in &chain {
                 rects[r].m = m;
                 done[r] = true;
             }
         }
+        // the edge cells: the smallest uniform cell size of any strip (so the middle cells of
+        // every strip are at least as large)
+        let edge_u = rects
+            .iter()
+            .map(|r| r.length / r.m as f64)
+            .fold(f64::INFINITY, f64::min);
+        let edge_v = rects
+            .iter()
+            .map(|r| r.height / r.n as f64)
+            .fold(f64::INFINITY, f64::min);
+        if !(edge_u > 0.0 && edge_v > 0.0) {
+            return Err(format!(
+                "a strip has no positive length or height (edge cells {edge_u} × {edge_v})"
+            ));
+        }
         let mut cells = 0;
         for r in rects.iter_mut() {
+            r.edge_u = edge_u;
+            r.edge_v = edge_v;
             r.first_cell = cells;
             cells += r.m * r.n;
         }
@@ -304,8 +387,10 @@ impl DomainMesh {
 
     /// Width and height of a cell.
     pub fn size(&self, c: u32) -> (f64, f64) {
-        let r = &self.rects[self.cell_at[c as usize].0 as usize];
-        (r.length / r.m as f64, r.height / r.n as f64)
+        let (r, i, j) = self.cell_at[c as usize];
+        let r = &self.rects[r as usize];
+        let (i, j) = (i as usize, j as usize);
+        (r.x(i + 1) - r.x(i), r.y(j + 1) - r.y(j))
     }
 
     /// The size of cell `c` along `axis` (its knot interval in that direction).
@@ -469,10 +554,10 @@ impl DomainMesh {
 
     /// The cell's rectangle in its strip's coordinates `[u0, u1] × [v0, v1]`.
     pub fn cell_box(&self, c: u32) -> [f64; 4] {
-        let (_, i, j) = self.cell_at[c as usize];
-        let (w, h) = self.size(c);
-        let (u0, v0) = (i as f64 * w, j as f64 * h);
-        [u0, u0 + w, v0, v0 + h]
+        let (r, i, j) = self.cell_at[c as usize];
+        let r = &self.rects[r as usize];
+        let (i, j) = (i as usize, j as usize);
+        [r.x(i), r.x(i + 1), r.y(j), r.y(j + 1)]
     }
 
     /// The Bézier patch of cell `c` for control points `control` (one per vertex), over its
