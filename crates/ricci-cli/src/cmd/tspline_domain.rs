@@ -12,8 +12,9 @@
 
 use crate::cmd::layout::Bar;
 use crate::cmd::tspline::Args;
-use crate::cmd::tspline_genus::{jumps_json, shared_keys, warn_not_converged, write_files};
-use crate::util::print_json;
+use crate::cmd::tspline_genus::{
+    jumps_json, print_report, shared_keys, warn_not_converged, write_files,
+};
 use ricci::analysis::forms::HolomorphicForms;
 use ricci::mesh::Surface;
 use ricci::spline::tspline::domain_continuity::{side_continuity, SideContinuity};
@@ -135,10 +136,8 @@ pub fn run_domain(
         warn_not_converged(a, max, tolerance, opts.max_iterations);
     }
     write_files(a, &patches, || samples_json(&fit, &patches), &mut out, t0)?;
-    if a.json {
-        print_json(&out);
-    } else {
-        println!(
+    print_report(a, &out, || {
+        format!(
             "{}: domain mesh of {} strips, {} control points, {} Bézier patches, error rms {:.3}% max {:.3}% of the longest side, {} iterations; continuity: {}; {:.2} s",
             a.mesh.display(),
             mesh.rects.len(),
@@ -149,7 +148,7 @@ pub fn run_domain(
             fit.steps.len(),
             out["continuity"]["class"].as_str().unwrap_or(""),
             t0.elapsed().as_secs_f64()
-        );
-    }
+        )
+    });
     Ok(())
 }

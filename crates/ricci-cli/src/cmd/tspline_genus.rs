@@ -206,6 +206,15 @@ pub(crate) fn shared_keys(
     }
 }
 
+/// The report on stdout: the JSON object with `--json`, else the one line `text`.
+pub(crate) fn print_report(a: &Args, out: &serde_json::Value, text: impl FnOnce() -> String) {
+    if a.json {
+        print_json(out);
+    } else {
+        println!("{}", text());
+    }
+}
+
 pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> anyhow::Result<()> {
     let mut bar = spinner(a.json);
     bar.0.set_message("holomorphic 1-forms");
@@ -300,10 +309,8 @@ pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> an
         warn_not_converged(a, max, tolerance, opts.max_iterations);
     }
     write_files(a, &patches, || samples_json(&fit, &patches), &mut out, t0)?;
-    if a.json {
-        print_json(&out);
-    } else {
-        println!(
+    print_report(a, &out, || {
+        format!(
             "{}: {} cylinders, {} control points, {} Bézier patches, error rms {:.3}% max {:.3}% of the longest side, {} iterations, {} inside cylinders (C0 on the knot lines), {} across the critical trajectories (gap {:.2e}%, normals up to {:.2}°), {:.2} s",
             a.mesh.display(),
             fit.splines.len(),
@@ -317,7 +324,7 @@ pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> an
             gap_percent,
             seams.max_angle_degrees(),
             t0.elapsed().as_secs_f64()
-        );
-    }
+        )
+    });
     Ok(())
 }
