@@ -1,6 +1,7 @@
 //! `ricci tspline` fit flags (issue 18): `--correction-gain`, `--rms-marks`, `--area-weights`
 //! reach the library (echoed in the JSON, and they change the fit the way their definitions
-//! say), bad values are refused with exit code 2, on a generated torus (no `RICCI_MESHES`).
+//! say), bad values are refused with exit code 2, on a generated torus (no `RICCI_MESHES`);
+//! and the genus-2 default (the domain-mesh spline) against the input's topology.
 
 use std::path::PathBuf;
 use std::process::{Command, Output};
@@ -166,4 +167,77 @@ fn bad_fit_flags_are_refused_with_exit_code_2() {
         let e = String::from_utf8_lossy(&o.stderr);
         assert!(e.contains(flag), "{flag} {value}: {e}");
     }
+}
+
+/// Genus 2, the default: one spline on the quad mesh of the glued strips. Checked against the
+/// topology of the input (generated genus 2, χ = −2): the quad mesh is closed, so control
+/// points − cells = χ; 2g − 2 = 2 simple zeros, each a vertex of valence 8, so 16 cell sides
+/// with a zero at an end; those sides C⁰ only, all the others C². The per-cylinder
+/// fit stays reachable by `--per-cylinder`.
+#[test]
+fn genus_two_default_is_the_domain_mesh_spline_and_per_cylinder_is_an_option() {
+    let d = tmp("genus2");
+    let mesh = d.join("genus2.off");
+    let o = ricci(&[
+        "generate",
+        "genus",
+        "--genus",
+        "2",
+        "--out",
+        mesh.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let m = mesh.to_str().unwrap();
+    let out = d.join("out");
+    let v = json(&ricci(&[
+        "tspline",
+        m,
+        "--tolerance",
+        "2%",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    assert_eq!(v["spline"], "domain_mesh", "{v}");
+    for key in [
+        "control_points",
+        "rms_error_percent",
+        "max_error_percent",
+        "iterations",
+        "continuity",
+        "seconds",
+    ] {
+        assert!(!v[key].is_null(), "no {key}: {v}");
+    }
+    let n = |k: &str| v[k].as_i64().unwrap();
+    assert_eq!(n("control_points") - n("cells"), -2, "{v}");
+    assert_eq!(n("bezier_patches"), n("cells"));
+    let c = &v["continuity"];
+    assert_eq!(c["extraordinary_points"], 2);
+    assert_eq!(c["at_zeros"]["sides"], 16, "{c}");
+    assert_eq!(c["at_zeros"]["class"], "C0", "{c}");
+    for k in ["one_interval_from_zeros", "elsewhere"] {
+        assert!(c[k]["class"] == "C2" || c[k]["class"] == "C3", "{k}: {c}");
+    }
+    assert_eq!(v["converged"], true, "{v}");
+    assert!(v["max_error_percent"].as_f64().unwrap() <= 2.0, "{v}");
+    for f in [
+        "tspline.step",
+        "tspline.igs",
+        "surface.obj",
+        "samples.json",
+        "tspline.json",
+    ] {
+        assert!(out.join(f).is_file(), "{f} not written");
+    }
+    let p = json(&ricci(&[
+        "tspline",
+        m,
+        "--tolerance",
+        "2%",
+        "--json",
+        "--per-cylinder",
+    ]));
+    assert_eq!(p["spline"], "per_cylinder", "{p}");
+    assert!(p["cylinders"].as_array().is_some_and(|c| !c.is_empty()));
 }

@@ -7,23 +7,11 @@
 //! along a horizontal trajectory), and the count of cylinders for genus 1 (one, no zeros).
 
 mod ricci_meshes;
+mod tspline_cases;
 
-use ricci::analysis::forms::{holomorphic_forms, FormsOptions, HolomorphicForms};
-use ricci::mesh::Surface;
-use ricci::metric::IntrinsicMetric;
-use ricci::progress::NoProgress;
+use ricci::analysis::forms::HolomorphicForms;
 use ricci::spline::tspline::cylinders::{cylinders, integral_form, CylinderDecomposition};
-
-fn forms(s: &Surface) -> HolomorphicForms {
-    holomorphic_forms(
-        &s.mesh,
-        &IntrinsicMetric::euclidean(s.edge_lengths()),
-        Some(&s.positions),
-        &FormsOptions::default(),
-        &mut NoProgress,
-    )
-    .unwrap()
-}
+use tspline_cases::{forms, genus_two_cases};
 
 fn decompose(name: &str, h: &HolomorphicForms, class: usize) -> CylinderDecomposition {
     let (form, defect) = integral_form(h, class).unwrap();
@@ -92,17 +80,7 @@ fn genus_one_is_one_cylinder_without_zeros() {
 
 #[test]
 fn genus_two_splits_into_cylinders_at_the_critical_trajectories() {
-    let mut cases = vec![("genus(2, 20)", ricci::mesh::generate::genus(2, 20).unwrap())];
-    match ricci_meshes::ricci_meshes() {
-        Some(dir) => cases.push((
-            "eight",
-            ricci::mesh::io::read_surface(&dir.join("eight.off"))
-                .unwrap()
-                .0,
-        )),
-        None => eprintln!("RICCI_MESHES is not set: skipping eight.off"),
-    }
-    for (name, s) in cases {
+    for (name, s) in genus_two_cases() {
         let h = forms(&s);
         for class in 0..4 {
             let d = decompose(name, &h, class);

@@ -7,38 +7,13 @@
 //! inside the cylinders from the patches' derivative jumps.
 
 mod ricci_meshes;
+mod tspline_cases;
 
-use ricci::analysis::forms::{holomorphic_forms, FormsOptions, HolomorphicForms};
+use tspline_cases::{forms, genus_two_cases};
+
 use ricci::mesh::Surface;
-use ricci::metric::IntrinsicMetric;
-use ricci::progress::NoProgress;
 use ricci::spline::tspline::cylinder_fit::{fit_cylinders, GenusFitOptions};
 use ricci::spline::tspline::genus_domain::{best_genus_domain, GenusDomain};
-
-fn forms(s: &Surface) -> HolomorphicForms {
-    holomorphic_forms(
-        &s.mesh,
-        &IntrinsicMetric::euclidean(s.edge_lengths()),
-        Some(&s.positions),
-        &FormsOptions::default(),
-        &mut NoProgress,
-    )
-    .unwrap()
-}
-
-fn cases() -> Vec<(&'static str, Surface)> {
-    let mut cases = vec![("genus(2, 20)", ricci::mesh::generate::genus(2, 20).unwrap())];
-    match ricci_meshes::ricci_meshes() {
-        Some(dir) => cases.push((
-            "eight",
-            ricci::mesh::io::read_surface(&dir.join("eight.off"))
-                .unwrap()
-                .0,
-        )),
-        None => eprintln!("RICCI_MESHES is not set: skipping eight.off"),
-    }
-    cases
-}
 
 fn check_domain(name: &str, s: &Surface, d: &GenusDomain) {
     let dec = &d.decomposition;
@@ -104,7 +79,7 @@ fn check_domain(name: &str, s: &Surface, d: &GenusDomain) {
 
 #[test]
 fn genus_two_data_points_get_cylinder_coordinates() {
-    for (name, s) in cases() {
+    for (name, s) in genus_two_cases() {
         let h = forms(&s);
         let d = best_genus_domain(&h, s.positions.len()).unwrap();
         check_domain(name, &s, &d);
@@ -114,7 +89,7 @@ fn genus_two_data_points_get_cylinder_coordinates() {
 #[test]
 fn genus_two_fit_meets_the_tolerance_and_is_c2_inside_the_cylinders() {
     let tolerance = 0.01;
-    for (name, s) in cases() {
+    for (name, s) in genus_two_cases() {
         let h = forms(&s);
         let d = best_genus_domain(&h, s.positions.len()).unwrap();
         let opts = GenusFitOptions {
@@ -310,7 +285,7 @@ fn gap_across(
 #[test]
 fn genus_two_fit_is_continuous_across_every_critical_trajectory() {
     let tolerance = 0.01;
-    for (name, s) in cases() {
+    for (name, s) in genus_two_cases() {
         let h = forms(&s);
         let d = best_genus_domain(&h, s.positions.len()).unwrap();
         let side = {
@@ -403,7 +378,7 @@ fn genus_two_zeros_are_c0_and_their_normal_jump_shrinks_under_refinement() {
         &[GenusFitOptions::default().line_tangent, 0.0],
     );
     let tolerances = env_list("TOLERANCES", &[0.02, 0.01]);
-    for (name, s) in cases() {
+    for (name, s) in genus_two_cases() {
         let h = forms(&s);
         let d = best_genus_domain(&h, s.positions.len()).unwrap();
         let side = fit_cylinders(

@@ -16,4 +16,5 @@ pub mod spectrum;
 pub mod spline;
 pub mod teichmuller;
 pub mod tspline;
+pub mod tspline_domain;
 pub mod tspline_genus;

@@ -90,6 +90,12 @@ pub struct Args {
     /// Factor applied to the thin-plate weight after every refinement (1 = constant).
     #[arg(long, default_value_t = 1.0)]
     pub smoothing_decay: f64,
+    /// Genus ≥ 2: fit one tensor-product spline per cylinder of the holomorphic 1-form (C⁰
+    /// across the critical trajectories and the knot lines through the zeros) instead of the
+    /// default, one spline on the domain manifold's quad mesh (C² on every cell side not at a
+    /// zero, C⁰ at the zeros).
+    #[arg(long)]
+    pub per_cylinder: bool,
     /// Budget: refinement iterations.
     #[arg(long, default_value_t = 30)]
     pub max_iterations: usize,
@@ -568,12 +574,11 @@ fn write_outputs(
     Ok(())
 }
 
-/// The files of `--out DIR` for the genus-0 domain: only the surface's half of the torus (the
-/// Bézier patches clipped to it), tessellated patch by patch; no pictures of the torus.
-fn write_half_outputs(
+/// `tspline.step`, `tspline.igs` (one face per Bézier patch) and `surface.obj` (tessellated
+/// patch by patch): the files of every domain whose patches are not a closed torus grid.
+pub(crate) fn write_patch_files(
     dir: &std::path::Path,
     a: &Args,
-    r: &FitResult,
     patches: &[BezierPatch],
 ) -> anyhow::Result<()> {
     write_atomic(
@@ -587,7 +592,18 @@ fn write_half_outputs(
     write_atomic(
         &dir.join("surface.obj"),
         obj(patches, a.tessellation).as_bytes(),
-    )?;
+    )
+}
+
+/// The files of `--out DIR` for the genus-0 domain: only the surface's half of the torus (the
+/// Bézier patches clipped to it), tessellated patch by patch; no pictures of the torus.
+fn write_half_outputs(
+    dir: &std::path::Path,
+    a: &Args,
+    r: &FitResult,
+    patches: &[BezierPatch],
+) -> anyhow::Result<()> {
+    write_patch_files(dir, a, patches)?;
     write_atomic(
         &dir.join("samples.json"),
         serde_json::to_string(&samples_json(&r.spline, patches))?.as_bytes(),

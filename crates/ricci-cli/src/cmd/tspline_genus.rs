@@ -1,7 +1,9 @@
 //! `ricci tspline` on closed surfaces of genus ≥ 2: the domain manifold is the cylinder
 //! decomposition of a holomorphic 1-form with integer imaginary periods
-//! (`ricci::spline::tspline::{cylinders, genus_domain}`), and each cylinder carries its own
-//! tensor-product cubic spline (`cylinder_fit`: C² inside a cylinder except C⁰ along the knot
+//! (`ricci::spline::tspline::{cylinders, genus_domain}`). By default its strips, glued by
+//! translations, carry one spline on one quad mesh (`tspline_domain`, C² on every cell side
+//! not at a zero); when they cannot be glued, or with `--per-cylinder`, each
+//! cylinder carries its own tensor-product cubic spline (`cylinder_fit`: C² inside a cylinder except C⁰ along the knot
 //! lines through the zero copies, pulled towards C¹ by a tangent penalty; the glued boundary
 //! rows are shared, so C⁰ across the critical trajectories — the JSON `continuity` reports the
 //! gaps and normal angles, measured). At the zeros themselves (the extraordinary points):
@@ -17,15 +19,15 @@ use crate::util::{print_json, write_atomic};
 use ricci::analysis::forms::{holomorphic_forms, FormsOptions};
 use ricci::mesh::Surface;
 use ricci::metric::IntrinsicMetric;
-use ricci::spline::tspline::cylinder_fit::{fit_cylinders, GenusFit, GenusFitOptions};
+use ricci::spline::tspline::cylinder_fit::{fit_cylinders, GenusFit, GenusFitOptions, GenusStep};
 use ricci::spline::tspline::cylinder_jumps::{AtZero, GluedSeams, Seam};
-use ricci::spline::tspline::export::{iges, obj, step};
-use ricci::spline::tspline::genus_domain::best_genus_domain;
+use ricci::spline::tspline::genus_domain::{best_genus_domain, GenusDomain};
+use ricci::spline::tspline::glue::gluing;
 use ricci::spline::tspline::{BezierPatch, Continuity};
 use serde_json::json;
 use std::time::Instant;
 
-fn jumps_json(c: &Continuity, orders: usize) -> serde_json::Value {
+pub(crate) fn jumps_json(c: &Continuity, orders: usize) -> serde_json::Value {
     let rel = c.relative();
     let per_order: Vec<_> = (0..=orders)
         .map(|k| json!({"order": k, "max_jump": c.jumps[k], "max_partial": c.magnitudes[k], "relative_jump": rel[k]}))
@@ -121,6 +123,98 @@ fn zeros_json(at: &[AtZero], scale: f64) -> serde_json::Value {
     })
 }
 
+/// The warning when a genus ≥ 2 fit stops above the tolerance (L∞ `max` in percent).
+pub(crate) fn warn_not_converged(a: &Args, max: f64, tolerance: f64, max_iterations: usize) {
+    eprintln!(
+        "warning: {}: the fit stopped at L∞ {:.3} % above the tolerance {:.3} % (budget: {} iterations, {} control points)",
+        a.mesh.display(),
+        max,
+        100.0 * tolerance,
+        max_iterations,
+        a.max_control_points
+    );
+}
+
+/// With `--out`: the STEP, IGES, OBJ (per-patch tessellation), samples and report files of a
+/// genus ≥ 2 fit; the report gets `out` and the final `seconds`.
+pub(crate) fn write_files(
+    a: &Args,
+    patches: &[BezierPatch],
+    samples: impl FnOnce() -> serde_json::Value,
+    out: &mut serde_json::Value,
+    t0: Instant,
+) -> anyhow::Result<()> {
+    let Some(dir) = &a.out else {
+        return Ok(());
+    };
+    crate::cmd::tspline::write_patch_files(dir, a, patches)?;
+    write_atomic(
+        &dir.join("samples.json"),
+        serde_json::to_string(&samples())?.as_bytes(),
+    )?;
+    out["out"] = json!(dir.display().to_string());
+    out["seconds"] = json!(t0.elapsed().as_secs_f64());
+    write_atomic(
+        &dir.join("tspline.json"),
+        serde_json::to_string_pretty(out)?.as_bytes(),
+    )?;
+    Ok(())
+}
+
+/// The report keys both genus ≥ 2 fits share: the input, the form and its zeros, the errors of
+/// the last step, the budget's outcome, the data and the times.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn shared_keys(
+    out: &mut serde_json::Value,
+    a: &Args,
+    surface: &Surface,
+    domain: &GenusDomain,
+    steps: &[GenusStep],
+    converged: bool,
+    tolerance: f64,
+    scale: f64,
+    fit_seconds: f64,
+    t0: Instant,
+) {
+    let (rms, max) = steps.last().map_or((f64::NAN, f64::NAN), |s| {
+        (s.rms_error_percent, s.max_error_percent)
+    });
+    let dec = &domain.decomposition;
+    for (k, v) in [
+        ("file", json!(a.mesh.display().to_string())),
+        (
+            "form",
+            json!({"imaginary_part": "sum of n_k times the harmonic form dual to loop k", "n": domain.combination, "saddle_levels": domain.levels}),
+        ),
+        ("zeros", json!(dec.zeros)),
+        ("critical_levels", json!(dec.levels)),
+        ("t_junctions", json!(0)),
+        ("rms_error_percent", json!(rms)),
+        ("max_error_percent", json!(max)),
+        ("tolerance_percent", json!(100.0 * tolerance)),
+        ("converged", json!(converged)),
+        ("iterations", json!(steps.len())),
+        ("steps", json!(steps)),
+        ("data_points", json!(surface.positions.len())),
+        ("unassigned_points", json!(domain.unassigned.len())),
+        ("holonomy_defect", json!(domain.holonomy_defect)),
+        ("scale", json!(scale)),
+        ("seconds_fit", json!(fit_seconds)),
+        ("seconds", json!(t0.elapsed().as_secs_f64())),
+    ] {
+        out[k] = v;
+    }
+}
+
+/// The report on stdout: the JSON object with `--json`, else the one line `text`.
+pub(crate) fn print_report(a: &Args, out: &serde_json::Value, text: impl FnOnce() -> String) {
+    if a.json {
+        print_json(out);
+    } else {
+        println!("{}", text());
+    }
+}
+
 pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> anyhow::Result<()> {
     let mut bar = spinner(a.json);
     bar.0.set_message("holomorphic 1-forms");
@@ -133,6 +227,23 @@ pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> an
     )?;
     bar.0.set_message("cylinders of the critical trajectories");
     let domain = best_genus_domain(&h, surface.positions.len())?;
+    let mut refused = None;
+    if !a.per_cylinder {
+        match gluing(&domain) {
+            Ok(g) => {
+                return crate::cmd::tspline_domain::run_domain(
+                    a, surface, &h, &domain, &g, tolerance, t0, bar,
+                )
+            }
+            Err(why) => {
+                eprintln!(
+                    "warning: {}: the cylinders' strips do not glue into one domain mesh ({why}); fitting one spline per cylinder instead (as --per-cylinder)",
+                    a.mesh.display()
+                );
+                refused = Some(why);
+            }
+        }
+    }
     let opts = GenusFitOptions {
         tolerance,
         smoothing: a.smoothing.max(1e-4),
@@ -161,7 +272,6 @@ pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> an
     let (rms, max) = last.as_ref().map_or((f64::NAN, f64::NAN), |s| {
         (s.rms_error_percent, s.max_error_percent)
     });
-    let dec = &domain.decomposition;
     let cylinders: Vec<_> = domain
         .cylinders
         .iter()
@@ -175,67 +285,32 @@ pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> an
         })
         .collect();
     let mut out = json!({
-        "file": a.mesh.display().to_string(),
         "domain": format!("cylinders of a holomorphic 1-form with integer imaginary periods (genus {})", h.genus),
-        "form": {"imaginary_part": "sum of n_k times the harmonic form dual to loop k", "n": domain.combination, "saddle_levels": domain.levels},
-        "zeros": dec.zeros,
-        "critical_levels": dec.levels,
+        "spline": "per_cylinder",
+        "domain_mesh_refused": refused,
         "cylinders": cylinders,
         "control_points": fit.control_points(),
-        "t_junctions": 0,
         "bezier_patches": patches.len(),
-        "rms_error_percent": rms,
-        "max_error_percent": max,
-        "tolerance_percent": 100.0 * tolerance,
-        "converged": fit.converged,
-        "iterations": fit.steps.len(),
-        "steps": fit.steps,
         "continuity": continuity,
-        "data_points": surface.positions.len(),
-        "unassigned_points": domain.unassigned.len(),
-        "holonomy_defect": domain.holonomy_defect,
-        "scale": fit.scale,
-        "seconds_fit": fit_seconds,
-        "seconds": t0.elapsed().as_secs_f64(),
     });
+    shared_keys(
+        &mut out,
+        a,
+        surface,
+        &domain,
+        &fit.steps,
+        fit.converged,
+        tolerance,
+        fit.scale,
+        fit_seconds,
+        t0,
+    );
     if !fit.converged {
-        eprintln!(
-            "warning: {}: the fit stopped at L∞ {:.3} % above the tolerance {:.3} % (budget: {} iterations, {} control points)",
-            a.mesh.display(),
-            max,
-            100.0 * tolerance,
-            opts.max_iterations,
-            opts.max_control_points
-        );
+        warn_not_converged(a, max, tolerance, opts.max_iterations);
     }
-    if let Some(dir) = &a.out {
-        write_atomic(
-            &dir.join("tspline.step"),
-            step(&patches, "tspline").as_bytes(),
-        )?;
-        write_atomic(
-            &dir.join("tspline.igs"),
-            iges(&patches, "tspline").as_bytes(),
-        )?;
-        write_atomic(
-            &dir.join("surface.obj"),
-            obj(&patches, a.tessellation).as_bytes(),
-        )?;
-        write_atomic(
-            &dir.join("samples.json"),
-            serde_json::to_string(&samples_json(&fit, &patches))?.as_bytes(),
-        )?;
-        out["out"] = json!(dir.display().to_string());
-        out["seconds"] = json!(t0.elapsed().as_secs_f64());
-        write_atomic(
-            &dir.join("tspline.json"),
-            serde_json::to_string_pretty(&out)?.as_bytes(),
-        )?;
-    }
-    if a.json {
-        print_json(&out);
-    } else {
-        println!(
+    write_files(a, &patches, || samples_json(&fit, &patches), &mut out, t0)?;
+    print_report(a, &out, || {
+        format!(
             "{}: {} cylinders, {} control points, {} Bézier patches, error rms {:.3}% max {:.3}% of the longest side, {} iterations, {} inside cylinders (C0 on the knot lines), {} across the critical trajectories (gap {:.2e}%, normals up to {:.2}°), {:.2} s",
             a.mesh.display(),
             fit.splines.len(),
@@ -249,7 +324,7 @@ pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> an
             gap_percent,
             seams.max_angle_degrees(),
             t0.elapsed().as_secs_f64()
-        );
-    }
+        )
+    });
     Ok(())
 }

@@ -188,7 +188,7 @@ pub fn extract(ts: &TSpline) -> Vec<BezierPatch> {
 }
 
 /// Jumps of the partial derivatives across patch sides, per order 0..=3.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
 pub struct Continuity {
     /// Largest jump (Euclidean norm in R³) over the sampled side points and the partials of
     /// each order.
@@ -211,6 +211,23 @@ impl Continuity {
             };
         }
         r
+    }
+
+    /// Compare every partial of orders 0..=3 of `a` at `pa` with that of `b` at `pb` (the same
+    /// point of the surface in the two patches' parameters).
+    pub fn compare(&mut self, a: &BezierPatch, pa: (f64, f64), b: &BezierPatch, pb: (f64, f64)) {
+        self.comparisons += 1;
+        for order in 0..4 {
+            for i in 0..=order {
+                let x = a.partial(pa.0, pa.1, i, order - i);
+                let y = b.partial(pb.0, pb.1, i, order - i);
+                let d =
+                    ((x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + (x[2] - y[2]).powi(2)).sqrt();
+                self.jumps[order] = self.jumps[order].max(d);
+                let m = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+                self.magnitudes[order] = self.magnitudes[order].max(m);
+            }
+        }
     }
 
     /// The largest `k` with relative jumps of orders ≤ k below `threshold` (`None`: the
@@ -253,9 +270,7 @@ pub fn continuity(
                 cu >= q.u0 && cu < q.u1 && cv >= q.v0 && cv < q.v1
             })
     };
-    let mut jumps = [0.0f64; 4];
-    let mut mags = [0.0f64; 4];
-    let mut comparisons = 0;
+    let mut out = Continuity::default();
     for q in patches {
         let dmin = (q.u1 - q.u0).min(q.v1 - q.v0) * 1e-6;
         for s in 0..samples {
@@ -269,29 +284,11 @@ pub fn continuity(
                     continue;
                 };
                 let other = &patches[o];
-                comparisons += 1;
                 // the same point in the neighbour's copy of the domain
                 let (cu, cv) = lattice.canonical(u + nu, v + nv);
-                let (ou, ov) = (cu - nu, cv - nv);
-                for order in 0..4 {
-                    for a in 0..=order {
-                        let b = order - a;
-                        let x = q.partial(u, v, a, b);
-                        let y = other.partial(ou, ov, a, b);
-                        let d =
-                            ((x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + (x[2] - y[2]).powi(2))
-                                .sqrt();
-                        jumps[order] = jumps[order].max(d);
-                        let m = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-                        mags[order] = mags[order].max(m);
-                    }
-                }
+                out.compare(q, (u, v), other, (cu - nu, cv - nv));
             }
         }
     }
-    Continuity {
-        jumps,
-        magnitudes: mags,
-        comparisons,
-    }
+    out
 }

@@ -1,11 +1,12 @@
 //! Genus ≥ 2: least squares on the spline of the domain manifold's quad mesh
-//! ([`super::domain_mesh`]), behind an option (the per-cylinder fit of [`super::cylinder_fit`]
-//! stays the default). The data points are located in the cells from their cylinder
-//! coordinates and the gluing's sheared coordinate; the fairness term is the squared second
-//! differences of the control net along the mesh lines through every regular vertex (as the
-//! per-cylinder fit's), the umbrella operator at the zeros; refinement shrinks the spacing
-//! (by 1/√2, uniformly: the mesh is conforming) until the largest error is below the tolerance or the
-//! budget of control points is spent.
+//! ([`super::domain_mesh`]), the default of `ricci tspline` for genus ≥ 2 (the per-cylinder
+//! fit of [`super::cylinder_fit`] is the `--per-cylinder` option). The data points are
+//! located in the cells from their cylinder coordinates and the gluing's sheared coordinate;
+//! the fairness term is the squared second differences of the control net along the mesh
+//! lines through every regular vertex (as the per-cylinder fit's), the umbrella operator at
+//! the zeros; refinement shrinks the spacing (by 1/√2, uniformly: the mesh is conforming)
+//! until the largest error is below the tolerance or the budget of control points is spent
+//! (the last refinement is cut to the largest mesh within the budget).
 
 use super::cylinder_fit::GenusStep;
 use super::domain_mesh::DomainMesh;
@@ -78,15 +79,10 @@ pub fn locate(
         .iter()
         .position(|r| r.cylinder == c && r.strip == s)?;
     let rc = &mesh.rects[r];
-    let (w, h) = (rc.length / rc.m as f64, rc.height / rc.n as f64);
-    let x = ((up - lay.lines[s]) / w).clamp(0.0, rc.m as f64);
-    let y = (v / h).clamp(0.0, rc.n as f64);
-    let (i, j) = (
-        (x.floor() as usize).min(rc.m - 1),
-        (y.floor() as usize).min(rc.n - 1),
-    );
+    let (i, x) = rc.column(up - lay.lines[s]);
+    let (j, y) = rc.row(v);
     let cell = (rc.first_cell + j * rc.m + i) as u32;
-    Some((cell, x - i as f64, y - j as f64))
+    Some((cell, x, y))
 }
 
 /// One least-squares solve on `mesh`.
@@ -171,6 +167,34 @@ fn solve(
     Ok(out)
 }
 
+/// A mesh with more than `count` and at most `budget` vertices, finer than the one of
+/// `spacing` (which has `count`): the vertices grow about as `1 / spacing²`, so a few spacings
+/// just above `spacing · √(count / budget)` are tried, coarsest last.
+fn fill_budget(
+    domain: &GenusDomain,
+    gluing: &Gluing,
+    spacing: f64,
+    count: usize,
+    budget: usize,
+) -> Result<Option<DomainMesh>> {
+    if count >= budget {
+        return Ok(None);
+    }
+    let base = spacing * (count as f64 / budget as f64).sqrt();
+    for k in 0..6 {
+        let mesh = DomainMesh::new(domain, gluing, base * (1.0 + 0.03 * k as f64))
+            .map_err(Error::numerical)?;
+        let n = mesh.n_vertices();
+        if n <= count {
+            return Ok(None);
+        }
+        if n <= budget {
+            return Ok(Some(mesh));
+        }
+    }
+    Ok(None)
+}
+
 /// Fit the data points of `domain` (positions by vertex) on the domain mesh, refining
 /// uniformly until `L∞ ≤ tolerance` or the budget is spent.
 pub fn fit_domain_mesh(
@@ -193,10 +217,28 @@ pub fn fit_domain_mesh(
     let mut spacing = opts.initial * l;
     let mut steps = Vec::new();
     let mut last: Option<DomainFit> = None;
+    let refine = opts.refine.clamp(0.1, 0.95);
+    let mut filled = false;
     for _ in 0..opts.max_iterations.max(1) {
-        let mesh = DomainMesh::new(domain, gluing, spacing).map_err(Error::numerical)?;
-        if last.is_some() && mesh.n_vertices() > opts.max_control_points {
-            break;
+        let mut mesh = DomainMesh::new(domain, gluing, spacing).map_err(Error::numerical)?;
+        if let Some(prev) = last
+            .as_ref()
+            .filter(|_| mesh.n_vertices() > opts.max_control_points)
+        {
+            // the next refinement is over the budget: one last fit on the largest mesh within it
+            match fill_budget(
+                domain,
+                gluing,
+                spacing / refine,
+                prev.mesh.n_vertices(),
+                opts.max_control_points,
+            )? {
+                Some(m) => {
+                    mesh = m;
+                    filled = true;
+                }
+                None => break,
+            }
         }
         let mut located = Vec::with_capacity(targets.len());
         for p in &domain.points {
@@ -236,10 +278,10 @@ pub fn fit_domain_mesh(
             converged,
             scale,
         });
-        if converged {
+        if converged || filled {
             break;
         }
-        spacing *= opts.refine.clamp(0.1, 0.95);
+        spacing *= refine;
     }
     last.ok_or_else(|| Error::numerical("domain mesh fit: no iteration ran"))
 }

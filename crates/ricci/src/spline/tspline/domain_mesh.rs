@@ -7,10 +7,13 @@
 //! `s + 1` of the same cylinder, the top to the bottom of one strip of the next band (equal
 //! lengths). Every rectangle corner is a zero of the form. Cutting every strip into `m × n`
 //! cells, with `m` the same along every chain of strips glued top to bottom and `n` the same
-//! in every cylinder, gives a conforming quad mesh of the closed surface (no T-junctions) whose
+//! in every cylinder (at least 5 each), gives a conforming quad mesh of the closed surface (no T-junctions) whose
 //! only vertices of valence ≠ 4 are the zeros (valence `4 (k + 1)` at a zero of order `k`).
 //! A ray from a vertex continues across a gluing by the translation: walking from cell to
-//! cell over a side is always defined; only walking *through* a zero is not.
+//! cell over a side is always defined; only walking *through* a zero is not. The two first and
+//! two last columns of every strip have one width `edge_u` and the two first and two last rows
+//! one height `edge_v` (the smallest uniform cell size of any strip; the middle cells share
+//! the rest): every cell within two knot intervals of a zero has the same size.
 //!
 //! **The spline.** One control point per vertex. Every cell is a bicubic Bézier patch whose 16
 //! points are affine combinations of control points, each computed **once** per mesh entity
@@ -26,11 +29,14 @@
 //!
 //! Hence: partition of unity (every combination is affine), chart independence (every point
 //! shared by two patches is one value), C⁰ everywhere; on every cell side **not incident to a
-//! zero** the two patches are pieces of one tensor-product B-spline row by row (the points
-//! that the replacements change are only the zero's corner point and points of rows/columns
-//! that the C² conditions across such a side do not involve), so the surface is **C²** there;
-//! on the sides incident to a zero it is C⁰ (C¹ defect vanishing to third order at the
-//! side's other end). So C² at every point at least one knot interval from the zeros.
+//! zero** the two patches are pieces of one tensor-product B-spline row by row: the replaced
+//! intervals equal the true ones (all cells near a zero have the edge size), so the only
+//! point no B-spline rule gives is the zero's own corner point, which the C² conditions across
+//! such a side do not involve — the surface is **C²** there (measured: relative jumps of
+//! orders 1 and 2 ≤ 1e-14, test `tspline_domain_mesh.rs`); on the sides incident to a zero it
+//! is C⁰ (C¹ defect vanishing to third order at the side's other end). So C² at every point
+//! of the surface but the sides at the zeros. (With uniform cells per strip the sides one
+//! interval from a zero jumped in the first derivative by ~0.1 of its size: session 12.)
 
 use super::bezier::BezierPatch;
 use super::genus_domain::GenusDomain;
@@ -57,7 +63,10 @@ pub struct DomainMesh {
     pub bezier: Vec<[[Combination; 4]; 4]>,
 }
 
-/// One strip of one cylinder.
+/// One strip of one cylinder, cut into `m × n` cells: the two first and the two last columns
+/// are `edge_u` wide, the two first and two last rows `edge_v` high (the same in every strip:
+/// every cell within two knot intervals of a zero has the same size, so the blossoms there
+/// need no replaced interval), the others share the rest equally.
 #[derive(Debug, Clone, Copy)]
 pub struct Rect {
     pub cylinder: usize,
@@ -66,13 +75,92 @@ pub struct Rect {
     pub height: f64,
     pub m: usize,
     pub n: usize,
+    pub edge_u: f64,
+    pub edge_v: f64,
     pub first_cell: usize,
+}
+
+/// The least number of cells along a strip side: two edge cells at each end and one between.
+pub const MIN_CELLS: usize = 5;
+
+/// Knot `i` (0..=k) of `k` intervals over `[0, len]`, the two at each end `e` long.
+fn knot(len: f64, k: usize, e: f64, i: usize) -> f64 {
+    if i <= 2 {
+        i as f64 * e
+    } else if i + 2 >= k {
+        len - (k - i) as f64 * e
+    } else {
+        2.0 * e + (i - 2) as f64 * (len - 4.0 * e) / (k - 4) as f64
+    }
+}
+
+/// The interval of `x` (clamped to `[0, len]`) and the local coordinate in it.
+fn interval(len: f64, k: usize, e: f64, x: f64) -> (usize, f64) {
+    let x = x.clamp(0.0, len);
+    let (mut lo, mut hi) = (0, k);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if knot(len, k, e, mid) <= x {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let (a, b) = (knot(len, k, e, lo), knot(len, k, e, lo + 1));
+    (lo, ((x - a) / (b - a)).clamp(0.0, 1.0))
+}
+
+impl Rect {
+    /// The start of column `i` (`i = m`: the strip's length).
+    pub fn x(&self, i: usize) -> f64 {
+        knot(self.length, self.m, self.edge_u, i)
+    }
+
+    /// The start of row `j` (`j = n`: the height).
+    pub fn y(&self, j: usize) -> f64 {
+        knot(self.height, self.n, self.edge_v, j)
+    }
+
+    /// The column of `x` along the strip and the local coordinate in it.
+    pub fn column(&self, x: f64) -> (usize, f64) {
+        interval(self.length, self.m, self.edge_u, x)
+    }
+
+    /// The row of `y` and the local coordinate in it.
+    pub fn row(&self, y: f64) -> (usize, f64) {
+        interval(self.height, self.n, self.edge_v, y)
+    }
 }
 
 const RIGHT: usize = 0;
 const TOP: usize = 1;
 const LEFT: usize = 2;
 const BOTTOM: usize = 3;
+
+/// A direction of the mesh lines: `U` along the strips (cell widths), `V` across them (cell
+/// heights).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Axis {
+    U,
+    V,
+}
+
+impl Axis {
+    fn other(self) -> Axis {
+        match self {
+            Axis::U => Axis::V,
+            Axis::V => Axis::U,
+        }
+    }
+
+    /// The sides of a cell before and after it along this direction.
+    fn sides(self) -> (usize, usize) {
+        match self {
+            Axis::U => (LEFT, RIGHT),
+            Axis::V => (BOTTOM, TOP),
+        }
+    }
+}
 
 /// Weights on `(P₋₁, P₀, P₁)` of the point at vertex 0 of a cubic B-spline whose anchors sit
 /// at the vertices, with intervals `d` = `(d₋₂, d₋₁, d₀, d₁)` around it (blossom `f(0,0,0)`).
@@ -117,7 +205,8 @@ fn find(p: &mut [u32], mut x: u32) -> u32 {
 }
 
 impl DomainMesh {
-    /// The mesh with cells of size about `spacing` (at least 2 × 2 per strip), or why not.
+    /// The mesh with cells of size about `spacing` (at least [`MIN_CELLS`] along every strip
+    /// side), or why not.
     pub fn new(domain: &GenusDomain, gluing: &Gluing, spacing: f64) -> Result<Self, String> {
         if !(spacing > 0.0) {
             return Err(format!("spacing {spacing} must be positive"));
@@ -127,7 +216,7 @@ impl DomainMesh {
         let mut index = std::collections::HashMap::new();
         for (c, lay) in gluing.layouts.iter().enumerate() {
             let ch = &domain.cylinders[c];
-            let n = ((ch.height / spacing).ceil() as usize).max(2);
+            let n = ((ch.height / spacing).ceil() as usize).max(MIN_CELLS);
             for s in 0..lay.lines.len() {
                 index.insert((c, s), rects.len());
                 rects.push(Rect {
@@ -137,6 +226,8 @@ impl DomainMesh {
                     height: ch.height,
                     m: 0,
                     n,
+                    edge_u: 0.0,
+                    edge_v: 0.0,
                     first_cell: 0,
                 });
             }
@@ -174,14 +265,31 @@ impl DomainMesh {
                 r = top[r];
             }
             let len = chain.iter().map(|&r| rects[r].length).fold(0.0, f64::max);
-            let m = ((len / spacing).ceil() as usize).max(2);
+            let m = ((len / spacing).ceil() as usize).max(MIN_CELLS);
             for &r in &chain {
                 rects[r].m = m;
                 done[r] = true;
             }
         }
+        // the edge cells: the smallest uniform cell size of any strip (so the middle cells of
+        // every strip are at least as large)
+        let edge_u = rects
+            .iter()
+            .map(|r| r.length / r.m as f64)
+            .fold(f64::INFINITY, f64::min);
+        let edge_v = rects
+            .iter()
+            .map(|r| r.height / r.n as f64)
+            .fold(f64::INFINITY, f64::min);
+        if !(edge_u > 0.0 && edge_v > 0.0) {
+            return Err(format!(
+                "a strip has no positive length or height (edge cells {edge_u} × {edge_v})"
+            ));
+        }
         let mut cells = 0;
         for r in rects.iter_mut() {
+            r.edge_u = edge_u;
+            r.edge_v = edge_v;
             r.first_cell = cells;
             cells += r.m * r.n;
         }
@@ -279,16 +387,26 @@ impl DomainMesh {
 
     /// Width and height of a cell.
     pub fn size(&self, c: u32) -> (f64, f64) {
-        let r = &self.rects[self.cell_at[c as usize].0 as usize];
-        (r.length / r.m as f64, r.height / r.n as f64)
+        let (r, i, j) = self.cell_at[c as usize];
+        let r = &self.rects[r as usize];
+        let (i, j) = (i as usize, j as usize);
+        (r.x(i + 1) - r.x(i), r.y(j + 1) - r.y(j))
+    }
+
+    /// The size of cell `c` along `axis` (its knot interval in that direction).
+    fn len(&self, c: u32, axis: Axis) -> f64 {
+        match axis {
+            Axis::U => self.size(c).0,
+            Axis::V => self.size(c).1,
+        }
     }
 
     fn w(&self, c: u32) -> f64 {
-        self.size(c).0
+        self.len(c, Axis::U)
     }
 
     fn h(&self, c: u32) -> f64 {
-        self.size(c).1
+        self.len(c, Axis::V)
     }
 
     /// The Bézier point at the lower-left corner of cell `c`.
@@ -317,26 +435,10 @@ impl DomainMesh {
         let left = self.corners[l as usize][0];
         let up = self.corners[c as usize][3];
         let down = self.corners[b as usize][0];
-        let wl2 = if self.is_zero(left) {
-            self.w(l)
-        } else {
-            self.w(self.nb(l, LEFT))
-        };
-        let wr2 = if self.is_zero(right) {
-            self.w(c)
-        } else {
-            self.w(self.nb(c, RIGHT))
-        };
-        let hb2 = if self.is_zero(down) {
-            self.h(b)
-        } else {
-            self.h(self.nb(b, BOTTOM))
-        };
-        let ht2 = if self.is_zero(up) {
-            self.h(c)
-        } else {
-            self.h(self.nb(c, TOP))
-        };
+        let wl2 = self.beyond(l, left, LEFT, Axis::U);
+        let wr2 = self.beyond(c, right, RIGHT, Axis::U);
+        let hb2 = self.beyond(b, down, BOTTOM, Axis::V);
+        let ht2 = self.beyond(c, up, TOP, Axis::V);
         let uw = corner_weights([wl2, self.w(l), self.w(c), wr2]);
         let vw = corner_weights([hb2, self.h(b), self.h(c), ht2]);
         let k = |x: u32| self.corners[x as usize];
@@ -354,86 +456,56 @@ impl DomainMesh {
         out
     }
 
-    /// The two points on the bottom side of cell `c` (`b₁₀`, `b₂₀`).
-    fn bottom_points(&self, c: u32) -> [Combination; 2] {
-        let b = self.nb(c, BOTTOM);
-        let [a0, a1, u1, u0] = self.corners[c as usize];
-        let (d0, d1) = (self.corners[b as usize][0], self.corners[b as usize][1]);
-        let dprev = if self.is_zero(a0) {
-            self.w(c)
+    /// The interval two steps from the cell before a vertex: the size along `axis` of the
+    /// neighbour of `c` across `side`, or `c`'s own when the vertex `v` between them is a zero
+    /// (no mesh line runs through a zero).
+    fn beyond(&self, c: u32, v: u32, side: usize, axis: Axis) -> f64 {
+        if self.is_zero(v) {
+            self.len(c, axis)
         } else {
-            self.w(self.nb(c, LEFT))
+            self.len(self.nb(c, side), axis)
+        }
+    }
+
+    /// The two Bézier points inside the side of cell `c` that runs along `along` from its
+    /// lower-left corner (the bottom side for `U`: `b₁₀`, `b₂₀`; the left side for `V`: `b₀₁`,
+    /// `b₀₂`): the blossom along the side (its interval and its two neighbours) of the
+    /// corner points of the mesh lines across it, each from the cell `c`, the cell before it
+    /// across the side, and the intervals beyond them.
+    fn side_points(&self, c: u32, along: Axis) -> [Combination; 2] {
+        let across = along.other();
+        let (prev, next) = along.sides();
+        let (before, after) = across.sides();
+        let b = self.nb(c, before);
+        // corner indices: the side's far end, and the start of the opposite side
+        let (end, far) = match along {
+            Axis::U => (1, 3),
+            Axis::V => (3, 1),
         };
-        let dnext = if self.is_zero(a1) {
-            self.w(c)
-        } else {
-            self.w(self.nb(c, RIGHT))
+        let q = self.corners[c as usize];
+        let (a0, a1, f0, f1) = (q[0], q[end], q[far], q[2]);
+        let (d0, d1) = (self.corners[b as usize][0], self.corners[b as usize][end]);
+        let aw = inner_weights([
+            self.beyond(c, a0, prev, along),
+            self.len(c, along),
+            self.beyond(c, a1, next, along),
+        ]);
+        let line = |lo: u32, hi: u32| {
+            corner_weights([
+                self.beyond(b, lo, before, across),
+                self.len(b, across),
+                self.len(c, across),
+                self.beyond(c, hi, after, across),
+            ])
         };
-        let uw = inner_weights([dprev, self.w(c), dnext]);
-        let column = |below: u32, up: u32| {
-            let hb2 = if self.is_zero(below) {
-                self.h(b)
-            } else {
-                self.h(self.nb(b, BOTTOM))
-            };
-            let ht2 = if self.is_zero(up) {
-                self.h(c)
-            } else {
-                self.h(self.nb(c, TOP))
-            };
-            corner_weights([hb2, self.h(b), self.h(c), ht2])
-        };
-        let cols = [(d0, a0, u0), (d1, a1, u1)];
-        let vws = [column(d0, u0), column(d1, u1)];
+        let lines = [(d0, a0, f0), (d1, a1, f1)];
+        let ws = [line(d0, f0), line(d1, f1)];
         std::array::from_fn(|p| {
             let mut out = Combination::new();
             for k in 0..2 {
-                let (x, y, z) = cols[k];
-                for (v, w) in [(x, vws[k][0]), (y, vws[k][1]), (z, vws[k][2])] {
-                    add(&mut out, v, uw[p][k] * w);
-                }
-            }
-            out
-        })
-    }
-
-    /// The two points on the left side of cell `c` (`b₀₁`, `b₀₂`).
-    fn left_points(&self, c: u32) -> [Combination; 2] {
-        let l = self.nb(c, LEFT);
-        let [a0, r0, r1, a1] = self.corners[c as usize];
-        let (l0, l1) = (self.corners[l as usize][0], self.corners[l as usize][3]);
-        let dprev = if self.is_zero(a0) {
-            self.h(c)
-        } else {
-            self.h(self.nb(c, BOTTOM))
-        };
-        let dnext = if self.is_zero(a1) {
-            self.h(c)
-        } else {
-            self.h(self.nb(c, TOP))
-        };
-        let vw = inner_weights([dprev, self.h(c), dnext]);
-        let row = |left: u32, right: u32| {
-            let wl2 = if self.is_zero(left) {
-                self.w(l)
-            } else {
-                self.w(self.nb(l, LEFT))
-            };
-            let wr2 = if self.is_zero(right) {
-                self.w(c)
-            } else {
-                self.w(self.nb(c, RIGHT))
-            };
-            corner_weights([wl2, self.w(l), self.w(c), wr2])
-        };
-        let rows = [(l0, a0, r0), (l1, a1, r1)];
-        let uws = [row(l0, r0), row(l1, r1)];
-        std::array::from_fn(|q| {
-            let mut out = Combination::new();
-            for k in 0..2 {
-                let (x, y, z) = rows[k];
-                for (v, w) in [(x, uws[k][0]), (y, uws[k][1]), (z, uws[k][2])] {
-                    add(&mut out, v, vw[q][k] * w);
+                let (x, y, z) = lines[k];
+                for (v, w) in [(x, ws[k][0]), (y, ws[k][1]), (z, ws[k][2])] {
+                    add(&mut out, v, aw[p][k] * w);
                 }
             }
             out
@@ -450,16 +522,16 @@ impl DomainMesh {
         out[3][0] = self.vertex_point(r);
         out[0][3] = self.vertex_point(t);
         out[3][3] = self.vertex_point(tr);
-        let [b1, b2] = self.bottom_points(cu);
+        let [b1, b2] = self.side_points(cu, Axis::U);
         out[1][0] = b1;
         out[2][0] = b2;
-        let [t1, t2] = self.bottom_points(t);
+        let [t1, t2] = self.side_points(t, Axis::U);
         out[1][3] = t1;
         out[2][3] = t2;
-        let [l1, l2] = self.left_points(cu);
+        let [l1, l2] = self.side_points(cu, Axis::V);
         out[0][1] = l1;
         out[0][2] = l2;
-        let [r1, r2] = self.left_points(r);
+        let [r1, r2] = self.side_points(r, Axis::V);
         out[3][1] = r1;
         out[3][2] = r2;
         let uw = inner_weights([self.w(self.nb(cu, LEFT)), self.w(cu), self.w(r)]);
@@ -482,10 +554,10 @@ impl DomainMesh {
 
     /// The cell's rectangle in its strip's coordinates `[u0, u1] × [v0, v1]`.
     pub fn cell_box(&self, c: u32) -> [f64; 4] {
-        let (_, i, j) = self.cell_at[c as usize];
-        let (w, h) = self.size(c);
-        let (u0, v0) = (i as f64 * w, j as f64 * h);
-        [u0, u0 + w, v0, v0 + h]
+        let (r, i, j) = self.cell_at[c as usize];
+        let r = &self.rects[r as usize];
+        let (i, j) = (i as usize, j as usize);
+        [r.x(i), r.x(i + 1), r.y(j), r.y(j + 1)]
     }
 
     /// The Bézier patch of cell `c` for control points `control` (one per vertex), over its
@@ -509,6 +581,46 @@ impl DomainMesh {
             v1: v1 + dv,
             control: p,
         }
+    }
+
+    /// Per strip, the translation of its `u` coordinate in the exported parameter plane: the
+    /// strips side by side along `u`, a quarter of the longest strip apart, so that every
+    /// Bézier patch has a parameter rectangle of its own (as the per-cylinder fit's offsets).
+    pub fn export_offsets(&self) -> Vec<f64> {
+        let gap = 0.25 * self.rects.iter().map(|r| r.length).fold(0.0, f64::max);
+        let mut at = 0.0;
+        self.rects
+            .iter()
+            .map(|r| {
+                let off = at;
+                at += r.length + gap;
+                off
+            })
+            .collect()
+    }
+
+    /// Every cell's Bézier patch (cell order) over its box in the exported parameters
+    /// ([`Self::export_offsets`]): one bicubic patch per cell, for STEP, IGES and OBJ.
+    pub fn patches(&self, control: &[[f64; 3]]) -> Vec<BezierPatch> {
+        let offsets = self.export_offsets();
+        (0..self.n_cells() as u32)
+            .map(|c| {
+                let r = self.cell_at[c as usize].0 as usize;
+                self.patch(c, control, offsets[r], 0.0)
+            })
+            .collect()
+    }
+
+    /// The spline's point at `(s, t) ∈ [0, 1]²` of cell `c` from the blending functions (not
+    /// the patches).
+    pub fn point(&self, c: u32, s: f64, t: f64, control: &[[f64; 3]]) -> [f64; 3] {
+        let mut x = [0.0; 3];
+        for (v, w) in self.blending(c, s, t) {
+            for d in 0..3 {
+                x[d] += w * control[v as usize][d];
+            }
+        }
+        x
     }
 
     /// The blending functions non-zero at `(s, t) ∈ [0, 1]²` of cell `c`: vertex and value

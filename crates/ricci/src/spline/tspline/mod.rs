@@ -25,11 +25,12 @@
 //!
 //! * [`domain_mesh`] — genus ≥ 2: one conforming quad mesh of knot intervals over all the
 //!   strips glued by translations (the zeros its only irregular vertices) and its spline,
-//!   C² two knot intervals from the zeros; [`domain_fit`] fits on it (an option: the
-//!   per-cylinder [`cylinder_fit`] stays the default).
+//!   C² on every cell side not incident to a zero; [`domain_fit`] fits on it (`ricci tspline`'s
+//!   default for genus ≥ 2; the per-cylinder [`cylinder_fit`] is the `--per-cylinder`
+//!   option); [`domain_continuity`] measures its derivative jumps across every cell side.
 //!
-//! What is not here yet: for genus ≥ 2 T-junctions and local refinement on the domain mesh,
-//! C² one interval from the zeros; surfaces of genus ≥ 2 with boundary.
+//! What is not here yet: for genus ≥ 2 T-junctions and local refinement on the domain mesh;
+//! surfaces of genus ≥ 2 with boundary.
 
 #![allow(clippy::needless_range_loop)]
 
@@ -41,6 +42,7 @@ pub mod curves;
 pub mod cylinder_fit;
 pub mod cylinder_jumps;
 pub mod cylinders;
+pub mod domain_continuity;
 pub mod domain_fit;
 pub mod domain_mesh;
 pub mod export;

@@ -1,0 +1,154 @@
+//! `ricci tspline` on closed surfaces of genus ≥ 2, the default: one cubic spline on the quad
+//! mesh of knot intervals over the whole domain manifold (the strips of the cylinders of a
+//! holomorphic 1-form glued by translations; `ricci::spline::tspline::{domain_mesh,
+//! domain_fit, domain_continuity}`, paper 003 §2–3), fitted by least squares with uniform
+//! refinement. Continuity, measured across every cell side (JSON `continuity`): C⁰ at the
+//! zeros (the extraordinary points), C² on every other side — reported apart for the sides
+//! one knot interval from a zero and the sides farther.
+//!
+//! Writes `tspline.step`, `tspline.igs` (one Bézier patch per cell, the strips side by side in
+//! the parameter plane), `surface.obj` (per-patch tessellation), `samples.json` (our
+//! evaluation from the blending functions) and `tspline.json`.
+
+use crate::cmd::layout::Bar;
+use crate::cmd::tspline::Args;
+use crate::cmd::tspline_genus::{
+    jumps_json, print_report, shared_keys, warn_not_converged, write_files,
+};
+use ricci::analysis::forms::HolomorphicForms;
+use ricci::mesh::Surface;
+use ricci::spline::tspline::domain_continuity::{side_continuity, SideContinuity};
+use ricci::spline::tspline::domain_fit::{fit_domain_mesh, DomainFit, DomainFitOptions};
+use ricci::spline::tspline::genus_domain::GenusDomain;
+use ricci::spline::tspline::glue::Gluing;
+use ricci::spline::tspline::{BezierPatch, Continuity};
+use serde_json::json;
+use std::time::Instant;
+
+/// Relative jump below which an order counts as continuous.
+const CONTINUOUS: f64 = 1e-8;
+
+fn class(c: &Continuity) -> String {
+    match c.class(CONTINUOUS) {
+        Some(k) => format!("C{k}"),
+        None => "discontinuous".to_string(),
+    }
+}
+
+/// The JSON `continuity`: per class of sides, the class measured and the jumps per order.
+fn continuity_json(s: &SideContinuity, zeros: usize, scale: f64) -> serde_json::Value {
+    let group = |c: &Continuity, sides: usize, what: &str| json!({"class": class(c), "sides": sides, "what": what, "jumps": jumps_json(c, 3)});
+    let gap = s.all().jumps[0];
+    json!({
+        "class": format!(
+            "{} at the zeros ({} sides with a zero at an end), {} on the {} sides one knot interval from a zero, {} on the other {} sides (at least two knot intervals from every zero); chart-independent to {:.1e} % of the longest side",
+            class(&s.at_zeros), s.sides[0], class(&s.one_interval_from_zeros), s.sides[1],
+            class(&s.elsewhere), s.sides[2], 100.0 * gap / scale
+        ),
+        "measured": format!("jumps of every partial derivative of orders 0-3 between the two Bézier patches of every cell side at {SIDE_SAMPLES} points per side, relative to the largest partial of that order; C^k = relative jumps of orders <= k below {CONTINUOUS:e}"),
+        "at_zeros": group(&s.at_zeros, s.sides[0], "sides with a zero at an end: C0 by construction (the Catmull-Clark limit point at the zero), not G1"),
+        "one_interval_from_zeros": group(&s.one_interval_from_zeros, s.sides[1], "sides with an end one knot interval from a zero: C2 by construction (every cell within two intervals of a zero has the same size)"),
+        "elsewhere": group(&s.elsewhere, s.sides[2], "all other sides, on the critical trajectories and the former knot lines included: C2 by construction"),
+        "chart_independence_percent": 100.0 * gap / scale,
+        "extraordinary_points": zeros,
+    })
+}
+
+const SIDE_SAMPLES: usize = 5;
+
+/// Samples of our own evaluation (the blending functions, not the patches) for the CAD check.
+fn samples_json(fit: &DomainFit, patches: &[BezierPatch]) -> serde_json::Value {
+    let mut out = Vec::with_capacity(2 * patches.len());
+    for (c, p) in patches.iter().enumerate() {
+        for (a, b) in [(0.31, 0.67), (0.73, 0.22)] {
+            let x = fit.mesh.point(c as u32, a, b, &fit.control);
+            let (u, v) = (p.u0 + a * (p.u1 - p.u0), p.v0 + b * (p.v1 - p.v0));
+            out.push(json!([u, v, x[0], x[1], x[2]]));
+        }
+    }
+    let bounds: Vec<[f64; 4]> = patches.iter().map(|p| [p.u0, p.u1, p.v0, p.v1]).collect();
+    json!({"samples": out, "patches": bounds, "samples_per_patch": 2})
+}
+
+#[allow(clippy::too_many_arguments)]
+pub fn run_domain(
+    a: &Args,
+    surface: &Surface,
+    h: &HolomorphicForms,
+    domain: &GenusDomain,
+    gluing: &Gluing,
+    tolerance: f64,
+    t0: Instant,
+    bar: Bar,
+) -> anyhow::Result<()> {
+    bar.0.set_message("fitting the spline on the domain mesh");
+    let opts = DomainFitOptions {
+        tolerance,
+        smoothing: a.smoothing.max(1e-4),
+        max_iterations: a.max_iterations.max(1),
+        max_control_points: a.max_control_points,
+        ..DomainFitOptions::default()
+    };
+    let fit = fit_domain_mesh(domain, gluing, &surface.positions, &opts)?;
+    let fit_seconds = t0.elapsed().as_secs_f64();
+    bar.0.set_message("derivative jumps across every cell side");
+    let sides = side_continuity(&fit.mesh, &fit.control, SIDE_SAMPLES);
+    let patches = fit.mesh.patches(&fit.control);
+    bar.0.finish_and_clear();
+    let mesh = &fit.mesh;
+    let continuity = continuity_json(&sides, domain.decomposition.zeros.len(), fit.scale);
+    let (rms, max) = fit.steps.last().map_or((f64::NAN, f64::NAN), |s| {
+        (s.rms_error_percent, s.max_error_percent)
+    });
+    let offsets = mesh.export_offsets();
+    let strips: Vec<_> = mesh
+        .rects
+        .iter()
+        .zip(&offsets)
+        .map(|(r, off)| {
+            json!({"cylinder": r.cylinder, "strip": r.strip, "length": r.length, "height": r.height,
+                   "cells_u": r.m, "cells_v": r.n, "u_offset": off})
+        })
+        .collect();
+    let mut out = json!({
+        "domain": format!("cylinders of a holomorphic 1-form with integer imaginary periods (genus {}), their strips glued by translations into one quad mesh of knot intervals", h.genus),
+        "spline": "domain_mesh",
+        "strips": strips,
+        "cells": mesh.n_cells(),
+        "control_points": mesh.n_vertices(),
+        "bezier_patches": patches.len(),
+        "continuity": continuity,
+        "gluing_mismatch": gluing.mismatch,
+    });
+    shared_keys(
+        &mut out,
+        a,
+        surface,
+        domain,
+        &fit.steps,
+        fit.converged,
+        tolerance,
+        fit.scale,
+        fit_seconds,
+        t0,
+    );
+    if !fit.converged {
+        warn_not_converged(a, max, tolerance, opts.max_iterations);
+    }
+    write_files(a, &patches, || samples_json(&fit, &patches), &mut out, t0)?;
+    print_report(a, &out, || {
+        format!(
+            "{}: domain mesh of {} strips, {} control points, {} Bézier patches, error rms {:.3}% max {:.3}% of the longest side, {} iterations; continuity: {}; {:.2} s",
+            a.mesh.display(),
+            mesh.rects.len(),
+            mesh.n_vertices(),
+            patches.len(),
+            rms,
+            max,
+            fit.steps.len(),
+            out["continuity"]["class"].as_str().unwrap_or(""),
+            t0.elapsed().as_secs_f64()
+        )
+    });
+    Ok(())
+}

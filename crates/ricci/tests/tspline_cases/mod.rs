@@ -1,0 +1,37 @@
+//! The genus ≥ 2 surfaces of the T-spline tests and their holomorphic 1-forms, shared by the
+//! test files (`mod ricci_meshes; mod tspline_cases;`): a generated genus-2 surface always,
+//! eight.off when `$RICCI_MESHES` is set.
+
+#![allow(dead_code)]
+
+use ricci::analysis::forms::{holomorphic_forms, FormsOptions, HolomorphicForms};
+use ricci::mesh::Surface;
+use ricci::metric::IntrinsicMetric;
+use ricci::progress::NoProgress;
+
+/// The holomorphic 1-forms of `s` (default options, the flat metric of its edge lengths).
+pub fn forms(s: &Surface) -> HolomorphicForms {
+    holomorphic_forms(
+        &s.mesh,
+        &IntrinsicMetric::euclidean(s.edge_lengths()),
+        Some(&s.positions),
+        &FormsOptions::default(),
+        &mut NoProgress,
+    )
+    .unwrap()
+}
+
+/// `genus(2, 20)` and, with `$RICCI_MESHES`, eight.off (a note on stderr without it).
+pub fn genus_two_cases() -> Vec<(&'static str, Surface)> {
+    let mut cases = vec![("genus(2, 20)", ricci::mesh::generate::genus(2, 20).unwrap())];
+    match crate::ricci_meshes::ricci_meshes() {
+        Some(dir) => cases.push((
+            "eight",
+            ricci::mesh::io::read_surface(&dir.join("eight.off"))
+                .unwrap()
+                .0,
+        )),
+        None => eprintln!("RICCI_MESHES is not set: skipping eight.off"),
+    }
+    cases
+}
