@@ -214,7 +214,7 @@ fn check_uv_obj(text: &str) -> (usize, usize, f64) {
             let q = &uv[3 * f..3 * f + 3];
             let a = (q[1][0] - q[0][0]) * (q[2][1] - q[0][1])
                 - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
-            !(a > 0.0)
+            a.is_nan() || a <= 0.0
         })
         .count();
     let len = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
@@ -289,7 +289,7 @@ fn camel_maps_have_no_flipped_triangles() {
         assert_eq!(v["flipped_faces"], 0, "{case}");
         assert!(seam_edges > 0, "{case}: no seam in the OBJ");
         assert!(mismatch < 1e-6, "{case}: seam length mismatch {mismatch:e}");
-        assert_eq!(err.contains("warning:"), false, "{case}: {err}");
+        assert!(!err.contains("warning:"), "{case}: {err}");
         let note = &v["chart_details"][0]["fallback"];
         assert_eq!(note.is_string(), fallback, "{case}: fallback {note}");
         assert_eq!(err.contains("note:"), fallback, "{case}: {err}");

@@ -57,7 +57,7 @@ pub(super) fn unresolved_triangles(triangles: &[[u32; 3]], uv: &[[f64; 2]]) -> u
             let longest = e(0, 1).max(e(1, 2)).max(e(2, 0));
             let a2 = (q[1][0] - q[0][0]) * (q[2][1] - q[0][1])
                 - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
-            !(a2 > tol * longest)
+            a2.is_nan() || a2 <= tol * longest
         })
         .count()
 }
