@@ -5,8 +5,7 @@
 //! `ParamOptions::cone_corrections`; `BENCH_PARAM_CHARTS=1` also prints per chart the flow
 //! runs, corrections and the flow's σ(2u). Cases ending in `w` use the wide cone search
 //! (`ConeSearch::Energy`), in `f` free homology seams (`SeamMode::Free`, `--seams free`).
-//! `BENCH_PARAM_INTERIOR=harmonic` (or `repair`) runs every case with the harmonic interior
-//! (`Interior::Harmonic`, `--interior harmonic`); `BENCH_PARAM_CONES=N` or `auto:D` replaces
+//! `BENCH_PARAM_CONES=N` or `auto:D` replaces
 //! the case's cones by `N` greedy cones or `--cones auto --max-area-distortion D`.
 //!
 //! ```sh
@@ -17,7 +16,7 @@
 
 use ricci::mesh::io::read_surface;
 use ricci::param::cones::{ConeSearch, CurvatureRule};
-use ricci::param::{parametrize, ConeSpec, Interior, ParamOptions, SeamMode};
+use ricci::param::{parametrize, ConeSpec, ParamOptions, SeamMode};
 use ricci::progress::NoProgress;
 use std::path::PathBuf;
 
@@ -103,11 +102,6 @@ fn main() {
                 continue;
             }
         };
-        let interior = match std::env::var("BENCH_PARAM_INTERIOR").as_deref() {
-            Ok("harmonic") => Interior::Harmonic,
-            Ok("repair") => Interior::Repair,
-            _ => Interior::Exact,
-        };
         let cones = match std::env::var("BENCH_PARAM_CONES") {
             Ok(c) => match c.strip_prefix("auto:") {
                 Some(d) => ConeSpec::Auto {
@@ -119,7 +113,6 @@ fn main() {
         };
         let opts = ParamOptions {
             cones,
-            interior,
             // `+c`: one round of cone-curvature correction on the nonlinear flow.
             cone_corrections: usize::from(name.ends_with("+c")),
             // `w`: the wide cone search (`ConeSearch::Energy`).

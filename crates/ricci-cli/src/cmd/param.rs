@@ -26,6 +26,11 @@
 //! `uv.triangles`, `uv.input_flipped_faces`.
 //! A disk whose own flow fails or stalls (free boundary, no cones asked for) is mapped through
 //! the flow on its double instead (`"route": "double"`, `"route_reason"`; [`double`]).
+//! When the map asked for would have flipped triangles (its scale factors beyond what
+//! double-precision UVs resolve: camel as a flat torus, or with 3–4 free-seam cones) or its
+//! flow does not converge, the chart is recomputed with rigid seams, then with up to four
+//! more greedy cones, and the first map without flipped triangles is written; stderr and
+//! `chart_details[].fallback` say so (given cones are never changed).
 //! The JSON report: `uv_faces`, `flipped_faces` (of what is written), `qc_mean`/`qc_p95`/`qc_max`
 //! (σmax/σmin per face), `log_area_sigma` (σ of log(A_uv/A_3d)), `cones`, `seam_length`,
 //! per-chart details and `seconds`.
@@ -200,6 +205,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .iter()
         .flat_map(|c| c.cones.iter().copied())
         .collect();
+    // A chart recomputed with rigid seams or more cones because the map asked for would
+    // have flipped triangles (`ricci::param` ladder): said on stderr, and in the JSON's
+    // `chart_details[].fallback`.
+    for c in &p.charts {
+        if let Some(why) = &c.fallback {
+            eprintln!("note: {name}: component {}: {why}", c.component);
+        }
+    }
     if let Some(path) = &a.out {
         let text = match &p.subdivision {
             Some(m) => obj_with_corner_uv(

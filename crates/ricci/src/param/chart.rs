@@ -9,13 +9,13 @@ use super::cones::{
     correct_cone_curvatures, greedy_cones_with, round_to_quarter_turns, ConeBudget,
 };
 use super::free::{free_seam_target, homology_disk, HomologyDisk};
-use super::harmonic::{harmonic_interior, repair_folds};
+use super::ladder::unresolved_triangles;
 use super::transfer::{
     folded_faces, input_route, scale_to_area, seam_edges, seam_report, subdivision_route,
     SubdivisionChart,
 };
 use super::{log_scale_sigma, BoundaryMode, Chart, Cone, ConeSpec};
-use super::{Interior, ParamOptions, Piece, SeamMode};
+use super::{ParamOptions, Piece, SeamMode};
 use crate::error::{Error, Result};
 use crate::flow::{flow_with_fallback, FlowResult, TargetSpec, UniformizationOptions};
 use crate::mesh::{topology, Mesh};
@@ -32,6 +32,9 @@ pub(super) struct ChartUv {
     pub cut: Vec<bool>,
     pub subdivision: Option<SubdivisionChart>,
     pub chart: Chart,
+    /// Written triangles (the subdivision's, else the input's faces) that fold or lie within
+    /// rounding of folding ([`super::ladder::unresolved_triangles`]).
+    pub flipped: usize,
 }
 
 /// Target curvature of a chart, with its cones, how they were chosen and the greedy's
@@ -95,6 +98,14 @@ fn closed_target(
     };
     let (mut cones, mut source, mut history) = (Vec::new(), "none".to_string(), Vec::new());
     let budget = match spec {
+        // Gauss–Bonnet: the curvatures sum to 4π on a sphere and each is below 2π.
+        ConeSpec::Count(k @ 1..=2) if genus == 0 => {
+            return Err(Error::input(format!(
+                "component {component} (closed, genus 0) needs at least 3 cones to be flattened \
+                 (their curvatures sum to 4π and each must stay below 2π); --cones {k} is too few \
+                 (or use --sphere)"
+            )));
+        }
         ConeSpec::Count(k) => Some(ConeBudget::Count(k)),
         ConeSpec::Auto {
             max_area_distortion,
@@ -343,7 +354,10 @@ pub(super) fn chart_uv(
     progress.report("cut", None, "cut graph through the cones and the handles");
     let faces = mesh.faces();
     let on_input = input_route(s, &lengths, r, &cone_vertices, needs_cut);
-    let (on_input, input_folds, interior) = with_interior(mesh, &lengths, on_input, opts.interior);
+    let input_folds = match &on_input {
+        Ok((_, uv)) => folded_faces(faces, uv),
+        Err(_) => faces.len(),
+    };
     let (cut, mut corner_uv, mut subdivision) = match on_input {
         Ok((cut, uv)) if input_folds == 0 && !opts.on_subdivision => (cut, uv, None),
         first => {
@@ -411,7 +425,6 @@ pub(super) fn chart_uv(
         } else {
             "input".into()
         },
-        interior: interior.name().into(),
         input_flipped_faces: input_folds,
         moved_cones: 0,
         seam_edges: seams.edges,
@@ -423,7 +436,12 @@ pub(super) fn chart_uv(
         flow_runs: kept.runs,
         cone_corrections: kept.corrections,
         log_scale_sigma: log_scale_sigma(s, &r.u),
+        fallback: None,
         seconds: t0.elapsed().as_secs_f64(),
+    };
+    let flipped = match &subdivision {
+        Some(sub) => unresolved_triangles(&sub.triangles, &sub.corner_uv),
+        None => unresolved_triangles(faces, &corner_uv),
     };
     let cut = match &disk {
         Some(d) => d.lift_cut(piece, &cut),
@@ -434,38 +452,8 @@ pub(super) fn chart_uv(
         cut,
         subdivision,
         chart,
+        flipped,
     })
-}
-
-/// The input route's result: the cut on input edges and one UV per input corner.
-type InputRoute = Result<(Vec<bool>, Vec<[f64; 2]>)>;
-
-/// The input route's UVs with the opt-in interior `want` ([`Interior`]), kept when it folds
-/// no input face, else the exact UVs; the input faces that fold (all when the route failed)
-/// and the interior used.
-fn with_interior(
-    mesh: &Mesh,
-    lengths: &[f64],
-    on_input: InputRoute,
-    want: Interior,
-) -> (InputRoute, usize, Interior) {
-    let faces = mesh.faces();
-    let (cut, uv) = match on_input {
-        Ok(x) => x,
-        Err(e) => return (Err(e), faces.len(), Interior::Exact),
-    };
-    let folds = folded_faces(faces, &uv);
-    let other = match want {
-        Interior::Harmonic => harmonic_interior(mesh, lengths, &cut, &uv)
-            .ok()
-            .filter(|h| folded_faces(faces, h) == 0),
-        Interior::Repair if folds > 0 => repair_folds(mesh, lengths, &cut, &uv).map(|r| r.0),
-        _ => None,
-    };
-    match other {
-        Some(x) => (Ok((cut, x)), 0, want),
-        None => (Ok((cut, uv)), folds, Interior::Exact),
-    }
 }
 
 /// UV per corner of the input's faces from the common subdivision: the corner of the piece

@@ -31,6 +31,7 @@ mod closed;
 mod green;
 mod held;
 
+use crate::analysis::forms::harmonic::cotan_weights;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::metric::IntrinsicMetric;
@@ -70,27 +71,18 @@ struct Laplacian {
 
 fn laplacian(mesh: &Mesh, lengths: &[f64]) -> Result<Laplacian> {
     let n = mesh.n_vertices();
-    let mut w = vec![0.0; mesh.n_edges()];
+    // The edge weights (cot α + cot β)/2 of the analysis module (one definition in the crate).
+    let w = cotan_weights(mesh, lengths).map_err(|e| {
+        Error::numerical(format!("{e} in the input metric; cones cannot be placed"))
+    })?;
     let mut area = vec![0.0; n];
     for f in 0..mesh.n_faces() as u32 {
-        let t = mesh.face(f);
-        let hs = mesh.face_halfedges(f);
-        // Edge of half-edge 3f+i joins t[i], t[i+1]; opposite corner t[i+2].
-        let l: Vec<f64> = hs
-            .iter()
-            .map(|&h| lengths[mesh.he_edge(h) as usize])
-            .collect();
-        let a = crate::numeric::vec3::heron([l[0], l[1], l[2]]);
-        if a.is_nan() || a <= 0.0 {
-            return Err(Error::numerical(format!(
-                "face {f} has zero area in the input metric; cones cannot be placed"
-            )));
-        }
-        for i in 0..3 {
-            let (x, y, z) = (l[i], l[(i + 1) % 3], l[(i + 2) % 3]);
-            // cot of the angle opposite x: (y² + z² − x²) / 4A.
-            w[mesh.he_edge(hs[i]) as usize] += (y * y + z * z - x * x) / (8.0 * a);
-            area[t[i] as usize] += a / 3.0;
+        let l = mesh
+            .face_halfedges(f)
+            .map(|h| lengths[mesh.he_edge(h) as usize]);
+        let a = crate::numeric::vec3::heron(l);
+        for v in mesh.face(f) {
+            area[v as usize] += a / 3.0;
         }
     }
     let mut cols: Vec<Vec<(u32, f64)>> = vec![Vec::new(); n];

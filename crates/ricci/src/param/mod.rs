@@ -45,14 +45,18 @@
 //!    (Gillespie–Springborn–Crane 2021 §5; [`crate::metric::common_subdivision`]): every
 //!    piece lies in one input face and one face of `T` and none folds
 //!    ([`Parametrization::subdivision`], [`Chart::uv_faces`]).
-//! 6. **Packing**: each chart scaled to its surface area, rotated to its smallest bounding
+//! 6. **Flip-free** ([`ladder`]): a chart whose written triangles fold, or lie within
+//!    rounding of folding (scale factors beyond what double-precision UVs resolve), or whose
+//!    flow does not converge, is recomputed with rigid seams, then with more greedy cones;
+//!    the chart says so ([`Chart::fallback`]).
+//! 7. **Packing**: each chart scaled to its surface area, rotated to its smallest bounding
 //!    box (not with `--seamless`), shelf-packed and scaled into `[margin, 1 − margin]²`.
 
 pub(crate) mod boundary;
 mod chart;
 pub mod cones;
 mod free;
-mod harmonic;
+mod ladder;
 pub mod seamless;
 pub(crate) mod seams;
 pub mod sphere;
@@ -141,52 +145,6 @@ impl SeamMode {
     }
 }
 
-/// Where the UVs of the vertices off the seams come from ([`ParamOptions::interior`];
-/// library only, not on the CLI: neither opt-in interior helps yet, BENCHMARKS session 12).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Interior {
-    /// The flat layout itself at every vertex: the discrete conformal map, exact at the
-    /// vertices (on the common subdivision when the input's faces would fold).
-    #[default]
-    Exact,
-    /// The seam (and boundary) vertices from the flat layout, the others by the
-    /// cotangent-harmonic extension of them on the input's faces (submodule `harmonic`;
-    /// Boundary First Flattening's interior): least conformal energy with that boundary, same
-    /// cones and seams. Used only when it folds no input face; otherwise the exact map.
-    Harmonic,
-    /// The exact layout, except where an input face would fold: the vertices of those faces
-    /// and a few rings around them (off the seams) move to the mean-value average of their
-    /// neighbours (submodule `harmonic`, `repair_folds`), so that the map stays on the
-    /// input's faces instead of the common subdivision. Falls back to the exact map (on the
-    /// subdivision) when that does not unfold every face.
-    Repair,
-}
-
-impl std::str::FromStr for Interior {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        match s {
-            "exact" => Ok(Interior::Exact),
-            "harmonic" => Ok(Interior::Harmonic),
-            "repair" => Ok(Interior::Repair),
-            _ => Err(format!(
-                "unknown interior '{s}' (expected exact, harmonic or repair)"
-            )),
-        }
-    }
-}
-
-impl Interior {
-    pub fn name(self) -> &'static str {
-        match self {
-            Interior::Exact => "exact",
-            Interior::Harmonic => "harmonic",
-            Interior::Repair => "repair",
-        }
-    }
-}
-
 /// Options of [`parametrize`].
 #[derive(Debug, Clone)]
 pub struct ParamOptions {
@@ -216,8 +174,6 @@ pub struct ParamOptions {
     /// Curvatures of the greedy cones with free seams (default least squares: the least
     /// linearised σ(2u) at the greedy's positions; `Dirichlet`: `u = 0` at the cones, BFF's).
     pub free_cone_rule: cones::CurvatureRule,
-    /// Exact layout at every vertex (default) or the harmonic interior ([`Interior`]).
-    pub interior: Interior,
 }
 
 impl Default for ParamOptions {
@@ -234,7 +190,6 @@ impl Default for ParamOptions {
             cone_search: cones::ConeSearch::Greedy,
             seams: SeamMode::Rigid,
             free_cone_rule: cones::CurvatureRule::LeastSquares,
-            interior: Interior::Exact,
         }
     }
 }
@@ -277,10 +232,6 @@ pub struct Chart {
     /// `"common_subdivision"` (the input's faces would fold, or the cut needs edges the flow
     /// flipped; [`Parametrization::subdivision`]).
     pub uv_faces: String,
-    /// `"harmonic"` when the vertices off the seams were moved to the harmonic extension
-    /// ([`Interior::Harmonic`]), `"repair"` when the vertices around input faces that would
-    /// fold were moved ([`Interior::Repair`]), else `"exact"`.
-    pub interior: String,
     /// Input faces whose own UV triangle is not positive (with the cut on input edges; all
     /// faces when no such cut exists) — the reason for `common_subdivision`.
     pub input_flipped_faces: usize,
@@ -303,6 +254,9 @@ pub struct Chart {
     /// area-weighted `σ(2u)` of the flow's conformal factor that was kept.
     pub cone_corrections: usize,
     pub log_scale_sigma: f64,
+    /// `None` when the chart is what was asked for; otherwise why and how it was recomputed
+    /// to get a map without flipped triangles (rigid seams, more cones: [`ladder`]).
+    pub fallback: Option<String>,
     pub seconds: f64,
 }
 
@@ -496,7 +450,7 @@ pub fn parametrize(
     let mut boxes = Vec::new();
     let mut chart_uvs = Vec::new();
     for (c, p) in ps.iter().enumerate() {
-        let mut cu = chart::chart_uv(p, c, opts, progress)?;
+        let mut cu = ladder::flip_free_chart(p, c, opts, progress)?;
         let wh = match cu.subdivision.as_mut() {
             Some(sub) => orient(&mut sub.corner_uv, &mut cu.corner_uv, !opts.seamless),
             None => orient(&mut cu.corner_uv, &mut [], !opts.seamless),
