@@ -7,7 +7,7 @@ degenerate faces, flipped faces from the report, route, CPU seconds of the child
     RICCI_MESHES=../shared/meshes python3 examples/must_show_converged.py [target/release/ricci]
 
 The full sweep of every shared mesh (with the flipped faces recounted from the OBJ) is the
-ignored test `cargo test --release -p ricci-cli --test sweep_meshes -- --ignored --nocapture`.
+ignored test `cargo test --release -p ricci-cli --test all sweep_meshes:: -- --ignored --nocapture`.
 """
 import json, os, resource, subprocess, sys, tempfile
 

@@ -11,7 +11,7 @@
 //! `sweep_small_meshes` runs the cheap meshes (a few seconds in release);
 //! `sweep_all_meshes` (ignored: minutes) runs every mesh and prints the table recorded in
 //! BENCHMARKS.md:
-//! `RICCI_MESHES=/work/shared/meshes cargo test --release -p ricci-cli --test sweep_meshes -- --ignored --nocapture`.
+//! `RICCI_MESHES=/work/shared/meshes cargo test --release -p ricci-cli --test all sweep_meshes:: -- --ignored --nocapture`.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

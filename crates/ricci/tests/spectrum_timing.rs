@@ -1,7 +1,7 @@
 //! Timing of the hyperbolic length spectrum (issue 17: fertility, botijo and seahorse2_100K,
 //! 12 lengths, each ≤ 5 s for the whole `ricci spectrum`): flow + double-double polish, then
 //! `surface_spectrum`, as `examples/bench_spectrum.rs` does. Ignored by default (a benchmark,
-//! not a check): `cargo test --release -p ricci --test spectrum_timing -- --ignored --nocapture`
+//! not a check): `cargo test --release -p ricci --test all spectrum_timing:: -- --ignored --nocapture`
 //! under `/usr/bin/time`. What it asserts is only the search's own guarantee: the 12 lengths
 //! are sorted and the enumeration is complete up to the last of them.
 

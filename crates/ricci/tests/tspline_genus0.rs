@@ -181,7 +181,7 @@ fn bunny_domain_puts_the_poles_at_the_ear_tips_and_fills_the_five_holes() {
 /// support meets the surface's half of the torus) and reach at most both its
 /// errors, recomputed here from the spline at the returned parameters over every input vertex.
 /// Ignored: ~110 CPU-s (BENCHMARKS.md "Session 11 (tfit11)"); run with
-/// `RICCI_MESHES=../shared/meshes cargo test --release -p ricci --test tspline_genus0 -- --ignored`.
+/// `RICCI_MESHES=../shared/meshes cargo test --release -p ricci --test all tspline_genus0:: -- --ignored`.
 #[test]
 #[ignore]
 fn bunny_meets_paper_003_table_1_count_rms_and_max_error() {
