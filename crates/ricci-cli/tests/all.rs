@@ -32,8 +32,12 @@ mod cli_info;
 mod cli_layout;
 #[path = "cli_layout_double.rs"]
 mod cli_layout_double;
+#[path = "cli_layout_round_boundary.rs"]
+mod cli_layout_round_boundary;
 #[path = "cli_metric_file.rs"]
 mod cli_metric_file;
+#[path = "cli_nonconvergence.rs"]
+mod cli_nonconvergence;
 #[path = "cli_param.rs"]
 mod cli_param;
 #[path = "cli_pou.rs"]
