@@ -25,7 +25,7 @@ use ricci::layout::deck::{deck_group_ext, DeckFrames};
 use ricci::layout::export::obj_with_corner_uv;
 use ricci::layout::input_uv::input_face_uvs;
 use ricci::layout::isometry::Complex;
-use ricci::layout::pipeline::{cut_disk, cut_disk_polished, uniformization_geometry, CutDisk};
+use ricci::layout::pipeline::{uniformization_geometry, CutDisk};
 use ricci::layout::place::{layout, layout_dd, minimax_centre, Space};
 use ricci::layout::subdivision_uv::{
     common_subdivision_uvs_ext, sphere_common_subdivision, sphere_flipped_faces,
@@ -40,6 +40,7 @@ use serde_json::{json, Value};
 use std::path::PathBuf;
 use std::time::Instant;
 
+mod cut;
 pub(crate) mod double;
 pub mod file_metric;
 mod json;
@@ -843,32 +844,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let disk = if simply_connected && comp.boundary_loops == 1 {
             None
         } else {
-            bar.0.set_message("cutting along canonical loops");
-            let deferred = polish_report["deferred"] == json!(true);
-            let d = if metric.is_double_double() || deferred {
-                let d = cut_disk_polished(work, &metric, work_positions, a.base, &mut bar)?;
-                polish_report["refined"] = json!(d.refined_polish);
-                if let (true, Some(p)) = (deferred, &d.refined_polish) {
-                    polish_report["steps"] = json!(p.steps);
-                    polish_report["residual_start"] = json!(p.residual_start);
-                    polish_report["residual_dd"] = json!(p.residual_dd);
-                    polish_report["converged"] = json!(p.converged);
-                }
-                d
-            } else {
-                cut_disk(work, &metric, work_positions, a.base, &mut bar)?
-            };
-            out["boundary_word"] = json!(d.polygon.word());
-            out["base_vertex"] = json!(d.cut.base);
-            out["refinement_splits"] = json!(d.cut.report.refinement_splits);
-            out["cut_attempts"] = json!(d.cut.report.attempts);
-            out["cut_failed_attempts"] = json!(d.cut.report.failed_attempts);
-            out["loop_lengths"] = json!(d
-                .cut
-                .loops
-                .iter()
-                .map(|l| json!({"label": l.label, "length": l.length}))
-                .collect::<Vec<_>>());
+            let d = cut::cut_stage(
+                work,
+                &metric,
+                work_positions,
+                a.base,
+                &mut polish_report,
+                &mut out,
+                &mut bar,
+            )?;
             crate::util::stage_done("cut");
             Some(d)
         };

@@ -38,12 +38,14 @@ pub mod double;
 pub(crate) mod error;
 pub(crate) mod newton;
 pub mod polish;
+mod solver;
 pub mod sphere;
 pub mod target;
 pub mod uniformize;
 
 pub use adaptive::ricci_flow_refined;
 pub use error::FlowError;
+pub use solver::{Solver, SphereRoute};
 pub use target::{separated_vertices, Target, TargetSpec};
 pub use uniformize::{
     flow_with_fallback, Fallback, FallbackFlow, TargetPolicy, UniformizationOptions,
@@ -55,57 +57,7 @@ use crate::metric::{euler_characteristic, ConformalStructure, Evaluator, Geometr
 use crate::progress::Progress;
 use serde::Serialize;
 use std::f64::consts::PI;
-use std::fmt;
-use std::str::FromStr;
 use std::time::Instant;
-
-/// The optimizer.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Solver {
-    Newton,
-    Gradient,
-}
-
-impl Solver {
-    pub fn name(self) -> &'static str {
-        match self {
-            Solver::Newton => "newton",
-            Solver::Gradient => "gradient",
-        }
-    }
-}
-
-impl fmt::Display for Solver {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Solver {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        match s.to_ascii_lowercase().as_str() {
-            "newton" => Ok(Solver::Newton),
-            "gradient" | "gradient-descent" | "flow" => Ok(Solver::Gradient),
-            _ => Err(format!(
-                "unknown solver '{s}' (expected newton or gradient)"
-            )),
-        }
-    }
-}
-
-/// How genus-0 closed surfaces reach the sphere.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum SphereRoute {
-    /// Spherical Newton first, the puncture route if it fails.
-    Auto,
-    /// Spherical Newton only.
-    Newton,
-    /// The puncture route directly.
-    Puncture,
-}
 
 /// The scheme used when the user names none: [`Scheme::Conformal`] (discrete conformal
 /// equivalence — vertex scaling with intrinsic Delaunay flips: the conformal class of the

@@ -124,6 +124,18 @@ fn progress_fraction(e0: f64, e: f64, tol: f64) -> f64 {
     ((e0 / e).ln() / (e0 / tol).ln()).clamp(0.0, 1.0)
 }
 
+/// The line search's first step length along `delta`: 1, or for S² and exact round-boundary
+/// steps (indefinite systems, `trust_region`) a trust region of 2 in u (radii change by at most
+/// e²), against wild steps from a nearly singular system.
+fn first_step(delta: &[f64], trust_region: bool) -> f64 {
+    let dmax = delta.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+    if trust_region && dmax > 2.0 {
+        2.0 / dmax
+    } else {
+        1.0
+    }
+}
+
 /// Newton's method from `u_start`.
 pub fn newton(
     ev: &mut Evaluator,
@@ -216,14 +228,7 @@ pub fn newton(
         // Line search, against the frozen target for chord steps.
         let g0: f64 = -r0.iter().zip(&sys.rhs).map(|(r, d)| r * d).sum::<f64>(); // ∇E·δ < 0
         let res0: f64 = r0.iter().map(|r| r * r).sum();
-        // S² and exact round-boundary steps (indefinite systems): a trust region of 2 in u
-        // (radii change by at most e²), against wild steps from a nearly singular system.
-        let dmax = delta.iter().fold(0.0f64, |m, d| m.max(d.abs()));
-        let t_start: f64 = if (settings.indefinite || exact_round) && dmax > 2.0 {
-            2.0 / dmax
-        } else {
-            1.0
-        };
+        let t_start = first_step(&delta, settings.indefinite || exact_round);
         let search = StepSearch {
             u: &u,
             delta: &delta,

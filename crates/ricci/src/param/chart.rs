@@ -298,6 +298,18 @@ fn open_and_plan(
     Ok((Some(disk), plan))
 }
 
+/// The cones `(piece vertex, curvature)` named by their input vertices, with their angles.
+fn input_cones(work: &Piece, cones: &[(u32, f64)]) -> Vec<Cone> {
+    cones
+        .iter()
+        .map(|&(v, k)| Cone {
+            vertex: work.vertices[v as usize],
+            curvature: k,
+            angle: 2.0 * PI - k,
+        })
+        .collect()
+}
+
 /// UVs of one connected component (module docs, steps 1–5).
 pub(super) fn chart_uv(
     piece: &Piece,
@@ -395,15 +407,7 @@ pub(super) fn chart_uv(
         .triangulation
         .as_ref()
         .ok_or_else(|| Error::numerical("the conformal flow returned no triangulation"))?;
-    let cones: Vec<Cone> = kept
-        .cones
-        .iter()
-        .map(|&(v, k)| Cone {
-            vertex: work.vertices[v as usize],
-            curvature: k,
-            angle: 2.0 * PI - k,
-        })
-        .collect();
+    let cones = input_cones(work, &kept.cones);
     let chart = Chart {
         component,
         faces: mesh.n_faces(),

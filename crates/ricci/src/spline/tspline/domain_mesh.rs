@@ -204,6 +204,34 @@ fn find(p: &mut [u32], mut x: u32) -> u32 {
     x
 }
 
+/// Give every strip the same edge cells — the two first and two last columns of width `edge_u`,
+/// the two first and two last rows of height `edge_v`, the smallest uniform cell size of any
+/// strip (so the middle cells of every strip are at least as large) — and number the cells
+/// strip by strip; the number of cells.
+fn size_edge_cells(rects: &mut [Rect]) -> Result<usize, String> {
+    let edge_u = rects
+        .iter()
+        .map(|r| r.length / r.m as f64)
+        .fold(f64::INFINITY, f64::min);
+    let edge_v = rects
+        .iter()
+        .map(|r| r.height / r.n as f64)
+        .fold(f64::INFINITY, f64::min);
+    if !(edge_u > 0.0 && edge_v > 0.0) {
+        return Err(format!(
+            "a strip has no positive length or height (edge cells {edge_u} × {edge_v})"
+        ));
+    }
+    let mut cells = 0;
+    for r in rects.iter_mut() {
+        r.edge_u = edge_u;
+        r.edge_v = edge_v;
+        r.first_cell = cells;
+        cells += r.m * r.n;
+    }
+    Ok(cells)
+}
+
 impl DomainMesh {
     /// The mesh with cells of size about `spacing` (at least [`MIN_CELLS`] along every strip
     /// side), or why not.
@@ -271,28 +299,7 @@ impl DomainMesh {
                 done[r] = true;
             }
         }
-        // the edge cells: the smallest uniform cell size of any strip (so the middle cells of
-        // every strip are at least as large)
-        let edge_u = rects
-            .iter()
-            .map(|r| r.length / r.m as f64)
-            .fold(f64::INFINITY, f64::min);
-        let edge_v = rects
-            .iter()
-            .map(|r| r.height / r.n as f64)
-            .fold(f64::INFINITY, f64::min);
-        if !(edge_u > 0.0 && edge_v > 0.0) {
-            return Err(format!(
-                "a strip has no positive length or height (edge cells {edge_u} × {edge_v})"
-            ));
-        }
-        let mut cells = 0;
-        for r in rects.iter_mut() {
-            r.edge_u = edge_u;
-            r.edge_v = edge_v;
-            r.first_cell = cells;
-            cells += r.m * r.n;
-        }
+        let cells = size_edge_cells(&mut rects)?;
         let right_rect = |r: usize| {
             let (c, s) = (rects[r].cylinder, rects[r].strip);
             let k = gluing.layouts[c].lines.len();
