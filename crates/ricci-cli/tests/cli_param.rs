@@ -324,7 +324,8 @@ fn log_area_sigma_of_obj(text: &str) -> f64 {
         let a3 = 0.5 * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
         let q = &uv[3 * f..3 * f + 3];
         let auv = 0.5
-            * ((q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]));
+            * ((q[1][0] - q[0][0]) * (q[2][1] - q[0][1])
+                - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]));
         if a3 > 0.0 && auv > 0.0 {
             let x = (auv / a3).ln();
             w += a3;
@@ -361,7 +362,10 @@ fn seam_transitions(text: &str) -> Vec<([usize; 2], f64, Option<[f64; 2]>)> {
             // Centre z of the rotation R with R(p − z) + z = q, p = uv[c], q = uv[d2].
             let (p, q) = (uv[c], uv[d2]);
             let (co, si) = (th.cos(), th.sin());
-            let rhs = [q[0] - (co * p[0] - si * p[1]), q[1] - (si * p[0] + co * p[1])];
+            let rhs = [
+                q[0] - (co * p[0] - si * p[1]),
+                q[1] - (si * p[0] + co * p[1]),
+            ];
             let (m00, m01, m10, m11) = (1.0 - co, si, -si, 1.0 - co);
             let det = m00 * m11 - m01 * m10;
             let centre = (det.abs() > 1e-12).then(|| {

@@ -125,7 +125,14 @@ pub(super) fn free_seam_target(
              --seams free cones must lie off the seams (or use --seams rigid)"
         ))
     };
-    held_boundary_cones(&disk.piece, disk.first_copy(), &spec, opts, progress, &on_seam)
+    held_boundary_cones(
+        &disk.piece,
+        disk.first_copy(),
+        &spec,
+        opts,
+        progress,
+        &on_seam,
+    )
 }
 
 /// Cones inside a surface whose boundary is held at `u = 0` (`piece`: the disk of free seams,
