@@ -1,5 +1,6 @@
 //! `ricci param`: one command from a mesh to a UV map on its own faces.
 
+use std::f64::consts::PI;
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -294,4 +295,184 @@ fn camel_maps_have_no_flipped_triangles() {
         assert_eq!(note.is_string(), fallback, "{case}: fallback {note}");
         assert_eq!(err.contains("note:"), fallback, "{case}: {err}");
     }
+}
+
+/// Area-weighted σ of `log(A_uv / A_3d)` over the faces of a UV OBJ, from its `v`, `vt` and
+/// `f` lines.
+fn log_area_sigma_of_obj(text: &str) -> f64 {
+    let pos: Vec<[f64; 3]> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let w: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            [w[0], w[1], w[2]]
+        })
+        .collect();
+    let (uv, v) = obj_corner_uv(text);
+    let (mut w, mut s1, mut s2) = (0.0, 0.0, 0.0);
+    for f in 0..uv.len() / 3 {
+        let p = |i: usize| pos[v[3 * f + i] - 1];
+        let (a, b) = (
+            [0, 1, 2].map(|k| p(1)[k] - p(0)[k]),
+            [0, 1, 2].map(|k| p(2)[k] - p(0)[k]),
+        );
+        let c = [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ];
+        let a3 = 0.5 * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        let q = &uv[3 * f..3 * f + 3];
+        let auv = 0.5
+            * ((q[1][0] - q[0][0]) * (q[2][1] - q[0][1])
+                - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]));
+        if a3 > 0.0 && auv > 0.0 {
+            let x = (auv / a3).ln();
+            w += a3;
+            s1 += a3 * x;
+            s2 += a3 * x * x;
+        }
+    }
+    let m = s1 / w;
+    (s2 / w - m * m).max(0.0).sqrt()
+}
+
+/// The transitions across the seams of a UV OBJ: for every seam edge (input vertices `a < b`
+/// as 0-based `v` indices), the rotation angle `θ ∈ (−π, π]` taking the edge on one side to
+/// the other and the rotation's centre (`None` for a translation).
+fn seam_transitions(text: &str) -> Vec<([usize; 2], f64, Option<[f64; 2]>)> {
+    use std::collections::HashMap;
+    let (uv, v) = obj_corner_uv(text);
+    let mut sides: HashMap<(usize, usize), (usize, usize)> = HashMap::new();
+    let mut out = Vec::new();
+    for f in 0..uv.len() / 3 {
+        for i in 0..3 {
+            let (c, d) = (3 * f + i, 3 * f + (i + 1) % 3);
+            let Some((c2, d2)) = sides.remove(&(v[d], v[c])) else {
+                sides.insert((v[c], v[d]), (c, d));
+                continue;
+            };
+            if uv[c] == uv[d2] && uv[d] == uv[c2] {
+                continue;
+            }
+            // Side 1: uv[c] → uv[d]; side 2: uv[d2] → uv[c2] (same vertices v[c] → v[d]).
+            let e1 = [uv[d][0] - uv[c][0], uv[d][1] - uv[c][1]];
+            let e2 = [uv[c2][0] - uv[d2][0], uv[c2][1] - uv[d2][1]];
+            let th = (e1[0] * e2[1] - e1[1] * e2[0]).atan2(e1[0] * e2[0] + e1[1] * e2[1]);
+            // Centre z of the rotation R with R(p − z) + z = q, p = uv[c], q = uv[d2].
+            let (p, q) = (uv[c], uv[d2]);
+            let (co, si) = (th.cos(), th.sin());
+            let rhs = [
+                q[0] - (co * p[0] - si * p[1]),
+                q[1] - (si * p[0] + co * p[1]),
+            ];
+            let (m00, m01, m10, m11) = (1.0 - co, si, -si, 1.0 - co);
+            let det = m00 * m11 - m01 * m10;
+            let centre = (det.abs() > 1e-12).then(|| {
+                [
+                    (rhs[0] * m11 - m01 * rhs[1]) / det,
+                    (m00 * rhs[1] - m10 * rhs[0]) / det,
+                ]
+            });
+            let (a, b) = (v[c] - 1, v[d] - 1);
+            out.push(([a.min(b), a.max(b)], th, centre));
+        }
+    }
+    out
+}
+
+/// Issue 16, cones on a surface with boundary: face.off with 4 greedy cones and the free
+/// boundary (BFF's `--nCones=4`). Recounted from the OBJ: every UV triangle has positive
+/// area; every seam edge has the same UV length on both sides, and the transitions are rigid
+/// motions, one per arc of the cut (four cone paths to the boundary: at most 7 distinct
+/// rotations; a non-rigid seam gives one per edge); at a cone that ends its path, the
+/// rotation is the cone's curvature (the holonomy around a cone, JSON's `cones`); σ(log area)
+/// recomputed from the OBJ is below the 0-cone map's. `--boundary round` with cones is
+/// refused in one sentence.
+#[test]
+fn face_with_four_cones_and_the_free_boundary() {
+    let Some(meshes) = ricci_meshes::ricci_meshes() else {
+        eprintln!("RICCI_MESHES not set: skipped");
+        return;
+    };
+    let mesh = meshes.join("face.off");
+    if !mesh.exists() {
+        eprintln!("{} missing: skipped", mesh.display());
+        return;
+    }
+    let run = |cones: &[&str], out: &std::path::Path| {
+        let o = Command::new(bin())
+            .arg("param")
+            .arg(&mesh)
+            .args(cones)
+            .args(["--json", "--out"])
+            .arg(out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        (v, std::fs::read_to_string(out).unwrap())
+    };
+    let (v4, t4) = run(&["--cones", "4"], &tmp("face-4.obj"));
+    let (_, t0) = run(&[], &tmp("face-0.obj"));
+    assert_eq!(v4["cone_count"], 4, "{v4}");
+    let (flipped, seams, mismatch) = check_uv_obj(&t4);
+    assert_eq!(flipped, 0, "{flipped} flipped UV triangles in the OBJ");
+    assert!(seams > 0, "no seam in the OBJ");
+    assert!(mismatch < 1e-6, "seam length mismatch {mismatch:e}");
+    // Distinct rigid motions among the seam edges' transitions.
+    let tr = seam_transitions(&t4);
+    let mut motions: Vec<(f64, Option<[f64; 2]>)> = Vec::new();
+    for &(_, th, centre) in &tr {
+        let same = |m: &(f64, Option<[f64; 2]>)| {
+            (m.0.abs() - th.abs()).abs() < 1e-6
+                && match (m.1, centre) {
+                    (Some(a), Some(b)) => (a[0] - b[0]).hypot(a[1] - b[1]) < 1e-4,
+                    (None, None) => true,
+                    _ => false,
+                }
+        };
+        if !motions.iter().any(same) {
+            motions.push((th, centre));
+        }
+    }
+    assert!(
+        (1..=7).contains(&motions.len()),
+        "{} distinct seam transitions over {} seam edges",
+        motions.len(),
+        tr.len()
+    );
+    if v4["uv_faces"] == "input" {
+        let mut leaves = 0;
+        for c in v4["cones"].as_array().unwrap() {
+            let cv = c["vertex"].as_u64().unwrap() as usize;
+            let k = c["curvature"].as_f64().unwrap();
+            let at: Vec<f64> = tr
+                .iter()
+                .filter(|(e, _, _)| e.contains(&cv))
+                .map(|x| x.1)
+                .collect();
+            if at.len() == 1 {
+                leaves += 1;
+                let wrapped = k - 2.0 * PI * (k / (2.0 * PI)).round();
+                assert!(
+                    (at[0].abs() - wrapped.abs()).abs() < 1e-6,
+                    "cone {cv}: curvature {k}, seam rotation {}",
+                    at[0]
+                );
+            }
+        }
+        assert!(leaves > 0, "no cone ends a cut path");
+    }
+    let (s4, s0) = (log_area_sigma_of_obj(&t4), log_area_sigma_of_obj(&t0));
+    assert!(s4 < s0, "σ(log area) 4 cones {s4}, no cone {s0}");
+    let bad = Command::new(bin())
+        .arg("param")
+        .arg(&mesh)
+        .args(["--cones", "4", "--boundary", "round", "--json"])
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(err.contains("need --boundary free"), "{err}");
 }

@@ -8,7 +8,7 @@ use super::boundary::fixed_angle_targets;
 use super::cones::{
     correct_cone_curvatures, greedy_cones_with, round_to_quarter_turns, ConeBudget,
 };
-use super::free::{free_seam_target, homology_disk, HomologyDisk};
+use super::free::{free_seam_target, held_boundary_cones, homology_disk, HomologyDisk};
 use super::ladder::unresolved_triangles;
 use super::transfer::{
     folded_faces, input_route, scale_to_area, seam_edges, seam_report, subdivision_route,
@@ -46,22 +46,48 @@ struct ConePlan {
     history: Vec<f64>,
 }
 
+/// Target of a chart with boundary: flat inside with the boundary condition of `opts`, or —
+/// with cones asked for (`--cones N|auto|V=K,…`) and the free boundary — cones inside placed
+/// and curved as on the disk of free seams ([`held_boundary_cones`]: the greedy with the
+/// boundary held, least-squares curvatures), the boundary held at `u = 0`.
 fn boundary_target(
     piece: &Piece,
     component: usize,
     opts: &ParamOptions,
     lengths: &[f64],
+    progress: &mut dyn Progress,
 ) -> Result<ConePlan> {
-    let has_cones = match &opts.cones {
+    let asks_cones = match &opts.cones {
         ConeSpec::Given(c) => c.iter().any(|x| piece.vertices.contains(&x.0)),
         ConeSpec::Count(k) => *k > 0,
-        _ => false,
+        ConeSpec::Auto { .. } => opts.boundary == BoundaryMode::Free && !opts.seamless,
+        ConeSpec::None | ConeSpec::Default => false,
     };
-    if has_cones {
+    if asks_cones && (opts.boundary != BoundaryMode::Free || opts.seamless) {
         return Err(Error::input(format!(
-            "component {component} has a boundary; cones on surfaces with boundary are not \
-             supported yet (the boundary takes the curvature)"
+            "component {component} has a boundary; cones on it need --boundary free without \
+             --seamless (with --boundary round or fixed-angles, or --seamless, the boundary \
+             takes the curvature)"
         )));
+    }
+    if asks_cones {
+        let on_boundary = |v: u32| {
+            Error::input(format!(
+                "cone vertex {v} lies on the boundary of component {component}; cones must be \
+                 interior vertices (the free boundary holds u = 0 there)"
+            ))
+        };
+        let n = piece.vertices.len();
+        let (target, cones, source, history) =
+            held_boundary_cones(piece, n, &opts.cones, opts, progress, &on_boundary)?;
+        if !cones.is_empty() {
+            return Ok(ConePlan {
+                target,
+                cones,
+                source,
+                history,
+            });
+        }
     }
     let mesh = &piece.surface.mesh;
     let target = match (opts.boundary, opts.seamless) {
@@ -269,7 +295,8 @@ fn open_and_plan(
 ) -> Result<(Option<HomologyDisk>, ConePlan)> {
     let lengths = piece.surface.edge_lengths();
     if boundary_loops > 0 {
-        return Ok((None, boundary_target(piece, component, opts, &lengths)?));
+        let plan = boundary_target(piece, component, opts, &lengths, progress)?;
+        return Ok((None, plan));
     }
     if opts.seams != SeamMode::Free || genus == 0 {
         let plan = closed_target(piece, component, genus, opts, &lengths, progress)?;

@@ -100,10 +100,11 @@ pub(super) fn homology_disk(piece: &Piece, component: usize) -> Result<HomologyD
     })
 }
 
-/// Cones of the disk (disk vertex ids), how they were chosen and the greedy's history: given
-/// cones by input vertex (refused on a seam), or the greedy with the seams held at `u = 0`.
+/// Cones of a chart (chart vertex ids), how they were chosen and the greedy's history.
 pub(super) type FreePlan = (TargetSpec, Vec<(u32, f64)>, String, Vec<f64>);
 
+/// Cones of the disk (disk vertex ids): given cones by input vertex (refused on a seam), or
+/// the greedy with the seams held at `u = 0` ([`held_boundary_cones`]).
 pub(super) fn free_seam_target(
     disk: &HomologyDisk,
     component: usize,
@@ -111,7 +112,6 @@ pub(super) fn free_seam_target(
     opts: &ParamOptions,
     progress: &mut dyn Progress,
 ) -> Result<FreePlan> {
-    let mesh = &disk.piece.surface.mesh;
     let spec = match &opts.cones {
         ConeSpec::Default if genus == 1 => ConeSpec::None,
         ConeSpec::Default => ConeSpec::Auto {
@@ -119,23 +119,52 @@ pub(super) fn free_seam_target(
         },
         c => c.clone(),
     };
+    let on_seam = |v: u32| {
+        Error::input(format!(
+            "cone vertex {v} lies on a homology seam of component {component}; with \
+             --seams free cones must lie off the seams (or use --seams rigid)"
+        ))
+    };
+    held_boundary_cones(
+        &disk.piece,
+        disk.first_copy(),
+        &spec,
+        opts,
+        progress,
+        &on_seam,
+    )
+}
+
+/// Cones inside a surface whose boundary is held at `u = 0` (`piece`: the disk of free seams,
+/// or a component with boundary flattened with the free boundary, Sawhney–Crane 2017 §4.3 with
+/// cones): given cones by input vertex among the piece's first `named` vertices (`on_boundary`
+/// names the error of one on the boundary), or the greedy of Ben-Chen–Gotsman–Bunin with the
+/// boundary held ([`free_boundary_cones`]) and the curvatures of
+/// [`ParamOptions::free_cone_rule`]. The target is `FreeBoundaryCones`; the source `given`,
+/// `greedy` or `none`.
+pub(super) fn held_boundary_cones(
+    piece: &Piece,
+    named: usize,
+    spec: &ConeSpec,
+    opts: &ParamOptions,
+    progress: &mut dyn Progress,
+    on_boundary: &dyn Fn(u32) -> Error,
+) -> Result<FreePlan> {
+    let mesh = &piece.surface.mesh;
     let budget = match spec {
         ConeSpec::Count(0) | ConeSpec::None | ConeSpec::Default => None,
-        ConeSpec::Count(k) => Some(ConeBudget::Count(k)),
+        ConeSpec::Count(k) => Some(ConeBudget::Count(*k)),
         ConeSpec::Auto {
             max_area_distortion,
         } => Some(ConeBudget::AreaDistortion {
-            bound: max_area_distortion,
+            bound: *max_area_distortion,
             max_cones: opts.max_cones,
         }),
         ConeSpec::Given(list) => {
             let mut cones = Vec::new();
-            for &(v, k) in &list {
-                // Disk vertex i < n is piece vertex i; find the piece vertex of input v.
-                let Some(l) = disk.piece.vertices[..disk.first_copy()]
-                    .iter()
-                    .position(|&w| w == v)
-                else {
+            for &(v, k) in list {
+                // Piece vertex l < named is the one of input vertex v.
+                let Some(l) = piece.vertices[..named].iter().position(|&w| w == v) else {
                     continue;
                 };
                 if k.is_nan() || k >= 2.0 * PI {
@@ -146,10 +175,7 @@ pub(super) fn free_seam_target(
                     )));
                 }
                 if mesh.is_boundary_vertex(l as u32) {
-                    return Err(Error::input(format!(
-                        "cone vertex {v} lies on a homology seam of component {component}; with \
-                         --seams free cones must lie off the seams (or use --seams rigid)"
-                    )));
+                    return Err(on_boundary(v));
                 }
                 cones.push((l as u32, k));
             }
@@ -159,15 +185,14 @@ pub(super) fn free_seam_target(
     };
     let (cones, history) = match budget {
         Some(b) => {
-            progress.report("cones", None, "greedy cone placement, seams held");
-            let lengths = disk.piece.surface.edge_lengths();
+            progress.report("cones", None, "greedy cone placement, boundary held");
+            let lengths = piece.surface.edge_lengths();
             let metric = IntrinsicMetric::euclidean(lengths);
             // The greedy's positions; curvatures for the least linearised σ(2u) by default
             // (the greedy's own, u = 0 at the cones, are one candidate of that least-squares
             // problem, so this is never worse in the linear model).
             let p = free_boundary_cones(mesh, &metric, b, opts.free_cone_rule)?;
-            let cones = p.cones;
-            (cones, p.distortion_history)
+            (p.cones, p.distortion_history)
         }
         None => (Vec::new(), Vec::new()),
     };

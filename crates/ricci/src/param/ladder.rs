@@ -19,12 +19,13 @@
 //! and the first map with no unresolved triangle is kept, with [`super::Chart::fallback`]
 //! saying what was asked, what it gave and what was used. The same ladder runs when the
 //! flow does not converge for the cones asked (camel, 5 rigid cones). Given cones
-//! (`--cones V=K,…`) and charts with boundary are never changed: their map is returned as it
-//! is (the CLI warns when it has flipped triangles). When no step gets to 0, the map with
-//! the fewest flipped triangles is kept, and said so.
+//! (`--cones V=K,…`) and charts with boundary are never changed — except that greedy cones
+//! with the free boundary get the second step, more cones — and their map is returned as it
+//! is (the CLI warns when it has flipped triangles). When no step gets to 0, the map with the
+//! fewest flipped triangles is kept, and said so.
 
 use super::chart::{chart_uv, ChartUv};
-use super::{ConeSpec, ParamOptions, Piece, SeamMode};
+use super::{BoundaryMode, ConeSpec, ParamOptions, Piece, SeamMode};
 use crate::error::{Kind, Result};
 use crate::mesh::topology;
 use crate::progress::Progress;
@@ -94,7 +95,11 @@ pub(super) fn flip_free_chart(
         Err(_) => return first,
     };
     let mesh = &piece.surface.mesh;
-    if matches!(opts.cones, ConeSpec::Given(_)) || mesh.has_boundary() {
+    // With boundary only greedy cones with the free boundary are changed (more cones).
+    let greedy_free = matches!(opts.cones, ConeSpec::Count(1..) | ConeSpec::Auto { .. })
+        && opts.boundary == BoundaryMode::Free
+        && !opts.seamless;
+    if matches!(opts.cones, ConeSpec::Given(_)) || mesh.has_boundary() && !greedy_free {
         return first;
     }
     let genus = topology(mesh).components[0].genus;
@@ -104,14 +109,14 @@ pub(super) fn flip_free_chart(
         (Err(_), _) => 0,
     };
     let mut steps = Vec::new();
-    if opts.seams == SeamMode::Free && genus >= 1 {
+    if opts.seams == SeamMode::Free && genus >= 1 && !mesh.has_boundary() {
         steps.push(ParamOptions {
             seams: SeamMode::Rigid,
             ..opts.clone()
         });
     }
     for k in count + 1..=count + EXTRA_CONES {
-        if k == 1 && genus == 1 && opts.seams == SeamMode::Rigid {
+        if k == 1 && genus == 1 && opts.seams == SeamMode::Rigid && !mesh.has_boundary() {
             continue;
         }
         steps.push(ParamOptions {

@@ -13,6 +13,12 @@
 //!      `2πχ − Σκ` moved to the boundary in proportion to the dual boundary lengths (BFF §4.2
 //!      "prescribed curvature").
 //!
+//!    With `free` and cones asked for (`--cones N|auto|V=K,…`, interior vertices), the chart
+//!    is flat inside except at the cones, placed by the greedy with the boundary held and
+//!    curved for the least linearised σ(2u) as on the disk of free seams (submodule `free`,
+//!    [`cones::free_boundary_cones`]); the cut runs from each cone to the boundary (step 3).
+//!    `round` and `fixed-angles` (and `--seamless`) with cones are refused.
+//!
 //!    Closed surfaces of genus ≥ 1 with [`SeamMode::Free`] (`--seams free`): cut along the
 //!    homology generators into a disk, which is flattened as above with `free` (`u = 0` on
 //!    the cut) and cones inside placed by the greedy with the cut held (submodule `free`); the
@@ -76,7 +82,9 @@ use std::time::Instant;
 /// Which cones a closed chart gets.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ConeSpec {
-    /// Genus 1: none; otherwise automatic with the default bound (`Auto { 1.0 }`).
+    /// Genus 1 and surfaces with boundary: none; otherwise automatic with the default bound
+    /// (`Auto { 1.0 }`). `Count`, `Auto` and `Given` place cones inside a surface with
+    /// boundary too (with the free boundary).
     Default,
     /// No cones (only a torus, or a surface with boundary, can be flat without).
     None,
