@@ -215,3 +215,66 @@ fn boundary_edges_split_and_positions_interpolate() {
         .unwrap_err();
     assert!(e.to_string().contains("boundary"), "{e}");
 }
+
+#[test]
+fn double_double_split_lengths_satisfy_the_cosine_laws() {
+    // `split_side_dd` (Stewart's theorem) against the cosine law at `a`, which the triangles
+    // (a, b, c) and (a, m, c) share, evaluated independently in double-double: E²
+    // `cos A = (p² + ab² − q²)/(2 p ab)`, H² `cos A = (cosh p cosh ab − cosh q)/(sinh p sinh ab)`.
+    use ricci::metric::refine::split_side_dd;
+    use ricci::numeric::dd::Dd;
+    let mut rng = Rng(0x5eed_dd14);
+    for g in [Geometry::Euclidean, Geometry::Hyperbolic] {
+        let mut worst = 0.0f64;
+        for k in 0..200 {
+            // Scales from 1e-3 (cosh near 1) to 1.
+            let s = 10f64.powf(-3.0 * rng.next());
+            let (ab, p) = (s * (0.5 + rng.next()), s * (0.5 + rng.next()));
+            let q = s * (0.5 + rng.next());
+            if !(q < ab + p && ab < p + q && p < ab + q) {
+                continue;
+            }
+            let t = if k % 2 == 0 {
+                0.5
+            } else {
+                0.1 + 0.8 * rng.next()
+            };
+            let (ab, p, q) = (Dd::new(ab), Dd::new(p), Dd::new(q));
+            let x = ab * Dd::new(t);
+            let y = ab - x;
+            let mc = split_side_dd(g, p, q, x, y);
+            let cos_a = |side: Dd, base: Dd, opp: Dd| match g {
+                Geometry::Euclidean => {
+                    (side.sqr() + base.sqr() - opp.sqr()) / (Dd::new(2.0) * side * base)
+                }
+                _ => (side.cosh() * base.cosh() - opp.cosh()) / (side.sinh() * base.sinh()),
+            };
+            let (c1, c2) = (cos_a(p, ab, q), cos_a(p, x, mc));
+            worst = worst.max((c1 - c2).abs().f64());
+        }
+        assert!(worst < 1e-20, "{g}: cosine laws differ by {worst:e}");
+    }
+}
+
+#[test]
+fn low_parts_are_carried_through_splits() {
+    let mut rng = Rng(42);
+    let (mesh, lengths) = torus_with_metric(6, 7, 0.3, 0.1, &mut rng);
+    let lo = vec![0.0; lengths.len()];
+    let mut r = Refiner::new_with_low_parts(&mesh, &lengths, Some(&lo), Geometry::Hyperbolic, None)
+        .unwrap();
+    r.raise_valence(0, 12).unwrap();
+    let done = r.finish().unwrap();
+    let dlo = done.lengths_lo.as_ref().expect("low parts kept");
+    assert_eq!(dlo.len(), done.lengths.len());
+    // The split edges' leading parts agree with the double-precision splits to rounding.
+    let plain =
+        ricci::metric::refine::raise_valence(&mesh, &lengths, Geometry::Hyperbolic, None, 0, 12)
+            .unwrap();
+    for (a, b) in plain.lengths.iter().zip(&done.lengths) {
+        assert!((a - b).abs() <= 1e-14 * b, "{a} vs {b}");
+    }
+    assert!(
+        Refiner::new_with_low_parts(&mesh, &lengths, Some(&lo), Geometry::Spherical, None).is_err()
+    );
+}

@@ -2,7 +2,7 @@
 //! the hyperbolic layout (`cut_disk_polished`, `layout_dd`), on generated surfaces (no
 //! `RICCI_MESHES` needed).
 
-use ricci::flow::polish::{curvature_dd, polish_metric, PolishSettings};
+use ricci::flow::polish::{curvature_dd, max_curvature_dd, polish_metric, PolishSettings};
 use ricci::layout::deck_group;
 use ricci::layout::pipeline::{
     cut_disk, cut_disk_polished, polish_uniformization, uniformization_metric,
@@ -216,9 +216,8 @@ fn vertex_scaling_metrics_are_polished_too() {
 
 #[test]
 fn a_double_precision_uniform_metric_is_polished_once_on_the_refined_mesh() {
-    // `ricci layout` passes the conformal flow's double-precision metric straight to
-    // `cut_disk_polished` (one polish, on the cut's refined mesh, instead of one before and
-    // one after the cut): the refined metric must reach double-double there, lay out with a
+    // A double-precision metric passed straight to `cut_disk_polished` (one polish, on the
+    // cut's refined mesh): the refined metric must reach double-double there, lay out with a
     // relation error at double-double level, and be the same hyperbolic metric as the one
     // polished first (on the edges both refined meshes keep from the flow's triangulation).
     let s = generate::genus(2, 16).unwrap();
@@ -266,4 +265,50 @@ fn a_double_precision_uniform_metric_is_polished_once_on_the_refined_mesh() {
         compared += 1;
     }
     assert!(compared > work.n_edges() / 2, "{compared} edges compared");
+}
+
+#[test]
+fn the_cut_splits_a_polished_metric_in_double_double_and_it_stays_converged() {
+    // Polished before the cut, the metric keeps its double-double accuracy through the cut's
+    // splits (Stewart's theorem in double-double): the refined metric's curvature right after
+    // the splits is at the polish's floor, so it is only checked, not polished (0 steps).
+    // Split in double (the leading parts alone), the same refined metric is ~1e-16 off.
+    let s = generate::genus(2, 16).unwrap();
+    let input = s.edge_lengths();
+    let flow = uniformization_metric(
+        &s.mesh,
+        &IntrinsicMetric::euclidean(input.to_vec()),
+        Geometry::Hyperbolic,
+        Scheme::Conformal,
+        1e-10,
+        &mut NoProgress,
+    )
+    .unwrap();
+    let p =
+        polish_uniformization(&s.mesh, &IntrinsicMetric::euclidean(input.to_vec()), &flow).unwrap();
+    assert!(p.converged, "{:?}", p.history);
+    let work = &flow.triangulation.as_ref().unwrap().simplicial.mesh;
+    let disk = cut_disk_polished(work, &p.metric, None, None, &mut NoProgress).unwrap();
+    let refined = &disk.cut.refined;
+    assert!(refined.splits() > 0, "the cut should refine");
+    let r = disk.refined_polish.expect("a refined metric is checked");
+    assert!(
+        r.residual_start <= 1e-20 && r.steps == 0 && r.converged,
+        "{r:?}"
+    );
+    // The same curvature by the polish's vertex-scaling length law (another evaluation).
+    let lo = refined.lengths_lo.clone().expect("low parts carried");
+    let dd =
+        IntrinsicMetric::with_low_parts(Geometry::Hyperbolic, refined.lengths.clone(), lo).unwrap();
+    let q = ricci::layout::pipeline::polish_lengths(&refined.mesh, &dd).unwrap();
+    assert!(q.residual_start <= 1e-20, "{:?}", q.history);
+    let plain = IntrinsicMetric::new(Geometry::Hyperbolic, refined.lengths.clone());
+    let k = max_curvature_dd(&refined.mesh, &plain).unwrap();
+    assert!(k > 1e-19, "double-precision splits: {k:e}");
+    // And the layout: relation and per-edge deck spread at the double-double level.
+    let l = layout_dd::<Hyperbolic>(&disk.mesh, &disk.metric, None).unwrap();
+    let g = deck_group::<Hyperbolic>(&l, &disk.polygon).unwrap();
+    assert!(l.flipped_faces.is_empty());
+    assert!(g.relation_error.unwrap() < 1e-20, "{:?}", g.relation_error);
+    assert!(g.max_edge_spread < 1e-20, "{}", g.max_edge_spread);
 }

@@ -155,13 +155,9 @@ pub struct PolishedLengths {
 pub enum Polish {
     /// Not at all (`--no-polish`).
     Off,
-    /// At once, on the metric's own triangulation.
+    /// At once, on the metric's own triangulation, before the cut (whose splits keep the
+    /// double-double lengths converged: `cut_disk_polished` only checks the refined metric).
     Now,
-    /// After the cut, on its refined mesh, when the metric is a conformal flow's uniform one
-    /// (`cut_disk_polished` polishes the refined metric in place anyway, and one Newton step
-    /// there reaches double-double from the flow's double precision as from a polished
-    /// metric: polishing before the cut too would be done twice). Otherwise as `Now`.
-    AfterCut,
 }
 
 /// [`metric`], then for hyperbolic metrics (unless `polish` is `Off`) the double-double polish
@@ -207,20 +203,6 @@ pub fn polished_metric(
     }
     if polish == Polish::Off {
         out.polish = json!({"applied": false, "reason": "--no-polish"});
-        out.flow = flow;
-        return Ok(out);
-    }
-    let uniform = |f: &FlowResult| {
-        f.triangulation.is_some()
-            && !f.fixed.iter().any(|&x| x)
-            && f.target.iter().all(|&k| k == 0.0)
-    };
-    if polish == Polish::AfterCut && flow.as_ref().is_some_and(uniform) {
-        out.polish = json!({
-            "applied": true, "method": "vertex scaling in place on the cut's refined mesh",
-            "deferred": true,
-        });
-        crate::util::stage_done("polish");
         out.flow = flow;
         return Ok(out);
     }
@@ -771,11 +753,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if let Some(b) = a.base {
         crate::util::check_vertex("--base", b, surface.mesh.n_vertices())?;
     }
-    // A disk is laid out as it is; everything else is cut first.
-    let disk_as_is = topology(&surface.mesh)
-        .components
-        .first()
-        .is_some_and(|c| c.genus == 0 && c.boundary_loops == 1);
     let mut bar = spinner(a.json);
     let polished = polished_metric(
         &surface,
@@ -783,10 +760,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.target.as_deref(),
         a.scheme,
         a.metric.as_ref(),
-        match (a.no_polish, disk_as_is) {
-            (true, _) => Polish::Off,
-            (false, true) => Polish::Now,
-            (false, false) => Polish::AfterCut,
+        if a.no_polish {
+            Polish::Off
+        } else {
+            Polish::Now
         },
         FlowLimits {
             tolerance: tolerance::flow_tolerance(&a, &surface.mesh, geometry),

@@ -236,9 +236,14 @@ pub fn canonical_cut(
 ) -> Result<CanonicalCut> {
     let (lengths, geometry) = (metric.lengths(), metric.geometry());
     let t0 = std::time::Instant::now();
+    // Low parts (a double-double metric) are carried through the splits in E² and H².
+    let lengths_lo = metric
+        .lengths_lo()
+        .filter(|_| geometry != Geometry::Spherical);
     let surface = Surface {
         mesh,
         lengths,
+        lengths_lo,
         geometry,
         positions,
     };
@@ -254,6 +259,8 @@ pub fn canonical_cut(
 struct Surface<'a> {
     mesh: &'a Mesh,
     lengths: &'a [f64],
+    /// Low parts of the lengths (double-double), kept through the refinement.
+    lengths_lo: Option<&'a [f64]>,
     geometry: Geometry,
     positions: Option<&'a [[f64; 3]]>,
 }
@@ -572,13 +579,17 @@ fn grade_base(surface: Surface, setup: &Setup, min_valence: usize) -> Result<Ref
     let Surface {
         mesh,
         lengths,
+        lengths_lo,
         geometry,
         positions,
     } = surface;
     if setup.paths_needed == 0 {
-        return Ok(Refined::identity(mesh, lengths, positions));
+        return Ok(Refined {
+            lengths_lo: lengths_lo.map(<[f64]>::to_vec),
+            ..Refined::identity(mesh, lengths, positions)
+        });
     }
-    let mut r = Refiner::new(mesh, lengths, geometry, positions)?;
+    let mut r = Refiner::new_with_low_parts(mesh, lengths, lengths_lo, geometry, positions)?;
     r.raise_valence(setup.base, min_valence)?;
     let grade = min_valence.max(2 * setup.paths_needed);
     let theta = r.cone_angle(setup.base);

@@ -256,6 +256,26 @@ pub fn curvature_dd(
     Ok(r.iter().map(|x| -x).collect())
 }
 
+/// The max |K| over the vertices of a hyperbolic metric given by its edge lengths (with low
+/// parts when double-double), evaluated in double-double from the lengths themselves (see the
+/// module docs): what a polish to target 0 would start from, at the cost of one residual.
+/// Errors: not H², a length count other than the mesh's edges, a face violating the triangle
+/// inequality, a curvature of 1e-3 or more somewhere.
+pub fn max_curvature_dd(mesh: &Mesh, metric: &IntrinsicMetric) -> Result<f64> {
+    metric.require(Geometry::Hyperbolic, "the double-double curvature")?;
+    if metric.len() != mesh.n_edges() {
+        return Err(Error::input(format!(
+            "{} edge lengths for a mesh with {} edges",
+            metric.len(),
+            mesh.n_edges()
+        )));
+    }
+    let lengths: Vec<Dd> = (0..mesh.n_edges()).map(|e| metric.length_dd(e)).collect();
+    let mut r = vec![0.0; mesh.n_vertices()];
+    residual_dd(mesh, &lengths, &mut r)?;
+    Ok(r.iter().fold(0.0, |m: f64, x| m.max(x.abs())))
+}
+
 /// Polish the hyperbolic metric of `structure` at variables `u` (a converged flow's) to
 /// double-double, for the target `K̄ = 0` on every vertex not `fixed` (see the module docs).
 /// `eta_lo` optionally gives low parts of the per-edge coefficients (vertex scaling of a

@@ -10,18 +10,21 @@
 //! `ricci layout` and `ricci spectrum`): [`polish_uniformization`] refines the flow's `u` by
 //! iterative refinement with a double-double curvature residual ([`crate::flow::polish`],
 //! from ~5e-15 to ~1e-30), and [`cut_disk_polished`] carries the double-double lengths
-//! through the cut: edges of the input keep their low parts; the cut's refinement computes
-//! the lengths of split and new edges in double precision, so the refined metric is polished
-//! once more, in place, by vertex scaling (`sinh(l/2) = e^{(ui+uj)/2} sinh(l⁰/2)` from the
-//! double-double lengths, target 0 on every vertex — new vertices are flat). The cut mesh
-//! then carries an [`IntrinsicMetric`] with low parts, which [`super::place::layout_dd`] uses. The deck maps computed
+//! through the cut: the cut's refinement computes the lengths of split and new edges in
+//! double-double too ([`crate::metric::refine::split_side_dd`], Stewart's theorem), so the
+//! refined metric is as converged as its input; its double-double curvature is checked
+//! ([`crate::flow::polish::max_curvature_dd`]) and only when it is above the polish tolerance
+//! (a double-precision input) is it polished in place by vertex scaling
+//! (`sinh(l/2) = e^{(ui+uj)/2} sinh(l⁰/2)`, target 0 on every vertex — new vertices are
+//! flat). The cut mesh then carries an [`IntrinsicMetric`] with low parts, which
+//! [`super::place::layout_dd`] uses. The deck maps computed
 //! from different edges of a side then agree to the double-double layout's own accuracy
 //! instead of ~κ·sinh r with κ ≈ 5e-15 (BENCHMARKS.md, Layout).
 
 use super::deck::Polygon;
 use crate::cut::{canonical_cut, CanonicalCut, Construction, CutOptions};
 use crate::error::{Error, Result};
-use crate::flow::polish::{polish_metric, PolishSettings, PolishedMetric};
+use crate::flow::polish::{max_curvature_dd, polish_metric, PolishSettings, PolishedMetric};
 use crate::flow::{flow_with_fallback, FlowResult, UniformizationOptions};
 use crate::mesh::Mesh;
 use crate::metric::{ConformalStructure, Geometry, IntrinsicMetric, Scheme};
@@ -219,11 +222,12 @@ pub fn polish_lengths(mesh: &Mesh, metric: &IntrinsicMetric) -> Result<PolishedM
 }
 
 /// [`cut_disk`] for a double-double H² metric with zero target curvature (e.g. the `metric`
-/// of [`polish_uniformization`]; missing low parts are 0): the cut runs on the leading parts;
-/// edges of the input keep their low parts, and when the cut refined the mesh (or the metric
-/// has no low parts: a double-precision uniform metric, polished here once instead of before
-/// and after the cut), the refined metric is polished in place ([`polish_lengths`]) before it
-/// is carried to the cut mesh.
+/// of [`polish_uniformization`]; missing low parts are 0): the cut runs on the leading parts
+/// and computes the refined lengths in double-double from the input's; when the cut refined
+/// the mesh, the refined metric's double-double curvature is checked and, if above the
+/// polish tolerance (or the metric has no low parts: a double-precision uniform metric,
+/// polished here once), it is polished in place ([`polish_lengths`]) before it is carried to
+/// the cut mesh. [`CutDisk::refined_polish`] reports either (0 steps when only checked).
 pub fn cut_disk_polished(
     mesh: &Mesh,
     metric: &IntrinsicMetric,
@@ -247,32 +251,44 @@ pub fn cut_disk_polished(
     let mut disk = cut_disk(mesh, metric, positions, base, progress)?;
     let refined = &disk.cut.refined;
     let rm = &refined.mesh;
-    let nv0 = refined.original_vertices as u32;
-    let mut rlo = vec![0.0; rm.n_edges()];
-    for (e, lo) in rlo.iter_mut().enumerate() {
-        let [a, b] = rm.edge_vertices(e as u32);
-        if a < nv0 && b < nv0 {
-            if let Some(h) = mesh.halfedge_between(a, b) {
-                let e0 = mesh.he_edge(h) as usize;
-                if metric[e0] == refined.lengths[e] {
-                    *lo = metric.low_part(e0);
-                }
-            }
-        }
-    }
+    let rlo = match &refined.lengths_lo {
+        Some(lo) => lo.clone(),
+        None => vec![0.0; rm.n_edges()],
+    };
     let refined_metric =
         IntrinsicMetric::with_low_parts(Geometry::Hyperbolic, refined.lengths.clone(), rlo)?;
-    let refined_metric = if refined.splits() > 0 || !metric.is_double_double() {
-        progress.report(
-            "polish",
-            None,
-            "polishing the refined metric in double-double",
-        );
-        let p = polish_lengths(rm, &refined_metric)?;
-        disk.refined_polish = Some(PolishReport::from(&p));
-        p.metric
-    } else {
+    let tolerance = PolishSettings::default().tolerance;
+    let refined_metric = if refined.splits() == 0 && metric.is_double_double() {
         refined_metric
+    } else {
+        // Split in double-double from a polished metric, the refined metric is as converged
+        // as its input: check, and polish only when it is not.
+        let start = if refined.lengths_lo.is_some() {
+            Some(max_curvature_dd(rm, &refined_metric)?)
+        } else {
+            None
+        };
+        match start {
+            Some(r) if r <= tolerance => {
+                disk.refined_polish = Some(PolishReport {
+                    steps: 0,
+                    residual_start: r,
+                    residual_dd: r,
+                    converged: true,
+                });
+                refined_metric
+            }
+            _ => {
+                progress.report(
+                    "polish",
+                    None,
+                    "polishing the refined metric in double-double",
+                );
+                let p = polish_lengths(rm, &refined_metric)?;
+                disk.refined_polish = Some(PolishReport::from(&p));
+                p.metric
+            }
+        }
     };
     disk.metric = refined_metric.carried_to(rm, &disk.mesh);
     Ok(disk)

@@ -12,6 +12,12 @@
 //! exactly up to rounding (tested to 1e-12). Positions, when given, are interpolated linearly
 //! (the split point of a straight edge in R³ stays on that edge).
 //!
+//! **Double-double lengths** ([`Refiner::new_with_low_parts`], E² and H²): a metric given with
+//! low parts (a polished hyperbolic metric, [`crate::flow::polish`]) keeps them through the
+//! splits: the new lengths come from Stewart's theorem in double-double
+//! ([`split_side_dd`]), so the refined metric has the curvature of the input to ~1e-30 and
+//! needs no polish of its own. Flips are computed in double and drop the low parts.
+//!
 //! Two refinements are built from splits:
 //!
 //! * [`Refiner::raise_valence`] (paper 000, Step 2 (i)): split the longest edge of the link of
@@ -37,6 +43,7 @@
 use super::Geometry;
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, NONE};
+use crate::numeric::dd::Dd;
 use crate::numeric::dijkstra::{Dijkstra, NO_PRED};
 use std::f64::consts::PI;
 
@@ -59,6 +66,9 @@ pub struct Refined {
     pub mesh: Mesh,
     /// Edge lengths of the refined mesh, by edge id (same geometry as the input metric).
     pub lengths: Vec<f64>,
+    /// Their low parts (double-double) when the input had them and no flip dropped them
+    /// ([`Refiner::new_with_low_parts`]).
+    pub lengths_lo: Option<Vec<f64>>,
     /// Positions, linearly interpolated, if the input had positions.
     pub positions: Option<Vec<[f64; 3]>>,
     /// Number of vertices of the input mesh (`new_vertices[k]` describes vertex
@@ -77,6 +87,7 @@ impl Refined {
         Refined {
             mesh: mesh.clone(),
             lengths: lengths.to_vec(),
+            lengths_lo: None,
             positions: positions.map(|p| p.to_vec()),
             original_vertices: mesh.n_vertices(),
             new_vertices: Vec::new(),
@@ -101,6 +112,8 @@ pub struct Refiner {
     twin: Vec<u32>,
     /// Length of every half-edge.
     len: Vec<f64>,
+    /// Low parts of the half-edge lengths (double-double), when carried.
+    len_lo: Option<Vec<f64>>,
     /// One corner (= outgoing interior half-edge) per vertex.
     vertex_corner: Vec<u32>,
     positions: Option<Vec<[f64; 3]>>,
@@ -117,6 +130,33 @@ impl Refiner {
         geometry: Geometry,
         positions: Option<&[[f64; 3]]>,
     ) -> Result<Refiner> {
+        Refiner::new_with_low_parts(mesh, lengths, None, geometry, positions)
+    }
+
+    /// [`Refiner::new`] for a metric given to double-double precision (`lengths_lo`: low parts
+    /// by edge id): splits compute the new lengths in double-double ([`split_side_dd`]).
+    /// Errors: low parts of the wrong count, or in S² (not implemented there).
+    pub fn new_with_low_parts(
+        mesh: &Mesh,
+        lengths: &[f64],
+        lengths_lo: Option<&[f64]>,
+        geometry: Geometry,
+        positions: Option<&[[f64; 3]]>,
+    ) -> Result<Refiner> {
+        if let Some(lo) = lengths_lo {
+            if lo.len() != lengths.len() {
+                return Err(Error::input(format!(
+                    "{} low parts of edge lengths given for {} lengths",
+                    lo.len(),
+                    lengths.len()
+                )));
+            }
+            if geometry == Geometry::Spherical {
+                return Err(Error::input(
+                    "double-double edge splits are implemented in E² and H², not in S²",
+                ));
+            }
+        }
         if lengths.len() != mesh.n_edges() {
             return Err(Error::input(format!(
                 "the metric has {} edge lengths but the mesh has {} edges",
@@ -151,6 +191,11 @@ impl Refiner {
             }
             len[h as usize] = lengths[mesh.he_edge(h) as usize];
         }
+        let len_lo = lengths_lo.map(|lo| {
+            (0..nh as u32)
+                .map(|h| lo[mesh.he_edge(h) as usize])
+                .collect()
+        });
         let vertex_corner = (0..mesh.n_vertices() as u32)
             .map(|v| mesh.vertex_halfedge(v))
             .collect();
@@ -160,6 +205,7 @@ impl Refiner {
             faces: mesh.faces().to_vec(),
             twin,
             len,
+            len_lo,
             vertex_corner,
             positions: positions.map(|p| p.to_vec()),
             new_vertices: Vec::new(),
@@ -169,9 +215,10 @@ impl Refiner {
 
     /// Continue refining an earlier result (provenance and face origins are kept).
     pub fn resume(refined: Refined, geometry: Geometry) -> Result<Refiner> {
-        let mut r = Refiner::new(
+        let mut r = Refiner::new_with_low_parts(
             &refined.mesh,
             &refined.lengths,
+            refined.lengths_lo.as_deref(),
             geometry,
             refined.positions.as_deref(),
         )?;
@@ -319,6 +366,7 @@ impl Refiner {
         let m = self.vertex_corner.len() as u32;
         let hg = self.twin[h as usize];
         let nf = self.faces.len() as u32;
+        let dd = self.split_lengths_dd(h, t);
         // f = (a, m, c), f1 = (m, b, c)
         let f1 = nf;
         self.faces[f as usize] = [a, m, c];
@@ -381,6 +429,10 @@ impl Refiner {
             set(self, 3 * g1 + 1, t_ad);
             self.vertex_corner[d as usize] = 3 * gf + 2;
         }
+        if let Some(s) = dd {
+            let g = (hg != NONE).then(|| (hg / 3, nf + 1));
+            self.set_split_dd(&s, f, f1, g);
+        }
         if let Some(p) = self.positions.as_mut() {
             let (pa, pb) = (p[a as usize], p[b as usize]);
             p.push([
@@ -391,6 +443,74 @@ impl Refiner {
         }
         self.new_vertices.push(SplitVertex { a, b, t });
         m
+    }
+
+    /// The double-double lengths of a split ([`Refiner::split`] of `h` at `t`), read before
+    /// the faces change: `None` when the low parts are not carried.
+    fn split_lengths_dd(&self, h: u32, t: f64) -> Option<SplitDd> {
+        let lo = self.len_lo.as_ref()?;
+        let g = self.geometry;
+        let dd = |k: u32| Dd::new(self.len[k as usize]) + Dd::new(lo[k as usize]);
+        let f = h / 3;
+        let i = h % 3;
+        let (h_bc, h_ca) = (3 * f + (i + 1) % 3, 3 * f + (i + 2) % 3);
+        let am = dd(h) * Dd::new(t);
+        let mb = dd(h) - am;
+        let seg = SplitSegment::new(g, am, mb);
+        let mc = seg.side(dd(h_ca), dd(h_bc));
+        let hg = self.twin[h as usize];
+        let (md, lo_ad, lo_db) = if hg == NONE {
+            (Dd::ZERO, 0.0, 0.0)
+        } else {
+            let gf = hg / 3;
+            let j = hg % 3;
+            let (h_ad, h_db) = (3 * gf + (j + 1) % 3, 3 * gf + (j + 2) % 3);
+            (
+                seg.side(dd(h_ad), dd(h_db)),
+                lo[h_ad as usize],
+                lo[h_db as usize],
+            )
+        };
+        Some(SplitDd {
+            am,
+            mb,
+            mc,
+            md,
+            lo_bc: lo[h_bc as usize],
+            lo_ca: lo[h_ca as usize],
+            lo_ad,
+            lo_db,
+        })
+    }
+
+    /// Write the double-double lengths of a split into the new faces `f = (a, m, c)`,
+    /// `f1 = (m, b, c)` and, when the edge was interior, `gf = (b, m, d)`, `g1 = (m, a, d)`.
+    fn set_split_dd(&mut self, s: &SplitDd, f: u32, f1: u32, g: Option<(u32, u32)>) {
+        let n = self.len.len();
+        let Some(lo) = self.len_lo.as_mut() else {
+            return;
+        };
+        lo.resize(n, 0.0);
+        let mut put = |k: u32, x: Dd| {
+            self.len[k as usize] = x.hi;
+            lo[k as usize] = x.lo;
+        };
+        put(3 * f, s.am);
+        put(3 * f + 1, s.mc);
+        put(3 * f1, s.mb);
+        put(3 * f1 + 2, s.mc);
+        if let Some((gf, g1)) = g {
+            put(3 * gf, s.mb);
+            put(3 * gf + 1, s.md);
+            put(3 * g1, s.am);
+            put(3 * g1 + 2, s.md);
+        }
+        lo[(3 * f + 2) as usize] = s.lo_ca;
+        lo[(3 * f1 + 1) as usize] = s.lo_bc;
+        if let Some((gf, g1)) = g {
+            lo[(3 * gf + 2) as usize] = s.lo_db;
+            lo[(3 * g1 + 1) as usize] = s.lo_ad;
+        }
     }
 
     /// Origin of half-edge `h` (`3f + i` starts at corner `i` of face `f`).
@@ -574,9 +694,17 @@ impl Refiner {
         for h in 0..mesh.n_corners() as u32 {
             lengths[mesh.he_edge(h) as usize] = self.len[h as usize];
         }
+        let lengths_lo = self.len_lo.map(|lo| {
+            let mut out = vec![0.0; mesh.n_edges()];
+            for h in 0..mesh.n_corners() as u32 {
+                out[mesh.he_edge(h) as usize] = lo[h as usize];
+            }
+            out
+        });
         Ok(Refined {
             mesh,
             lengths,
+            lengths_lo,
             positions: self.positions,
             original_vertices: self.original_vertices,
             new_vertices: self.new_vertices,
@@ -648,4 +776,83 @@ pub fn side(g: Geometry, b: f64, c: f64, theta: f64) -> f64 {
                 .asin()
         }
     }
+}
+
+/// The double-double lengths of one split (see [`Refiner::split`]): the two halves `am`,
+/// `mb` of the split edge, the new edges `mc` (and `md` across, 0 on the boundary), and the
+/// low parts of the four old edges that move to new half-edges.
+#[derive(Debug, Clone, Copy)]
+struct SplitDd {
+    am: Dd,
+    mb: Dd,
+    mc: Dd,
+    md: Dd,
+    lo_bc: f64,
+    lo_ca: f64,
+    lo_ad: f64,
+    lo_db: f64,
+}
+
+/// The distance from `c` to the point `m` of the side `ab` of a triangle `(a, b, c)` with
+/// `|am| = x`, `|mb| = y`, from `p = |ca|` and `q = |cb|`, in double-double, by Stewart's
+/// theorem in its half-angle form (no cancellation of `cosh` near 1 on short sides):
+/// E² `|mc|² = (p² y + q² x)/(x + y) − x y`; H² (`cosh|mc| sinh(x+y) = cosh p sinh y +
+/// cosh q sinh x` with `cosh z = 1 + 2 sinh²(z/2)`)
+/// `sinh²(|mc|/2) = (P sinh y + Q sinh x − sinh x sinh²(y/2) − sinh y sinh²(x/2)) / sinh(x+y)`,
+/// `P = sinh²(p/2)`, `Q = sinh²(q/2)`. Only E² and H² (S² metrics carry no low parts).
+pub fn split_side_dd(g: Geometry, p: Dd, q: Dd, x: Dd, y: Dd) -> Dd {
+    SplitSegment::new(g, x, y).side(p, q)
+}
+
+/// The split edge's part of [`split_side_dd`], shared by the two faces of a split.
+struct SplitSegment {
+    g: Geometry,
+    x: Dd,
+    y: Dd,
+    /// H²: `sinh x`, `sinh y`, `sinh²(x/2)`, `sinh²(y/2)`, `sinh(x + y)`.
+    h: [Dd; 5],
+}
+
+impl SplitSegment {
+    fn new(g: Geometry, x: Dd, y: Dd) -> SplitSegment {
+        let h = if g == Geometry::Hyperbolic {
+            [
+                x.sinh(),
+                y.sinh(),
+                half_sinh_sqr(x),
+                half_sinh_sqr(y),
+                (x + y).sinh(),
+            ]
+        } else {
+            [Dd::ZERO; 5]
+        };
+        SplitSegment { g, x, y, h }
+    }
+
+    /// `|mc|` from `p = |ca|`, `q = |cb|` (see [`split_side_dd`]).
+    fn side(&self, p: Dd, q: Dd) -> Dd {
+        let (x, y) = (self.x, self.y);
+        if self.g == Geometry::Hyperbolic {
+            let [sx, sy, s2x, s2y, sxy] = self.h;
+            let num = half_sinh_sqr(p) * sy + half_sinh_sqr(q) * sx - sx * s2y - sy * s2x;
+            let m2 = num / sxy;
+            if m2.hi > 0.0 {
+                Dd::new(2.0) * m2.sqrt().asinh()
+            } else {
+                Dd::ZERO
+            }
+        } else {
+            let m2 = (p.sqr() * y + q.sqr() * x) / (x + y) - x * y;
+            if m2.hi > 0.0 {
+                m2.sqrt()
+            } else {
+                Dd::ZERO
+            }
+        }
+    }
+}
+
+/// `sinh²(z/2)`.
+fn half_sinh_sqr(z: Dd) -> Dd {
+    (z * Dd::new(0.5)).sinh().sqr()
 }

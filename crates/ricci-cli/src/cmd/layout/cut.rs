@@ -1,5 +1,5 @@
-//! The cut stage of `ricci layout`: the canonical cut of the surface into a disk (polished to
-//! double-double when the metric is, or when its polish was deferred to after the cut), and its
+//! The cut stage of `ricci layout`: the canonical cut of the surface into a disk (its refined
+//! metric checked, and polished if needed, in double-double when the metric is), and its
 //! report (boundary word, base vertex, refinement splits, attempts, loop lengths).
 
 use super::Bar;
@@ -20,16 +20,9 @@ pub fn cut_stage(
     bar: &mut Bar,
 ) -> anyhow::Result<CutDisk> {
     bar.0.set_message("cutting along canonical loops");
-    let deferred = polish_report["deferred"] == json!(true);
-    let d = if metric.is_double_double() || deferred {
+    let d = if metric.is_double_double() {
         let d = cut_disk_polished(work, metric, work_positions, base, bar)?;
         polish_report["refined"] = json!(d.refined_polish);
-        if let (true, Some(p)) = (deferred, &d.refined_polish) {
-            polish_report["steps"] = json!(p.steps);
-            polish_report["residual_start"] = json!(p.residual_start);
-            polish_report["residual_dd"] = json!(p.residual_dd);
-            polish_report["converged"] = json!(p.converged);
-        }
         d
     } else {
         cut_disk(work, metric, work_positions, base, bar)?

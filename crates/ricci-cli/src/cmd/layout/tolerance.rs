@@ -1,5 +1,5 @@
 //! The flow tolerance of `ricci layout`: the conformal flow's hyperbolic uniformization is
-//! polished to double-double after the cut, so the flow needs to come only within the
+//! polished to double-double before the cut, so the flow needs to come only within the
 //! polish's reach (`ricci::flow::uniformize::polished_layout_tolerance`, 1e-10 instead of
 //! `layout_tolerance`'s 1e-12).
 

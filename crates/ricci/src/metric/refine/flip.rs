@@ -85,6 +85,8 @@ impl Refiner {
     /// with the same id (the one holding its whole corner at `c`, resp. `d`).
     pub fn flip(&mut self, h: u32) -> Result<()> {
         let l_cd = self.flip_length(h)?;
+        // The flipped diagonal is computed in double: the low parts are no longer valid.
+        self.len_lo = None;
         let f = h / 3;
         let i = h % 3;
         let (h_ab, h_bc, h_ca) = (h, 3 * f + (i + 1) % 3, 3 * f + (i + 2) % 3);
