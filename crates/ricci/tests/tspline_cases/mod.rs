@@ -24,7 +24,7 @@ pub fn forms(s: &Surface) -> HolomorphicForms {
 /// `genus(2, 20)` and, with `$RICCI_MESHES`, eight.off (a note on stderr without it).
 pub fn genus_two_cases() -> Vec<(&'static str, Surface)> {
     let mut cases = vec![("genus(2, 20)", ricci::mesh::generate::genus(2, 20).unwrap())];
-    match crate::ricci_meshes::ricci_meshes() {
+    match super::ricci_meshes::ricci_meshes() {
         Some(dir) => cases.push((
             "eight",
             ricci::mesh::io::read_surface(&dir.join("eight.off"))
