@@ -438,7 +438,7 @@ where
                 .max((S::distance(p[2], p[0]) - l[2]).abs())
         };
         // Per face in parallel (rayon): a face's choice reads only its own corners.
-        let better: Vec<(usize, [S::Point; 3], [(u32, u32); 3])> = faces
+        let better: Vec<(usize, Choice<S::Point>)> = faces
             .par_iter()
             .enumerate()
             .filter_map(|(f, t)| {
@@ -468,10 +468,10 @@ where
                 }
                 let (m, p, src) = best?;
                 let take = m < m0 || S::orientation(now[0], now[1], now[2]) <= 0.0;
-                take.then_some((f, p, src))
+                take.then_some((f, (m, p, src)))
             })
             .collect();
-        for (f, p, src) in &better {
+        for (f, (_, p, src)) in &better {
             corner[3 * f..3 * f + 3].copy_from_slice(p);
             source[3 * f..3 * f + 3].copy_from_slice(src);
         }
