@@ -19,6 +19,7 @@ use super::isometry::Isometry;
 use super::place::{Frame, Space};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
+use rayon::prelude::*;
 
 /// UVs per corner of the input faces (three per face, in face order).
 #[derive(Debug, Clone)]
@@ -182,60 +183,49 @@ where
         )));
     }
     // Searched in three levels (identity; pairings; products), the next only when the
-    // previous leaves the face spread out or flipped.
+    // previous leaves the face spread out or flipped. Every face's search reads only the
+    // layout, so the faces are searched in parallel (rayon) with the same results.
     let (cands, level_end) = candidate_maps(group);
     let images = Images::<S>::new(positions, &copies, &cands);
-    let mut buf = Vec::new();
-    let mut nearest = |w: u32, p: S::Point, n: usize| images.nearest(w, p, n, &mut buf);
     // First pass with the identity only: the typical size of a face in the layout.
-    let mut spread = vec![0.0f64; faces.len()];
-    let mut corner = Vec::with_capacity(3 * faces.len());
-    let mut source = Vec::with_capacity(3 * faces.len());
-    for (f, t) in faces.iter().enumerate() {
-        let ca = copies[t[0] as usize][0];
-        let pa = positions[ca as usize];
-        let (db, pb, sb) = nearest(t[1], pa, 1);
-        let (dc, pc, sc) = nearest(t[2], pa, 1);
-        spread[f] = db.max(dc).max(S::distance(pb, pc));
-        corner.extend([pa, pb, pc]);
-        source.extend([(ca, 0), sb, sc]);
-    }
-    let mut sorted: Vec<f64> = spread.iter().copied().filter(|x| x.is_finite()).collect();
+    let first: Vec<Choice<S::Point>> = faces
+        .par_iter()
+        .map_init(Vec::new, |buf, t| {
+            let ca = copies[t[0] as usize][0];
+            let pa = positions[ca as usize];
+            let (db, pb, sb) = images.nearest(t[1], pa, 1, buf);
+            let (dc, pc, sc) = images.nearest(t[2], pa, 1, buf);
+            let spread = db.max(dc).max(S::distance(pb, pc));
+            (spread, [pa, pb, pc], [(ca, 0), sb, sc])
+        })
+        .collect();
+    let mut sorted: Vec<f64> = first
+        .iter()
+        .map(|c| c.0)
+        .filter(|x| x.is_finite())
+        .collect();
     sorted.sort_by(f64::total_cmp);
     let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
+    let across: Vec<Option<Choice<S::Point>>> = match group {
+        None => Vec::new(),
+        Some(_) => faces
+            .par_iter()
+            .zip(first.par_iter())
+            .map_init(Vec::new, |buf, (t, now)| {
+                images.across_seams(t, now, median, &level_end, buf)
+            })
+            .collect(),
+    };
+    let mut corner = Vec::with_capacity(3 * faces.len());
+    let mut source = Vec::with_capacity(3 * faces.len());
     let mut seam_faces = 0;
-    for (f, t) in faces.iter().enumerate() {
-        let orient = S::orientation(corner[3 * f], corner[3 * f + 1], corner[3 * f + 2]);
-        let suspicious = spread[f] > 4.0 * median || orient <= 0.0;
-        if !suspicious || group.is_none() {
-            continue;
-        }
-        // Every copy of `a`, the candidate maps of one level after the other for `b`, `c`.
-        let mut best = (
-            f64::INFINITY,
-            [corner[3 * f], corner[3 * f + 1], corner[3 * f + 2]],
-            [source[3 * f], source[3 * f + 1], source[3 * f + 2]],
-        );
-        for &n in &level_end[1..] {
-            for &ca in &copies[t[0] as usize] {
-                let pa = positions[ca as usize];
-                let (db, pb, sb) = nearest(t[1], pa, n);
-                let (dc, pc, sc) = nearest(t[2], pa, n);
-                let total = db.max(dc).max(S::distance(pb, pc));
-                if total < best.0 {
-                    best = (total, [pa, pb, pc], [(ca, 0), sb, sc]);
-                }
-            }
-            let [pa, pb, pc] = best.1;
-            if best.0 <= 4.0 * median && S::orientation(pa, pb, pc) > 0.0 {
-                break;
-            }
-        }
-        if best.0 < spread[f] {
+    for (f, mut choice) in first.into_iter().enumerate() {
+        if let Some(Some(better)) = across.get(f) {
             seam_faces += 1;
-            corner[3 * f..3 * f + 3].copy_from_slice(&best.1);
-            source[3 * f..3 * f + 3].copy_from_slice(&best.2);
+            choice = *better;
         }
+        corner.extend(choice.1);
+        source.extend(choice.2);
     }
     if let (Some(l), Some(_)) = (side_lengths, group) {
         seam_faces += images.match_side_lengths(faces, l, &mut corner, &mut source);
@@ -356,6 +346,42 @@ where
         best
     }
 
+    /// The second and third levels of [`face_uvs_with_lengths`]' search for face `t`, whose
+    /// identity-only choice is `now` (spread, corners, sources), when it is spread out (over
+    /// 4× the `median` spread) or flipped: every copy of `a`, the candidate maps of one level
+    /// after the other for `b`, `c`. `Some` when that finds a smaller spread.
+    fn across_seams(
+        &self,
+        t: &[u32; 3],
+        now: &Choice<S::Point>,
+        median: f64,
+        level_end: &[usize; 3],
+        buf: &mut Vec<(f64, u32, u32)>,
+    ) -> Option<Choice<S::Point>> {
+        let (spread, p, src) = *now;
+        let suspicious = spread > 4.0 * median || S::orientation(p[0], p[1], p[2]) <= 0.0;
+        if !suspicious {
+            return None;
+        }
+        let mut best = (f64::INFINITY, p, src);
+        for &n in &level_end[1..] {
+            for &ca in &self.copies[t[0] as usize] {
+                let pa = self.positions[ca as usize];
+                let (db, pb, sb) = self.nearest(t[1], pa, n, buf);
+                let (dc, pc, sc) = self.nearest(t[2], pa, n, buf);
+                let total = db.max(dc).max(S::distance(pb, pc));
+                if total < best.0 {
+                    best = (total, [pa, pb, pc], [(ca, 0), sb, sc]);
+                }
+            }
+            let [pa, pb, pc] = best.1;
+            if best.0 <= 4.0 * median && S::orientation(pa, pb, pc) > 0.0 {
+                break;
+            }
+        }
+        (best.0 < spread).then_some(best)
+    }
+
     /// The `keep` images of vertex `w` whose distance from `p` is nearest to `want`:
     /// (mismatch, point, (copy, map)), sorted by mismatch, ties in (copy, map) order.
     fn matching(
@@ -411,40 +437,44 @@ where
                 .max((S::distance(p[1], p[2]) - l[1]).abs())
                 .max((S::distance(p[2], p[0]) - l[2]).abs())
         };
-        let mut changed = 0;
-        for (f, t) in faces.iter().enumerate() {
-            let l = side_lengths[f];
-            let now = [corner[3 * f], corner[3 * f + 1], corner[3 * f + 2]];
-            let tol = 1e-6 * l[0].max(l[1]).max(l[2]);
-            let m0 = mismatch(now, l);
-            if S::orientation(now[0], now[1], now[2]) > 0.0 && m0 <= tol {
-                continue;
-            }
-            let mut best: Option<Choice<S::Point>> = None;
-            for &ca in &self.copies[t[0] as usize] {
-                let pa = self.positions[ca as usize];
-                let bs = self.matching(t[1], pa, l[0], 6);
-                let cs = self.matching(t[2], pa, l[2], 6);
-                for &(_, pb, sb) in &bs {
-                    for &(_, pc, sc) in &cs {
-                        if S::orientation(pa, pb, pc) <= 0.0 {
-                            continue;
-                        }
-                        let m = mismatch([pa, pb, pc], l);
-                        if best.as_ref().is_none_or(|b| m < b.0) {
-                            best = Some((m, [pa, pb, pc], [(ca, 0), sb, sc]));
+        // Per face in parallel (rayon): a face's choice reads only its own corners.
+        let better: Vec<(usize, Choice<S::Point>)> = faces
+            .par_iter()
+            .enumerate()
+            .filter_map(|(f, t)| {
+                let l = side_lengths[f];
+                let now = [corner[3 * f], corner[3 * f + 1], corner[3 * f + 2]];
+                let tol = 1e-6 * l[0].max(l[1]).max(l[2]);
+                let m0 = mismatch(now, l);
+                if S::orientation(now[0], now[1], now[2]) > 0.0 && m0 <= tol {
+                    return None;
+                }
+                let mut best: Option<Choice<S::Point>> = None;
+                for &ca in &self.copies[t[0] as usize] {
+                    let pa = self.positions[ca as usize];
+                    let bs = self.matching(t[1], pa, l[0], 6);
+                    let cs = self.matching(t[2], pa, l[2], 6);
+                    for &(_, pb, sb) in &bs {
+                        for &(_, pc, sc) in &cs {
+                            if S::orientation(pa, pb, pc) <= 0.0 {
+                                continue;
+                            }
+                            let m = mismatch([pa, pb, pc], l);
+                            if best.as_ref().is_none_or(|b| m < b.0) {
+                                best = Some((m, [pa, pb, pc], [(ca, 0), sb, sc]));
+                            }
                         }
                     }
                 }
-            }
-            if let Some((m, p, src)) = best {
-                if m < m0 || S::orientation(now[0], now[1], now[2]) <= 0.0 {
-                    corner[3 * f..3 * f + 3].copy_from_slice(&p);
-                    source[3 * f..3 * f + 3].copy_from_slice(&src);
-                    changed += 1;
-                }
-            }
+                let (m, p, src) = best?;
+                let take = m < m0 || S::orientation(now[0], now[1], now[2]) <= 0.0;
+                take.then_some((f, (m, p, src)))
+            })
+            .collect();
+        for (f, (_, p, src)) in &better {
+            corner[3 * f..3 * f + 3].copy_from_slice(p);
+            source[3 * f..3 * f + 3].copy_from_slice(src);
         }
-        changed
+        better.len()
     }
 }

@@ -38,6 +38,7 @@ use crate::metric::common_subdivision::{
 use crate::metric::intrinsic::{length_of_lambda, IntrinsicTriangulation};
 use crate::metric::{Geometry, IntrinsicMetric};
 use crate::numeric::dd::Cdd;
+use rayon::prelude::*;
 
 /// The common subdivision with its UVs (see the module docs).
 #[derive(Debug, Clone)]
@@ -310,7 +311,7 @@ where
         _ => maps.iter().map(S::Frame::from_iso).collect(),
     };
     let ext: Vec<ExtPoint<S>> = source
-        .iter()
+        .par_iter()
         .map(|&(c, k)| {
             let c = c as usize;
             let p = S::Frame::ext(layout.positions[c], Some(layout.positions_lo[c]));

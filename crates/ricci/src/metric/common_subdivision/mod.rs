@@ -367,15 +367,10 @@ impl CommonSubdivision {
                 tri.n_vertices
             )));
         }
-        let mut out = Vec::with_capacity(3 * self.triangles.len());
-        for (t, &f) in self.t_face.iter().enumerate() {
-            let p = [0, 1, 2].map(|i| corner_uv[3 * f as usize + i]);
-            for c in 0..3 {
-                let beta = self.beta(t, c, u);
-                out.push(interpolate(geometry, &p, &beta)?);
-            }
-        }
-        Ok(out)
+        self.per_piece_corner(|t, f, c| {
+            let p = [0, 1, 2].map(|i| corner_uv[3 * f + i]);
+            interpolate(geometry, &p, &self.beta(t, c, u))
+        })
     }
 
     /// Projective weights `β_i = w_i e^{−u_i}` of corner `c` of triangle `t` on its face of
@@ -427,20 +422,31 @@ impl CommonSubdivision {
                 tri.n_vertices
             )));
         }
-        let mut out = Vec::with_capacity(3 * self.triangles.len());
-        for (t, &f) in self.t_face.iter().enumerate() {
+        self.per_piece_corner(|t, f, c| {
             let p = [0, 1, 2].map(|i| {
-                let (h, l) = (corner_hi[3 * f as usize + i], corner_lo[3 * f as usize + i]);
+                let (h, l) = (corner_hi[3 * f + i], corner_lo[3 * f + i]);
                 Cdd {
                     re: Dd::new(h[0]) + Dd::new(l[0]),
                     im: Dd::new(h[1]) + Dd::new(l[1]),
                 }
             });
-            for c in 0..3 {
-                out.push(self.piece_uv_hyperbolic_dd(t, c, u, &p)?);
-            }
-        }
-        Ok(out)
+            self.piece_uv_hyperbolic_dd(t, c, u, &p)
+        })
+    }
+
+    /// `uv(t, f, c)` for every corner `c` of every triangle `t` (on face `f` of `T`), in
+    /// corner order (`3t + c`), computed in parallel (rayon; each value depends only on its
+    /// own inputs); the first error in that order, if any.
+    fn per_piece_corner(
+        &self,
+        uv: impl Fn(usize, usize, usize) -> Result<[f64; 2]> + Sync,
+    ) -> Result<Vec<[f64; 2]>> {
+        use rayon::prelude::*;
+        let all: Vec<Result<[f64; 2]>> = (0..3 * self.t_face.len())
+            .into_par_iter()
+            .map(|k| uv(k / 3, self.t_face[k / 3] as usize, k % 3))
+            .collect();
+        all.into_iter().collect()
     }
 
     /// UV of corner `c` of triangle `t` when the corners of its face of `T` are at `p`
