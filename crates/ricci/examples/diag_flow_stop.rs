@@ -2,8 +2,8 @@
 //! deck generators after the flow to 1e-12 and to 1e-10, by the two polish routes of the
 //! layout pipeline — the flow variables polished to double-double before the cut
 //! (`polish_uniformization`, the class fixed by the input) and the flow's double lengths
-//! polished in place on the cut's refined mesh (`ricci layout`'s deferred polish, the class of
-//! the rounded lengths).
+//! polished in place on the cut's refined mesh (the class of the rounded lengths; `ricci layout`
+//! did this until session 13, and now polishes before the cut, docs/notes/wave2-s13-dd14.md).
 //!
 //! `cargo run --release -p ricci --example diag_flow_stop -- MESH`
 use ricci::layout::pipeline::{cut_disk_polished, polish_uniformization, uniformization_metric};
@@ -76,7 +76,7 @@ fn main() {
     }
     println!(
         "1e-12 vs 1e-10, largest relative difference of the {} translation lengths: \
-         deferred polish (ricci layout) {:.2e}, polish before the cut {:.2e}",
+         polish after the cut {:.2e}, polish before the cut {:.2e}",
         deferred[0].len(),
         max_rel(&deferred[0], &deferred[1]),
         max_rel(&polished[0], &polished[1])
