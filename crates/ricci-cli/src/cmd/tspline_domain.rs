@@ -164,14 +164,11 @@ pub fn domain_spline(
     })
 }
 
-#[allow(clippy::too_many_arguments)]
+/// `ricci tspline` on genus ≥ 2 after [`domain_spline`]: the warning when the fit stopped
+/// above the tolerance, the pictures and files of `--out`, the report on stdout.
 pub fn run_domain(
     a: &Args,
-    surface: &Surface,
-    h: &HolomorphicForms,
-    domain: &GenusDomain,
-    gluing: &Gluing,
-    filled: usize,
+    spline: DomainSpline,
     tolerance: f64,
     t0: Instant,
     mut bar: Bar,
@@ -181,9 +178,7 @@ pub fn run_domain(
         patches,
         report: mut out,
         max_iterations,
-    } = domain_spline(
-        a, surface, h, domain, gluing, filled, tolerance, t0, &mut bar,
-    )?;
+    } = spline;
     let (rms, max) = fit.steps.last().map_or((f64::NAN, f64::NAN), |s| {
         (s.rms_error_percent, s.max_error_percent)
     });

@@ -260,9 +260,10 @@ pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> an
     if !a.per_cylinder {
         match gluing(&domain) {
             Ok(g) => {
-                return crate::cmd::tspline_domain::run_domain(
-                    a, surface, &h, &domain, &g, loops, tolerance, t0, bar,
-                )
+                let spline = crate::cmd::tspline_domain::domain_spline(
+                    a, surface, &h, &domain, &g, loops, tolerance, t0, &mut bar,
+                )?;
+                return crate::cmd::tspline_domain::run_domain(a, spline, tolerance, t0, bar);
             }
             Err(why) => {
                 eprintln!(

@@ -135,6 +135,17 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         class("elsewhere"),
         sides("elsewhere")
     ));
+    sec.paragraphs.push(format!(
+        "The refinement is uniform (no T-junctions yet on this mesh): to bring the worst vertex \
+         within the tolerance every strip is refined, so the {} control points outnumber the \
+         {} vertices and most cells hold no vertex ({:.2} vertices per cell); between the \
+         vertices the surface is shaped by the fairness term alone, and the zebra stripes show \
+         the ripples this leaves where the cells are smallest. At the zeros the spline is \
+         only C⁰ (G¹ is not guaranteed) and the stripes may kink there.",
+        r.fit.mesh.n_vertices(),
+        surface.positions.len(),
+        surface.positions.len() as f64 / cells.max(1) as f64
+    ));
     let e = |k: &str| {
         c[k]["jumps"]["relative_jumps"]
             .as_array()
