@@ -799,3 +799,73 @@ fn pou_surface_has_no_jumps_and_stays_close_to_the_surface() {
         assert!(imgs.iter().any(|t| t["src"] == want), "no picture {want}");
     }
 }
+
+/// The `tspline` stage is the domain-mesh spline of the demo's own surface: its numbers are
+/// those of `ricci tspline surface.off --json` run here on the written file (the command the
+/// page shows), and they fit the surface's topology (closed, χ = −2): control points − cells
+/// = χ, Σ (valence − 4) over the zeros = −4χ so the sides at the zeros number 4·zeros + 8,
+/// every cell has four sides each shared by two cells (2·cells sides in all); C⁰ at the zeros,
+/// C² elsewhere, within the 0.5 % tolerance; both pictures on the page.
+#[test]
+fn tspline_stage_is_ricci_tspline_of_the_demo_surface() {
+    let (dir, v) = demo();
+    let s = stage(v, "tspline");
+    let surface = dir.join("surface.off");
+    let out = ricci(&[
+        "tspline",
+        surface.to_str().unwrap(),
+        "--tolerance",
+        "0.5%",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let cli: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(cli["spline"], "domain_mesh", "{cli}");
+    for k in [
+        "control_points",
+        "cells",
+        "bezier_patches",
+        "iterations",
+        "converged",
+        "t_junctions",
+    ] {
+        assert_eq!(s[k], cli[k], "{k}");
+    }
+    for k in ["rms_error_percent", "max_error_percent"] {
+        let (a, b) = (f(&s[k]), f(&cli[k]));
+        assert!(
+            (a - b).abs() <= 1e-9 * b.abs().max(1e-12),
+            "{k}: stage {a}, ricci tspline {b}"
+        );
+    }
+    let (c, cc) = (&s["continuity"], &cli["continuity"]);
+    for k in ["at_zeros", "one_interval_from_zeros", "elsewhere"] {
+        assert_eq!(c[k]["sides"], cc[k]["sides"], "{k}");
+        assert_eq!(c[k]["class"], cc[k]["class"], "{k}");
+    }
+    let n = |x: &Value| x.as_i64().unwrap();
+    assert_eq!(n(&s["control_points"]) - n(&s["cells"]), -2, "{s}");
+    let zeros = n(&c["extraordinary_points"]);
+    assert_eq!(zeros, n(&s["zeros"]));
+    assert_eq!(n(&c["at_zeros"]["sides"]), 4 * zeros + 8, "{c}");
+    let all: i64 = ["at_zeros", "one_interval_from_zeros", "elsewhere"]
+        .iter()
+        .map(|k| n(&c[*k]["sides"]))
+        .sum();
+    assert_eq!(all, 2 * n(&s["cells"]));
+    assert_eq!(c["at_zeros"]["class"], "C0", "{c}");
+    for k in ["one_interval_from_zeros", "elsewhere"] {
+        assert!(c[k]["class"] == "C2" || c[k]["class"] == "C3", "{k}: {c}");
+    }
+    assert_eq!(s["converged"], true);
+    assert!(f(&s["max_error_percent"]) <= 0.5, "{s}");
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    let imgs = img_tags(&html);
+    for want in ["tspline-tmesh.png", "tspline-zebra.png"] {
+        assert!(imgs.iter().any(|t| t["src"] == want), "no picture {want}");
+    }
+}

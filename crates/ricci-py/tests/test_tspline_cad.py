@@ -132,4 +132,4 @@ def test_other_topologies_are_refused_naming_the_missing_domain(generated, tmp_p
     )
     code, out, err = cli("tspline", two, "--json", check=False)
     assert code == 1
-    assert "boundary loop" in out["error"] and "double cover" in out["error"]
+    assert "boundary loops" in out["error"] and "each component" in out["error"]

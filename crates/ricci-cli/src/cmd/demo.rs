@@ -147,7 +147,7 @@ pub const STAGES: &[Stage] = &[
     },
 
     Stage { id: "param", title: "Conformal UV map with cones", reference: "ricci param: greedy cones (Ben-Chen–Gotsman–Bunin 2008), conformal flow with intrinsic Delaunay flips, cut, UVs on the input's faces", needs: &["surface"], run: param_stage::param },
-    Stage { id: "tspline", title: "Manifold T-spline of a torus", reference: "cubic T-spline over the flat torus, adaptive least-squares fit, analysis-suitable T-mesh (paper 003 §3)", needs: &[], run: tspline_stage::tspline },
+    Stage { id: "tspline", title: "Manifold T-spline of the surface", reference: "one cubic spline on the domain manifold's quad mesh of knot intervals (cylinders of a holomorphic 1-form glued by translations), least-squares fit with uniform refinement, continuity measured across every cell side (paper 003 §2–3)", needs: &["surface"], run: tspline_stage::tspline },
     Stage { id: "forms", title: "Holomorphic 1-forms and the conformal net", reference: "harmonic basis, Hodge star, period matrix, zeros, conformal net and critical horizontal trajectories (paper 002 §4.2, §6.3)", needs: &["surface"], run: forms_stage::forms },
     Stage { id: "geodesics", title: "Shortest closed geodesics on the surface", reference: "axes of the deck transformations of the shortest classes, pulled back into the fundamental polygon (paper 002 §6.3.3)", needs: &["layout"], run: geodesics_stage::geodesics },
 ];

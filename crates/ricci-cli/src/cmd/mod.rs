@@ -18,3 +18,4 @@ pub mod teichmuller;
 pub mod tspline;
 pub mod tspline_domain;
 pub mod tspline_genus;
+pub mod tspline_pictures;

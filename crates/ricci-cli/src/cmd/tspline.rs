@@ -6,9 +6,10 @@
 //! the cylinders of a holomorphic 1-form (`tspline_genus`), and connected surfaces of genus 0,
 //! closed or with boundary loops, over the flat torus of the double of an annulus (loops
 //! filled, one face cut at each of two poles: `ricci::spline::tspline::genus0`; the data lie on
-//! half of the torus), and surfaces of genus 1 with boundary loops over the flat torus of the
-//! surface with its loops filled by fans (no data on the fills). Other topologies are refused
-//! with a sentence naming the missing domain and what works.
+//! half of the torus), and surfaces of genus ≥ 1 with boundary loops over the domain of the
+//! surface with its loops filled by fans (no data on the fills; genus 1: the flat torus,
+//! genus ≥ 2: the cylinders of a holomorphic 1-form). Several components are refused with a
+//! sentence saying what works.
 //!
 //! `--out DIR` writes `tspline.step` (AP214, one `B_SPLINE_SURFACE_WITH_KNOTS` face per Bézier
 //! patch), `tspline.igs` (entity 128 per patch), `surface.obj` (closed welded tessellation on a lattice grid), `tmesh.svg`
@@ -16,13 +17,15 @@
 //! points of our evaluation, to check readers against), `tmesh-surface.png` (the T-mesh's
 //! edges mapped onto the surface through the fit, T-junctions in red: paper 003 Fig. 5/7),
 //! `zebra.png` (reflection lines of the fitted surface) and `tspline.json` (the report).
-//! For genus 0 it writes only the surface's half of the torus (the Bézier patches clipped to
+//! For genus ≥ 2 (`tspline_domain`) the pictures show the domain mesh (`tspline_pictures`)
+//! and there is no `tmesh.svg`. For genus 0 it writes only the surface's half of the torus (the Bézier patches clipped to
 //! the strip between the seams): `tspline.step`, `tspline.igs`, `surface.obj` (per-patch
 //! tessellation), `samples.json`, `spline.json`, `tspline.json`; and JSON `control_points`
 //! counts the control points whose blending function meets that half (the budget
 //! `--max-control-points` counts the same), `control_points_total` all of them.
 
 use crate::cmd::layout::spinner;
+use crate::cmd::tspline_pictures::{line, render_net_and_zebra};
 use crate::util::{print_json, read_surface, write_atomic, write_json_atomic, UsageError};
 use ricci::spline::tspline::curves::{tmesh_on_surface, torus_tessellation};
 use ricci::spline::tspline::export::{iges, obj, step, torus_obj};
@@ -35,7 +38,7 @@ use ricci::spline::tspline::{
     chart_independence, continuity, extract, BezierPatch, ChartIndependence, Continuity, Lattice,
     TSpline,
 };
-use ricci_render::{render, Image, Paint, Polyline, RenderOptions, Style, View};
+use ricci_render::{Image, Polyline, RenderOptions, View};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -43,8 +46,8 @@ use std::time::Instant;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Mesh file (OBJ, OFF, PLY, STL); closed surfaces of genus ≥ 1, and genus 0 (closed or
-    /// with boundary loops).
+    /// Mesh file (OBJ, OFF, PLY, STL): one connected surface, closed or with boundary loops
+    /// (filled for the domain; the fills carry no data), of any genus.
     pub mesh: PathBuf,
     /// Fitting tolerance L∞, as a fraction of the longest bounding-box side ("0.5%" or 0.005).
     #[arg(long, default_value = "0.5%")]
@@ -116,7 +119,7 @@ pub struct Args {
     pub json: bool,
 }
 
-fn parse_tolerance(s: &str) -> Result<f64, UsageError> {
+pub(crate) fn parse_tolerance(s: &str) -> Result<f64, UsageError> {
     parse_fraction("--tolerance", s, false)
 }
 
@@ -204,30 +207,15 @@ pub fn pictures(
     let mut polylines: Vec<Polyline> = curves
         .edges
         .into_iter()
-        .map(|points| Polyline {
-            points,
-            color: [0.12, 0.12, 0.16],
-            width: 1.0,
-            closed: false,
-        })
+        .map(|points| line(points, [0.12, 0.12, 0.16], 1.0, false))
         .collect();
-    polylines.extend(curves.t_junctions.into_iter().map(|points| Polyline {
-        points,
-        color: [0.9, 0.05, 0.05],
-        width: 2.5,
-        closed: true,
-    }));
-    let net = Style {
-        polylines,
-        ..Style::default()
-    };
-    let tmesh = render(&positions, &triangles, &net, &opts)?.image;
-    let zebra = Style {
-        paint: Paint::Zebra(ricci_render::Zebra::default()),
-        ..Style::default()
-    };
-    let zebra = render(&positions, &triangles, &zebra, &opts)?.image;
-    Ok((tmesh, zebra))
+    polylines.extend(
+        curves
+            .t_junctions
+            .into_iter()
+            .map(|points| line(points, [0.9, 0.05, 0.05], 2.5, true)),
+    );
+    render_net_and_zebra(&positions, &triangles, polylines, &opts)
 }
 
 fn samples_json(ts: &TSpline, patches: &[BezierPatch]) -> serde_json::Value {
@@ -387,18 +375,13 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         Some(c) => (topo.components.len(), c.genus, c.boundary_loops),
         None => (0, 0, 0),
     };
-    if comps == 1 && genus >= 2 && loops == 0 {
+    if comps == 1 && genus >= 2 {
         return crate::cmd::tspline_genus::run_genus(&a, &surface, tolerance, t0);
     }
     let genus0 = comps == 1 && genus == 0;
-    if !genus0 && (comps != 1 || genus != 1) {
-        let what = if comps != 1 {
-            "fit each component on its own (one file per component); the double cover of paper 003 §2 for boundaries of genus ≥ 2 is not built yet".to_string()
-        } else {
-            format!("its domain manifold (paper 003 §2: the double cover, genus {}) is not built yet; with its holes closed it is a closed genus-{genus} surface, which works", 2 * genus + loops as i64 - 1)
-        };
+    if comps != 1 {
         anyhow::bail!(
-            "{}: ricci tspline supports closed surfaces of genus ≥ 1, connected surfaces of genus 0 (closed or with boundary loops) and of genus 1 with boundary loops for now (domains: the flat torus, the cylinders of a holomorphic 1-form, the double of an annulus, the flat torus of the filled surface); this mesh has {comps} component(s), genus {genus} and {loops} boundary loop(s): {what}",
+            "{}: ricci tspline supports closed surfaces of genus ≥ 1 and connected surfaces of any genus with boundary loops (filled for the domain); this mesh has {comps} components: fit each component on its own (one file per component)",
             a.mesh.display()
         );
     }

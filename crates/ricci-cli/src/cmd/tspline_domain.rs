@@ -6,22 +6,31 @@
 //! zeros (the extraordinary points), C² on every other side — reported apart for the sides
 //! one knot interval from a zero and the sides farther.
 //!
+//! Surfaces with boundary loops: the loops are filled by fans for the domain and the fills
+//! carry no data (JSON `filled_loops`).
+//!
 //! Writes `tspline.step`, `tspline.igs` (one Bézier patch per cell, the strips side by side in
 //! the parameter plane), `surface.obj` (per-patch tessellation), `samples.json` (our
-//! evaluation from the blending functions) and `tspline.json`.
+//! evaluation from the blending functions), `tmesh-surface.png` and `zebra.png` (the domain
+//! mesh on the surface and reflection lines: `tspline_pictures`; not with `--no-pictures`)
+//! and `tspline.json`.
 
 use crate::cmd::layout::Bar;
 use crate::cmd::tspline::Args;
 use crate::cmd::tspline_genus::{
-    jumps_json, print_report, shared_keys, warn_not_converged, write_files,
+    filled_json, jumps_json, print_report, shared_keys, warn_not_converged, write_files,
 };
+use crate::cmd::tspline_pictures::{domain_caption, domain_pictures, ZEBRA_CAPTION};
+use crate::util::write_atomic;
 use ricci::analysis::forms::HolomorphicForms;
 use ricci::mesh::Surface;
+use ricci::progress::Progress;
 use ricci::spline::tspline::domain_continuity::{side_continuity, SideContinuity};
 use ricci::spline::tspline::domain_fit::{fit_domain_mesh, DomainFit, DomainFitOptions};
 use ricci::spline::tspline::genus_domain::GenusDomain;
 use ricci::spline::tspline::glue::Gluing;
 use ricci::spline::tspline::{BezierPatch, Continuity};
+use ricci_render::RenderOptions;
 use serde_json::json;
 use std::time::Instant;
 
@@ -70,18 +79,31 @@ fn samples_json(fit: &DomainFit, patches: &[BezierPatch]) -> serde_json::Value {
     json!({"samples": out, "patches": bounds, "samples_per_patch": 2})
 }
 
+/// A fitted domain-mesh spline and its report (the JSON of `ricci tspline --json` but `out`).
+pub struct DomainSpline {
+    pub fit: DomainFit,
+    pub patches: Vec<BezierPatch>,
+    pub report: serde_json::Value,
+    pub max_iterations: usize,
+}
+
+/// Fit the domain-mesh spline of `surface` (its data points: `surface.positions`) over
+/// `domain` glued by `gluing`, measure its continuity and write the report: the one path of
+/// `ricci tspline` on genus ≥ 2 and of the demo's `tspline` stage. `filled` boundary loops
+/// were filled for the domain (no data on them).
 #[allow(clippy::too_many_arguments)]
-pub fn run_domain(
+pub fn domain_spline(
     a: &Args,
     surface: &Surface,
     h: &HolomorphicForms,
     domain: &GenusDomain,
     gluing: &Gluing,
+    filled: usize,
     tolerance: f64,
     t0: Instant,
-    bar: Bar,
-) -> anyhow::Result<()> {
-    bar.0.set_message("fitting the spline on the domain mesh");
+    progress: &mut dyn Progress,
+) -> anyhow::Result<DomainSpline> {
+    progress.report("tspline", None, "fitting the spline on the domain mesh");
     let opts = DomainFitOptions {
         tolerance,
         smoothing: a.smoothing.max(1e-4),
@@ -91,15 +113,11 @@ pub fn run_domain(
     };
     let fit = fit_domain_mesh(domain, gluing, &surface.positions, &opts)?;
     let fit_seconds = t0.elapsed().as_secs_f64();
-    bar.0.set_message("derivative jumps across every cell side");
+    progress.report("tspline", None, "derivative jumps across every cell side");
     let sides = side_continuity(&fit.mesh, &fit.control, SIDE_SAMPLES);
     let patches = fit.mesh.patches(&fit.control);
-    bar.0.finish_and_clear();
     let mesh = &fit.mesh;
     let continuity = continuity_json(&sides, domain.decomposition.zeros.len(), fit.scale);
-    let (rms, max) = fit.steps.last().map_or((f64::NAN, f64::NAN), |s| {
-        (s.rms_error_percent, s.max_error_percent)
-    });
     let offsets = mesh.export_offsets();
     let strips: Vec<_> = mesh
         .rects
@@ -110,9 +128,15 @@ pub fn run_domain(
                    "cells_u": r.m, "cells_v": r.n, "u_offset": off})
         })
         .collect();
-    let mut out = json!({
-        "domain": format!("cylinders of a holomorphic 1-form with integer imaginary periods (genus {}), their strips glued by translations into one quad mesh of knot intervals", h.genus),
+    let with = if filled > 0 {
+        format!(" of the surface with its {filled} boundary loop(s) filled by fans (the fills carry no data)")
+    } else {
+        String::new()
+    };
+    let mut report = json!({
+        "domain": format!("cylinders of a holomorphic 1-form with integer imaginary periods (genus {}){with}, their strips glued by translations into one quad mesh of knot intervals", h.genus),
         "spline": "domain_mesh",
+        "filled_loops": filled_json(filled),
         "strips": strips,
         "cells": mesh.n_cells(),
         "control_points": mesh.n_vertices(),
@@ -121,7 +145,7 @@ pub fn run_domain(
         "gluing_mismatch": gluing.mismatch,
     });
     shared_keys(
-        &mut out,
+        &mut report,
         a,
         surface,
         domain,
@@ -132,10 +156,60 @@ pub fn run_domain(
         fit_seconds,
         t0,
     );
+    Ok(DomainSpline {
+        fit,
+        patches,
+        report,
+        max_iterations: opts.max_iterations,
+    })
+}
+
+/// `ricci tspline` on genus ≥ 2 after [`domain_spline`]: the warning when the fit stopped
+/// above the tolerance, the pictures and files of `--out`, the report on stdout.
+pub fn run_domain(
+    a: &Args,
+    spline: DomainSpline,
+    tolerance: f64,
+    t0: Instant,
+    mut bar: Bar,
+) -> anyhow::Result<()> {
+    let DomainSpline {
+        fit,
+        patches,
+        report: mut out,
+        max_iterations,
+    } = spline;
+    let (rms, max) = fit.steps.last().map_or((f64::NAN, f64::NAN), |s| {
+        (s.rms_error_percent, s.max_error_percent)
+    });
     if !fit.converged {
-        warn_not_converged(a, max, tolerance, opts.max_iterations);
+        warn_not_converged(a, max, tolerance, max_iterations);
     }
+    if let (Some(dir), false) = (&a.out, a.no_pictures) {
+        bar.report(
+            "tspline",
+            None,
+            "pictures of the domain mesh and zebra stripes",
+        );
+        let opts = RenderOptions {
+            width: 1200,
+            height: 900,
+            supersample: 2,
+            ..RenderOptions::default()
+        };
+        let (net, zebra, info) = domain_pictures(&fit, a.tessellation, &opts)?;
+        write_atomic(&dir.join("tmesh-surface.png"), &net.to_png()?)?;
+        write_atomic(&dir.join("zebra.png"), &zebra.to_png()?)?;
+        out["pictures"] = json!({
+            "tmesh-surface.png": domain_caption(&info, fit.mesh.n_cells()),
+            "zebra.png": ZEBRA_CAPTION,
+            "knot_line_stride": info.stride,
+            "triangles": info.triangles,
+        });
+    }
+    bar.0.finish_and_clear();
     write_files(a, &patches, || samples_json(&fit, &patches), &mut out, t0)?;
+    let mesh = &fit.mesh;
     print_report(a, &out, || {
         format!(
             "{}: domain mesh of {} strips, {} control points, {} Bézier patches, error rms {:.3}% max {:.3}% of the longest side, {} iterations; continuity: {}; {:.2} s",

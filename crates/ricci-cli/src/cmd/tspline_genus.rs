@@ -1,4 +1,5 @@
-//! `ricci tspline` on closed surfaces of genus ≥ 2: the domain manifold is the cylinder
+//! `ricci tspline` on surfaces of genus ≥ 2 (boundary loops filled by fans, the fills without
+//! data: [`genus_domain_of`]): the domain manifold is the cylinder
 //! decomposition of a holomorphic 1-form with integer imaginary periods
 //! (`ricci::spline::tspline::{cylinders, genus_domain}`). By default its strips, glued by
 //! translations, carry one spline on one quad mesh (`tspline_domain`, C² on every cell side
@@ -9,18 +10,21 @@
 //! gaps and normal angles, measured). At the zeros themselves (the extraordinary points):
 //! C⁰, G¹ not guaranteed, the corner normals' angle measured (`continuity.at_zeros`).
 //!
-//! Writes the same files as the genus-1 path except the pictures and `tmesh.svg`:
-//! `tspline.step`, `tspline.igs`, `surface.obj` (per-patch tessellation), `samples.json` and
-//! `tspline.json`.
+//! Writes the same files as the genus-1 path except `tmesh.svg` (and, per cylinder, the
+//! pictures): `tspline.step`, `tspline.igs`, `surface.obj` (per-patch tessellation),
+//! `samples.json` and `tspline.json`.
 
 use crate::cmd::layout::spinner;
 use crate::cmd::tspline::Args;
 use crate::util::{print_json, write_atomic};
+use ricci::analysis::forms::HolomorphicForms;
 use ricci::analysis::forms::{holomorphic_forms, FormsOptions};
 use ricci::mesh::Surface;
 use ricci::metric::IntrinsicMetric;
+use ricci::progress::Progress;
 use ricci::spline::tspline::cylinder_fit::{fit_cylinders, GenusFit, GenusFitOptions, GenusStep};
 use ricci::spline::tspline::cylinder_jumps::{AtZero, GluedSeams, Seam};
+use ricci::spline::tspline::genus0::fill_boundary_loops;
 use ricci::spline::tspline::genus_domain::{best_genus_domain, GenusDomain};
 use ricci::spline::tspline::glue::gluing;
 use ricci::spline::tspline::{BezierPatch, Continuity};
@@ -215,25 +219,51 @@ pub(crate) fn print_report(a: &Args, out: &serde_json::Value, text: impl FnOnce(
     }
 }
 
+/// The domain of a connected surface of genus ≥ 2: its boundary loops, if any, filled by fans
+/// (`fill_boundary_loops`; the fills' centres carry no data: only the first
+/// `surface.positions.len()` vertices are data points), the holomorphic 1-forms of the closed
+/// surface and the cylinders of the best form. The one path of `ricci tspline` and of the
+/// demo's `tspline` stage.
+pub(crate) fn genus_domain_of(
+    surface: &Surface,
+    progress: &mut dyn Progress,
+) -> anyhow::Result<(HolomorphicForms, GenusDomain, usize)> {
+    let filled = if surface.mesh.boundary_loops().is_empty() {
+        None
+    } else {
+        Some(fill_boundary_loops(surface)?)
+    };
+    let (closed, loops) = filled.as_ref().map_or((surface, 0), |(s, n)| (s, *n));
+    progress.report("tspline", None, "holomorphic 1-forms");
+    let h = holomorphic_forms(
+        &closed.mesh,
+        &IntrinsicMetric::euclidean(closed.edge_lengths()),
+        Some(&closed.positions),
+        &FormsOptions::default(),
+        progress,
+    )?;
+    progress.report("tspline", None, "cylinders of the critical trajectories");
+    let domain = best_genus_domain(&h, surface.positions.len())?;
+    Ok((h, domain, loops))
+}
+
+/// The JSON `filled_loops` of a genus ≥ 2 report: how many boundary loops were filled by fans
+/// and that the fills carry no data.
+pub(crate) fn filled_json(loops: usize) -> serde_json::Value {
+    json!({"loops": loops, "note": if loops == 0 { "closed surface: nothing filled" } else { "each boundary loop filled by a fan around its centroid for the domain (a closed surface of the same genus); the fills carry no data: the spline over them is not fitted to anything, only faired, and is not part of the input surface" }})
+}
+
 pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> anyhow::Result<()> {
     let mut bar = spinner(a.json);
-    bar.0.set_message("holomorphic 1-forms");
-    let h = holomorphic_forms(
-        &surface.mesh,
-        &IntrinsicMetric::euclidean(surface.edge_lengths()),
-        Some(&surface.positions),
-        &FormsOptions::default(),
-        &mut bar,
-    )?;
-    bar.0.set_message("cylinders of the critical trajectories");
-    let domain = best_genus_domain(&h, surface.positions.len())?;
+    let (h, domain, loops) = genus_domain_of(surface, &mut bar)?;
     let mut refused = None;
     if !a.per_cylinder {
         match gluing(&domain) {
             Ok(g) => {
-                return crate::cmd::tspline_domain::run_domain(
-                    a, surface, &h, &domain, &g, tolerance, t0, bar,
-                )
+                let spline = crate::cmd::tspline_domain::domain_spline(
+                    a, surface, &h, &domain, &g, loops, tolerance, t0, &mut bar,
+                )?;
+                return crate::cmd::tspline_domain::run_domain(a, spline, tolerance, t0, bar);
             }
             Err(why) => {
                 eprintln!(
@@ -288,6 +318,7 @@ pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> an
         "domain": format!("cylinders of a holomorphic 1-form with integer imaginary periods (genus {})", h.genus),
         "spline": "per_cylinder",
         "domain_mesh_refused": refused,
+        "filled_loops": filled_json(loops),
         "cylinders": cylinders,
         "control_points": fit.control_points(),
         "bezier_patches": patches.len(),

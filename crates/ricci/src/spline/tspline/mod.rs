@@ -29,8 +29,9 @@
 //!   default for genus ≥ 2; the per-cylinder [`cylinder_fit`] is the `--per-cylinder`
 //!   option); [`domain_continuity`] measures its derivative jumps across every cell side.
 //!
-//! What is not here yet: for genus ≥ 2 T-junctions and local refinement on the domain mesh;
-//! surfaces of genus ≥ 2 with boundary.
+//! Surfaces with boundary loops of genus ≥ 1 use the domain of the surface with its loops
+//! filled by fans ([`genus0::fill_boundary_loops`]; the fills carry no data). What is not here
+//! yet: for genus ≥ 2 T-junctions and local refinement on the domain mesh.
 
 #![allow(clippy::needless_range_loop)]
 
