@@ -25,6 +25,7 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky,
     SymmetricOrdering,
 };
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
@@ -58,6 +59,15 @@ fn lower<'a>(
         values,
     )
 }
+
+/// Always the supernodal factorization (faer's default picks simplicial below 40 flops per
+/// factor nonzero). The Hessians of the conformal flow on meshes of 35–50 k vertices lie near
+/// that switch and, as their pattern grows with the flips, went simplicial or supernodal from
+/// one Newton step to the next; supernodal was the faster there, and for the Laplacian of the
+/// cone placement (`ricci param --cones 8 --seams free`, seahorse2_100K and camel: 3–5 % less
+/// CPU time for the whole command than faer's default, 2 % less than a switch at 20;
+/// BENCHMARKS.md, session 14 spd16). Both are exact factorizations of the same matrix.
+const SUPERNODAL_THRESHOLD: SupernodalThreshold = SupernodalThreshold::FORCE_SUPERNODAL;
 
 /// A reusable sparse symmetric factorization for one sparsity pattern (lower triangle).
 pub struct SymmetricSolver {
@@ -133,11 +143,16 @@ impl SymmetricSolver {
             Some((f, i)) => SymmetricOrdering::Custom(PermRef::new_checked(f, i, n)),
             None => SymmetricOrdering::Amd,
         };
-        let symbolic =
-            factorize_symbolic_cholesky(sym, Side::Lower, order, CholeskySymbolicParams::default())
-                .map_err(|e| {
-                    Error::numerical(format!("symbolic Cholesky factorization failed: {e:?}"))
-                })?;
+        let symbolic = factorize_symbolic_cholesky(
+            sym,
+            Side::Lower,
+            order,
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SUPERNODAL_THRESHOLD,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| Error::numerical(format!("symbolic Cholesky factorization failed: {e:?}")))?;
         let par = Par::Seq;
         let req = StackReq::any_of(&[
             symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),

@@ -31,6 +31,9 @@ pub(super) struct ChartUv {
     pub corner_uv: Vec<[f64; 2]>,
     pub cut: Vec<bool>,
     pub subdivision: Option<SubdivisionChart>,
+    /// The subdivision's triangles as a mesh (built for the seam report; reused by
+    /// [`super::parametrize`] when this is the only chart).
+    pub subdivision_mesh: Option<Mesh>,
     pub chart: Chart,
     /// Written triangles (the subdivision's, else the input's faces) that fold or lie within
     /// rounding of folding ([`super::ladder::unresolved_triangles`]).
@@ -417,13 +420,16 @@ pub(super) fn chart_uv(
             }
         }
     };
+    let mut subdivision_mesh = None;
     let seams = match subdivision.as_mut() {
         Some(sub) => {
             scale_to_area(&sub.positions, &sub.triangles, &mut sub.corner_uv);
             corner_uv = input_corners_of(mesh, sub);
             let m = Mesh::from_triangles(sub.positions.len(), sub.triangles.clone())?;
             let seam = seam_edges(&m, &sub.corner_uv);
-            seam_report(&m, &sub.positions, &sub.corner_uv, &seam)
+            let report = seam_report(&m, &sub.positions, &sub.corner_uv, &seam);
+            subdivision_mesh = Some(m);
+            report
         }
         None => {
             scale_to_area(&s.positions, faces, &mut corner_uv);
@@ -482,6 +488,7 @@ pub(super) fn chart_uv(
         corner_uv,
         cut,
         subdivision,
+        subdivision_mesh,
         chart,
         flipped,
     })

@@ -457,6 +457,7 @@ pub fn parametrize(
     let mut charts = Vec::new();
     let mut boxes = Vec::new();
     let mut chart_uvs = Vec::new();
+    let mut subdivision_meshes = Vec::new();
     for (c, p) in ps.iter().enumerate() {
         let mut cu = ladder::flip_free_chart(p, c, opts, progress)?;
         let wh = match cu.subdivision.as_mut() {
@@ -475,6 +476,7 @@ pub fn parametrize(
         }
         charts.push(cu.chart);
         chart_uvs.push((cu.corner_uv, cu.subdivision));
+        subdivision_meshes.push(cu.subdivision_mesh);
     }
     // Shelf packing, tallest first.
     let gap = 0.02 * boxes.iter().map(|b| b.0 * b.1).sum::<f64>().sqrt();
@@ -515,11 +517,18 @@ pub fn parametrize(
     }
     let input_stats = uv_stats(&surface.positions, surface.mesh.faces(), &corner_uv);
     let subdivision = if chart_uvs.iter().any(|x| x.1.is_some()) {
+        // One chart: the mesh of its subdivision is the whole map's (same points, same
+        // triangles), already built by the chart.
+        let single = match subdivision_meshes.as_mut_slice() {
+            [m] => m.take(),
+            _ => None,
+        };
         Some(subdivision_map(
             &ps,
             &chart_uvs,
             &place,
             input_stats.clone(),
+            single,
         )?)
     } else {
         None
@@ -540,12 +549,14 @@ pub fn parametrize(
 type ChartParts<'a> = (&'a [[f64; 3]], &'a [[u32; 3]], Vec<u32>, &'a [[f64; 2]]);
 
 /// The whole map on the common subdivision: every chart's subdivision, or its input faces
-/// when it has none, with the packed UVs (`place(chart, uv)`).
+/// when it has none, with the packed UVs (`place(chart, uv)`). `single`: the mesh of these
+/// triangles when it is already built (one chart); it is used when its counts match.
 fn subdivision_map(
     ps: &[Piece],
     charts: &[(Vec<[f64; 2]>, Option<transfer::SubdivisionChart>)],
     place: &dyn Fn(usize, [f64; 2]) -> [f64; 2],
     input_stats: DistortionStats,
+    single: Option<Mesh>,
 ) -> Result<SubdivisionMap> {
     let (mut positions, mut triangles, mut input_face, mut corner_uv) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -580,7 +591,10 @@ fn subdivision_map(
         input_face.extend(faces);
         corner_uv.extend(uv.iter().map(|&q| place(c, q)));
     }
-    let mesh = Mesh::from_triangles(positions.len(), triangles)?;
+    let mesh = match single {
+        Some(m) if m.n_vertices() == positions.len() && m.faces() == triangles.as_slice() => m,
+        _ => Mesh::from_triangles(positions.len(), triangles)?,
+    };
     let seam = transfer::seam_edges(&mesh, &corner_uv);
     Ok(SubdivisionMap {
         positions,
