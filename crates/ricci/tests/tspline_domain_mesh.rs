@@ -179,6 +179,37 @@ fn jumps(a: &BezierPatch, b: &BezierPatch, side: usize) -> [f64; 3] {
     std::array::from_fn(|o| jump[o] / scale[o].max(1e-300))
 }
 
+/// Vertices within one knot interval of a zero (the corners of the cells with a zero corner).
+fn ring(m: &DomainMesh) -> Vec<bool> {
+    let mut ring = vec![false; m.n_vertices()];
+    for q in &m.corners {
+        if q.iter().any(|&v| m.is_zero(v)) {
+            for &v in q {
+                ring[v as usize] = true;
+            }
+        }
+    }
+    ring
+}
+
+/// The class of a side: 0 with a zero at an end, 1 with an end one interval from a zero, 2
+/// the others.
+fn class(m: &DomainMesh, ring: &[bool], c: u32, side: usize, at_zero: bool) -> usize {
+    let q = m.corners[c as usize];
+    let ends = if side == 0 {
+        [q[1], q[2]]
+    } else {
+        [q[2], q[3]]
+    };
+    if at_zero {
+        0
+    } else if ends.iter().any(|&v| ring[v as usize]) {
+        1
+    } else {
+        2
+    }
+}
+
 fn e3(x: [f64; 3]) -> String {
     format!("[{:.2e}, {:.2e}, {:.2e}]", x[0], x[1], x[2])
 }
@@ -190,15 +221,7 @@ fn domain_mesh_spline_is_chart_independent_and_c2_one_knot_interval_from_the_zer
         let control: Vec<[f64; 3]> = (0..m.n_vertices())
             .map(|_| [rng.next(), rng.next(), rng.next()])
             .collect();
-        // vertices within one knot interval (a corner of a cell with a zero corner)
-        let mut ring = vec![false; m.n_vertices()];
-        for q in &m.corners {
-            if q.iter().any(|&v| m.is_zero(v)) {
-                for &v in q {
-                    ring[v as usize] = true;
-                }
-            }
-        }
+        let ring = ring(&m);
         // per class: 0 sides with a zero at an end, 1 sides with an end one interval from a
         // zero, 2 the others; largest jumps of orders 0, 1, 2 and counts
         let mut worst = [[0.0f64; 3]; 3];
@@ -208,19 +231,7 @@ fn domain_mesh_spline_is_chart_independent_and_c2_one_knot_interval_from_the_zer
         for (c, side, at_zero) in m.sides() {
             let (a, b) = across(&m, &control, c, side);
             let j = jumps(&a, &b, side);
-            let q = m.corners[c as usize];
-            let ends = if side == 0 {
-                [q[1], q[2]]
-            } else {
-                [q[2], q[3]]
-            };
-            let class = if at_zero {
-                0
-            } else if ends.iter().any(|&v| ring[v as usize]) {
-                1
-            } else {
-                2
-            };
+            let class = class(&m, &ring, c, side, at_zero);
             count[class] += 1;
             for o in 0..3 {
                 worst[class][o] = worst[class][o].max(j[o]);
@@ -308,31 +319,12 @@ fn angle(a: &BezierPatch, b: &BezierPatch, u: f64, v: f64) -> Option<f64> {
 /// Per class of side (as in the test above): largest relative jumps of orders 0, 1, 2, and the
 /// largest normal angle (degrees) at 11 points of every side at a zero, ends included.
 fn measure(m: &DomainMesh, control: &[[f64; 3]]) -> ([[f64; 3]; 3], f64) {
-    let mut ring = vec![false; m.n_vertices()];
-    for q in &m.corners {
-        if q.iter().any(|&v| m.is_zero(v)) {
-            for &v in q {
-                ring[v as usize] = true;
-            }
-        }
-    }
+    let ring = ring(m);
     let mut worst = [[0.0f64; 3]; 3];
     let mut normal = 0.0f64;
     for (c, side, at_zero) in m.sides() {
         let (a, b) = across(m, control, c, side);
-        let q = m.corners[c as usize];
-        let ends = if side == 0 {
-            [q[1], q[2]]
-        } else {
-            [q[2], q[3]]
-        };
-        let class = if at_zero {
-            0
-        } else if ends.iter().any(|&v| ring[v as usize]) {
-            1
-        } else {
-            2
-        };
+        let class = class(m, &ring, c, side, at_zero);
         let j = jumps(&a, &b, side);
         for o in 0..3 {
             worst[class][o] = worst[class][o].max(j[o]);

@@ -14,6 +14,7 @@
 //! patches' normals `∂u × ∂v` along every side at a zero, its ends included.
 
 use super::bezier::{BezierPatch, Continuity};
+use super::cylinder_jumps::{cross, norm};
 use super::domain_mesh::DomainMesh;
 
 /// Jumps per order (0..=3) across the cell sides, per class.
@@ -53,18 +54,6 @@ pub fn normal_angle(
         na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2],
     );
     Some(s.atan2(c).to_degrees())
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
 
 /// The same point of a side in both patches' parameters at `t ∈ [0, 1]` along it: right side,
