@@ -132,7 +132,7 @@ struct Knots {
 
 impl Knots {
     /// The distance of knot `i ≤ levels + 2` from its end.
-    fn from_end(&self, i: usize) -> f64 {
+    fn end_offset(&self, i: usize) -> f64 {
         match i {
             0 => 0.0,
             i if i <= self.levels + 1 => self.e * (1u64 << (i - 1)) as f64,
@@ -144,11 +144,11 @@ impl Knots {
     fn knot(&self, i: usize) -> f64 {
         let g = self.levels + 2;
         if i <= g {
-            self.from_end(i)
+            self.end_offset(i)
         } else if i + g >= self.k {
-            self.len - self.from_end(self.k - i)
+            self.len - self.end_offset(self.k - i)
         } else {
-            let end = self.from_end(g);
+            let end = self.end_offset(g);
             end + (i - g) as f64 * (self.len - 2.0 * end) / (self.k - 2 * g) as f64
         }
     }
@@ -217,9 +217,12 @@ impl Rect {
     }
 }
 
+/// `(i, j)` of a Bézier point of a cell, `i` along `u`.
+type BezierIndex = (usize, usize);
+
 /// Per cell corner `[lower left, lower right, upper right, upper left]`: its Bézier index and
 /// those of the points next to it along `u` and along `v`.
-const CORNER_POINTS: [((usize, usize), (usize, usize), (usize, usize)); 4] = [
+const CORNER_POINTS: [(BezierIndex, BezierIndex, BezierIndex); 4] = [
     ((0, 0), (1, 0), (0, 1)),
     ((3, 0), (2, 0), (3, 1)),
     ((3, 3), (2, 3), (3, 2)),
