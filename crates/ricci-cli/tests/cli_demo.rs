@@ -857,7 +857,7 @@ fn tspline_stage_is_ricci_tspline_of_the_demo_surface() {
         .map(|k| n(&c[*k]["sides"]))
         .sum();
     assert_eq!(all, 2 * n(&s["cells"]));
-    assert_eq!(c["at_zeros"]["class"], "C0", "{c}");
+    assert_eq!(c["at_zeros"]["class"], "C1", "{c}");
     for k in ["one_interval_from_zeros", "elsewhere"] {
         assert!(c[k]["class"] == "C2" || c[k]["class"] == "C3", "{k}: {c}");
     }

@@ -55,7 +55,8 @@ fn continuity_json(s: &SideContinuity, zeros: usize, scale: f64) -> serde_json::
             class(&s.elsewhere), s.sides[2], 100.0 * gap / scale
         ),
         "measured": format!("jumps of every partial derivative of orders 0-3 between the two Bézier patches of every cell side at {SIDE_SAMPLES} points per side, relative to the largest partial of that order; C^k = relative jumps of orders <= k below {CONTINUOUS:e}"),
-        "at_zeros": group(&s.at_zeros, s.sides[0], "sides with a zero at an end: C0 by construction (the Catmull-Clark limit point at the zero), not G1"),
+        "at_zeros": group(&s.at_zeros, s.sides[0], "sides with a zero at an end: G1 — C1 in the translation chart, by linear conditions the fit keeps on the control points around every zero (the first derivatives at the zero span one plane)"),
+        "normal_angle_at_zeros_degrees": s.normal_angle_at_zeros,
         "one_interval_from_zeros": group(&s.one_interval_from_zeros, s.sides[1], "sides with an end one knot interval from a zero: C2 by construction (every cell within two intervals of a zero has the same size)"),
         "elsewhere": group(&s.elsewhere, s.sides[2], "all other sides, on the critical trajectories and the former knot lines included: C2 by construction"),
         "chart_independence_percent": 100.0 * gap / scale,

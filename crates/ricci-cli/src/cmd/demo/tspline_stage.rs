@@ -85,7 +85,7 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         num(&rep["max_error_percent"]),
     );
     let zeros = domain.decomposition.zeros.len();
-    let expected = class("at_zeros") == "C0"
+    let expected = class("at_zeros") == "C1"
         && class("one_interval_from_zeros") == "C2"
         && class("elsewhere") == "C2";
     if !r.fit.converged || !expected {

@@ -4,13 +4,17 @@
 //!
 //! The sides fall into three classes by the distance of their ends to the zeros (paper 003
 //! §2's extraordinary points, the mesh's only irregular vertices): sides with a zero at an end
-//! (C⁰ by construction: the Catmull–Clark point there), sides with an end one knot interval
+//! (C⁰ for a general net; C¹ in the translation chart, hence G¹, for a net that satisfies the
+//! mesh's conditions at the zeros, as every fitted one does: [`super::domain_mesh`]), sides with an end one knot interval
 //! from a zero (a corner of a cell that has a zero as a corner: C² since the cells near the
 //! zeros have one size, see [`super::domain_mesh`]), and all the other sides (C²). Both patches of a side are evaluated at the same
 //! surface points in their own cells' coordinates: the neighbour across a side is a
 //! translation away (the gluing), so its partial derivatives are those of the same chart.
+//! Tangent-plane continuity at the zeros is measured directly: the angle between the two
+//! patches' normals `∂u × ∂v` along every side at a zero, its ends included.
 
 use super::bezier::{BezierPatch, Continuity};
+use super::cylinder_jumps::{cross, norm};
 use super::domain_mesh::DomainMesh;
 
 /// Jumps per order (0..=3) across the cell sides, per class.
@@ -24,6 +28,48 @@ pub struct SideContinuity {
     pub elsewhere: Continuity,
     /// Sides per class, in the order above.
     pub sides: [usize; 3],
+    /// Largest angle (degrees) between the two patches' normals along the sides at a zero (0:
+    /// G¹ there), over the sampled points and both ends of every such side.
+    pub normal_angle_at_zeros: f64,
+    /// Points where that angle was measured (points where a normal vanishes are skipped).
+    pub normal_comparisons: usize,
+}
+
+/// The angle in degrees between the normals `∂u × ∂v` of `a` at `pa` and of `b` at `pb`, or
+/// `None` where either normal is degenerate (relative to its partials).
+pub fn normal_angle(
+    a: &BezierPatch,
+    pa: (f64, f64),
+    b: &BezierPatch,
+    pb: (f64, f64),
+) -> Option<f64> {
+    let normal = |p: &BezierPatch, (u, v): (f64, f64)| {
+        let (x, y) = (p.partial(u, v, 1, 0), p.partial(u, v, 0, 1));
+        let n = cross(x, y);
+        (norm(n) > 1e-12 * norm(x) * norm(y)).then_some(n)
+    };
+    let (na, nb) = (normal(a, pa)?, normal(b, pb)?);
+    let (s, c) = (
+        norm(cross(na, nb)),
+        na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2],
+    );
+    Some(s.atan2(c).to_degrees())
+}
+
+/// The same point of a side in both patches' parameters at `t ∈ [0, 1]` along it: right side,
+/// `a`'s right edge is `b`'s left edge; top side, `a`'s top is `b`'s bottom.
+fn side_point(a: &BezierPatch, b: &BezierPatch, side: usize, t: f64) -> ((f64, f64), (f64, f64)) {
+    if side == 0 {
+        (
+            (a.u1, a.v0 + t * (a.v1 - a.v0)),
+            (b.u0, b.v0 + t * (b.v1 - b.v0)),
+        )
+    } else {
+        (
+            (a.u0 + t * (a.u1 - a.u0), a.v1),
+            (b.u0 + t * (b.u1 - b.u0), b.v0),
+        )
+    }
 }
 
 impl SideContinuity {
@@ -94,20 +140,17 @@ pub fn side_continuity(mesh: &DomainMesh, control: &[[f64; 3]], samples: usize) 
             _ => &mut out.elsewhere,
         };
         for k in 0..samples {
-            let t = (k as f64 + 0.5) / samples as f64;
-            // right side: a's right edge is b's left edge; top side: a's top is b's bottom
-            let (pa, pb) = if side == 0 {
-                (
-                    (a.u1, a.v0 + t * (a.v1 - a.v0)),
-                    (b.u0, b.v0 + t * (b.v1 - b.v0)),
-                )
-            } else {
-                (
-                    (a.u0 + t * (a.u1 - a.u0), a.v1),
-                    (b.u0 + t * (b.u1 - b.u0), b.v0),
-                )
-            };
+            let (pa, pb) = side_point(a, b, side, (k as f64 + 0.5) / samples as f64);
             acc.compare(a, pa, b, pb);
+        }
+        if class == 0 {
+            for k in 0..=samples {
+                let (pa, pb) = side_point(a, b, side, k as f64 / samples as f64);
+                if let Some(angle) = normal_angle(a, pa, b, pb) {
+                    out.normal_angle_at_zeros = out.normal_angle_at_zeros.max(angle);
+                    out.normal_comparisons += 1;
+                }
+            }
         }
     }
     out

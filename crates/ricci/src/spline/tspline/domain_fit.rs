@@ -4,9 +4,14 @@
 //! located in the cells from their cylinder coordinates and the gluing's sheared coordinate;
 //! the fairness term is the squared second differences of the control net along the mesh
 //! lines through every regular vertex (as the per-cylinder fit's), the umbrella operator at
-//! the zeros; refinement shrinks the spacing (by 1/√2, uniformly: the mesh is conforming)
-//! until the largest error is below the tolerance or the budget of control points is spent
-//! (the last refinement is cut to the largest mesh within the budget).
+//! the zeros. Refinement is local where it can be: while a point of a cell next to a zero
+//! ([`DomainMesh::near_zero`]) is beyond the tolerance, the mesh is refined once more at the
+//! zeros ([`DomainMesh::graded`]: two columns and rows per strip); while a point elsewhere is,
+//! the spacing shrinks (by 1/√2, everywhere); until the largest error is below the tolerance
+//! or the budget of control points is spent (the last refinement is cut to the largest mesh
+//! within the budget). By default the unknowns
+//! are the free values of the mesh's [`super::domain_mesh::Reduction`]: the fitted net is G¹ at
+//! every zero ([`DomainFitOptions::g1_at_zeros`]).
 
 use super::cylinder_fit::GenusStep;
 use super::domain_mesh::DomainMesh;
@@ -30,6 +35,8 @@ pub struct DomainFit {
     pub converged: bool,
     /// Longest bounding-box side (errors in percent are relative to it).
     pub scale: f64,
+    /// Levels of refinement at the zeros of the last mesh.
+    pub levels: usize,
 }
 
 /// Options of [`fit_domain_mesh`].
@@ -46,7 +53,16 @@ pub struct DomainFitOptions {
     pub refine: f64,
     pub max_iterations: usize,
     pub max_control_points: usize,
+    /// Fit only nets that are G¹ at the zeros (the mesh's linear conditions there); `false`:
+    /// every control point free, C⁰ at the zeros.
+    pub g1_at_zeros: bool,
+    /// Refine at the zeros only where the error there exceeds the tolerance (`false`: every
+    /// refinement uniform).
+    pub local_refinement: bool,
 }
+
+/// The most levels of refinement at the zeros; beyond, errors there refine uniformly.
+pub const MAX_LEVELS: usize = 8;
 
 impl Default for DomainFitOptions {
     fn default() -> Self {
@@ -57,6 +73,8 @@ impl Default for DomainFitOptions {
             refine: std::f64::consts::FRAC_1_SQRT_2,
             max_iterations: 16,
             max_control_points: 20_000,
+            g1_at_zeros: true,
+            local_refinement: true,
         }
     }
 }
@@ -85,18 +103,25 @@ pub fn locate(
     Some((cell, x, y))
 }
 
-/// One least-squares solve on `mesh`.
+/// One least-squares solve on `mesh`; with `g1`, for the free values of the mesh's reduction
+/// (the net is G¹ at the zeros).
 fn solve(
     mesh: &DomainMesh,
     located: &[(u32, f64, f64)],
     targets: &[[f64; 3]],
     smoothing: f64,
+    g1: bool,
 ) -> Result<Vec<[f64; 3]>> {
-    let n = mesh.n_vertices();
+    let unknowns = |row: Vec<(u32, f64)>| if g1 { mesh.reduce(&row) } else { row };
+    let n = if g1 {
+        mesh.reduction.free
+    } else {
+        mesh.n_vertices()
+    };
     let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::new();
     let mut b = Mat::<f64>::zeros(n, 3);
     for (&(c, s, t), p) in located.iter().zip(targets) {
-        let row = mesh.blending(c, s, t);
+        let row = unknowns(mesh.blending(c, s, t));
         for &(r, x) in &row {
             for &(q, y) in &row {
                 trip.push(Triplet::new(r as usize, q as usize, x * y));
@@ -106,10 +131,11 @@ fn solve(
             }
         }
     }
-    let w = smoothing * (located.len() as f64 / n as f64).max(1.0);
+    let w = smoothing * (located.len() as f64 / mesh.n_vertices() as f64).max(1.0);
     let mut push = |row: &[(u32, f64)]| {
-        for &(r, x) in row {
-            for &(q, y) in row {
+        let row = unknowns(row.to_vec());
+        for &(r, x) in &row {
+            for &(q, y) in &row {
                 trip.push(Triplet::new(r as usize, q as usize, w * x * y));
             }
         }
@@ -124,7 +150,7 @@ fn solve(
         push(&[(mesh.corners[l as usize][0], 1.0), (a, -2.0), (q[1], 1.0)]);
         push(&[(mesh.corners[bt as usize][0], 1.0), (a, -2.0), (q[3], 1.0)]);
     }
-    for z in (0..n as u32).filter(|&z| mesh.is_zero(z)) {
+    for z in (0..mesh.n_vertices() as u32).filter(|&z| mesh.is_zero(z)) {
         let mut nb: Vec<u32> = Vec::new();
         for q in &mesh.corners {
             for k in 0..4 {
@@ -158,7 +184,10 @@ fn solve(
         ))
     })?;
     chol.solve_in_place(b.as_mut());
-    let out: Vec<[f64; 3]> = (0..n).map(|i| [b[(i, 0)], b[(i, 1)], b[(i, 2)]]).collect();
+    let mut out: Vec<[f64; 3]> = (0..n).map(|i| [b[(i, 0)], b[(i, 1)], b[(i, 2)]]).collect();
+    if g1 {
+        out = mesh.expand(&out);
+    }
     if out.iter().flatten().any(|x| !x.is_finite()) {
         return Err(Error::numerical(
             "domain mesh fit: the solve gave non-finite control points",
@@ -174,6 +203,7 @@ fn fill_budget(
     domain: &GenusDomain,
     gluing: &Gluing,
     spacing: f64,
+    levels: usize,
     count: usize,
     budget: usize,
 ) -> Result<Option<DomainMesh>> {
@@ -182,7 +212,7 @@ fn fill_budget(
     }
     let base = spacing * (count as f64 / budget as f64).sqrt();
     for k in 0..6 {
-        let mesh = DomainMesh::new(domain, gluing, base * (1.0 + 0.03 * k as f64))
+        let mesh = DomainMesh::graded(domain, gluing, base * (1.0 + 0.03 * k as f64), levels)
             .map_err(Error::numerical)?;
         let n = mesh.n_vertices();
         if n <= count {
@@ -195,8 +225,8 @@ fn fill_budget(
     Ok(None)
 }
 
-/// Fit the data points of `domain` (positions by vertex) on the domain mesh, refining
-/// uniformly until `L∞ ≤ tolerance` or the budget is spent.
+/// Fit the data points of `domain` (positions by vertex) on the domain mesh, refining (at the
+/// zeros or uniformly, module doc) until `L∞ ≤ tolerance` or the budget is spent.
 pub fn fit_domain_mesh(
     domain: &GenusDomain,
     gluing: &Gluing,
@@ -219,8 +249,10 @@ pub fn fit_domain_mesh(
     let mut last: Option<DomainFit> = None;
     let refine = opts.refine.clamp(0.1, 0.95);
     let mut filled = false;
+    let (mut levels, mut previous_spacing) = (0, spacing);
     for _ in 0..opts.max_iterations.max(1) {
-        let mut mesh = DomainMesh::new(domain, gluing, spacing).map_err(Error::numerical)?;
+        let mut mesh =
+            DomainMesh::graded(domain, gluing, spacing, levels).map_err(Error::numerical)?;
         if let Some(prev) = last
             .as_ref()
             .filter(|_| mesh.n_vertices() > opts.max_control_points)
@@ -229,7 +261,8 @@ pub fn fit_domain_mesh(
             match fill_budget(
                 domain,
                 gluing,
-                spacing / refine,
+                previous_spacing,
+                levels,
                 prev.mesh.n_vertices(),
                 opts.max_control_points,
             )? {
@@ -250,7 +283,7 @@ pub fn fit_domain_mesh(
             })?;
             located.push(x);
         }
-        let control = solve(&mesh, &located, &targets, opts.smoothing)?;
+        let control = solve(&mesh, &located, &targets, opts.smoothing, opts.g1_at_zeros)?;
         let errors: Vec<f64> = located
             .iter()
             .zip(&targets)
@@ -269,6 +302,18 @@ pub fn fit_domain_mesh(
             max_error_percent: 100.0 * max / scale,
         });
         let converged = max <= opts.tolerance * scale;
+        // where the tolerance is exceeded: next to a zero, elsewhere
+        let (mut near, mut far) = (false, false);
+        for (&(c, _, _), &e) in located.iter().zip(&errors) {
+            if e > opts.tolerance * scale {
+                if opts.local_refinement && levels < MAX_LEVELS && mesh.near_zero(c) {
+                    near = true;
+                } else {
+                    far = true;
+                }
+            }
+        }
+        let mesh_levels = mesh.rects.first().map_or(0, |r| r.levels);
         last = Some(DomainFit {
             mesh,
             control,
@@ -277,11 +322,18 @@ pub fn fit_domain_mesh(
             steps: steps.clone(),
             converged,
             scale,
+            levels: mesh_levels,
         });
         if converged || filled {
             break;
         }
-        spacing *= refine;
+        previous_spacing = spacing;
+        if far {
+            spacing *= refine;
+        }
+        if near {
+            levels += 1;
+        }
     }
     last.ok_or_else(|| Error::numerical("domain mesh fit: no iteration ran"))
 }

@@ -15,6 +15,14 @@
 //! one height `edge_v` (the smallest uniform cell size of any strip; the middle cells share
 //! the rest): every cell within two knot intervals of a zero has the same size.
 //!
+//! **Local refinement at the zeros** ([`DomainMesh::graded`]): with `levels = L` the first
+//! edge interval `E` at each end of every strip side is cut into `e, e, 2e, …, 2^{L−1} e`
+//! (`e = E / 2^L`): the cells at a zero shrink by `2^L` in both directions while the rest of
+//! the mesh keeps its size; each level adds two columns per strip and two rows per cylinder
+//! (mesh lines through the whole strip: the mesh stays conforming, no T-junction). The two
+//! intervals next to every zero stay equal (`e, e`), so everything said below holds as for
+//! `L = 0`.
+//!
 //! **The spline.** One control point per vertex. Every cell is a bicubic Bézier patch whose 16
 //! points are affine combinations of control points, each computed **once** per mesh entity
 //! from the knot intervals (cell widths and heights) by blossoming the cubic B-spline:
@@ -24,8 +32,8 @@
 //!   needed beyond an end of the side that is a zero is replaced by the side's own;
 //! * the point at a vertex of valence 4: the B-spline's value there (3 × 3 neighbours, the
 //!   same replacement for an interval beyond a neighbouring zero); at a zero of valence `n`:
-//!   the Catmull–Clark limit point `(n² P + 4 Σ eᵢ + Σ fᵢ) / (n (n + 5))` (edge and face
-//!   neighbours), which is the B-spline's rule for `n = 4` and uniform intervals.
+//!   the mean of the `n` side points next to it (the first inner Bézier point of every side
+//!   at the zero).
 //!
 //! Hence: partition of unity (every combination is affine), chart independence (every point
 //! shared by two patches is one value), C⁰ everywhere; on every cell side **not incident to a
@@ -33,10 +41,23 @@
 //! intervals equal the true ones (all cells near a zero have the edge size), so the only
 //! point no B-spline rule gives is the zero's own corner point, which the C² conditions across
 //! such a side do not involve — the surface is **C²** there (measured: relative jumps of
-//! orders 1 and 2 ≤ 1e-14, test `tspline_domain_mesh.rs`); on the sides incident to a zero it
-//! is C⁰ (C¹ defect vanishing to third order at the side's other end). So C² at every point
-//! of the surface but the sides at the zeros. (With uniform cells per strip the sides one
-//! interval from a zero jumped in the first derivative by ~0.1 of its size: session 12.)
+//! orders 1 and 2 ≤ 1e-14, test `tspline_domain_mesh.rs`). (With uniform cells per strip the
+//! sides one interval from a zero jumped in the first derivative by ~0.1 of its size:
+//! session 12.)
+//!
+//! **G¹ at the zeros** (paper 003 §3: the extraordinary points). Across a side at a zero the
+//! cross-boundary derivative of the two patches differs only in the Bézier column at the zero
+//! (the other three columns are B-spline rows over cells of one size), so the surface is C¹ in
+//! the translation chart across every side at a zero — and hence **G¹** there (one tangent plane
+//! on both sides wherever the normal is defined) — iff the side's two neighbour points across
+//! it and the zero's point are collinear in the ratio of the cell sizes. These are linear
+//! conditions on the control points of the zero's 1-ring (the first Bézier points `dₖ` along the
+//! rays from the zero satisfy `dₖ₊₁ − p = −(dₖ₋₁ − p)`: the first derivatives at the zero span
+//! one plane, the tangent plane of every patch there). [`Reduction`] solves them once per mesh:
+//! some ring vertices become fixed combinations of the others ([`DomainMesh::reduction`]); a net
+//! expanded from free values ([`DomainMesh::expand`]) is G¹ at every zero, measured as the
+//! angle between the two patches' normals along every side at a zero
+//! ([`super::domain_continuity`]). A net that is not is only C⁰ there.
 
 use super::bezier::BezierPatch;
 use super::genus_domain::GenusDomain;
@@ -61,6 +82,19 @@ pub struct DomainMesh {
     pub valence: Vec<u32>,
     /// Per cell: its 16 Bézier points as combinations, `bezier[cell][i][j]`, `i` along `u`.
     pub bezier: Vec<[[Combination; 4]; 4]>,
+    /// The control nets that are G¹ at the zeros: every vertex as a combination of free values.
+    pub reduction: Reduction,
+}
+
+/// The linear conditions for G¹ at the zeros (C¹ in the translation chart across every side at
+/// a zero, see the module doc) solved once: some vertices of the zeros' 1-rings are fixed
+/// combinations of the others.
+#[derive(Debug, Clone, Default)]
+pub struct Reduction {
+    /// The number of free values (control points that remain unknowns).
+    pub free: usize,
+    /// Per vertex: its value as a combination of free values (indices `0..free`).
+    pub expand: Vec<Combination>,
 }
 
 /// One strip of one cylinder, cut into `m × n` cells: the two first and the two last columns
@@ -77,60 +111,123 @@ pub struct Rect {
     pub n: usize,
     pub edge_u: f64,
     pub edge_v: f64,
+    /// Levels of refinement at the zeros (the same in every strip; see the module doc).
+    pub levels: usize,
     pub first_cell: usize,
 }
 
 /// The least number of cells along a strip side: two edge cells at each end and one between.
 pub const MIN_CELLS: usize = 5;
 
-/// Knot `i` (0..=k) of `k` intervals over `[0, len]`, the two at each end `e` long.
-fn knot(len: f64, k: usize, e: f64, i: usize) -> f64 {
-    if i <= 2 {
-        i as f64 * e
-    } else if i + 2 >= k {
-        len - (k - i) as f64 * e
-    } else {
-        2.0 * e + (i - 2) as f64 * (len - 4.0 * e) / (k - 4) as f64
+/// The knots of one strip side: `k` intervals over `[0, len]`; at each end the intervals
+/// `e, e, 2e, …, 2^{levels−1} e, E` with `E = 2^levels e` (for `levels = 0`: `e, e`), the
+/// middle ones equal.
+#[derive(Debug, Clone, Copy)]
+struct Knots {
+    len: f64,
+    k: usize,
+    e: f64,
+    levels: usize,
+}
+
+impl Knots {
+    /// The distance of knot `i ≤ levels + 2` from its end.
+    fn end_offset(&self, i: usize) -> f64 {
+        match i {
+            0 => 0.0,
+            i if i <= self.levels + 1 => self.e * (1u64 << (i - 1)) as f64,
+            _ => self.e * (1u64 << (self.levels + 1)) as f64,
+        }
+    }
+
+    /// Knot `i` (0..=k).
+    fn knot(&self, i: usize) -> f64 {
+        let g = self.levels + 2;
+        if i <= g {
+            self.end_offset(i)
+        } else if i + g >= self.k {
+            self.len - self.end_offset(self.k - i)
+        } else {
+            let end = self.end_offset(g);
+            end + (i - g) as f64 * (self.len - 2.0 * end) / (self.k - 2 * g) as f64
+        }
     }
 }
 
 /// The interval of `x` (clamped to `[0, len]`) and the local coordinate in it.
-fn interval(len: f64, k: usize, e: f64, x: f64) -> (usize, f64) {
-    let x = x.clamp(0.0, len);
-    let (mut lo, mut hi) = (0, k);
+fn interval(kn: Knots, x: f64) -> (usize, f64) {
+    let x = x.clamp(0.0, kn.len);
+    let (mut lo, mut hi) = (0, kn.k);
     while hi - lo > 1 {
         let mid = (lo + hi) / 2;
-        if knot(len, k, e, mid) <= x {
+        if kn.knot(mid) <= x {
             lo = mid;
         } else {
             hi = mid;
         }
     }
-    let (a, b) = (knot(len, k, e, lo), knot(len, k, e, lo + 1));
+    let (a, b) = (kn.knot(lo), kn.knot(lo + 1));
     (lo, ((x - a) / (b - a)).clamp(0.0, 1.0))
 }
 
 impl Rect {
     /// The start of column `i` (`i = m`: the strip's length).
     pub fn x(&self, i: usize) -> f64 {
-        knot(self.length, self.m, self.edge_u, i)
+        self.knots_u().knot(i)
+    }
+
+    fn knots_u(&self) -> Knots {
+        Knots {
+            len: self.length,
+            k: self.m,
+            e: self.edge_u,
+            levels: self.levels,
+        }
+    }
+
+    fn knots_v(&self) -> Knots {
+        Knots {
+            len: self.height,
+            k: self.n,
+            e: self.edge_v,
+            levels: self.levels,
+        }
+    }
+
+    /// Whether cell `(i, j)` is in a corner block (the refined cells around a zero: the first or
+    /// last `levels + 2` columns and rows).
+    pub fn near_corner(&self, i: usize, j: usize) -> bool {
+        let g = self.levels + 2;
+        (i < g || i + g >= self.m) && (j < g || j + g >= self.n)
     }
 
     /// The start of row `j` (`j = n`: the height).
     pub fn y(&self, j: usize) -> f64 {
-        knot(self.height, self.n, self.edge_v, j)
+        self.knots_v().knot(j)
     }
 
     /// The column of `x` along the strip and the local coordinate in it.
     pub fn column(&self, x: f64) -> (usize, f64) {
-        interval(self.length, self.m, self.edge_u, x)
+        interval(self.knots_u(), x)
     }
 
     /// The row of `y` and the local coordinate in it.
     pub fn row(&self, y: f64) -> (usize, f64) {
-        interval(self.height, self.n, self.edge_v, y)
+        interval(self.knots_v(), y)
     }
 }
+
+/// `(i, j)` of a Bézier point of a cell, `i` along `u`.
+type BezierIndex = (usize, usize);
+
+/// Per cell corner `[lower left, lower right, upper right, upper left]`: its Bézier index and
+/// those of the points next to it along `u` and along `v`.
+const CORNER_POINTS: [(BezierIndex, BezierIndex, BezierIndex); 4] = [
+    ((0, 0), (1, 0), (0, 1)),
+    ((3, 0), (2, 0), (3, 1)),
+    ((3, 3), (2, 3), (3, 2)),
+    ((0, 3), (1, 3), (0, 2)),
+];
 
 const RIGHT: usize = 0;
 const TOP: usize = 1;
@@ -206,16 +303,18 @@ fn find(p: &mut [u32], mut x: u32) -> u32 {
 
 /// Give every strip the same edge cells — the two first and two last columns of width `edge_u`,
 /// the two first and two last rows of height `edge_v`, the smallest uniform cell size of any
-/// strip (so the middle cells of every strip are at least as large) — and number the cells
-/// strip by strip; the number of cells.
-fn size_edge_cells(rects: &mut [Rect]) -> Result<usize, String> {
+/// strip (so the middle cells of every strip are at least as large), each end's first one
+/// refined `levels` times (`m`, `n` count the refined cells: `2 levels` more) — and number the
+/// cells strip by strip; the number of cells.
+fn size_edge_cells(rects: &mut [Rect], levels: usize) -> Result<usize, String> {
+    let fine = (1u64 << levels) as f64;
     let edge_u = rects
         .iter()
-        .map(|r| r.length / r.m as f64)
+        .map(|r| r.length / (r.m - 2 * levels) as f64 / fine)
         .fold(f64::INFINITY, f64::min);
     let edge_v = rects
         .iter()
-        .map(|r| r.height / r.n as f64)
+        .map(|r| r.height / (r.n - 2 * levels) as f64 / fine)
         .fold(f64::INFINITY, f64::min);
     if !(edge_u > 0.0 && edge_v > 0.0) {
         return Err(format!(
@@ -226,6 +325,7 @@ fn size_edge_cells(rects: &mut [Rect]) -> Result<usize, String> {
     for r in rects.iter_mut() {
         r.edge_u = edge_u;
         r.edge_v = edge_v;
+        r.levels = levels;
         r.first_cell = cells;
         cells += r.m * r.n;
     }
@@ -236,15 +336,30 @@ impl DomainMesh {
     /// The mesh with cells of size about `spacing` (at least [`MIN_CELLS`] along every strip
     /// side), or why not.
     pub fn new(domain: &GenusDomain, gluing: &Gluing, spacing: f64) -> Result<Self, String> {
+        Self::graded(domain, gluing, spacing, 0)
+    }
+
+    /// The mesh of [`Self::new`] refined `levels` times at the zeros (module doc).
+    pub fn graded(
+        domain: &GenusDomain,
+        gluing: &Gluing,
+        spacing: f64,
+        levels: usize,
+    ) -> Result<Self, String> {
         if !(spacing > 0.0) {
             return Err(format!("spacing {spacing} must be positive"));
+        }
+        if levels > 20 {
+            return Err(format!(
+                "{levels} levels of refinement at the zeros (at most 20)"
+            ));
         }
         // rectangles and their top neighbours
         let mut rects = Vec::new();
         let mut index = std::collections::HashMap::new();
         for (c, lay) in gluing.layouts.iter().enumerate() {
             let ch = &domain.cylinders[c];
-            let n = ((ch.height / spacing).ceil() as usize).max(MIN_CELLS);
+            let n = ((ch.height / spacing).ceil() as usize).max(MIN_CELLS) + 2 * levels;
             for s in 0..lay.lines.len() {
                 index.insert((c, s), rects.len());
                 rects.push(Rect {
@@ -256,6 +371,7 @@ impl DomainMesh {
                     n,
                     edge_u: 0.0,
                     edge_v: 0.0,
+                    levels,
                     first_cell: 0,
                 });
             }
@@ -293,13 +409,13 @@ impl DomainMesh {
                 r = top[r];
             }
             let len = chain.iter().map(|&r| rects[r].length).fold(0.0, f64::max);
-            let m = ((len / spacing).ceil() as usize).max(MIN_CELLS);
+            let m = ((len / spacing).ceil() as usize).max(MIN_CELLS) + 2 * levels;
             for &r in &chain {
                 rects[r].m = m;
                 done[r] = true;
             }
         }
-        let cells = size_edge_cells(&mut rects)?;
+        let cells = size_edge_cells(&mut rects, levels)?;
         let right_rect = |r: usize| {
             let (c, s) = (rects[r].cylinder, rects[r].strip);
             let k = gluing.layouts[c].lines.len();
@@ -370,9 +486,220 @@ impl DomainMesh {
             cell_at,
             valence,
             bezier: Vec::new(),
+            reduction: Reduction::default(),
         };
         mesh.bezier = (0..cells).map(|c| mesh.extract(c)).collect();
+        mesh.points_at_zeros();
+        mesh.reduction = mesh.g1_reduction()?;
         Ok(mesh)
+    }
+
+    /// The Bézier point at every zero: the mean of the side points next to it (each side point
+    /// is met from both cells of its side, so every one counts twice).
+    fn points_at_zeros(&mut self) {
+        let mut sums: std::collections::HashMap<u32, (Combination, usize)> = Default::default();
+        for c in 0..self.n_cells() {
+            for k in 0..4 {
+                let z = self.corners[c][k];
+                if !self.is_zero(z) {
+                    continue;
+                }
+                let (_, along_u, along_v) = CORNER_POINTS[k];
+                let e = sums.entry(z).or_default();
+                for (i, j) in [along_u, along_v] {
+                    for &(v, w) in &self.bezier[c][i][j] {
+                        add(&mut e.0, v, w);
+                    }
+                    e.1 += 1;
+                }
+            }
+        }
+        for c in 0..self.n_cells() {
+            for k in 0..4 {
+                if let Some((sum, n)) = sums.get(&self.corners[c][k]) {
+                    let (i, j) = CORNER_POINTS[k].0;
+                    self.bezier[c][i][j] = sum.iter().map(|&(v, w)| (v, w / *n as f64)).collect();
+                }
+            }
+        }
+    }
+
+    /// The conditions of C¹ across every side at a zero, per zero: for each of the side's four
+    /// Bézier points `S` (shared), the points `a`, `b` next to it across the side in the two
+    /// cells (sizes `α`, `β` across the side), `β a + α b − (α + β) S = 0`.
+    fn g1_conditions(&self) -> Vec<(u32, Vec<Combination>)> {
+        let mut out: std::collections::BTreeMap<u32, Vec<Combination>> = Default::default();
+        for (a, side, at_zero) in self.sides() {
+            if !at_zero {
+                continue;
+            }
+            let b = self.nb(a, side);
+            let q = self.corners[a as usize];
+            let ends = if side == RIGHT {
+                [q[1], q[2]]
+            } else {
+                [q[2], q[3]]
+            };
+            let Some(&z) = ends.iter().find(|&&v| self.is_zero(v)) else {
+                continue;
+            };
+            let axis = if side == RIGHT { Axis::U } else { Axis::V };
+            let (alpha, beta) = (self.len(a, axis), self.len(b, axis));
+            let (ba, bb) = (&self.bezier[a as usize], &self.bezier[b as usize]);
+            for k in 0..4 {
+                let (s, x, y) = if side == RIGHT {
+                    (&ba[3][k], &ba[2][k], &bb[1][k])
+                } else {
+                    (&ba[k][3], &ba[k][2], &bb[k][1])
+                };
+                let mut row = Combination::new();
+                for (comb, w) in [(x, beta), (y, alpha), (s, -(alpha + beta))] {
+                    for &(v, c) in comb {
+                        add(&mut row, v, w * c);
+                    }
+                }
+                out.entry(z).or_default().push(row);
+            }
+        }
+        out.into_iter().collect()
+    }
+
+    /// Solve [`Self::g1_conditions`] zero by zero (Gauss–Jordan with full pivoting on the
+    /// 1-ring's vertices): the pivots become combinations of the other vertices.
+    fn g1_reduction(&self) -> Result<Reduction, String> {
+        let nv = self.n_vertices();
+        let mut dependent: Vec<Option<Combination>> = vec![None; nv];
+        let mut used = vec![false; nv];
+        for (z, rows) in self.g1_conditions() {
+            // substitute the vertices already solved for (rings of other zeros)
+            let rows: Vec<Combination> = rows
+                .iter()
+                .map(|r| {
+                    let mut out = Combination::new();
+                    for &(v, w) in r {
+                        match &dependent[v as usize] {
+                            Some(d) => d.iter().for_each(|&(x, c)| add(&mut out, x, w * c)),
+                            None => add(&mut out, v, w),
+                        }
+                    }
+                    out
+                })
+                .collect();
+            let mut cols: Vec<u32> = rows.iter().flatten().map(|x| x.0).collect();
+            cols.sort_unstable();
+            cols.dedup();
+            // one scale for the whole group: the conditions that hold identically (the three
+            // columns away from the zero, module doc) stay at rounding level
+            let big = rows.iter().flatten().fold(0.0f64, |a, x| a.max(x.1.abs()));
+            if !(big > 0.0) {
+                continue;
+            }
+            let mut m: Vec<Vec<f64>> = rows
+                .iter()
+                .map(|r| {
+                    let mut dense = vec![0.0; cols.len()];
+                    for &(v, w) in r {
+                        dense[cols.binary_search(&v).unwrap_or(0)] += w / big;
+                    }
+                    dense
+                })
+                .collect();
+            let candidate: Vec<bool> = cols.iter().map(|&v| !used[v as usize]).collect();
+            let mut pivots: Vec<(usize, usize)> = Vec::new();
+            const TOL: f64 = 1e-10;
+            for r in 0..m.len() {
+                let mut best = (0.0, 0, 0);
+                for (i, row) in m.iter().enumerate().skip(r) {
+                    for (j, &x) in row.iter().enumerate() {
+                        if candidate[j] && !pivots.iter().any(|p| p.1 == j) && x.abs() > best.0 {
+                            best = (x.abs(), i, j);
+                        }
+                    }
+                }
+                if best.0 <= TOL {
+                    break;
+                }
+                let (_, i, j) = best;
+                m.swap(r, i);
+                let d = m[r][j];
+                m[r].iter_mut().for_each(|x| *x /= d);
+                let pivot_row = m[r].clone();
+                for (i, row) in m.iter_mut().enumerate() {
+                    if i != r && row[j] != 0.0 {
+                        let f = row[j];
+                        row.iter_mut()
+                            .zip(&pivot_row)
+                            .for_each(|(x, p)| *x -= f * p);
+                    }
+                }
+                pivots.push((r, j));
+            }
+            if m[pivots.len()..]
+                .iter()
+                .any(|row| row.iter().any(|x| x.abs() > TOL))
+            {
+                return Err(format!(
+                    "the G1 conditions at zero {z} involve vertices already solved for at another zero (the zeros are too close for the mesh)"
+                ));
+            }
+            for &(r, j) in &pivots {
+                let expr: Combination = cols
+                    .iter()
+                    .enumerate()
+                    .filter(|&(k, _)| k != j && m[r][k].abs() > 1e-15)
+                    .map(|(k, &v)| (v, -m[r][k]))
+                    .collect();
+                dependent[cols[j] as usize] = Some(expr);
+            }
+            cols.iter().for_each(|&v| used[v as usize] = true);
+        }
+        let mut index = vec![u32::MAX; nv];
+        let mut free = 0u32;
+        for v in 0..nv {
+            if dependent[v].is_none() {
+                index[v] = free;
+                free += 1;
+            }
+        }
+        let expand = (0..nv)
+            .map(|v| match &dependent[v] {
+                Some(d) => d.iter().map(|&(x, w)| (index[x as usize], w)).collect(),
+                None => vec![(index[v], 1.0)],
+            })
+            .collect();
+        Ok(Reduction {
+            free: free as usize,
+            expand,
+        })
+    }
+
+    /// The control points of the free values `free` ([`Reduction::free`] of them): a net that is
+    /// G¹ at every zero.
+    pub fn expand(&self, free: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        self.reduction
+            .expand
+            .iter()
+            .map(|comb| {
+                let mut x = [0.0; 3];
+                for &(f, w) in comb {
+                    for d in 0..3 {
+                        x[d] += w * free[f as usize][d];
+                    }
+                }
+                x
+            })
+            .collect()
+    }
+
+    /// A combination of control points as a combination of the free values.
+    pub fn reduce(&self, row: &[(u32, f64)]) -> Combination {
+        let mut out = Combination::new();
+        for &(v, w) in row {
+            for &(f, c) in &self.reduction.expand[v as usize] {
+                add(&mut out, f, w * c);
+            }
+        }
+        out
     }
 
     pub fn n_cells(&self) -> usize {
@@ -381,6 +708,12 @@ impl DomainMesh {
 
     pub fn n_vertices(&self) -> usize {
         self.valence.len()
+    }
+
+    /// Whether cell `c` is in the refined block around a zero ([`Rect::near_corner`]).
+    pub fn near_zero(&self, c: u32) -> bool {
+        let (r, i, j) = self.cell_at[c as usize];
+        self.rects[r as usize].near_corner(i as usize, j as usize)
     }
 
     /// Whether vertex `v` is a zero (valence ≠ 4).
@@ -421,19 +754,7 @@ impl DomainMesh {
         let a = self.corners[c as usize][0];
         let mut out = Combination::new();
         if self.is_zero(a) {
-            // Catmull–Clark limit point over every cell with a corner at a
-            let n = self.valence[a as usize] as f64;
-            let norm = n * (n + 5.0);
-            add(&mut out, a, n * n / norm);
-            for q in &self.corners {
-                for k in 0..4 {
-                    if q[k] == a {
-                        add(&mut out, q[(k + 1) % 4], 2.0 / norm);
-                        add(&mut out, q[(k + 3) % 4], 2.0 / norm);
-                        add(&mut out, q[(k + 2) % 4], 1.0 / norm);
-                    }
-                }
-            }
+            // the mean of the side points next to the zero: [`Self::points_at_zeros`]
             return out;
         }
         let (l, b) = (self.nb(c, LEFT), self.nb(c, BOTTOM));
