@@ -59,7 +59,7 @@ pub type ExtPoint<S> = <<S as Space>::Frame as Frame>::Ext;
 
 /// A model space to lay out in: points, isometries and the placement of one triangle.
 pub trait Space: Background {
-    type Point: Copy + std::fmt::Debug + Send + Sync + 'static;
+    type Point: Copy + PartialEq + std::fmt::Debug + Send + Sync + 'static;
     type Iso: Isometry<Point = Self::Point>;
     /// The working precision of face frames and deck groups (see [`Frame`]).
     type Frame: Frame<Iso = Self::Iso>;
@@ -86,6 +86,12 @@ pub trait Space: Background {
     #[inline]
     fn distance_key(a: Self::Point, b: Self::Point) -> f64 {
         Self::distance(a, b)
+    }
+    /// The [`Space::distance_key`] of two points at distance `d` (to the same few ulps): a
+    /// search can rule a point out by its key alone, without its exact distance.
+    #[inline]
+    fn key_of_distance(d: f64) -> f64 {
+        d
     }
     /// Whether [`Space::distance`] from `p` is accurate to 1e-9, so that searches may be
     /// pruned there with [`Isometry::displacement_bound`].
@@ -172,6 +178,10 @@ impl Space for Euclidean {
     fn distance_key(a: Complex, b: Complex) -> f64 {
         (a - b).norm_sqr()
     }
+    #[inline]
+    fn key_of_distance(d: f64) -> f64 {
+        d * d
+    }
     fn toward(a: Complex, b: Complex, t: f64) -> Complex {
         a + (b - a) * t
     }
@@ -215,6 +225,12 @@ impl Space for Hyperbolic {
     #[inline]
     fn distance_key(a: Complex, b: Complex) -> f64 {
         disk_distance_key(a, b)
+    }
+    /// `sinh²(d/2)` ([`disk_distance_key`]).
+    #[inline]
+    fn key_of_distance(d: f64) -> f64 {
+        let s = (0.5 * d).sinh();
+        s * s
     }
     #[inline]
     fn resolved(p: Complex) -> bool {
