@@ -288,10 +288,11 @@ where
         let disp: Vec<f64> = cands.iter().map(|g| g.displacement_bound()).collect();
         let mut by_disp: Vec<u32> = (1..cands.len() as u32).collect();
         by_disp.sort_by(|&a, &b| disp[a as usize].total_cmp(&disp[b as usize]));
-        let by_disp_below = level_end
-            .iter()
-            .map(|&n| (n, by_disp.iter().copied().filter(|&k| (k as usize) < n).collect()))
-            .collect();
+        let below = |n: usize| -> Vec<u32> {
+            let maps = by_disp.iter().copied();
+            maps.filter(|&k| (k as usize) < n).collect()
+        };
+        let by_disp_below = level_end.iter().map(|&n| (n, below(n))).collect();
         Images {
             positions,
             copies,
