@@ -186,15 +186,15 @@ where
     // previous leaves the face spread out or flipped. Every face's search reads only the
     // layout, so the faces are searched in parallel (rayon) with the same results.
     let (cands, level_end) = candidate_maps(group);
-    let images = Images::<S>::new(positions, &copies, &cands);
+    let images = Images::<S>::new(positions, &copies, &cands, &level_end);
     // First pass with the identity only: the typical size of a face in the layout.
     let first: Vec<Choice<S::Point>> = faces
         .par_iter()
         .map_init(Vec::new, |buf, t| {
             let ca = copies[t[0] as usize][0];
             let pa = positions[ca as usize];
-            let (db, pb, sb) = images.nearest(t[1], pa, 1, buf);
-            let (dc, pc, sc) = images.nearest(t[2], pa, 1, buf);
+            let (db, pb, sb) = images.nearest(t[1], pa, 1, f64::INFINITY, buf);
+            let (dc, pc, sc) = images.nearest(t[2], pa, 1, f64::INFINITY, buf);
             let spread = db.max(dc).max(S::distance(pb, pc));
             (spread, [pa, pb, pc], [(ca, 0), sb, sc])
         })
@@ -204,8 +204,13 @@ where
         .map(|c| c.0)
         .filter(|x| x.is_finite())
         .collect();
-    sorted.sort_by(f64::total_cmp);
-    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
+    // The element at the middle of the sorted spreads (a selection, not a sort).
+    let mid = sorted.len() / 2;
+    let median = if sorted.is_empty() {
+        0.0
+    } else {
+        *sorted.select_nth_unstable_by(mid, f64::total_cmp).1
+    };
     let across: Vec<Option<Choice<S::Point>>> = match group {
         None => Vec::new(),
         Some(_) => faces
@@ -261,6 +266,8 @@ struct Images<'a, S: Space> {
     disp: Vec<f64>,
     /// The candidate maps but the first, by increasing `disp` (ties by index).
     by_disp: Vec<u32>,
+    /// Per level end `n` of [`candidate_maps`]: the maps of `by_disp` below `n`, in its order.
+    by_disp_below: Vec<(usize, Vec<u32>)>,
 }
 
 /// Rounding allowance of the pruning bounds of [`Images`].
@@ -272,35 +279,47 @@ impl<'a, S: Space> Images<'a, S>
 where
     S::Iso: Isometry<Point = S::Point>,
 {
-    fn new(positions: &'a [S::Point], copies: &'a [Vec<u32>], cands: &'a [S::Iso]) -> Self {
+    fn new(
+        positions: &'a [S::Point],
+        copies: &'a [Vec<u32>],
+        cands: &'a [S::Iso],
+        level_end: &[usize],
+    ) -> Self {
         let disp: Vec<f64> = cands.iter().map(|g| g.displacement_bound()).collect();
         let mut by_disp: Vec<u32> = (1..cands.len() as u32).collect();
         by_disp.sort_by(|&a, &b| disp[a as usize].total_cmp(&disp[b as usize]));
+        let below = |n: usize| -> Vec<u32> {
+            let maps = by_disp.iter().copied();
+            maps.filter(|&k| (k as usize) < n).collect()
+        };
+        let by_disp_below = level_end.iter().map(|&n| (n, below(n))).collect();
         Images {
             positions,
             copies,
             cands,
             disp,
             by_disp,
+            by_disp_below,
         }
     }
 
     /// Nearest image of vertex `w` to `p` under the first `n` candidate maps: (distance,
-    /// point, (copy, map)), the first in (copy, map) order among equal distances. `buf`:
-    /// scratch space.
+    /// point, (copy, map)), the first in (copy, map) order among equal distances. `upper`:
+    /// the distance from `p` of some image among these (∞ if none is known), a bound to prune
+    /// with from the start. `buf`: scratch space.
     fn nearest(
         &self,
         w: u32,
         p: S::Point,
         n: usize,
+        upper: f64,
         buf: &mut Vec<(f64, u32, u32)>,
     ) -> (f64, S::Point, (u32, u32)) {
         buf.clear();
-        let (mut kmin, mut upper) = (f64::INFINITY, f64::INFINITY);
-        let prune_p = S::resolved(p);
+        let (mut kmin, mut upper) = (f64::INFINITY, upper);
+        let prune_p = n > 1 && S::resolved(p);
         for &c in &self.copies[w as usize] {
             let q = self.positions[c as usize];
-            let start = buf.len();
             let mut visit = |k: usize, buf: &mut Vec<(f64, u32, u32)>| {
                 let gq = self.cands[k].apply(q);
                 let key = S::distance_key(gq, p);
@@ -314,10 +333,27 @@ where
                 continue;
             }
             let gq = visit(0, buf);
-            upper = upper.min(S::distance(gq, p));
-            if n > 1 && prune_p && S::resolved(q) {
-                let dq = S::distance(q, p);
-                for &k in &self.by_disp {
+            if !prune_p {
+                // No bound is used: every map is visited.
+                for k in 1..n {
+                    visit(k, buf);
+                }
+                continue;
+            }
+            let dq = S::resolved(q).then(|| S::distance(q, p));
+            // The first map is the identity: its image is `q` itself, measured once.
+            let d0 = match dq {
+                Some(d) if gq == q => d,
+                _ => S::distance(gq, p),
+            };
+            upper = upper.min(d0);
+            if let Some(dq) = dq {
+                // The maps below `n` in `by_disp`'s order (the same visits as filtering it).
+                let order = match self.by_disp_below.iter().find(|(m, _)| *m == n) {
+                    Some((_, below)) => &below[..],
+                    None => &self.by_disp[..],
+                };
+                for &k in order {
                     if self.disp[k as usize] - dq > upper + slack(upper + dq) {
                         break;
                     }
@@ -325,7 +361,6 @@ where
                         visit(k as usize, buf);
                     }
                 }
-                buf[start..].sort_unstable_by_key(|e| e.2);
             } else {
                 for k in 1..n {
                     visit(k, buf);
@@ -334,11 +369,14 @@ where
         }
         let band = kmin + 1e-9 * kmin + 1e-200;
         let mut best = (f64::INFINITY, p, (u32::MAX, 0));
+        // `buf` holds the maps of a copy in the order visited (by displacement when pruned):
+        // ties are broken by (copy, map) explicitly, as the exhaustive search meets them.
         for &(key, c, k) in buf.iter() {
             if key <= band {
                 let gq = self.cands[k as usize].apply(self.positions[c as usize]);
                 let d = S::distance(gq, p);
-                if d < best.0 {
+                let found = best.2 .0 != u32::MAX;
+                if d < best.0 || (found && d == best.0 && (c, k) < best.2) {
                     best = (d, gq, (c, k));
                 }
             }
@@ -364,11 +402,16 @@ where
             return None;
         }
         let mut best = (f64::INFINITY, p, src);
+        let copies_a = &self.copies[t[0] as usize];
+        // Per copy of `a`: the distances of `b`'s and `c`'s nearest images at the last level,
+        // images under maps the next level has too — its pruning bounds from the start.
+        let mut seeds = vec![(f64::INFINITY, f64::INFINITY); copies_a.len()];
         for &n in &level_end[1..] {
-            for &ca in &self.copies[t[0] as usize] {
+            for (&ca, seed) in copies_a.iter().zip(seeds.iter_mut()) {
                 let pa = self.positions[ca as usize];
-                let (db, pb, sb) = self.nearest(t[1], pa, n, buf);
-                let (dc, pc, sc) = self.nearest(t[2], pa, n, buf);
+                let (db, pb, sb) = self.nearest(t[1], pa, n, seed.0, buf);
+                let (dc, pc, sc) = self.nearest(t[2], pa, n, seed.1, buf);
+                *seed = (db, dc);
                 let total = db.max(dc).max(S::distance(pb, pc));
                 if total < best.0 {
                     best = (total, [pa, pb, pc], [(ca, 0), sb, sc]);
@@ -384,6 +427,12 @@ where
 
     /// The `keep` images of vertex `w` whose distance from `p` is nearest to `want`:
     /// (mismatch, point, (copy, map)), sorted by mismatch, ties in (copy, map) order.
+    ///
+    /// Once `keep` images are found, an image whose mismatch is surely above the `keep`-th
+    /// smallest so far cannot be among the result: it is ruled out by its
+    /// [`Space::distance_key`] against the keys of the distances `want ∓ worst` (1e-9
+    /// relative slack, far above the few ulps between key and distance), without its exact
+    /// distance.
     fn matching(
         &self,
         w: u32,
@@ -391,9 +440,19 @@ where
         want: f64,
         keep: usize,
     ) -> Vec<(f64, S::Point, (u32, u32))> {
-        let mut v = Vec::new();
-        // The `keep` smallest mismatches so far (ascending).
+        type Found<P> = (f64, P, (u32, u32));
+        let before = |a: &Found<S::Point>, b: &Found<S::Point>| {
+            a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)).is_lt()
+        };
+        if keep == 0 {
+            return Vec::new();
+        }
+        // The `keep` first images so far in (mismatch, copy, map) order, in that order.
+        let mut v: Vec<Found<S::Point>> = Vec::with_capacity(keep + 1);
+        // The `keep` smallest mismatches so far (ascending), and the key interval outside
+        // which an image's mismatch is surely above the largest of them.
         let mut top: Vec<f64> = Vec::with_capacity(keep + 1);
+        let mut keys = (f64::NEG_INFINITY, f64::INFINITY);
         let prune_p = S::resolved(p);
         for &c in &self.copies[w as usize] {
             let q = self.positions[c as usize];
@@ -402,25 +461,59 @@ where
             let order = std::iter::once(0).chain(self.by_disp.iter().copied());
             for k in order.take(self.cands.len()) {
                 let k = k as usize;
-                if prune && top.len() == keep && keep > 0 {
+                if prune && top.len() == keep {
                     let worst = top[keep - 1];
                     if self.disp[k] - dq - want > worst + slack(worst + want + dq) {
                         break;
                     }
                 }
                 let gq = self.cands[k].apply(q);
+                let key = S::distance_key(gq, p);
+                // Infinite keys (overflow) and NaN are measured.
+                if key.is_finite() && (key < keys.0 || key > keys.1) {
+                    continue;
+                }
                 let m = (S::distance(gq, p) - want).abs();
-                v.push((m, gq, (c, k as u32)));
-                if keep > 0 && (top.len() < keep || m < top[keep - 1]) {
+                let found = (m, gq, (c, k as u32));
+                if v.len() < keep || before(&found, &v[keep - 1]) {
+                    let at = v.partition_point(|x| before(x, &found));
+                    v.insert(at, found);
+                    v.truncate(keep);
+                }
+                if top.len() < keep || m < top[keep - 1] {
                     let at = top.partition_point(|&x| x <= m);
                     top.insert(at, m);
                     top.truncate(keep);
+                    if top.len() == keep && !top.iter().any(|x| x.is_nan()) {
+                        keys = Self::mismatch_keys(want, top[keep - 1]);
+                    }
                 }
             }
         }
-        v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
-        v.truncate(keep);
         v
+    }
+
+    /// Keys `(lo, hi)` such that an image whose [`Space::distance_key`] lies outside
+    /// `[lo, hi]` has a distance `d` with `|d − want| > worst` (see [`Images::matching`]);
+    /// the whole line when that cannot be told: NaN or infinite bounds, and keys below 1e-280,
+    /// where an underflowing key loses its relative accuracy.
+    fn mismatch_keys(want: f64, worst: f64) -> (f64, f64) {
+        const REL: f64 = 1e-9;
+        const SMALLEST: f64 = 1e-280;
+        let far = want + worst;
+        let hi = S::key_of_distance(far * (1.0 + REL)) * (1.0 + REL);
+        let near = want - worst;
+        let lo = S::key_of_distance(near * (1.0 - REL)) * (1.0 - REL);
+        // `!(x >= y)` is also true for NaN.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        let (lo_unknown, hi_unknown) = (
+            !(near > 0.0) || !(lo >= SMALLEST) || !lo.is_finite(),
+            !(hi >= SMALLEST) || !hi.is_finite(),
+        );
+        (
+            if lo_unknown { f64::NEG_INFINITY } else { lo },
+            if hi_unknown { f64::INFINITY } else { hi },
+        )
     }
 
     /// See [`face_uvs_with_lengths`]; returns the number of faces changed.

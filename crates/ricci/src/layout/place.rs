@@ -52,6 +52,7 @@ use crate::error::{Error, Result};
 use crate::mesh::{topology, Mesh, NONE};
 use crate::metric::{Background, Euclidean, Geometry, Hyperbolic, IntrinsicMetric, Spherical};
 use crate::numeric::dd::Cdd;
+use rayon::prelude::*;
 use std::collections::VecDeque;
 
 /// The working-precision point of a space.
@@ -59,7 +60,7 @@ pub type ExtPoint<S> = <<S as Space>::Frame as Frame>::Ext;
 
 /// A model space to lay out in: points, isometries and the placement of one triangle.
 pub trait Space: Background {
-    type Point: Copy + std::fmt::Debug + Send + Sync + 'static;
+    type Point: Copy + PartialEq + std::fmt::Debug + Send + Sync + 'static;
     type Iso: Isometry<Point = Self::Point>;
     /// The working precision of face frames and deck groups (see [`Frame`]).
     type Frame: Frame<Iso = Self::Iso>;
@@ -86,6 +87,12 @@ pub trait Space: Background {
     #[inline]
     fn distance_key(a: Self::Point, b: Self::Point) -> f64 {
         Self::distance(a, b)
+    }
+    /// The [`Space::distance_key`] of two points at distance `d` (to the same few ulps): a
+    /// search can rule a point out by its key alone, without its exact distance.
+    #[inline]
+    fn key_of_distance(d: f64) -> f64 {
+        d
     }
     /// Whether [`Space::distance`] from `p` is accurate to 1e-9, so that searches may be
     /// pruned there with [`Isometry::displacement_bound`].
@@ -172,6 +179,10 @@ impl Space for Euclidean {
     fn distance_key(a: Complex, b: Complex) -> f64 {
         (a - b).norm_sqr()
     }
+    #[inline]
+    fn key_of_distance(d: f64) -> f64 {
+        d * d
+    }
     fn toward(a: Complex, b: Complex, t: f64) -> Complex {
         a + (b - a) * t
     }
@@ -215,6 +226,12 @@ impl Space for Hyperbolic {
     #[inline]
     fn distance_key(a: Complex, b: Complex) -> f64 {
         disk_distance_key(a, b)
+    }
+    /// `sinh²(d/2)` ([`disk_distance_key`]).
+    #[inline]
+    fn key_of_distance(d: f64) -> f64 {
+        let s = (0.5 * d).sinh();
+        s * s
     }
     #[inline]
     fn resolved(p: Complex) -> bool {
@@ -529,12 +546,14 @@ fn layout_parts<S: Space>(
     // resolution of the model near the unit circle): restart from the face nearest to the
     // minimax centre of the boundary.
     let centre = minimax_centre::<S>(&boundary_points(mesh, &first.positions));
+    // The face whose first corner is nearest the centre (the first of equals); each
+    // distance measured once, in parallel.
+    let d: Vec<f64> = (0..nf as u32)
+        .into_par_iter()
+        .map(|f| S::distance(first.positions[mesh.face(f)[0] as usize], centre))
+        .collect();
     let best = (0..nf as u32)
-        .min_by(|&f, &g| {
-            let df = S::distance(first.positions[mesh.face(f)[0] as usize], centre);
-            let dg = S::distance(first.positions[mesh.face(g)[0] as usize], centre);
-            df.total_cmp(&dg)
-        })
+        .min_by(|&f, &g| d[f as usize].total_cmp(&d[g as usize]))
         .unwrap_or(seed);
     if best == seed {
         return Ok(first);
@@ -564,15 +583,14 @@ pub fn minimax_centre<S: Space>(points: &[S::Point]) -> S::Point {
     };
     let mut c = first;
     for it in 1..300 {
-        // The farthest point (the last of equals, as `max_by`), one distance per point.
-        let mut far = first;
-        let mut d_far = S::distance(c, first);
-        for &p in &points[1..] {
-            let d = S::distance(c, p);
-            if d.total_cmp(&d_far) != std::cmp::Ordering::Less {
-                (far, d_far) = (p, d);
-            }
-        }
+        // The farthest point (the last of equals, as `max_by`), one distance per point; in
+        // parallel, the same point: the largest (distance, index).
+        let far = points
+            .par_iter()
+            .enumerate()
+            .map(|(i, &p)| (S::distance(c, p), i))
+            .max_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+            .map_or(first, |(_, i)| points[i]);
         c = S::toward(c, far, 1.0 / (it as f64 + 1.0));
     }
     c
@@ -588,12 +606,17 @@ fn canonical_triangles<S: Space>(
     let len = |h: u32| lengths[mesh.he_edge(h) as usize];
     let lo = |h: u32| lengths_lo.map_or(0.0, |l| l[mesh.he_edge(h) as usize]);
     (0..mesh.n_faces() as u32)
+        .into_par_iter()
         .map(|f| {
             let [a, b, c] = mesh.face_halfedges(f);
             S::seed_ext([len(a), len(b), len(c)], [lo(a), lo(b), lo(c)])
         })
         .collect()
 }
+
+/// [`layout_from`]'s verdicts of a placed face.
+const FLIPPED: u8 = 1;
+const DEGENERATE: u8 = 2;
 
 /// Breadth-first placement from `seed` with the faces' canonical triangles
 /// ([`canonical_triangles`]).
@@ -697,31 +720,43 @@ fn layout_from<S: Space>(
         }
         push(g, &mut heap, &cost, &frame);
     }
-    // Measurements.
-    let mut flipped = Vec::new();
-    let mut degenerate = Vec::new();
-    for f in 0..nf as u32 {
-        let [a, b, c] = mesh.face(f);
-        let [ha, hb, hc] = mesh.face_halfedges(f);
-        let metric_area = S::area(len(hb), len(hc), len(ha));
-        let o = S::Frame::orientation(pos[a as usize], pos[b as usize], pos[c as usize]);
-        if o < 0.0 {
-            flipped.push(f);
-        } else if o == 0.0 || metric_area <= 0.0 {
-            degenerate.push(f);
-        }
-    }
-    let mut max_err = 0.0f64;
-    for e in 0..mesh.n_edges() as u32 {
-        let [a, b] = mesh.edge_vertices(e);
-        let d = S::Frame::point_distance(pos[a as usize], pos[b as usize]);
-        max_err = max_err.max((d - lengths[e as usize]).abs());
-    }
+    // Measurements, per face and per edge in parallel (the maxima ignore NaN as a fold
+    // with `f64::max` does, in any order).
+    let verdict: Vec<u8> = (0..nf as u32)
+        .into_par_iter()
+        .map(|f| {
+            let [a, b, c] = mesh.face(f);
+            let [ha, hb, hc] = mesh.face_halfedges(f);
+            let metric_area = S::area(len(hb), len(hc), len(ha));
+            let o = S::Frame::orientation(pos[a as usize], pos[b as usize], pos[c as usize]);
+            if o < 0.0 {
+                FLIPPED
+            } else if o == 0.0 || metric_area <= 0.0 {
+                DEGENERATE
+            } else {
+                0
+            }
+        })
+        .collect();
+    let with = |x: u8| {
+        (0..nf as u32)
+            .filter(|&f| verdict[f as usize] == x)
+            .collect::<Vec<u32>>()
+    };
+    let (flipped, degenerate) = (with(FLIPPED), with(DEGENERATE));
+    let max_err = (0..mesh.n_edges() as u32)
+        .into_par_iter()
+        .map(|e| {
+            let [a, b] = mesh.edge_vertices(e);
+            let d = S::Frame::point_distance(pos[a as usize], pos[b as usize]);
+            (d - lengths[e as usize]).abs()
+        })
+        .reduce(|| 0.0, f64::max);
     let origin = S::Frame::ext(S::base_point(), None);
     let max_radius = pos
-        .iter()
+        .par_iter()
         .map(|&p| S::Frame::point_distance(origin, p))
-        .fold(0.0, f64::max);
+        .reduce(|| 0.0, f64::max);
     let mut positions = Vec::with_capacity(nv);
     let mut positions_lo = Vec::new();
     for &p in &pos {
