@@ -78,6 +78,8 @@ mod param;
 mod param_free;
 #[path = "param_interior.rs"]
 mod param_interior;
+#[path = "param_lscm.rs"]
+mod param_lscm;
 #[path = "param_placement.rs"]
 mod param_placement;
 #[path = "param_seamless.rs"]

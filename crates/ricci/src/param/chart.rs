@@ -10,6 +10,7 @@ use super::cones::{
 };
 use super::free::{free_seam_target, held_boundary_cones, homology_disk, HomologyDisk};
 use super::ladder::unresolved_triangles;
+use super::lscm::improve;
 use super::transfer::{
     folded_faces, input_route, scale_to_area, seam_edges, seam_report, subdivision_route,
     SubdivisionChart,
@@ -400,15 +401,32 @@ pub(super) fn chart_uv(
         Ok((_, uv)) => folded_faces(faces, uv),
         Err(_) => faces.len(),
     };
+    // The least-squares conformal map on the input faces, same cones and seam rotations
+    // ([`super::lscm`]); it may unfold what the exact map folds.
+    let mut lscm_refined = false;
+    let on_input = match on_input {
+        Ok((cut, uv)) if opts.lscm_refinement && !opts.on_subdivision => {
+            progress.report("layout", None, "least-squares conformal refinement");
+            match improve(&s.positions, mesh, &cut, &cone_vertices, &uv, input_folds) {
+                Some(better) => {
+                    lscm_refined = true;
+                    Ok((cut, better))
+                }
+                None => Ok((cut, uv)),
+            }
+        }
+        other => other,
+    };
+    let written_folds = if lscm_refined { 0 } else { input_folds };
     let (cut, mut corner_uv, mut subdivision) = match on_input {
-        Ok((cut, uv)) if input_folds == 0 && !opts.on_subdivision => (cut, uv, None),
+        Ok((cut, uv)) if written_folds == 0 && !opts.on_subdivision => (cut, uv, None),
         first => {
             progress.report("layout", None, "UVs on the common subdivision");
             match (
                 subdivision_route(s, &lengths, r, &cone_vertices, needs_cut),
                 first,
             ) {
-                (Ok(sub), Ok((cut, uv))) if sub.flipped > input_folds => (cut, uv, None),
+                (Ok(sub), Ok((cut, uv))) if sub.flipped > written_folds => (cut, uv, None),
                 (Ok(sub), _) => (sub.input_cut.clone(), Vec::new(), Some(sub)),
                 (Err(_), Ok((cut, uv))) => (cut, uv, None),
                 (Err(e), Err(first)) => {
@@ -463,6 +481,7 @@ pub(super) fn chart_uv(
             "input".into()
         },
         input_flipped_faces: input_folds,
+        lscm_refined,
         moved_cones: 0,
         seam_edges: seams.edges,
         seam_length: seams.length,

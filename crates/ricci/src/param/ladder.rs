@@ -40,6 +40,14 @@ pub(super) const EXTRA_CONES: usize = 4;
 /// (moving the corners by `δ` changes twice the area by at most about `2δ` times the
 /// perimeter). These are the triangles that packing and writing could fold.
 pub(super) fn unresolved_triangles(triangles: &[[u32; 3]], uv: &[[f64; 2]]) -> usize {
+    unresolved_flags(triangles, uv)
+        .iter()
+        .filter(|&&x| x)
+        .count()
+}
+
+/// Per triangle: is it unresolved ([`unresolved_triangles`])?
+pub(super) fn unresolved_flags(triangles: &[[u32; 3]], uv: &[[f64; 2]]) -> Vec<bool> {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     let mut big = 0.0f64;
     for p in uv {
@@ -52,7 +60,7 @@ pub(super) fn unresolved_triangles(triangles: &[[u32; 3]], uv: &[[f64; 2]]) -> u
     let size = (hi[0] - lo[0]).hypot(hi[1] - lo[1]).max(big);
     let tol = 4.0 * f64::EPSILON * size;
     (0..triangles.len())
-        .filter(|&t| {
+        .map(|t| {
             let q = &uv[3 * t..3 * t + 3];
             let e = |i: usize, j: usize| (q[j][0] - q[i][0]).hypot(q[j][1] - q[i][1]);
             let longest = e(0, 1).max(e(1, 2)).max(e(2, 0));
@@ -60,7 +68,7 @@ pub(super) fn unresolved_triangles(triangles: &[[u32; 3]], uv: &[[f64; 2]]) -> u
                 - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
             a2.is_nan() || a2 <= tol * longest
         })
-        .count()
+        .collect()
 }
 
 /// What a chart's options ask for, in words (`"free seams, 3 cones"`).

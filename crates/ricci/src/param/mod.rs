@@ -51,6 +51,10 @@
 //!    (Gillespie–Springborn–Crane 2021 §5; [`crate::metric::common_subdivision`]): every
 //!    piece lies in one input face and one face of `T` and none folds
 //!    ([`Parametrization::subdivision`], [`Chart::uv_faces`]).
+//!    Before that, the UVs on the input faces move to the least-squares conformal map with
+//!    the same cones, seam rotations and boundary ([`lscm`]; [`Chart::lscm_refined`]), kept
+//!    when no triangle folds: it lowers the distortion of the input's own triangles and can
+//!    unfold what the exact map folds, and then the input faces carry the map.
 //! 6. **Flip-free** ([`ladder`]): a chart whose written triangles fold, or lie within
 //!    rounding of folding (scale factors beyond what double-precision UVs resolve), or whose
 //!    flow does not converge, is recomputed with rigid seams, then with more greedy cones;
@@ -63,6 +67,7 @@ mod chart;
 pub mod cones;
 mod free;
 mod ladder;
+mod lscm;
 pub mod seamless;
 pub(crate) mod seams;
 pub mod sphere;
@@ -182,6 +187,10 @@ pub struct ParamOptions {
     /// Curvatures of the greedy cones with free seams (default least squares: the least
     /// linearised σ(2u) at the greedy's positions; `Dirichlet`: `u = 0` at the cones, BFF's).
     pub free_cone_rule: cones::CurvatureRule,
+    /// Move the UVs on the input faces to the least-squares conformal map with the same
+    /// cones, seam rotations and boundary, kept when nothing folds (submodule `lscm`;
+    /// default true).
+    pub lscm_refinement: bool,
 }
 
 impl Default for ParamOptions {
@@ -198,6 +207,7 @@ impl Default for ParamOptions {
             cone_search: cones::ConeSearch::Greedy,
             seams: SeamMode::Rigid,
             free_cone_rule: cones::CurvatureRule::LeastSquares,
+            lscm_refinement: true,
         }
     }
 }
@@ -243,6 +253,9 @@ pub struct Chart {
     /// Input faces whose own UV triangle is not positive (with the cut on input edges; all
     /// faces when no such cut exists) — the reason for `common_subdivision`.
     pub input_flipped_faces: usize,
+    /// The UVs on the input faces are the least-squares conformal refinement of the exact
+    /// map (same cones, seam rotations and boundary; submodule `lscm`).
+    pub lscm_refined: bool,
     /// Cut edges (input edges) and their total 3D length.
     pub seam_edges: usize,
     pub seam_length: f64,
