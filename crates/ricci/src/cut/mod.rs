@@ -479,10 +479,23 @@ fn greedy(
             round_attempt = 0;
             continue;
         }
-        // Keep what was found, add a free row of vertices along it and more edges at the base
-        // vertex, and resume.
+        // Keep what was found, add a free row of vertices along it (only near the base vertex
+        // when a handle other than the last failed, see `NEAR_BASE_REACH`) and more edges at
+        // the base vertex, and resume.
+        let complete = partial
+            .iter()
+            .filter(|p| matches!(p.kind, system::RawKind::Handle { which: 1, .. }))
+            .count();
+        let reach = (complete + 1 < genus).then_some(NEAR_BASE_REACH);
         min_valence = refined.mesh.valence(base) + 4;
-        refined = widen(refined, &partial, base, surface.geometry, min_valence)?;
+        refined = widen(
+            refined,
+            &partial,
+            base,
+            surface.geometry,
+            min_valence,
+            reach,
+        )?;
         prior = partial;
     };
     progress.report("cut", Some(0.9), "slicing");
@@ -598,15 +611,29 @@ fn grade_base(surface: Surface, setup: &Setup, min_valence: usize) -> Result<Ref
     r.finish()
 }
 
+/// Widening near the base vertex after a handle other than the last failed: the part of the
+/// loops within this fraction of the distance from the base vertex to their farthest vertex.
+/// Where a handle does not fit, its candidate loops are lassos of a single branch: the gap at
+/// the base vertex opens into a corridor between two earlier loops that left it side by side,
+/// too narrow for the two strands of `a_i` and for `b_i`. On botijo that corridor is near the
+/// base vertex (widening only there: the same four attempts succeed with 14 805 splits instead
+/// of 27 137); on seahorse2_100K, whose last handle fails, it is not (widening only near the
+/// base vertex there makes every attempt of the first round fail), so a failed last handle
+/// widens along the whole loops (BENCHMARKS.md, session 14, bot15).
+const NEAR_BASE_REACH: f64 = 0.25;
+
 /// Split every edge that touches a vertex of the given paths (except cut edges and edges at the
 /// base vertex): a free row of vertices appears on both sides of every path, so later loops
-/// can pass between earlier ones. The base vertex's valence is raised to `min_valence`.
+/// can pass between earlier ones. With `reach`, only vertices within `reach` times the
+/// largest distance from the base vertex to a path vertex count. The base vertex's valence is
+/// raised to `min_valence`.
 fn widen(
     refined: Refined,
     paths: &[RawPath],
     base: u32,
     geometry: Geometry,
     min_valence: usize,
+    reach: Option<f64>,
 ) -> Result<Refined> {
     let mesh = &refined.mesh;
     let mut on_path = vec![false; mesh.n_vertices()];
@@ -620,6 +647,17 @@ fn widen(
         }
     }
     on_path[base as usize] = false;
+    if let Some(f) = reach {
+        let d = distances(mesh, &refined.lengths, &[base]);
+        let far = paths
+            .iter()
+            .flat_map(|p| p.vertices.iter())
+            .map(|&v| d[v as usize])
+            .fold(0.0, f64::max);
+        for (v, on) in on_path.iter_mut().enumerate() {
+            *on &= d[v] <= f * far;
+        }
+    }
     let mut todo = Vec::new();
     for e in 0..mesh.n_edges() as u32 {
         let [a, b] = mesh.edge_vertices(e);
