@@ -720,8 +720,22 @@ fn layout_from<S: Space>(
         }
         push(g, &mut heap, &cost, &frame);
     }
-    // Measurements, per face and per edge in parallel (the maxima ignore NaN as a fold
-    // with `f64::max` does, in any order).
+    measured_layout::<S>(mesh, lengths, &pos, seed, depth)
+}
+
+/// The [`Layout`] of the placed points `pos`, with its measurements: flipped and degenerate
+/// faces, the largest edge-length error and the largest distance from the base point —
+/// per face and per edge in parallel (the maxima ignore NaN as a fold with `f64::max` does,
+/// in any order).
+fn measured_layout<S: Space>(
+    mesh: &Mesh,
+    lengths: &[f64],
+    pos: &[ExtPoint<S>],
+    seed: u32,
+    depth: u32,
+) -> Layout<S::Point> {
+    let nf = mesh.n_faces();
+    let len = |h: u32| lengths[mesh.he_edge(h) as usize];
     let verdict: Vec<u8> = (0..nf as u32)
         .into_par_iter()
         .map(|f| {
@@ -757,9 +771,9 @@ fn layout_from<S: Space>(
         .par_iter()
         .map(|&p| S::Frame::point_distance(origin, p))
         .reduce(|| 0.0, f64::max);
-    let mut positions = Vec::with_capacity(nv);
+    let mut positions = Vec::with_capacity(pos.len());
     let mut positions_lo = Vec::new();
-    for &p in &pos {
+    for &p in pos {
         let (hi, lo) = S::Frame::split(p);
         positions.push(hi);
         if let Some(lo) = lo {
