@@ -23,7 +23,7 @@ use ricci::param::{parametrize, ConeSpec, ParamOptions, Parametrization};
 use ricci::progress::NoProgress;
 
 /// qc of every face (σmax/σmin of the linear map from the 3D triangle to its UV triangle).
-fn face_qc(s: &Surface, uv: &[[f64; 2]]) -> Vec<f64> {
+pub(crate) fn face_qc(s: &Surface, uv: &[[f64; 2]]) -> Vec<f64> {
     s.mesh
         .faces()
         .iter()
@@ -52,7 +52,7 @@ fn face_qc(s: &Surface, uv: &[[f64; 2]]) -> Vec<f64> {
         .collect()
 }
 
-fn p95(mut x: Vec<f64>) -> f64 {
+pub(crate) fn p95(mut x: Vec<f64>) -> f64 {
     x.sort_by(f64::total_cmp);
     x[((x.len() - 1) as f64 * 0.95).round() as usize]
 }
@@ -66,7 +66,7 @@ fn map(s: &Surface, cones: ConeSpec, refine: bool) -> Parametrization {
     parametrize(s, &opts, &mut NoProgress).unwrap()
 }
 
-fn uv_area2(q: &[[f64; 2]]) -> f64 {
+pub(crate) fn uv_area2(q: &[[f64; 2]]) -> f64 {
     (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1])
 }
 

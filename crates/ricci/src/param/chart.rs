@@ -5,6 +5,7 @@
 //! flat triangulation.
 
 use super::boundary::fixed_angle_targets;
+use super::develop::input_map;
 use super::cones::{
     correct_cone_curvatures, greedy_cones_with, round_to_quarter_turns, ConeBudget,
 };
@@ -418,7 +419,7 @@ pub(super) fn chart_uv(
         other => other,
     };
     let written_folds = if lscm_refined { 0 } else { input_folds };
-    let (cut, mut corner_uv, mut subdivision) = match on_input {
+    let (mut cut, mut corner_uv, mut subdivision) = match on_input {
         Ok((cut, uv)) if written_folds == 0 && !opts.on_subdivision => (cut, uv, None),
         first => {
             progress.report("layout", None, "UVs on the common subdivision");
@@ -438,6 +439,21 @@ pub(super) fn chart_uv(
             }
         }
     };
+    // On the subdivision: the same map developed on the input faces along a cut on any input
+    // edges, refined until nothing folds ([`super::develop`]).
+    let mut input_folds = input_folds;
+    if let Some(sub) = subdivision
+        .as_ref()
+        .filter(|_| opts.lscm_refinement && !opts.on_subdivision)
+    {
+        progress.report("layout", None, "developed map on the input faces");
+        if let Some((c, uv, folds)) =
+            input_map(&s.positions, mesh, &lengths, &cone_vertices, needs_cut, sub)
+        {
+            (cut, corner_uv, subdivision) = (c, uv, None);
+            (input_folds, lscm_refined) = (folds, true);
+        }
+    }
     let mut subdivision_mesh = None;
     let seams = match subdivision.as_mut() {
         Some(sub) => {
