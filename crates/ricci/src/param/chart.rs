@@ -5,10 +5,10 @@
 //! flat triangulation.
 
 use super::boundary::fixed_angle_targets;
-use super::develop::input_map;
 use super::cones::{
     correct_cone_curvatures, greedy_cones_with, round_to_quarter_turns, ConeBudget,
 };
+use super::develop::input_map;
 use super::free::{free_seam_target, held_boundary_cones, homology_disk, HomologyDisk};
 use super::ladder::unresolved_triangles;
 use super::lscm::improve;
