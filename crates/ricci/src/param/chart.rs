@@ -402,6 +402,7 @@ pub(super) fn chart_uv(
         Ok((_, uv)) => folded_faces(faces, uv),
         Err(_) => faces.len(),
     };
+    let no_input_cut = on_input.is_err();
     // The least-squares conformal map on the input faces, same cones and seam rotations
     // ([`super::lscm`]); it may unfold what the exact map folds.
     let mut lscm_refined = false;
@@ -439,12 +440,13 @@ pub(super) fn chart_uv(
             }
         }
     };
-    // On the subdivision: the same map developed on the input faces along a cut on any input
-    // edges, refined until nothing folds ([`super::develop`]).
+    // On the subdivision because no cut on kept input edges reaches every cone: the same map
+    // developed on the input faces along a cut on any input edges, refined until nothing
+    // folds ([`super::develop`]).
     let mut input_folds = input_folds;
     if let Some(sub) = subdivision
         .as_ref()
-        .filter(|_| opts.lscm_refinement && !opts.on_subdivision)
+        .filter(|_| no_input_cut && opts.lscm_refinement && !opts.on_subdivision)
     {
         progress.report("layout", None, "developed map on the input faces");
         if let Some((c, uv, folds)) =
