@@ -19,7 +19,7 @@
 #[path = "ricci_meshes/mod.rs"]
 mod ricci_meshes;
 
-use crate::param_lscm::{face_qc, p95, uv_area2};
+use crate::param_lscm::{face_qc, p95, seam_ratio, uv_area2};
 use ricci::mesh::Surface;
 use ricci::param::{parametrize, ConeSpec, ParamOptions, Parametrization, SeamMode};
 use ricci::progress::NoProgress;
@@ -116,18 +116,7 @@ fn camel_is_developed_on_its_input_faces() {
             continue;
         }
         seams += 1;
-        let uv = &new.corner_uv;
-        let h = m.edge_halfedge(e);
-        let g = m.he_twin(h);
-        let (pa, pb) = (uv[h as usize], uv[m.he_next(h) as usize]);
-        let (qb, qa) = (uv[g as usize], uv[m.he_next(g) as usize]);
-        let d1 = [pb[0] - pa[0], pb[1] - pa[1]];
-        let d2 = [qb[0] - qa[0], qb[1] - qa[1]];
-        let n = d1[0] * d1[0] + d1[1] * d1[1];
-        let r = [
-            (d2[0] * d1[0] + d2[1] * d1[1]) / n,
-            (d2[1] * d1[0] - d2[0] * d1[1]) / n,
-        ];
+        let r = seam_ratio(m, &new.corner_uv, e);
         let scale_error = (r[0].hypot(r[1]) - 1.0).abs();
         let angle = r[1].atan2(r[0]);
         let angle_error = holonomies
