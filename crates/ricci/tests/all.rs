@@ -74,6 +74,8 @@ mod mesh_files;
 mod metric_derivatives;
 #[path = "param.rs"]
 mod param;
+#[path = "param_develop.rs"]
+mod param_develop;
 #[path = "param_free.rs"]
 mod param_free;
 #[path = "param_interior.rs"]

@@ -23,7 +23,7 @@ use ricci::param::{parametrize, ConeSpec, ParamOptions, Parametrization};
 use ricci::progress::NoProgress;
 
 /// qc of every face (σmax/σmin of the linear map from the 3D triangle to its UV triangle).
-fn face_qc(s: &Surface, uv: &[[f64; 2]]) -> Vec<f64> {
+pub(crate) fn face_qc(s: &Surface, uv: &[[f64; 2]]) -> Vec<f64> {
     s.mesh
         .faces()
         .iter()
@@ -52,7 +52,7 @@ fn face_qc(s: &Surface, uv: &[[f64; 2]]) -> Vec<f64> {
         .collect()
 }
 
-fn p95(mut x: Vec<f64>) -> f64 {
+pub(crate) fn p95(mut x: Vec<f64>) -> f64 {
     x.sort_by(f64::total_cmp);
     x[((x.len() - 1) as f64 * 0.95).round() as usize]
 }
@@ -66,7 +66,7 @@ fn map(s: &Surface, cones: ConeSpec, refine: bool) -> Parametrization {
     parametrize(s, &opts, &mut NoProgress).unwrap()
 }
 
-fn uv_area2(q: &[[f64; 2]]) -> f64 {
+pub(crate) fn uv_area2(q: &[[f64; 2]]) -> f64 {
     (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1])
 }
 
@@ -124,24 +124,27 @@ fn compare(name: &str, s: &Surface, cones: ConeSpec) -> (f64, f64) {
     (q0, q1)
 }
 
+/// `d₂/d₁` of the two sides' UV edge vectors across the interior edge `e` (complex).
+pub(crate) fn seam_ratio(m: &ricci::mesh::Mesh, uv: &[[f64; 2]], e: u32) -> [f64; 2] {
+    let h = m.edge_halfedge(e);
+    let g = m.he_twin(h);
+    let (pa, pb) = (uv[h as usize], uv[m.he_next(h) as usize]);
+    let (qb, qa) = (uv[g as usize], uv[m.he_next(g) as usize]);
+    let d1 = [pb[0] - pa[0], pb[1] - pa[1]];
+    let d2 = [qb[0] - qa[0], qb[1] - qa[1]];
+    let n = d1[0] * d1[0] + d1[1] * d1[1];
+    [
+        (d2[0] * d1[0] + d2[1] * d1[1]) / n,
+        (d2[1] * d1[0] - d2[0] * d1[1]) / n,
+    ]
+}
+
 /// Across every seam edge: `d₂/d₁` of the two sides' UV edge vectors, the same in both maps
 /// (global similarities of the packing cancel in the ratio).
 fn check_seams(name: &str, s: &Surface, exact: &Parametrization, refined: &Parametrization) {
     let m = &s.mesh;
     assert_eq!(exact.seam, refined.seam, "{name}: same cut");
-    let ratio = |uv: &[[f64; 2]], e: u32| {
-        let h = m.edge_halfedge(e);
-        let g = m.he_twin(h);
-        let (pa, pb) = (uv[h as usize], uv[m.he_next(h) as usize]);
-        let (qb, qa) = (uv[g as usize], uv[m.he_next(g) as usize]);
-        let d1 = [pb[0] - pa[0], pb[1] - pa[1]];
-        let d2 = [qb[0] - qa[0], qb[1] - qa[1]];
-        let n = d1[0] * d1[0] + d1[1] * d1[1];
-        [
-            (d2[0] * d1[0] + d2[1] * d1[1]) / n,
-            (d2[1] * d1[0] - d2[0] * d1[1]) / n,
-        ]
-    };
+    let ratio = |uv: &[[f64; 2]], e: u32| seam_ratio(m, uv, e);
     let (mut worst, mut seam_edges) = (0.0f64, 0);
     for e in 0..m.n_edges() as u32 {
         if !exact.seam[e as usize] || m.is_boundary_edge(e) {

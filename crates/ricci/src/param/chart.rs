@@ -8,6 +8,7 @@ use super::boundary::fixed_angle_targets;
 use super::cones::{
     correct_cone_curvatures, greedy_cones_with, round_to_quarter_turns, ConeBudget,
 };
+use super::develop::input_map;
 use super::free::{free_seam_target, held_boundary_cones, homology_disk, HomologyDisk};
 use super::ladder::unresolved_triangles;
 use super::lscm::improve;
@@ -401,6 +402,7 @@ pub(super) fn chart_uv(
         Ok((_, uv)) => folded_faces(faces, uv),
         Err(_) => faces.len(),
     };
+    let no_input_cut = on_input.is_err();
     // The least-squares conformal map on the input faces, same cones and seam rotations
     // ([`super::lscm`]); it may unfold what the exact map folds.
     let mut lscm_refined = false;
@@ -418,7 +420,7 @@ pub(super) fn chart_uv(
         other => other,
     };
     let written_folds = if lscm_refined { 0 } else { input_folds };
-    let (cut, mut corner_uv, mut subdivision) = match on_input {
+    let (mut cut, mut corner_uv, mut subdivision) = match on_input {
         Ok((cut, uv)) if written_folds == 0 && !opts.on_subdivision => (cut, uv, None),
         first => {
             progress.report("layout", None, "UVs on the common subdivision");
@@ -438,6 +440,22 @@ pub(super) fn chart_uv(
             }
         }
     };
+    // On the subdivision because no cut on kept input edges reaches every cone: the same map
+    // developed on the input faces along a cut on any input edges, refined until nothing
+    // folds ([`super::develop`]).
+    let mut input_folds = input_folds;
+    if let Some(sub) = subdivision
+        .as_ref()
+        .filter(|_| no_input_cut && opts.lscm_refinement && !opts.on_subdivision)
+    {
+        progress.report("layout", None, "developed map on the input faces");
+        if let Some((c, uv, folds)) =
+            input_map(&s.positions, mesh, &lengths, &cone_vertices, needs_cut, sub)
+        {
+            (cut, corner_uv, subdivision) = (c, uv, None);
+            (input_folds, lscm_refined) = (folds, true);
+        }
+    }
     let mut subdivision_mesh = None;
     let seams = match subdivision.as_mut() {
         Some(sub) => {

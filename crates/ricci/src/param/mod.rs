@@ -65,6 +65,7 @@
 pub(crate) mod boundary;
 mod chart;
 pub mod cones;
+mod develop;
 mod free;
 mod ladder;
 mod lscm;
