@@ -37,17 +37,19 @@ pub fn input_face_map(
 ) -> Result<Vec<[f64; 2]>> {
     let nv = input.n_vertices();
     let mut table: HashMap<(u32, u32), [f64; 2]> = HashMap::with_capacity(nv + nv / 4);
+    let t_keys = seams::wedge_keys(t_mesh, t_cut);
     for h in 0..t_mesh.n_corners() as u32 {
         let v = t_mesh.he_origin(h);
         if (v as usize) < nv {
-            let key = seams::wedge_key(t_mesh, h, t_cut);
+            let key = t_keys[h as usize];
             table.entry((v, key)).or_insert(t_uv[h as usize]);
         }
     }
     let mut out = Vec::with_capacity(input.n_corners());
+    let keys = seams::wedge_keys(input, cut);
     for h in 0..input.n_corners() as u32 {
         let v = input.he_origin(h);
-        let key = seams::wedge_key(input, h, cut);
+        let key = keys[h as usize];
         let uv = table.get(&(v, key)).ok_or_else(|| {
             Error::numerical(format!(
                 "input vertex {v} (face {}) has no position in the layout of the intrinsic \
