@@ -14,13 +14,13 @@ use super::ladder::unresolved_triangles;
 use super::lscm::improve;
 use super::transfer::{
     folded_faces, input_route, scale_to_area, seam_edges, seam_report, subdivision_route,
-    SubdivisionChart,
+    SeamReport, SubdivisionChart,
 };
 use super::{log_scale_sigma, BoundaryMode, Chart, Cone, ConeSpec};
 use super::{ParamOptions, Piece, SeamMode};
 use crate::error::{Error, Result};
 use crate::flow::{flow_with_fallback, FlowResult, TargetSpec, UniformizationOptions};
-use crate::mesh::{topology, Mesh};
+use crate::mesh::{topology, Mesh, Surface};
 use crate::metric::{Geometry, IntrinsicMetric, Scheme};
 use crate::progress::Progress;
 use std::collections::HashMap;
@@ -342,6 +342,33 @@ fn input_cones(work: &Piece, cones: &[(u32, f64)]) -> Vec<Cone> {
         .collect()
 }
 
+/// Closed genus ≥ 1 with `--seamless`: the flow's result with the least change of log lengths
+/// that makes the holonomy of the homology loops quarter turns too (`seamless`, CSZZ 2019).
+fn seamless_result(
+    kept: &KeptFlow,
+    n_vertices: usize,
+    progress: &mut dyn Progress,
+) -> Result<FlowResult> {
+    let t_mesh = &kept
+        .r
+        .triangulation
+        .as_ref()
+        .ok_or_else(|| Error::numerical("the conformal flow returned no triangulation"))?
+        .simplicial
+        .mesh;
+    let lengths = super::seamless::chart_holonomy(
+        t_mesh,
+        &kept.r.metric(),
+        n_vertices,
+        &kept.cones,
+        progress,
+    )?;
+    Ok(FlowResult {
+        lengths,
+        ..kept.r.clone()
+    })
+}
+
 /// UVs of one connected component (module docs, steps 1–5).
 pub(super) fn chart_uv(
     piece: &Piece,
@@ -368,26 +395,7 @@ pub(super) fn chart_uv(
     let kept = flow_with_corrections(work, component, &lengths, &plan, opts, progress)?;
     let seamless_metric;
     let r = if opts.seamless && comp.genus > 0 && comp.boundary_loops == 0 {
-        // Closed genus ≥ 1: the least change of log lengths that makes the holonomy of the
-        // homology loops quarter turns too (`seamless`, CSZZ 2019).
-        let t_mesh = &kept
-            .r
-            .triangulation
-            .as_ref()
-            .ok_or_else(|| Error::numerical("the conformal flow returned no triangulation"))?
-            .simplicial
-            .mesh;
-        let lengths = super::seamless::chart_holonomy(
-            t_mesh,
-            &kept.r.metric(),
-            mesh.n_vertices(),
-            &kept.cones,
-            progress,
-        )?;
-        seamless_metric = FlowResult {
-            lengths,
-            ..kept.r.clone()
-        };
+        seamless_metric = seamless_result(&kept, mesh.n_vertices(), progress)?;
         &seamless_metric
     } else {
         &kept.r
@@ -403,41 +411,22 @@ pub(super) fn chart_uv(
         Err(_) => faces.len(),
     };
     let no_input_cut = on_input.is_err();
-    // The least-squares conformal map on the input faces, same cones and seam rotations
-    // ([`super::lscm`]); it may unfold what the exact map folds.
-    let mut lscm_refined = false;
-    let on_input = match on_input {
-        Ok((cut, uv)) if opts.lscm_refinement && !opts.on_subdivision => {
-            progress.report("layout", None, "least-squares conformal refinement");
-            match improve(&s.positions, mesh, &cut, &cone_vertices, &uv, input_folds) {
-                Some(better) => {
-                    lscm_refined = true;
-                    Ok((cut, better))
-                }
-                None => Ok((cut, uv)),
-            }
-        }
-        other => other,
-    };
+    let mut on_input = on_input;
+    let mut lscm_refined = lscm_refinement(
+        s,
+        &cone_vertices,
+        opts,
+        &mut on_input,
+        input_folds,
+        progress,
+    );
     let written_folds = if lscm_refined { 0 } else { input_folds };
     let (mut cut, mut corner_uv, mut subdivision) = match on_input {
         Ok((cut, uv)) if written_folds == 0 && !opts.on_subdivision => (cut, uv, None),
         first => {
             progress.report("layout", None, "UVs on the common subdivision");
-            match (
-                subdivision_route(s, &lengths, r, &cone_vertices, needs_cut),
-                first,
-            ) {
-                (Ok(sub), Ok((cut, uv))) if sub.flipped > written_folds => (cut, uv, None),
-                (Ok(sub), _) => (sub.input_cut.clone(), Vec::new(), Some(sub)),
-                (Err(_), Ok((cut, uv))) => (cut, uv, None),
-                (Err(e), Err(first)) => {
-                    return Err(Error::numerical(format!(
-                        "component {component}: no cut on the input's edges ({first}), and \
-                         none on the common subdivision ({e})"
-                    )));
-                }
-            }
+            let sub = subdivision_route(s, &lengths, r, &cone_vertices, needs_cut);
+            subdivision_unless_worse(sub, first, written_folds, component)?
         }
     };
     // On the subdivision because no cut on kept input edges reaches every cone: the same map
@@ -456,22 +445,13 @@ pub(super) fn chart_uv(
             (input_folds, lscm_refined) = (folds, true);
         }
     }
-    let mut subdivision_mesh = None;
-    let seams = match subdivision.as_mut() {
-        Some(sub) => {
-            scale_to_area(&sub.positions, &sub.triangles, &mut sub.corner_uv);
-            corner_uv = input_corners_of(mesh, sub);
-            let m = Mesh::from_triangles(sub.positions.len(), sub.triangles.clone())?;
-            let seam = seam_edges(&m, &sub.corner_uv);
-            let report = seam_report(&m, &sub.positions, &sub.corner_uv, &seam);
-            subdivision_mesh = Some(m);
-            report
-        }
-        None => {
-            scale_to_area(&s.positions, faces, &mut corner_uv);
-            seam_report(mesh, &s.positions, &corner_uv, &cut)
-        }
-    };
+    let (seams, subdivision_mesh) = scaled_seams(
+        &s.positions,
+        mesh,
+        &cut,
+        &mut corner_uv,
+        subdivision.as_mut(),
+    )?;
     let tr = r
         .triangulation
         .as_ref()
@@ -528,6 +508,82 @@ pub(super) fn chart_uv(
         subdivision_mesh,
         chart,
         flipped,
+    })
+}
+
+/// The common subdivision's map `sub`, unless it folds more triangles than the input faces'
+/// map `first` (which folds `written_folds`), or cannot be built while `first` can.
+fn subdivision_unless_worse(
+    sub: Result<SubdivisionChart>,
+    first: Result<(Vec<bool>, Vec<[f64; 2]>)>,
+    written_folds: usize,
+    component: usize,
+) -> Result<(Vec<bool>, Vec<[f64; 2]>, Option<SubdivisionChart>)> {
+    Ok(match (sub, first) {
+        (Ok(sub), Ok((cut, uv))) if sub.flipped > written_folds => (cut, uv, None),
+        (Ok(sub), _) => (sub.input_cut.clone(), Vec::new(), Some(sub)),
+        (Err(_), Ok((cut, uv))) => (cut, uv, None),
+        (Err(e), Err(first)) => {
+            return Err(Error::numerical(format!(
+                "component {component}: no cut on the input's edges ({first}), and none on \
+                 the common subdivision ({e})"
+            )));
+        }
+    })
+}
+
+/// The least-squares conformal map on the input faces, same cones and seam rotations
+/// ([`super::lscm`]), in place of the exact map on the input route when it is kept (it may
+/// unfold what the exact map folds); says whether it was.
+fn lscm_refinement(
+    s: &Surface,
+    cone_vertices: &[u32],
+    opts: &ParamOptions,
+    on_input: &mut Result<(Vec<bool>, Vec<[f64; 2]>)>,
+    input_folds: usize,
+    progress: &mut dyn Progress,
+) -> bool {
+    let Ok((cut, uv)) = on_input.as_mut() else {
+        return false;
+    };
+    if !opts.lscm_refinement || opts.on_subdivision {
+        return false;
+    }
+    progress.report("layout", None, "least-squares conformal refinement");
+    match improve(&s.positions, &s.mesh, cut, cone_vertices, uv, input_folds) {
+        Some(better) => {
+            *uv = better;
+            true
+        }
+        None => false,
+    }
+}
+
+/// Scales the written UVs to the surface's area and measures the seams: on the common
+/// subdivision (whose mesh is returned for reuse; the input corners take its UVs) or on the
+/// input faces cut along `cut`.
+fn scaled_seams(
+    positions: &[[f64; 3]],
+    mesh: &Mesh,
+    cut: &[bool],
+    corner_uv: &mut Vec<[f64; 2]>,
+    subdivision: Option<&mut SubdivisionChart>,
+) -> Result<(SeamReport, Option<Mesh>)> {
+    Ok(match subdivision {
+        Some(sub) => {
+            scale_to_area(&sub.positions, &sub.triangles, &mut sub.corner_uv);
+            *corner_uv = input_corners_of(mesh, sub);
+            let m = Mesh::from_triangles(sub.positions.len(), sub.triangles.clone())?;
+            let seam = seam_edges(&m, &sub.corner_uv);
+            (
+                seam_report(&m, &sub.positions, &sub.corner_uv, &seam),
+                Some(m),
+            )
+        }
+        None => {
+            scale_to_area(positions, mesh.faces(), corner_uv);
+            (seam_report(mesh, positions, corner_uv, cut), None)
+        }
     })
 }
 

@@ -121,19 +121,16 @@ impl Bundle {
     }
 }
 
-/// The least-squares conformal refinement (module docs) of the corner UVs `uv[3f + i]` of
-/// `mesh` (3D `positions`) opened along `cut`, with the wedges of `cones` and of vertices not
-/// `movable` pinned, face `f`'s energy multiplied by `boost[f]`. Returns the new corner UVs;
-/// the caller checks them for folds.
-fn refine(
-    positions: &[[f64; 3]],
+/// The wedges of `mesh` opened along `cut` (module docs) in classes linked by the seam
+/// rotations of `uv`, the classes of `cones`, of vertices not `movable` and of the boundary
+/// pinned (and at least two pinned in all); per corner, its wedge's root and rotation.
+fn wedge_classes(
     mesh: &Mesh,
     cut: &[bool],
     cones: &[u32],
     uv: &[C],
     movable: &[bool],
-    boost: &[f64],
-) -> Result<Vec<C>> {
+) -> Result<(Bundle, Vec<(u32, C)>)> {
     let nc = mesh.n_corners();
     // Wedges: one per (vertex, sector between cut or boundary edges).
     let mut ids: HashMap<(u32, u32), u32> = HashMap::with_capacity(nc / 5);
@@ -220,6 +217,25 @@ fn refine(
         let Some(far) = far else { break };
         b.pinned[roots[far].0 as usize] = true;
     }
+    Ok((b, roots))
+}
+
+/// The least-squares conformal refinement (module docs) of the corner UVs `uv[3f + i]` of
+/// `mesh` (3D `positions`) opened along `cut`, with the wedges of `cones` and of vertices not
+/// `movable` pinned, face `f`'s energy multiplied by `boost[f]`. Returns the new corner UVs;
+/// the caller checks them for folds.
+fn refine(
+    positions: &[[f64; 3]],
+    mesh: &Mesh,
+    cut: &[bool],
+    cones: &[u32],
+    uv: &[C],
+    movable: &[bool],
+    boost: &[f64],
+) -> Result<Vec<C>> {
+    let nc = mesh.n_corners();
+    let (b, roots) = wedge_classes(mesh, cut, cones, uv, movable)?;
+    let nw = b.parent.len();
     let mut col = vec![u32::MAX; nw];
     let mut n = 0usize;
     for (w, c) in col.iter_mut().enumerate() {
