@@ -470,6 +470,8 @@ fn check_bordered_genus_two(mesh: &std::path::Path, loops: usize, name: &str) {
         "--tolerance",
         "1%",
         "--json",
+        "--tessellation",
+        "16",
         "--out",
         out.to_str().unwrap(),
     ]));
@@ -498,10 +500,14 @@ fn check_bordered_genus_two(mesh: &std::path::Path, loops: usize, name: &str) {
     );
     assert_eq!(chi, -2, "surface.obj, welded");
     let d = max_distance(&surface.positions, &points, &tris);
-    // chords of 4 segments per cell side: far below 1e-3 of the longest side on these cells
+    // chords of 16 segments per cell side: below 1e-3 of the longest side on these cells;
+    // vertices without cylinder coordinates (JSON `unassigned_points`, on a critical level)
+    // are no data and the reported L∞ does not cover them: then the bound is the tolerance
+    let unassigned = v["unassigned_points"].as_u64().unwrap();
+    let bound = if unassigned > 0 { max.max(1.0) } else { max };
     assert!(
-        d <= max / 100.0 * scale + 1e-3 * scale,
-        "an input vertex is {:.3} % of the longest side from the spline (reported L∞ {max:.3} %)",
+        d <= bound / 100.0 * scale + 1e-3 * scale,
+        "an input vertex is {:.3} % of the longest side from the spline (reported L∞ {max:.3} %, {unassigned} unassigned)",
         100.0 * d / scale
     );
     for f in [

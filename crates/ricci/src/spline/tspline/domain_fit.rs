@@ -309,7 +309,7 @@ fn triangle_points(
         let (lo, hi) = ratios
             .iter()
             .fold((f64::INFINITY, 0.0f64), |(a, b), &r| (a.min(r), b.max(r)));
-        if !(hi <= 1.5 * lo) {
+        if hi > 1.5 * lo || !hi.is_finite() {
             continue;
         }
         let wt = w * area(t) / mean.max(1e-300);
