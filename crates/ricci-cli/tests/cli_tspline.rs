@@ -230,17 +230,7 @@ fn genus_two_default_is_the_domain_mesh_spline_and_per_cylinder_is_an_option() {
         .iter()
         .map(|t| t.map(|x| x as usize))
         .collect();
-    let scale = (0..3)
-        .map(|k| {
-            let (lo, hi) = surface
-                .positions
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
-                    (a.min(p[k]), b.max(p[k]))
-                });
-            hi - lo
-        })
-        .fold(0.0, f64::max);
+    let scale = longest_side(&surface.positions);
     let (spline_points, _) = read_obj(&out.join("surface.obj"));
     let measured = 100.0 * max_distance(&spline_points, &surface.positions, &tris) / scale;
     let reported = v["max_deviation_between_vertices_percent"]
@@ -263,6 +253,18 @@ fn genus_two_default_is_the_domain_mesh_spline_and_per_cylinder_is_an_option() {
     ]));
     assert_eq!(p["spline"], "per_cylinder", "{p}");
     assert!(p["cylinders"].as_array().is_some_and(|c| !c.is_empty()));
+}
+
+/// The longest side of the bounding box of `positions`.
+fn longest_side(positions: &[[f64; 3]]) -> f64 {
+    (0..3)
+        .map(|k| {
+            let (lo, hi) = positions.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+                (lo.min(p[k]), hi.max(p[k]))
+            });
+            hi - lo
+        })
+        .fold(0.0, f64::max)
 }
 
 /// `ricci generate genus --genus 2` into `dir`.
@@ -480,18 +482,7 @@ fn check_bordered_genus_two(mesh: &std::path::Path, loops: usize, name: &str) {
     assert_eq!(v["data_points"], surface.positions.len());
     check_closed_genus_two_mesh(&v, 1.0);
     let max = v["max_error_percent"].as_f64().unwrap();
-    // the input's longest bounding-box side
-    let scale = (0..3)
-        .map(|k| {
-            let (lo, hi) = surface
-                .positions
-                .iter()
-                .fold((f64::MAX, f64::MIN), |(lo, hi), p| {
-                    (lo.min(p[k]), hi.max(p[k]))
-                });
-            hi - lo
-        })
-        .fold(0.0, f64::max);
+    let scale = longest_side(&surface.positions);
     let (points, tris) = read_obj(&out.join("surface.obj"));
     let (chi, closed) = welded_euler(&points, &tris, 1e-9 * scale);
     assert!(

@@ -142,9 +142,9 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     sec.paragraphs.push(format!(
         "The tolerance is checked at the {} vertices; the surface between them is measured \
          too: the spline at 16 points of every cell is within {:.2} % (max) and {:.3} % (rms) \
-         of the longest side of the input triangles ({}). The {} control points are fewer \
-         than the vertices ({:.2} vertices per cell), so the fairness shapes the cells without \
-         a vertex, and the zebra stripes show where.",
+         of the longest side of the input triangles ({}). With {} control points \
+         ({:.2} vertices per cell) the fairness shapes the cells without a vertex, and the \
+         zebra stripes show where.",
         surface.positions.len(),
         num(&r.report["max_deviation_between_vertices_percent"]),
         num(&r.report["rms_deviation_between_vertices_percent"]),
