@@ -804,8 +804,8 @@ fn pou_surface_has_no_jumps_and_stays_close_to_the_surface() {
 /// those of `ricci tspline surface.off --json` run here on the written file (the command the
 /// page shows), and they fit the surface's topology (closed, χ = −2): control points − cells
 /// = χ, Σ (valence − 4) over the zeros = −4χ so the sides at the zeros number 4·zeros + 8,
-/// every cell has four sides each shared by two cells (2·cells sides in all); C⁰ at the zeros,
-/// C² elsewhere, within the 0.5 % tolerance; both pictures on the page.
+/// every cell has four sides each shared by two cells (2·cells sides in all); G¹ (class C1)
+/// at the zeros, C² elsewhere, within the 0.5 % tolerance; both pictures on the page.
 #[test]
 fn tspline_stage_is_ricci_tspline_of_the_demo_surface() {
     let (dir, v) = demo();

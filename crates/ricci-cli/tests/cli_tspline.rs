@@ -188,7 +188,7 @@ fn genus_two_default_is_the_domain_mesh_spline_and_per_cylinder_is_an_option() {
         "tspline",
         m,
         "--tolerance",
-        "2%",
+        "1%",
         "--json",
         "--out",
         out.to_str().unwrap(),
@@ -204,7 +204,7 @@ fn genus_two_default_is_the_domain_mesh_spline_and_per_cylinder_is_an_option() {
     ] {
         assert!(!v[key].is_null(), "no {key}: {v}");
     }
-    check_closed_genus_two_mesh(&v, 2.0);
+    check_closed_genus_two_mesh(&v, 1.0);
     assert_eq!(v["bezier_patches"], v["cells"]);
     assert_eq!(v["continuity"]["extraordinary_points"], 2);
     for f in [
@@ -219,6 +219,30 @@ fn genus_two_default_is_the_domain_mesh_spline_and_per_cylinder_is_an_option() {
     for f in ["tmesh-surface.png", "zebra.png"] {
         assert_eq!(png_size(&out.join(f)), (1200, 900), "{f}");
     }
+    // between the vertices: every point of the exported tessellation (points of the spline)
+    // to the input triangles, measured here by brute force, within the reported maximum (its
+    // samples are other points of the same cells: 25 % + 0.1 % of the longest side of slack)
+    // and within 3 % of the longest side
+    let (surface, _) = ricci::mesh::io::read_surface(&mesh).unwrap();
+    let tris: Vec<[usize; 3]> = surface
+        .mesh
+        .faces()
+        .iter()
+        .map(|t| t.map(|x| x as usize))
+        .collect();
+    let scale = longest_side(&surface.positions);
+    let (spline_points, _) = read_obj(&out.join("surface.obj"));
+    let measured = 100.0 * max_distance(&spline_points, &surface.positions, &tris) / scale;
+    let reported = v["max_deviation_between_vertices_percent"]
+        .as_f64()
+        .unwrap();
+    let rms = v["rms_deviation_between_vertices_percent"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        measured <= 1.25 * reported + 0.1 && measured <= 3.0 && rms <= reported,
+        "between the vertices: measured {measured} %, reported max {reported} %, rms {rms} %"
+    );
     let p = json(&ricci(&[
         "tspline",
         m,
@@ -229,6 +253,18 @@ fn genus_two_default_is_the_domain_mesh_spline_and_per_cylinder_is_an_option() {
     ]));
     assert_eq!(p["spline"], "per_cylinder", "{p}");
     assert!(p["cylinders"].as_array().is_some_and(|c| !c.is_empty()));
+}
+
+/// The longest side of the bounding box of `positions`.
+fn longest_side(positions: &[[f64; 3]]) -> f64 {
+    (0..3)
+        .map(|k| {
+            let (lo, hi) = positions.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+                (lo.min(p[k]), hi.max(p[k]))
+            });
+            hi - lo
+        })
+        .fold(0.0, f64::max)
 }
 
 /// `ricci generate genus --genus 2` into `dir`.
@@ -249,8 +285,8 @@ fn generated_genus_two(dir: &std::path::Path) -> PathBuf {
 /// The report `v` of a domain-mesh spline of a closed genus-2 surface (or of one with its
 /// loops filled), against the topology: the quad mesh is closed, so control points − cells =
 /// χ = −2; Σ (valence − 4) over the zeros = −4χ = 8, so the sides with a zero at an end number
-/// 4·zeros + 8 (16 for two simple zeros of valence 8); those sides C⁰ only, all the others
-/// C²; converged within `tolerance_percent`.
+/// 4·zeros + 8 (16 for two simple zeros of valence 8); those sides C¹ in the translation
+/// chart (G¹), all the others C²; converged within `tolerance_percent`.
 fn check_closed_genus_two_mesh(v: &serde_json::Value, tolerance_percent: f64) {
     assert_eq!(v["spline"], "domain_mesh", "{v}");
     let n = |k: &str| v[k].as_i64().unwrap();
@@ -423,7 +459,7 @@ fn max_distance(queries: &[[f64; 3]], points: &[[f64; 3]], tris: &[[usize; 3]]) 
 /// boundary loops, checked against the input: the loops are filled (JSON `filled_loops`),
 /// the domain mesh is that of a closed genus-2 surface (control points − cells = χ = −2;
 /// Σ (valence − 4) over the zeros = −4χ = 8, so the sides at the zeros number 4·zeros + 8),
-/// C⁰ at the zeros and C² elsewhere as measured; the exported tessellation `surface.obj`,
+/// G¹ (class C1) at the zeros and C² elsewhere as measured; the exported tessellation `surface.obj`,
 /// welded, is one closed surface of Euler characteristic −2 (the patches meet: C⁰ and the
 /// fills included), and every input vertex lies within the reported L∞ error (≤ the
 /// tolerance) of it, up to the tessellation's chords.
@@ -436,6 +472,8 @@ fn check_bordered_genus_two(mesh: &std::path::Path, loops: usize, name: &str) {
         "--tolerance",
         "1%",
         "--json",
+        "--tessellation",
+        "16",
         "--out",
         out.to_str().unwrap(),
     ]));
@@ -444,18 +482,7 @@ fn check_bordered_genus_two(mesh: &std::path::Path, loops: usize, name: &str) {
     assert_eq!(v["data_points"], surface.positions.len());
     check_closed_genus_two_mesh(&v, 1.0);
     let max = v["max_error_percent"].as_f64().unwrap();
-    // the input's longest bounding-box side
-    let scale = (0..3)
-        .map(|k| {
-            let (lo, hi) = surface
-                .positions
-                .iter()
-                .fold((f64::MAX, f64::MIN), |(lo, hi), p| {
-                    (lo.min(p[k]), hi.max(p[k]))
-                });
-            hi - lo
-        })
-        .fold(0.0, f64::max);
+    let scale = longest_side(&surface.positions);
     let (points, tris) = read_obj(&out.join("surface.obj"));
     let (chi, closed) = welded_euler(&points, &tris, 1e-9 * scale);
     assert!(
@@ -464,10 +491,14 @@ fn check_bordered_genus_two(mesh: &std::path::Path, loops: usize, name: &str) {
     );
     assert_eq!(chi, -2, "surface.obj, welded");
     let d = max_distance(&surface.positions, &points, &tris);
-    // chords of 4 segments per cell side: far below 1e-3 of the longest side on these cells
+    // chords of 16 segments per cell side: below 1e-3 of the longest side on these cells;
+    // vertices without cylinder coordinates (JSON `unassigned_points`, on a critical level)
+    // are no data and the reported L∞ does not cover them: then the bound is the tolerance
+    let unassigned = v["unassigned_points"].as_u64().unwrap();
+    let bound = if unassigned > 0 { max.max(1.0) } else { max };
     assert!(
-        d <= max / 100.0 * scale + 1e-3 * scale,
-        "an input vertex is {:.3} % of the longest side from the spline (reported L∞ {max:.3} %)",
+        d <= bound / 100.0 * scale + 1e-3 * scale,
+        "an input vertex is {:.3} % of the longest side from the spline (reported L∞ {max:.3} %, {unassigned} unassigned)",
         100.0 * d / scale
     );
     for f in [

@@ -1,9 +1,15 @@
 //! `ricci tspline` on closed surfaces of genus ≥ 2, the default: one cubic spline on the quad
 //! mesh of knot intervals over the whole domain manifold (the strips of the cylinders of a
 //! holomorphic 1-form glued by translations; `ricci::spline::tspline::{domain_mesh,
-//! domain_fit, domain_continuity}`, paper 003 §2–3), fitted by least squares with uniform
-//! refinement. Continuity, measured across every cell side (JSON `continuity`): C⁰ at the
-//! zeros (the extraordinary points), C² on every other side — reported apart for the sides
+//! domain_fit, domain_continuity}`, paper 003 §2–3), fitted by least squares, refined at the
+//! zeros (a conforming mesh graded towards them) while the error there exceeds the tolerance
+//! and uniformly while it is exceeded elsewhere. Two fits: the input vertices only, and with
+//! points on the input triangles (centroid, edge midpoints) too; the one nearer the triangles
+//! between the vertices is kept (JSON `max_deviation_between_vertices_percent`,
+//! `rms_deviation_between_vertices_percent`, `between_vertices_data`). Continuity, measured
+//! across every cell side (JSON `continuity`): G¹ at the zeros (the extraordinary points; C¹
+//! in the translation chart, by linear conditions on the control points around every zero;
+//! `normal_angle_at_zeros_degrees`), C² on every other side — reported apart for the sides
 //! one knot interval from a zero and the sides farther.
 //!
 //! Surfaces with boundary loops: the loops are filled by fans for the domain and the fills
@@ -26,7 +32,10 @@ use ricci::analysis::forms::HolomorphicForms;
 use ricci::mesh::Surface;
 use ricci::progress::Progress;
 use ricci::spline::tspline::domain_continuity::{side_continuity, SideContinuity};
-use ricci::spline::tspline::domain_fit::{fit_domain_mesh, DomainFit, DomainFitOptions};
+use ricci::spline::tspline::domain_fit::{
+    deviation_between_vertices, fit_domain_mesh, fit_domain_mesh_on_triangles, DomainFit,
+    DomainFitOptions,
+};
 use ricci::spline::tspline::genus_domain::GenusDomain;
 use ricci::spline::tspline::glue::Gluing;
 use ricci::spline::tspline::{BezierPatch, Continuity};
@@ -65,6 +74,9 @@ fn continuity_json(s: &SideContinuity, zeros: usize, scale: f64) -> serde_json::
 }
 
 const SIDE_SAMPLES: usize = 5;
+
+/// Points per cell side at which the distance to the input triangles is measured.
+const BETWEEN_SAMPLES: usize = 4;
 
 /// Samples of our own evaluation (the blending functions, not the patches) for the CAD check.
 fn samples_json(fit: &DomainFit, patches: &[BezierPatch]) -> serde_json::Value {
@@ -112,8 +124,37 @@ pub fn domain_spline(
         max_control_points: a.max_control_points,
         ..DomainFitOptions::default()
     };
-    let fit = fit_domain_mesh(domain, gluing, &surface.positions, &opts)?;
+    // two fits — the input vertices only, and points on the input triangles too — and the
+    // one nearer the triangles between the vertices is kept (the second is not always:
+    // docs/notes/wave2-s14-tsz18.md)
+    let triangles = surface.mesh.faces();
+    let vertices_only = fit_domain_mesh(domain, gluing, &surface.positions, &opts)?;
+    let on_triangles =
+        fit_domain_mesh_on_triangles(domain, gluing, &surface.positions, triangles, &opts)?;
     let fit_seconds = t0.elapsed().as_secs_f64();
+    progress.report(
+        "tspline",
+        None,
+        "distance to the input triangles between the vertices",
+    );
+    let a_dev = deviation_between_vertices(
+        &vertices_only,
+        &surface.positions,
+        triangles,
+        BETWEEN_SAMPLES,
+    );
+    let b_dev = deviation_between_vertices(
+        &on_triangles,
+        &surface.positions,
+        triangles,
+        BETWEEN_SAMPLES,
+    );
+    let on = on_triangles.converged >= vertices_only.converged && b_dev.0 < a_dev.0;
+    let (fit, (between_max, between_rms)) = if on {
+        (on_triangles, b_dev)
+    } else {
+        (vertices_only, a_dev)
+    };
     progress.report("tspline", None, "derivative jumps across every cell side");
     let sides = side_continuity(&fit.mesh, &fit.control, SIDE_SAMPLES);
     let patches = fit.mesh.patches(&fit.control);
@@ -144,6 +185,10 @@ pub fn domain_spline(
         "bezier_patches": patches.len(),
         "continuity": continuity,
         "gluing_mismatch": gluing.mismatch,
+        "max_deviation_between_vertices_percent": between_max,
+        "rms_deviation_between_vertices_percent": between_rms,
+        "between_vertices_data": if on { "points on the input triangles (centroid, edge midpoints) in the least squares too, weight 0.1 per point times area over mean area; kept because nearer the triangles between the vertices than the fit of the vertices only" } else { "the input vertices only (the fit with points on the input triangles too was not nearer the triangles between the vertices)" },
+        "between_vertices_measured": format!("the spline at {BETWEEN_SAMPLES}x{BETWEEN_SAMPLES} points of every cell (cell coordinates (i + 1/2)/{BETWEEN_SAMPLES}) to the closest point of the input triangles, in percent of the longest bounding-box side (the tolerance is checked at the input vertices; filled loops have no triangles to be near)"),
     });
     shared_keys(
         &mut report,

@@ -20,6 +20,8 @@ use super::genus_domain::GenusDomain;
 use super::glue::Gluing;
 use crate::error::{Error, Result};
 use crate::numeric::sparse::Cholesky;
+use crate::numeric::vec3::{cross, norm, sub};
+use crate::spline::surface::MeshDistance;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
 
@@ -59,6 +61,11 @@ pub struct DomainFitOptions {
     /// Refine at the zeros only where the error there exceeds the tolerance (`false`: every
     /// refinement uniform).
     pub local_refinement: bool,
+    /// Weight (relative to an input vertex's, times the triangle's area over the mean area) of
+    /// the points on the input triangles — centroid and edge midpoints — that
+    /// [`fit_domain_mesh_on_triangles`] adds to the least squares: they keep the surface near
+    /// the mesh between the vertices, in cells without a vertex too. `0`: vertices only.
+    pub between_vertices: f64,
 }
 
 /// The most levels of refinement at the zeros; beyond, errors there refine uniformly.
@@ -75,6 +82,7 @@ impl Default for DomainFitOptions {
             max_control_points: 20_000,
             g1_at_zeros: true,
             local_refinement: true,
+            between_vertices: 0.1,
         }
     }
 }
@@ -105,10 +113,14 @@ pub fn locate(
 
 /// One least-squares solve on `mesh`; with `g1`, for the free values of the mesh's reduction
 /// (the net is G¹ at the zeros).
+/// `weights` per data point (empty: all 1); the fairness weight grows with `vertices`, the
+/// number of input vertices among the data.
 fn solve(
     mesh: &DomainMesh,
     located: &[(u32, f64, f64)],
     targets: &[[f64; 3]],
+    weights: &[f64],
+    vertices: usize,
     smoothing: f64,
     g1: bool,
 ) -> Result<Vec<[f64; 3]>> {
@@ -120,18 +132,19 @@ fn solve(
     };
     let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::new();
     let mut b = Mat::<f64>::zeros(n, 3);
-    for (&(c, s, t), p) in located.iter().zip(targets) {
+    for (k, (&(c, s, t), p)) in located.iter().zip(targets).enumerate() {
+        let wk = weights.get(k).copied().unwrap_or(1.0);
         let row = unknowns(mesh.blending(c, s, t));
         for &(r, x) in &row {
             for &(q, y) in &row {
-                trip.push(Triplet::new(r as usize, q as usize, x * y));
+                trip.push(Triplet::new(r as usize, q as usize, wk * x * y));
             }
             for d in 0..3 {
-                b[(r as usize, d)] += x * p[d];
+                b[(r as usize, d)] += wk * x * p[d];
             }
         }
     }
-    let w = smoothing * (located.len() as f64 / mesh.n_vertices() as f64).max(1.0);
+    let w = smoothing * (vertices as f64 / mesh.n_vertices() as f64).max(1.0);
     let mut push = |row: &[(u32, f64)]| {
         let row = unknowns(row.to_vec());
         for &(r, x) in &row {
@@ -147,8 +160,13 @@ fn solve(
             continue;
         }
         let q = mesh.corners[c as usize];
-        push(&[(mesh.corners[l as usize][0], 1.0), (a, -2.0), (q[1], 1.0)]);
-        push(&[(mesh.corners[bt as usize][0], 1.0), (a, -2.0), (q[3], 1.0)]);
+        // second divided differences, scaled to (1, −2, 1) on cells of equal size: zero on
+        // linear functions across the graded cells at the zeros too
+        let (hl, hb, (hu, hv)) = (mesh.size(l).0, mesh.size(bt).1, mesh.size(c));
+        let (ul, ur) = (2.0 * hu / (hl + hu), 2.0 * hl / (hl + hu));
+        let (vb, vt) = (2.0 * hv / (hb + hv), 2.0 * hb / (hb + hv));
+        push(&[(mesh.corners[l as usize][0], ul), (a, -2.0), (q[1], ur)]);
+        push(&[(mesh.corners[bt as usize][0], vb), (a, -2.0), (q[3], vt)]);
     }
     for z in (0..mesh.n_vertices() as u32).filter(|&z| mesh.is_zero(z)) {
         let mut nb: Vec<u32> = Vec::new();
@@ -225,12 +243,151 @@ fn fill_budget(
     Ok(None)
 }
 
+/// Points on the input triangles whose three vertices are data points of one cylinder: the
+/// centroid and the three edge midpoints, at the mean of the vertices' cylinder coordinates
+/// (`u` unwrapped across the seam; triangles spanning more than a quarter of the circumference
+/// are left out), as `(cylinder, u, v, position, weight)`; weight `w · area / mean area`.
+fn triangle_points(
+    domain: &GenusDomain,
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    w: f64,
+) -> Vec<(usize, f64, f64, [f64; 3], f64)> {
+    if w <= 0.0 || triangles.is_empty() {
+        return Vec::new();
+    }
+    let mut at = vec![usize::MAX; positions.len()];
+    for (k, p) in domain.points.iter().enumerate() {
+        if let Some(x) = at.get_mut(p.vertex as usize) {
+            *x = k;
+        }
+    }
+    let area = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|v| positions[v as usize]);
+        0.5 * norm(cross(sub(b, a), sub(c, a)))
+    };
+    let mean = triangles.iter().map(area).sum::<f64>() / triangles.len() as f64;
+    let mut out = Vec::new();
+    for t in triangles {
+        let Some(k) = t
+            .iter()
+            .map(|&v| at.get(v as usize).copied().filter(|&k| k != usize::MAX))
+            .collect::<Option<Vec<usize>>>()
+        else {
+            continue;
+        };
+        let q = k.iter().map(|&k| domain.points[k]).collect::<Vec<_>>();
+        let c = q[0].cylinder;
+        if q.iter().any(|p| p.cylinder != c) {
+            continue;
+        }
+        let l = domain.cylinders[c].circumference;
+        let u: Vec<f64> = q
+            .iter()
+            .map(|p| q[0].u + (p.u - q[0].u + 0.5 * l).rem_euclid(l) - 0.5 * l)
+            .collect();
+        // a cylinder glued to itself: a triangle across that trajectory has `v` near 0 and `H`
+        let h = domain.cylinders[c].height;
+        if u.iter().any(|x| (x - u[0]).abs() > 0.25 * l)
+            || q.iter().any(|p| (p.v - q[0].v).abs() > 0.25 * h)
+        {
+            continue;
+        }
+        let x = t.map(|v| positions[v as usize]);
+        // the cylinder coordinates must be close to an affine image of the triangle (not so
+        // around a zero, where the chart is branched): same orientation as the majority, and
+        // the edges' lengths over their lengths in the chart within a factor 1.5 of each other
+        let (du, dv) = (
+            [u[1] - u[0], u[2] - u[0]],
+            [q[1].v - q[0].v, q[2].v - q[0].v],
+        );
+        let signed = du[0] * dv[1] - du[1] * dv[0];
+        let ratios: Vec<f64> = [(0, 1), (1, 2), (2, 0)]
+            .iter()
+            .map(|&(i, j)| norm(sub(x[i], x[j])) / (u[i] - u[j]).hypot(q[i].v - q[j].v).max(1e-300))
+            .collect();
+        let (lo, hi) = ratios
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(a, b), &r| (a.min(r), b.max(r)));
+        if hi > 1.5 * lo || !hi.is_finite() {
+            continue;
+        }
+        let wt = w * area(t) / mean.max(1e-300);
+        let all = [
+            [1.0 / 3.0; 3],
+            [0.5, 0.5, 0.0],
+            [0.0, 0.5, 0.5],
+            [0.5, 0.0, 0.5],
+        ];
+        for bary in all.iter() {
+            let ub: f64 = (0..3).map(|i| bary[i] * u[i]).sum();
+            let vb: f64 = (0..3).map(|i| bary[i] * q[i].v).sum();
+            let p = std::array::from_fn(|d| (0..3).map(|i| bary[i] * x[i][d]).sum());
+            out.push((c, ub.rem_euclid(l), vb, p, wt, signed > 0.0));
+        }
+    }
+    // orientation: the charts of a holomorphic form keep it, so the minority is wrong
+    let positive = out.iter().filter(|e| e.5).count();
+    let keep = 2 * positive >= out.len();
+    let out: Vec<_> = out
+        .into_iter()
+        .filter(|e| e.5 == keep)
+        .map(|e| (e.0, e.1, e.2, e.3, e.4))
+        .collect();
+    out
+}
+
+/// Distance of the spline to the input triangles between the vertices: the fitted surface at
+/// `k × k` points of every cell (`((i + ½)/k, (j + ½)/k)`) to the closest point of the
+/// triangles (exact point–triangle distance, [`MeshDistance`]); `(max, rms)` in percent of the
+/// longest bounding-box side ([`DomainFit::scale`]).
+pub fn deviation_between_vertices(
+    fit: &DomainFit,
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    k: usize,
+) -> (f64, f64) {
+    use rayon::prelude::*;
+    let k = k.max(1);
+    let dist = MeshDistance::new(positions, triangles);
+    let d: Vec<f64> = (0..fit.mesh.n_cells() as u32)
+        .into_par_iter()
+        .flat_map_iter(|c| {
+            let dist = &dist;
+            (0..k * k).map(move |ij| {
+                let (s, t) = (
+                    ((ij % k) as f64 + 0.5) / k as f64,
+                    ((ij / k) as f64 + 0.5) / k as f64,
+                );
+                dist.distance(fit.mesh.point(c, s, t, &fit.control))
+            })
+        })
+        .collect();
+    let max = d.iter().fold(0.0f64, |a, &b| a.max(b));
+    let rms = (d.iter().map(|x| x * x).sum::<f64>() / d.len().max(1) as f64).sqrt();
+    let s = 100.0 / fit.scale.max(1e-300);
+    (max * s, rms * s)
+}
+
 /// Fit the data points of `domain` (positions by vertex) on the domain mesh, refining (at the
-/// zeros or uniformly, module doc) until `L∞ ≤ tolerance` or the budget is spent.
+/// zeros or uniformly, module doc) until `L∞ ≤ tolerance` or the budget is spent. Vertices
+/// only: [`fit_domain_mesh_on_triangles`] with no triangles.
 pub fn fit_domain_mesh(
     domain: &GenusDomain,
     gluing: &Gluing,
     positions: &[[f64; 3]],
+    opts: &DomainFitOptions,
+) -> Result<DomainFit> {
+    fit_domain_mesh_on_triangles(domain, gluing, positions, &[], opts)
+}
+
+/// [`fit_domain_mesh`] with points on the input `triangles` as data too
+/// ([`DomainFitOptions::between_vertices`]); the tolerance is still checked at the vertices.
+pub fn fit_domain_mesh_on_triangles(
+    domain: &GenusDomain,
+    gluing: &Gluing,
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
     opts: &DomainFitOptions,
 ) -> Result<DomainFit> {
     let scale = bbox_scale(positions);
@@ -239,11 +396,16 @@ pub fn fit_domain_mesh(
         .iter()
         .map(|c| c.circumference)
         .fold(0.0, f64::max);
-    let targets: Vec<[f64; 3]> = domain
+    let mut targets: Vec<[f64; 3]> = domain
         .points
         .iter()
         .map(|p| positions[p.vertex as usize])
         .collect();
+    let n_vertices = targets.len();
+    let extra = triangle_points(domain, positions, triangles, opts.between_vertices);
+    let mut weights = vec![1.0; n_vertices];
+    targets.extend(extra.iter().map(|e| e.3));
+    weights.extend(extra.iter().map(|e| e.4));
     let mut spacing = opts.initial * l;
     let mut steps = Vec::new();
     let mut last: Option<DomainFit> = None;
@@ -283,10 +445,31 @@ pub fn fit_domain_mesh(
             })?;
             located.push(x);
         }
-        let control = solve(&mesh, &located, &targets, opts.smoothing, opts.g1_at_zeros)?;
+        let mut data = located.clone();
+        let mut data_targets = targets[..n_vertices].to_vec();
+        let mut data_weights = weights[..n_vertices].to_vec();
+        for (e, (&t, &w)) in extra
+            .iter()
+            .zip(targets[n_vertices..].iter().zip(&weights[n_vertices..]))
+        {
+            if let Some(x) = locate(&mesh, gluing, domain, e.0, e.1, e.2) {
+                data.push(x);
+                data_targets.push(t);
+                data_weights.push(w);
+            }
+        }
+        let control = solve(
+            &mesh,
+            &data,
+            &data_targets,
+            &data_weights,
+            n_vertices,
+            opts.smoothing,
+            opts.g1_at_zeros,
+        )?;
         let errors: Vec<f64> = located
             .iter()
-            .zip(&targets)
+            .zip(&targets[..n_vertices])
             .map(|(&(c, s, t), q)| {
                 let p = mesh.patch(c, &control, 0.0, 0.0);
                 let [u0, u1, v0, v1] = [p.u0, p.u1, p.v0, p.v1];
