@@ -511,6 +511,10 @@ pub(super) fn chart_uv(
     })
 }
 
+/// The cut of the input's edges, the corner UVs on the input faces (empty when the map is on
+/// the common subdivision) and the common subdivision's map, if that is the one written.
+type WrittenMap = (Vec<bool>, Vec<[f64; 2]>, Option<SubdivisionChart>);
+
 /// The common subdivision's map `sub`, unless it folds more triangles than the input faces'
 /// map `first` (which folds `written_folds`), or cannot be built while `first` can.
 fn subdivision_unless_worse(
@@ -518,7 +522,7 @@ fn subdivision_unless_worse(
     first: Result<(Vec<bool>, Vec<[f64; 2]>)>,
     written_folds: usize,
     component: usize,
-) -> Result<(Vec<bool>, Vec<[f64; 2]>, Option<SubdivisionChart>)> {
+) -> Result<WrittenMap> {
     Ok(match (sub, first) {
         (Ok(sub), Ok((cut, uv))) if sub.flipped > written_folds => (cut, uv, None),
         (Ok(sub), _) => (sub.input_cut.clone(), Vec::new(), Some(sub)),

@@ -11,7 +11,7 @@ use super::common::{opts, png};
 use super::report::{Section, Status, Table};
 use super::{Ctx, Env};
 use crate::cmd::tspline::{parse_tolerance, Args};
-use crate::cmd::tspline_domain::domain_spline;
+use crate::cmd::tspline_domain::{domain_spline, DomainSpline};
 use crate::cmd::tspline_genus::genus_domain_of;
 use crate::cmd::tspline_pictures::{domain_caption, domain_pictures, ZEBRA_CAPTION};
 use clap::Parser;
@@ -160,6 +160,54 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         r.fit.mesh.n_vertices(),
         surface.positions.len() as f64 / cells.max(1) as f64
     ));
+    sec.tables.push(results_table(
+        &r,
+        domain.cylinders.len(),
+        zeros,
+        tolerance,
+        [seconds_fit, t0.elapsed().as_secs_f64()],
+    ));
+    sec.commands = vec![format!("ricci {} --out tspline --json", COMMAND.join(" "))];
+    sec.summary = json!({
+        "vertices": surface.positions.len(),
+        "genus": h.genus,
+        "zeros": zeros,
+        "cylinders": domain.cylinders.len(),
+        "strips": r.fit.mesh.rects.len(),
+        "control_points": rep["control_points"],
+        "cells": rep["cells"],
+        "bezier_patches": rep["bezier_patches"],
+        "t_junctions": rep["t_junctions"],
+        "iterations": rep["iterations"],
+        "rms_error_percent": rep["rms_error_percent"],
+        "max_error_percent": rep["max_error_percent"],
+        "tolerance_percent": rep["tolerance_percent"],
+        "converged": rep["converged"],
+        "continuity": rep["continuity"],
+        "pictures": {"knot_line_stride": info.stride, "segments_per_cell_side": info.segments_per_cell_side, "triangles": info.triangles},
+        "seconds": t0.elapsed().as_secs_f64(),
+    });
+    Ok(sec)
+}
+
+/// The stage's table: the domain mesh, the fit and its measured continuity, from the report of
+/// `ricci tspline` (`seconds`: fit and continuity; total).
+fn results_table(
+    r: &DomainSpline,
+    cylinders: usize,
+    zeros: usize,
+    tolerance: f64,
+    seconds: [f64; 2],
+) -> Table {
+    let rep = &r.report;
+    let c = &rep["continuity"];
+    let class = |k: &str| c[k]["class"].as_str().unwrap_or("?").to_string();
+    let sides = |k: &str| c[k]["sides"].as_u64().unwrap_or(0);
+    let (rms, max) = (
+        num(&rep["rms_error_percent"]),
+        num(&rep["max_error_percent"]),
+    );
+    let cells = r.fit.mesh.n_cells();
     let e = |k: &str| {
         c[k]["jumps"]["relative_jumps"]
             .as_array()
@@ -171,7 +219,7 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
             })
             .unwrap_or_default()
     };
-    sec.tables.push(Table::key_values(
+    Table::key_values(
         "Domain-mesh spline of the genus-2 surface (ricci tspline)",
         vec![
             (
@@ -180,7 +228,7 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
             ),
             (
                 "cylinders / strips",
-                format!("{} / {}", domain.cylinders.len(), r.fit.mesh.rects.len()),
+                format!("{cylinders} / {}", r.fit.mesh.rects.len()),
             ),
             ("control points", r.fit.mesh.n_vertices().to_string()),
             (
@@ -237,29 +285,8 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
             ("relative jumps elsewhere, orders 0..3", e("elsewhere")),
             (
                 "time (fit and continuity; total)",
-                format!("{seconds_fit:.2}; {:.2} s", t0.elapsed().as_secs_f64()),
+                format!("{:.2}; {:.2} s", seconds[0], seconds[1]),
             ),
         ],
-    ));
-    sec.commands = vec![format!("ricci {} --out tspline --json", COMMAND.join(" "))];
-    sec.summary = json!({
-        "vertices": surface.positions.len(),
-        "genus": h.genus,
-        "zeros": zeros,
-        "cylinders": domain.cylinders.len(),
-        "strips": r.fit.mesh.rects.len(),
-        "control_points": rep["control_points"],
-        "cells": rep["cells"],
-        "bezier_patches": rep["bezier_patches"],
-        "t_junctions": rep["t_junctions"],
-        "iterations": rep["iterations"],
-        "rms_error_percent": rep["rms_error_percent"],
-        "max_error_percent": rep["max_error_percent"],
-        "tolerance_percent": rep["tolerance_percent"],
-        "converged": rep["converged"],
-        "continuity": rep["continuity"],
-        "pictures": {"knot_line_stride": info.stride, "segments_per_cell_side": info.segments_per_cell_side, "triangles": info.triangles},
-        "seconds": t0.elapsed().as_secs_f64(),
-    });
-    Ok(sec)
+    )
 }
