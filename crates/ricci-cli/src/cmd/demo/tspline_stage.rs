@@ -75,15 +75,12 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     )?);
     sec.pictures
         .push(png(env, "tspline-zebra.png", &zebra, ZEBRA_CAPTION)?);
-
     let rep = &r.report;
     let c = &rep["continuity"];
     let class = |k: &str| c[k]["class"].as_str().unwrap_or("?").to_string();
     let sides = |k: &str| c[k]["sides"].as_u64().unwrap_or(0);
-    let (rms, max) = (
-        num(&rep["rms_error_percent"]),
-        num(&rep["max_error_percent"]),
-    );
+    let rms = num(&rep["rms_error_percent"]);
+    let max = num(&rep["max_error_percent"]);
     let zeros = domain.decomposition.zeros.len();
     let expected = class("at_zeros") == "C1"
         && class("one_interval_from_zeros") == "C2"
