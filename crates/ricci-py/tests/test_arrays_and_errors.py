@@ -143,8 +143,10 @@ def test_bad_options_are_usage_errors(generated):
 
 def test_gil_is_released_during_the_numerics():
     # While one thread runs a flow, another Python thread must keep running. With the GIL
-    # held for the whole call, the counter could not move until the flow returned.
-    path = shared("kitten.nf20k.off")
+    # held for the whole call, the counter could not move until the flow returned. botijo's
+    # hyperbolic flow takes ~0.6 s here (kitten's, 0.09 s since session 14, was too short to
+    # tell the two apart with 10 ms sleeps).
+    path = shared("botijo.off")
     counts = []
     done = threading.Event()
 
