@@ -74,6 +74,8 @@ mod mesh_files;
 mod metric_derivatives;
 #[path = "param.rs"]
 mod param;
+#[path = "param_boundary_cones.rs"]
+mod param_boundary_cones;
 #[path = "param_develop.rs"]
 mod param_develop;
 #[path = "param_free.rs"]

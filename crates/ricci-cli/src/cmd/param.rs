@@ -11,9 +11,11 @@
 //! 2π − K); `file:PATH` reads per-vertex curvatures (the `--target file:` format of
 //! `ricci flow`; nonzero entries are cones); `none` (a torus).
 //! Components with boundary have no cones by default; `N`, `auto` and `V=K,…` (interior
-//! vertices) put cones inside them with `--boundary free` (the boundary held at `u = 0`, cones
-//! by the greedy with the boundary held, least-squares curvatures, a cut from each cone to
-//! the boundary: BFF's `--nCones`); with `round`/`fixed-angles` or `--seamless` they are refused.
+//! vertices) put cones inside them (cones by the greedy with the boundary held, least-squares
+//! curvatures, a cut from each cone to the boundary: BFF's `--nCones`) under every boundary
+//! condition: `free` holds `u = 0`, `round` puts the boundary on a circle turning by
+//! `2πχ − ΣK̄`, `fixed-angles` keeps the boundary's corner angles (greedy cones carry the
+//! interior's curvature), `--seamless` rounds cones and boundary turning to quarter turns.
 //! `--seams free` (closed components of genus ≥ 1): the homology seams are free — the surface
 //! cut along its homology generators is flattened as a disk with the least area distortion
 //! along the cut (`u = 0`, Boundary First Flattening's kind of map) and greedy cones inside;

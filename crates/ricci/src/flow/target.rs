@@ -57,6 +57,11 @@ pub enum TargetSpec {
     /// free`, the boundary being the cut through the homology generators).
     FreeBoundaryCones(Vec<(u32, f64)>),
     RoundBoundary,
+    /// `round-boundary` with cones `(vertex, K̄)` at interior vertices: the boundary loops on
+    /// circles whose total turning leaves `2πχ − Σ K̄` to them (library use: `ricci param
+    /// --boundary round --cones …`; genus 0: the longest loop turns by `2π − Σ K̄`, the others
+    /// by `−2π`).
+    RoundBoundaryCones(Vec<(u32, f64)>),
     GeodesicBoundary,
     File(PathBuf),
     /// One value per vertex (library use).
@@ -79,6 +84,10 @@ impl fmt::Display for TargetSpec {
                 write!(f, "free-boundary+cone:{}", s.join(","))
             }
             TargetSpec::RoundBoundary => write!(f, "round-boundary"),
+            TargetSpec::RoundBoundaryCones(c) => {
+                let s: Vec<String> = c.iter().map(|(v, k)| format!("{v}={k}")).collect();
+                write!(f, "round-boundary+cone:{}", s.join(","))
+            }
             TargetSpec::GeodesicBoundary => write!(f, "geodesic-boundary"),
             TargetSpec::File(p) => write!(f, "file:{}", p.display()),
             TargetSpec::PerVertex(_) => write!(f, "per-vertex"),
@@ -450,7 +459,7 @@ pub fn resolve(mesh: &Mesh, geometry: Geometry, spec: &TargetSpec) -> Result<Tar
                 }
             }
         }
-        TargetSpec::RoundBoundary => {
+        TargetSpec::RoundBoundary | TargetSpec::RoundBoundaryCones(_) => {
             if geometry != Geometry::Euclidean {
                 return Err(Error::input(
                     "round-boundary is defined for the euclidean geometry only",
@@ -471,6 +480,20 @@ pub fn resolve(mesh: &Mesh, geometry: Geometry, spec: &TargetSpec) -> Result<Tar
             }
             let genus = topo.components[0].genus;
             let b = loops.len();
+            let mut cone_sum = 0.0;
+            if let TargetSpec::RoundBoundaryCones(list) = spec {
+                for &(v, k) in list {
+                    check_vertex(v)?;
+                    if mesh.is_boundary_vertex(v) {
+                        return Err(Error::input(format!(
+                            "cone vertex {v} lies on the boundary, which the round boundary \
+                             puts on a circle"
+                        )));
+                    }
+                    t.curvature[v as usize] = k;
+                    cone_sum += k;
+                }
+            }
             // Genus 0: totals are set from the loop lengths in `set_round_totals`.
             for l in &loops {
                 let vertices: Vec<u32> = l.iter().map(|&h| mesh.he_origin(h)).collect();
@@ -481,7 +504,7 @@ pub fn resolve(mesh: &Mesh, geometry: Geometry, spec: &TargetSpec) -> Result<Tar
                     total: if genus == 0 {
                         0.0
                     } else {
-                        2.0 * PI * chi as f64 / b as f64
+                        (2.0 * PI * chi as f64 - cone_sum) / b as f64
                     },
                 });
             }
@@ -519,8 +542,23 @@ pub fn set_round_totals(
         let longest = (0..target.round_loops.len())
             .max_by(|&a, &b| len(&target.round_loops[a]).total_cmp(&len(&target.round_loops[b])))
             .unwrap_or(0);
+        // Cones inside (`RoundBoundaryCones`) take their curvature from the longest loop.
+        let mut on_loop = vec![false; target.curvature.len()];
+        for l in &target.round_loops {
+            for &v in &l.vertices {
+                on_loop[v as usize] = true;
+            }
+        }
+        let inside: f64 = (0..on_loop.len())
+            .filter(|&v| !on_loop[v])
+            .map(|v| target.curvature[v])
+            .sum();
         for (k, l) in target.round_loops.iter_mut().enumerate() {
-            l.total = if k == longest { 2.0 * PI } else { -2.0 * PI };
+            l.total = if k == longest {
+                2.0 * PI - inside
+            } else {
+                -2.0 * PI
+            };
         }
     }
     target.update_round(lengths, dlengths, edge_vertices);

@@ -4,7 +4,7 @@
 //! own faces when they do not fold, otherwise on the common subdivision of the input and the
 //! flat triangulation.
 
-use super::boundary::fixed_angle_targets;
+use super::boundary::{cones_carrying_the_interior, fixed_angle_targets};
 use super::cones::{
     correct_cone_curvatures, greedy_cones_with, round_to_quarter_turns, ConeBudget,
 };
@@ -51,10 +51,13 @@ struct ConePlan {
     history: Vec<f64>,
 }
 
-/// Target of a chart with boundary: flat inside with the boundary condition of `opts`, or —
-/// with cones asked for (`--cones N|auto|V=K,…`) and the free boundary — cones inside placed
-/// and curved as on the disk of free seams ([`held_boundary_cones`]: the greedy with the
-/// boundary held, least-squares curvatures), the boundary held at `u = 0`.
+/// Target of a chart with boundary: flat inside, or — with cones asked for (`--cones
+/// N|auto|V=K,…`) — cones inside, given or placed and curved by the greedy with the boundary
+/// held ([`held_boundary_cones`]: least-squares curvatures), and on the boundary the condition
+/// of `opts` ([`super::boundary`]): `free` holds `u = 0`; `round` puts each loop on a circle
+/// carrying `2πχ − Σ K̄` (genus 0: the longest loop `2π − Σ K̄`, holes `−2π`); `fixed-angles`
+/// keeps the boundary's geodesic curvature, greedy cones moved to carry the interior's
+/// curvature; `--seamless` rounds the cones and the boundary's turning to quarter turns.
 fn boundary_target(
     piece: &Piece,
     component: usize,
@@ -65,48 +68,46 @@ fn boundary_target(
     let asks_cones = match &opts.cones {
         ConeSpec::Given(c) => c.iter().any(|x| piece.vertices.contains(&x.0)),
         ConeSpec::Count(k) => *k > 0,
-        ConeSpec::Auto { .. } => opts.boundary == BoundaryMode::Free && !opts.seamless,
+        ConeSpec::Auto { .. } => true,
         ConeSpec::None | ConeSpec::Default => false,
     };
-    if asks_cones && (opts.boundary != BoundaryMode::Free || opts.seamless) {
-        return Err(Error::input(format!(
-            "component {component} has a boundary; cones on it need --boundary free without \
-             --seamless (with --boundary round or fixed-angles, or --seamless, the boundary \
-             takes the curvature)"
-        )));
-    }
-    if asks_cones {
+    let (mut cones, source, history) = if asks_cones {
         let on_boundary = |v: u32| {
             Error::input(format!(
                 "cone vertex {v} lies on the boundary of component {component}; cones must be \
-                 interior vertices (the free boundary holds u = 0 there)"
+                 interior vertices (the boundary follows --boundary)"
             ))
         };
         let n = piece.vertices.len();
-        let (target, cones, source, history) =
+        let (_, cones, source, history) =
             held_boundary_cones(piece, n, &opts.cones, opts, progress, &on_boundary)?;
-        if !cones.is_empty() {
-            return Ok(ConePlan {
-                target,
-                cones,
-                source,
-                history,
-            });
-        }
-    }
+        (cones, source, history)
+    } else {
+        (Vec::new(), "none".to_string(), Vec::new())
+    };
     let mesh = &piece.surface.mesh;
     let target = match (opts.boundary, opts.seamless) {
-        (BoundaryMode::Free, false) => TargetSpec::FreeBoundary,
-        (BoundaryMode::Round, false) => TargetSpec::RoundBoundary,
+        (BoundaryMode::Free, false) if cones.is_empty() => TargetSpec::FreeBoundary,
+        (BoundaryMode::Free, false) => TargetSpec::FreeBoundaryCones(cones.clone()),
+        (BoundaryMode::Round, false) if cones.is_empty() => TargetSpec::RoundBoundary,
+        // With cones summing beyond 2π (camelhead: 11.07 for 4 greedy cones) the loop turns
+        // negatively: arcs of one radius curving away from the chart, still constant
+        // geodesic curvature.
+        (BoundaryMode::Round, false) => TargetSpec::RoundBoundaryCones(cones.clone()),
         (BoundaryMode::FixedAngles, _) | (_, true) => {
-            TargetSpec::PerVertex(fixed_angle_targets(mesh, lengths, opts.seamless))
+            if opts.boundary == BoundaryMode::FixedAngles && source == "greedy" {
+                cones = cones_carrying_the_interior(mesh, lengths, &cones, component)?;
+            }
+            let (t, used) = fixed_angle_targets(mesh, lengths, &cones, opts.seamless);
+            cones = used;
+            TargetSpec::PerVertex(t)
         }
     };
     Ok(ConePlan {
         target,
-        cones: Vec::new(),
-        source: "none".into(),
-        history: Vec::new(),
+        cones,
+        source,
+        history,
     })
 }
 

@@ -13,11 +13,19 @@
 //!      `2πχ − Σκ` moved to the boundary in proportion to the dual boundary lengths (BFF §4.2
 //!      "prescribed curvature").
 //!
-//!    With `free` and cones asked for (`--cones N|auto|V=K,…`, interior vertices), the chart
-//!    is flat inside except at the cones, placed by the greedy with the boundary held and
-//!    curved for the least linearised σ(2u) as on the disk of free seams (submodule `free`,
+//!    With cones asked for (`--cones N|auto|V=K,…`, interior vertices), the chart is flat
+//!    inside except at the cones, placed by the greedy with the boundary held and curved for
+//!    the least linearised σ(2u) as on the disk of free seams (submodule `free`,
 //!    [`cones::free_boundary_cones`]); the cut runs from each cone to the boundary (step 3).
-//!    `round` and `fixed-angles` (and `--seamless`) with cones are refused.
+//!    The boundary then follows its condition with what the cones leave (Gauss–Bonnet,
+//!    `Σ κ̄ + Σ K̄ = 2πχ`; submodule `boundary`): `free` holds `u = 0`; `round` puts every
+//!    loop on a circle ([`crate::flow::TargetSpec::RoundBoundaryCones`]; genus 0: the longest
+//!    loop turns by `2π − Σ K̄`, the holes by `−2π`), laid out as arcs of one radius between
+//!    the cuts; `fixed-angles` keeps the surface's corner angles, greedy cones moved by a
+//!    common amount to carry the interior's curvature (given cones keep theirs and the
+//!    rest goes to the boundary as without cones). `--seamless` on a chart with boundary is
+//!    `fixed-angles` with the cones rounded to quarter turns and then the boundary's turning
+//!    to quarter turns with the total the cones leave.
 //!
 //!    Closed surfaces of genus ≥ 1 with [`SeamMode::Free`] (`--seams free`): cut along the
 //!    homology generators into a disk, which is flattened as above with `free` (`u = 0` on
@@ -90,7 +98,7 @@ use std::time::Instant;
 pub enum ConeSpec {
     /// Genus 1 and surfaces with boundary: none; otherwise automatic with the default bound
     /// (`Auto { 1.0 }`). `Count`, `Auto` and `Given` place cones inside a surface with
-    /// boundary too (with the free boundary).
+    /// boundary too (under every boundary condition).
     Default,
     /// No cones (only a torus, or a surface with boundary, can be flat without).
     None,
