@@ -103,13 +103,13 @@ fn given_cones_usage_errors_and_sphere() {
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["cone_count"], 4);
     assert_eq!(v["flipped_faces"], 0);
-    let round = Command::new(bin())
+    let bad = Command::new(bin())
         .arg("param")
         .arg(&mesh)
         .args(["--cones", "0=banana", "--json"])
         .output()
         .unwrap();
-    assert!(!round.status.success());
+    assert!(!bad.status.success());
     // Gauss–Bonnet: 1 or 2 cones cannot flatten a sphere (curvatures sum to 4π, each < 2π);
     // 3 can.
     for k in ["1", "2", "3"] {
@@ -179,8 +179,8 @@ fn free_seams_are_reported_and_written_on_the_input_faces() {
         .args(["--seams", "loose", "--json"])
         .output()
         .unwrap();
-    assert!(!round.status.success());
-    assert!(String::from_utf8_lossy(&round.stderr).contains("unknown seams 'loose'"));
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown seams 'loose'"));
 }
 
 /// Corner UVs of an OBJ's faces: `uv[3f + i]` from the `vt` of corner `i` of face `f`, with
