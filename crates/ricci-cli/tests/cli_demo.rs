@@ -801,7 +801,7 @@ fn pou_surface_has_no_jumps_and_stays_close_to_the_surface() {
 }
 
 /// The `tspline` stage is the domain-mesh spline of the demo's own surface: its numbers are
-/// those of `ricci tspline surface.off --json` run here on the written file (the command the
+/// those of `ricci tspline surface.off --tolerance 0.5% --smoothing 1e-3 --json` run here on the written file (the command the
 /// page shows), and they fit the surface's topology (closed, χ = −2): control points − cells
 /// = χ, Σ (valence − 4) over the zeros = −4χ so the sides at the zeros number 4·zeros + 8,
 /// every cell has four sides each shared by two cells (2·cells sides in all); G¹ (class C1)
@@ -816,6 +816,8 @@ fn tspline_stage_is_ricci_tspline_of_the_demo_surface() {
         surface.to_str().unwrap(),
         "--tolerance",
         "0.5%",
+        "--smoothing",
+        "1e-3",
         "--json",
     ]);
     assert!(

@@ -9,7 +9,7 @@
 //! T-junctions.
 
 use ricci::spline::tspline::domain_fit::DomainFit;
-use ricci_render::{render, Image, Paint, Polyline, RenderOptions, Style};
+use ricci_render::{render, Camera, Image, Paint, Polyline, RenderOptions, Style};
 use std::collections::HashMap;
 
 /// Colour of the cell sides and of the T-mesh edges.
@@ -68,7 +68,7 @@ pub struct DomainPictures {
 /// `k × k` grid, points shared by two patches merged (the spline is C⁰, so they agree up to
 /// rounding: merged when equal to `1e-9` of `scale`); and, per domain-mesh vertex that is a
 /// zero, its index in the tessellation.
-fn tessellate(fit: &DomainFit, k: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<u32>) {
+fn tessellate(fit: &DomainFit, k: usize) -> Tessellation {
     let mesh = &fit.mesh;
     let eps = 1e-9 * fit.scale.max(f64::MIN_POSITIVE);
     let mut index: HashMap<[i64; 3], u32> = HashMap::new();
@@ -76,6 +76,7 @@ fn tessellate(fit: &DomainFit, k: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<u
     let mut triangles = Vec::with_capacity(2 * k * k * mesh.n_cells());
     let mut zeros: HashMap<u32, u32> = HashMap::new();
     let mut ids = vec![0u32; (k + 1) * (k + 1)];
+    let mut sides = Vec::with_capacity(mesh.n_cells());
     for c in 0..mesh.n_cells() as u32 {
         let p = mesh.patch(c, &fit.control, 0.0, 0.0);
         for j in 0..=k {
@@ -101,6 +102,10 @@ fn tessellate(fit: &DomainFit, k: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<u
                 triangles.push([a, cc, d]);
             }
         }
+        sides.push([
+            (0..=k).map(|j| ids[j * (k + 1)]).collect(),
+            ids[..=k].to_vec(),
+        ]);
         // corners [lower left, lower right, upper right, upper left]
         let at = [0, k, (k + 1) * (k + 1) - 1, k * (k + 1)];
         for (q, &v) in mesh.corners[c as usize].iter().enumerate() {
@@ -111,39 +116,98 @@ fn tessellate(fit: &DomainFit, k: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<u
     }
     let mut z: Vec<(u32, u32)> = zeros.into_iter().collect();
     z.sort_unstable();
-    (
+    Tessellation {
         positions,
         triangles,
-        z.into_iter().map(|(_, i)| i).collect(),
-    )
+        zeros: z.into_iter().map(|(_, i)| i).collect(),
+        sides,
+    }
+}
+
+/// The welded tessellation of [`tessellate`]: per domain-mesh zero its point, per cell the
+/// points of its left and bottom sides (`k + 1` each, bottom to top and left to right).
+struct Tessellation {
+    positions: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    zeros: Vec<u32>,
+    sides: Vec<[Vec<u32>; 2]>,
+}
+
+/// The pieces of the polyline through `points` (with unit `normals`, pointing out of the
+/// closed surface) on the side facing the viewer: a segment is kept when the normal at both of
+/// its ends has a positive component towards the viewer (`to_viewer`). Back-face culling: the
+/// renderer's depth test alone lets lines of the far side show beside the silhouette, where
+/// the tessellation's chords lie inside the curve the lines follow and the lines are moved
+/// towards the viewer.
+pub fn facing_pieces(
+    points: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    to_viewer: impl Fn([f64; 3]) -> [f64; 3],
+) -> Vec<Vec<[f64; 3]>> {
+    let facing: Vec<bool> = points
+        .iter()
+        .zip(normals)
+        .map(|(&p, n)| {
+            let v = to_viewer(p);
+            n[0] * v[0] + n[1] * v[1] + n[2] * v[2] > 0.0
+        })
+        .collect();
+    let mut out: Vec<Vec<[f64; 3]>> = Vec::new();
+    let mut run: Vec<[f64; 3]> = Vec::new();
+    for i in 0..points.len() {
+        if facing[i] {
+            run.push(points[i]);
+        } else if !run.is_empty() {
+            out.push(std::mem::take(&mut run));
+        }
+    }
+    out.push(run);
+    out.retain(|r| r.len() >= 2);
+    out
+}
+
+/// Outward unit normals of the closed tessellation: its angle-weighted vertex normals, flipped
+/// when the enclosed signed volume is negative (the cells' orientation points inwards).
+fn outward_normals(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<[f64; 3]> {
+    let volume: f64 = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| positions[v as usize]);
+            a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0])
+        })
+        .sum();
+    let sign = if volume < 0.0 { -1.0 } else { 1.0 };
+    ricci_render::render::vertex_normals(positions, triangles)
+        .into_iter()
+        .map(|n| n.map(|x| sign * x))
+        .collect()
 }
 
 /// The images of the cells' left and bottom sides (each side once: every side is the left or
 /// the bottom side of a cell) on every `stride`-th knot line of each strip and on the strips'
-/// sides, with `per_side` segments each; the strips' sides in their own colour.
-fn cell_sides(fit: &DomainFit, stride: usize, per_side: usize) -> Vec<Polyline> {
-    let mesh = &fit.mesh;
+/// sides, along the tessellation's points (the lines lie on the rendered surface), only their
+/// pieces facing the viewer ([`facing_pieces`]); the strips' sides in their own colour.
+fn cell_sides(
+    fit: &DomainFit,
+    t: &Tessellation,
+    stride: usize,
+    to_viewer: impl Fn([f64; 3]) -> [f64; 3],
+) -> Vec<Polyline> {
+    let normals = outward_normals(&t.positions, &t.triangles);
     let mut out = Vec::new();
-    for c in 0..mesh.n_cells() as u32 {
-        let (_, i, j) = mesh.cell_at[c as usize];
-        let p = mesh.patch(c, &fit.control, 0.0, 0.0);
-        let along = |vertical: bool| -> Vec<[f64; 3]> {
-            (0..=per_side)
-                .map(|m| {
-                    let t = m as f64 / per_side as f64;
-                    if vertical {
-                        p.point(p.u0, p.v0 + t * (p.v1 - p.v0))
-                    } else {
-                        p.point(p.u0 + t * (p.u1 - p.u0), p.v0)
-                    }
-                })
-                .collect()
-        };
-        for (k, vertical) in [(i as usize, true), (j as usize, false)] {
-            if k == 0 {
-                out.push(line(along(vertical), STRIP, 1.8, false));
-            } else if k % stride == 0 {
-                out.push(line(along(vertical), EDGE, 0.8, false));
+    for (c, sides) in t.sides.iter().enumerate() {
+        let (_, i, j) = fit.mesh.cell_at[c];
+        for (k, ids) in [(i as usize, &sides[0]), (j as usize, &sides[1])] {
+            let (color, width) = match k {
+                0 => (STRIP, 1.8),
+                k if k % stride == 0 => (EDGE, 0.8),
+                _ => continue,
+            };
+            let points: Vec<[f64; 3]> = ids.iter().map(|&v| t.positions[v as usize]).collect();
+            let n: Vec<[f64; 3]> = ids.iter().map(|&v| normals[v as usize]).collect();
+            for piece in facing_pieces(&points, &n, &to_viewer) {
+                out.push(line(piece, color, width, false));
             }
         }
     }
@@ -163,19 +227,24 @@ pub fn domain_pictures(
     let budget = ((TRIANGLES / (2 * cells)) as f64).sqrt().floor() as usize;
     let k = per_side.min(budget).max(1);
     let stride = ((cells as f64 / DRAWN_CELLS as f64).sqrt().ceil() as usize).max(1);
-    let (positions, triangles, zeros) = tessellate(fit, k);
-    let mut polylines = cell_sides(fit, stride, 4);
-    for &z in &zeros {
-        let mut ring = crate::util::ring_marker(&positions, &triangles, z, 0.02, ZERO);
+    let t = tessellate(fit, k);
+    let camera = Camera::frame(
+        &t.positions,
+        &opts.view,
+        [0.0, 0.0, opts.width as f64, opts.height as f64],
+    )?;
+    let mut polylines = cell_sides(fit, &t, stride, |p| camera.to_viewer(p));
+    for &z in &t.zeros {
+        let mut ring = crate::util::ring_marker(&t.positions, &t.triangles, z, 0.02, ZERO);
         ring.width = 3.0;
         polylines.push(ring);
     }
-    let (net, zebra) = render_net_and_zebra(&positions, &triangles, polylines, opts)?;
+    let (net, zebra) = render_net_and_zebra(&t.positions, &t.triangles, polylines, opts)?;
     let info = DomainPictures {
         stride,
         segments_per_cell_side: k,
-        triangles: triangles.len(),
-        zeros: zeros.len(),
+        triangles: t.triangles.len(),
+        zeros: t.zeros.len(),
     };
     Ok((net, zebra, info))
 }
@@ -191,10 +260,69 @@ pub fn domain_caption(info: &DomainPictures, cells: usize) -> String {
         format!("the sides of all {cells} cells")
     };
     format!(
-        "The domain mesh on the surface: {lines} mapped through the spline in dark grey, the strips' sides (critical horizontal trajectories of the 1-form and the vertical sides through its zeros) in blue, and the {} zeros of the form — the extraordinary points, where the spline is C⁰ — ringed in orange. The mesh is conforming: no T-junctions.",
+        "The domain mesh on the surface: {lines} mapped through the spline in dark grey, the strips' sides (critical horizontal trajectories of the 1-form and the vertical sides through its zeros) in blue, and the {} zeros of the form — the extraordinary points, where the spline is G¹ — ringed in orange; lines on the far side of the surface are not drawn. The mesh is conforming: no T-junctions.",
         info.zeros
     )
 }
 
 /// The caption of the zebra picture of a domain-mesh spline.
-pub const ZEBRA_CAPTION: &str = "Reflection lines (zebra) on the domain-mesh spline: C² on every cell side not at a zero, so the stripes run smoothly across the cells and the strips' sides; at the zeros (C⁰, G¹ not guaranteed) they may kink.";
+pub const ZEBRA_CAPTION: &str = "Reflection lines (zebra) on the domain-mesh spline: C² on every cell side not at a zero, so the stripes run smoothly across the cells and the strips' sides; at the zeros (G¹: C¹ in the translation chart) they stay continuous but their width may jump.";
+
+#[cfg(test)]
+mod tests {
+    use super::facing_pieces;
+
+    /// A great circle of the unit sphere seen from +z (orthographic): the pieces drawn hold
+    /// every point of the near half and none of the far half.
+    #[test]
+    fn facing_pieces_drop_the_far_side_of_a_sphere() {
+        let n = 64;
+        let points: Vec<[f64; 3]> = (0..n)
+            .map(|k| {
+                let a = 2.0 * std::f64::consts::PI * (k as f64 + 0.25) / n as f64;
+                [a.cos(), 0.0, a.sin()]
+            })
+            .collect();
+        let pieces = facing_pieces(&points, &points, |_| [0.0, 0.0, 1.0]);
+        let drawn: Vec<[f64; 3]> = pieces.concat();
+        assert_eq!(drawn.iter().filter(|p| p[2] <= 0.0).count(), 0);
+        let near = points.iter().filter(|p| p[2] > 0.0).count();
+        assert_eq!(drawn.len(), near);
+        assert_eq!(pieces.len(), 1, "one arc");
+        // inward normals would draw the far half instead
+        let inward: Vec<[f64; 3]> = points.iter().map(|p| p.map(|x| -x)).collect();
+        let wrong = facing_pieces(&points, &inward, |_| [0.0, 0.0, 1.0]).concat();
+        assert!(wrong.iter().all(|p| p[2] < 0.0));
+    }
+
+    /// The octahedron with its faces in either orientation: the normals point outwards.
+    #[test]
+    fn outward_normals_point_out_whatever_the_orientation() {
+        let positions = vec![
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let out: Vec<[u32; 3]> = vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        let flipped: Vec<[u32; 3]> = out.iter().map(|t| [t[0], t[2], t[1]]).collect();
+        for tris in [out, flipped] {
+            let n = super::outward_normals(&positions, &tris);
+            for (p, n) in positions.iter().zip(&n) {
+                let d = p[0] * n[0] + p[1] * n[1] + p[2] * n[2];
+                assert!((d - 1.0).abs() < 1e-12, "{p:?} {n:?}");
+            }
+        }
+    }
+}
