@@ -5,6 +5,7 @@
 //! in the texture coordinates. Coordinates are written as computed (plane coordinates, or
 //! Poincaré-disk coordinates for H²), with 17 significant digits.
 
+use rayon::prelude::*;
 use std::fmt::Write;
 
 /// OBJ text: `positions`/`faces` of the surface, `uv`/`uv_faces` of the cut mesh (one face per
@@ -20,13 +21,18 @@ pub fn obj_with_uv(
     for c in comments {
         let _ = writeln!(s, "# {c}");
     }
-    for p in positions {
+    lines(&mut s, positions, |s, p| {
         let _ = writeln!(s, "v {:e} {:e} {:e}", p[0], p[1], p[2]);
-    }
-    for t in uv {
+    });
+    lines(&mut s, uv, |s, t| {
         let _ = writeln!(s, "vt {:e} {:e}", t[0], t[1]);
-    }
-    for (f, t) in faces.iter().zip(uv_faces) {
+    });
+    let corners: Vec<([u32; 3], [u32; 3])> = faces
+        .iter()
+        .copied()
+        .zip(uv_faces.iter().copied())
+        .collect();
+    lines(&mut s, &corners, |s, (f, t)| {
         let _ = writeln!(
             s,
             "f {}/{} {}/{} {}/{}",
@@ -37,8 +43,27 @@ pub fn obj_with_uv(
             f[2] + 1,
             t[2] + 1
         );
-    }
+    });
     s
+}
+
+/// Appends the lines `line` writes for each item to `s`, in item order; blocks of items are
+/// formatted in parallel (rayon) — the same text as one sequential pass.
+fn lines<T: Sync>(s: &mut String, items: &[T], line: impl Fn(&mut String, &T) + Sync) {
+    const BLOCK: usize = 8192;
+    let blocks: Vec<String> = items
+        .par_chunks(BLOCK)
+        .map(|block| {
+            let mut b = String::with_capacity(48 * block.len());
+            for x in block {
+                line(&mut b, x);
+            }
+            b
+        })
+        .collect();
+    for b in blocks {
+        s.push_str(&b);
+    }
 }
 
 /// OBJ text of a surface with one texture coordinate per face corner (`corner_uv[3f + i]`
@@ -50,19 +75,35 @@ pub fn obj_with_corner_uv(
     corner_uv: &[[f64; 2]],
     comments: &[String],
 ) -> String {
-    let mut index: std::collections::HashMap<(u32, u64, u64), u32> =
-        std::collections::HashMap::with_capacity(positions.len() + positions.len() / 8);
-    let mut uv = Vec::with_capacity(positions.len());
+    // Per vertex, the list of its distinct coordinates so far (`head[v]`, then `next[i]`
+    // from entry i of `uv`; `u32::MAX` ends a list), compared bit for bit.
+    let nv = faces
+        .iter()
+        .flatten()
+        .map(|&v| v as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let mut head = vec![u32::MAX; nv.max(positions.len())];
+    let mut next: Vec<u32> = Vec::with_capacity(positions.len());
+    let mut uv: Vec<[f64; 2]> = Vec::with_capacity(positions.len());
     let mut uv_faces = Vec::with_capacity(faces.len());
+    let same = |a: [f64; 2], b: [f64; 2]| a.map(f64::to_bits) == b.map(f64::to_bits);
     for (f, t) in faces.iter().enumerate() {
         let mut out = [0u32; 3];
         for i in 0..3 {
             let c = corner_uv[3 * f + i];
-            let key = (t[i], c[0].to_bits(), c[1].to_bits());
-            out[i] = *index.entry(key).or_insert_with(|| {
+            let v = t[i] as usize;
+            let mut at = head[v];
+            while at != u32::MAX && !same(uv[at as usize], c) {
+                at = next[at as usize];
+            }
+            if at == u32::MAX {
+                at = uv.len() as u32;
                 uv.push(c);
-                (uv.len() - 1) as u32
-            });
+                next.push(head[v]);
+                head[v] = at;
+            }
+            out[i] = at;
         }
         uv_faces.push(out);
     }

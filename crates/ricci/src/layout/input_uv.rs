@@ -250,6 +250,44 @@ where
 /// A face's corners with their mismatch and sources (copy, map).
 type Choice<P> = (f64, [P; 3], [(u32, u32); 3]);
 
+/// The images an [`Images::nearest`] search visited: (distance key, image, copy, map).
+type Visits<P> = Vec<(f64, P, u32, u32)>;
+
+/// The last few images whose exact distance from a search's point was measured: near the
+/// identity, many candidate maps (products `x x⁻¹`, `Q_s Q_s⁻¹`, …) send a copy to the same
+/// rounded point, whose distance is then measured once ([`Space::distance`] is a function of
+/// the two points: the same value as measuring again).
+struct Measured<P> {
+    seen: [Option<(P, f64)>; 4],
+    next: usize,
+}
+
+impl<P> Default for Measured<P> {
+    fn default() -> Self {
+        Measured {
+            seen: [None, None, None, None],
+            next: 0,
+        }
+    }
+}
+
+impl<P: Copy + PartialEq> Measured<P> {
+    /// `S::distance(q, p)` for the search's point `p` (the same `p` at every call).
+    fn distance<S: Space<Point = P>>(&mut self, q: P, p: P) -> f64 {
+        for &(r, d) in self.seen.iter().flatten() {
+            // Equal coordinates (±0 alike) give equal distances: every formula of
+            // `Space::distance` reads the coordinates through differences, squares and norms.
+            if r == q {
+                return d;
+            }
+        }
+        let d = S::distance(q, p);
+        self.seen[self.next] = Some((q, d));
+        self.next = (self.next + 1) % self.seen.len();
+        d
+    }
+}
+
 /// The images of the surface's vertices under the candidate deck maps.
 ///
 /// Both searches return what an exhaustive search over (copy, map) in that order with
@@ -313,20 +351,20 @@ where
         p: S::Point,
         n: usize,
         upper: f64,
-        buf: &mut Vec<(f64, u32, u32)>,
+        buf: &mut Visits<S::Point>,
     ) -> (f64, S::Point, (u32, u32)) {
         buf.clear();
         let (mut kmin, mut upper) = (f64::INFINITY, upper);
         let prune_p = n > 1 && S::resolved(p);
         for &c in &self.copies[w as usize] {
             let q = self.positions[c as usize];
-            let mut visit = |k: usize, buf: &mut Vec<(f64, u32, u32)>| {
+            let mut visit = |k: usize, buf: &mut Visits<S::Point>| {
                 let gq = self.cands[k].apply(q);
                 let key = S::distance_key(gq, p);
                 if key < kmin {
                     kmin = key;
                 }
-                buf.push((key, c, k as u32));
+                buf.push((key, gq, c, k as u32));
                 gq
             };
             if n == 0 {
@@ -369,12 +407,12 @@ where
         }
         let band = kmin + 1e-9 * kmin + 1e-200;
         let mut best = (f64::INFINITY, p, (u32::MAX, 0));
+        let mut measured = Measured::default();
         // `buf` holds the maps of a copy in the order visited (by displacement when pruned):
         // ties are broken by (copy, map) explicitly, as the exhaustive search meets them.
-        for &(key, c, k) in buf.iter() {
+        for &(key, gq, c, k) in buf.iter() {
             if key <= band {
-                let gq = self.cands[k as usize].apply(self.positions[c as usize]);
-                let d = S::distance(gq, p);
+                let d = measured.distance::<S>(gq, p);
                 let found = best.2 .0 != u32::MAX;
                 if d < best.0 || (found && d == best.0 && (c, k) < best.2) {
                     best = (d, gq, (c, k));
@@ -394,7 +432,7 @@ where
         now: &Choice<S::Point>,
         median: f64,
         level_end: &[usize; 3],
-        buf: &mut Vec<(f64, u32, u32)>,
+        buf: &mut Visits<S::Point>,
     ) -> Option<Choice<S::Point>> {
         let (spread, p, src) = *now;
         let suspicious = spread > 4.0 * median || S::orientation(p[0], p[1], p[2]) <= 0.0;
@@ -454,6 +492,7 @@ where
         let mut top: Vec<f64> = Vec::with_capacity(keep + 1);
         let mut keys = (f64::NEG_INFINITY, f64::INFINITY);
         let prune_p = S::resolved(p);
+        let mut measured = Measured::default();
         for &c in &self.copies[w as usize] {
             let q = self.positions[c as usize];
             let prune = prune_p && S::resolved(q);
@@ -473,7 +512,7 @@ where
                 if key.is_finite() && (key < keys.0 || key > keys.1) {
                     continue;
                 }
-                let m = (S::distance(gq, p) - want).abs();
+                let m = (measured.distance::<S>(gq, p) - want).abs();
                 let found = (m, gq, (c, k as u32));
                 if v.len() < keep || before(&found, &v[keep - 1]) {
                     let at = v.partition_point(|x| before(x, &found));

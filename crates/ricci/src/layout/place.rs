@@ -538,33 +538,30 @@ fn layout_parts<S: Space>(
     // The relative placement of each face on the parent it was placed from, kept for the
     // second pass: a face placed from the same parent edge again reuses it (same bits).
     let mut relatives: Vec<(u32, Option<S::Frame>)> = vec![(NONE, None); nf];
-    let first = layout_from::<S>(mesh, lengths, &canonical, seed, &mut relatives);
+    let (first, depth) = layout_from::<S>(mesh, lengths, &canonical, seed, &mut relatives);
     if seed_face.is_some() || !mesh.has_boundary() {
-        return Ok(first);
+        return Ok(measured_layout::<S>(mesh, lengths, &first, seed, depth));
     }
     // Errors grow with the distance from the seed (in H² exponentially, through the
     // resolution of the model near the unit circle): restart from the face nearest to the
-    // minimax centre of the boundary.
-    let centre = minimax_centre::<S>(&boundary_points(mesh, &first.positions));
+    // minimax centre of the boundary. (The first walk's positions are only measured when it
+    // is the result.)
+    let rounded: Vec<S::Point> = first.iter().map(|&p| S::Frame::split(p).0).collect();
+    let centre = minimax_centre::<S>(&boundary_points(mesh, &rounded));
     // The face whose first corner is nearest the centre (the first of equals); each
     // distance measured once, in parallel.
     let d: Vec<f64> = (0..nf as u32)
         .into_par_iter()
-        .map(|f| S::distance(first.positions[mesh.face(f)[0] as usize], centre))
+        .map(|f| S::distance(rounded[mesh.face(f)[0] as usize], centre))
         .collect();
     let best = (0..nf as u32)
         .min_by(|&f, &g| d[f as usize].total_cmp(&d[g as usize]))
         .unwrap_or(seed);
     if best == seed {
-        return Ok(first);
+        return Ok(measured_layout::<S>(mesh, lengths, &first, seed, depth));
     }
-    Ok(layout_from::<S>(
-        mesh,
-        lengths,
-        &canonical,
-        best,
-        &mut relatives,
-    ))
+    let (pos, depth) = layout_from::<S>(mesh, lengths, &canonical, best, &mut relatives);
+    Ok(measured_layout::<S>(mesh, lengths, &pos, best, depth))
 }
 
 fn boundary_points<P: Copy>(mesh: &Mesh, pos: &[P]) -> Vec<P> {
@@ -619,108 +616,183 @@ const FLIPPED: u8 = 1;
 const DEGENERATE: u8 = 2;
 
 /// Breadth-first placement from `seed` with the faces' canonical triangles
-/// ([`canonical_triangles`]).
+/// ([`canonical_triangles`]): the positions in the working precision and the largest
+/// breadth-first depth of a vertex.
+///
+/// The walk's order depends on the lengths alone (not on the frames), so it is run first
+/// ([`walk`]); then the relative placements, which read only canonical triangles and lengths,
+/// are computed in parallel (rayon), the frames — each its parent's composed with its
+/// relative placement — one tree level after the other (the faces of a level in parallel),
+/// and the positions in parallel. Every value is the same operation on the same inputs as in
+/// a sequential walk, so the layout is the same to the bit.
 fn layout_from<S: Space>(
     mesh: &Mesh,
     lengths: &[f64],
     canonical: &[[ExtPoint<S>; 3]],
     seed: u32,
     relatives: &mut [(u32, Option<S::Frame>)],
-) -> Layout<S::Point> {
+) -> (Vec<ExtPoint<S>>, u32) {
+    let nf = mesh.n_faces();
+    let len = |h: u32| lengths[mesh.he_edge(h) as usize];
+    let canon = |f: u32| canonical[f as usize];
+    let w = walk(mesh, lengths, seed);
+    // Relative placement of g = (i, j, k) (counter-clockwise, t = i → j) on its parent f:
+    // g's canonical triangle with its corners i, j onto (p_i, p_j) in f's canonical triangle.
+    // A face placed from the same parent edge as in an earlier walk reuses it (same bits).
+    let rels: Vec<S::Frame> = w
+        .steps
+        .par_iter()
+        .map(|&(g, t)| match relatives[g as usize] {
+            (parent, Some(rel)) if parent == t => rel,
+            _ => {
+                let h = mesh.he_twin(t); // the parent's half-edge j → i
+                let cf = canon(mesh.he_face(h));
+                // h runs j → i: its origin (corner h % 3) is j, its tip is i.
+                let (pj, pi) = (cf[(h % 3) as usize], cf[((h + 1) % 3) as usize]);
+                let (tn, tp) = (mesh.he_next(t), mesh.he_prev(t));
+                let ti = (t % 3) as usize; // corner of i in g
+                S::relative(&canon(g), ti, pi, pj, [len(t), len(tn), len(tp)])
+            }
+        })
+        .collect();
+    for (&(g, t), &rel) in w.steps.iter().zip(&rels) {
+        relatives[g as usize] = (t, Some(rel));
+    }
+    // Every face gets a frame: the isometry taking its canonical triangle (vertex 0 at the
+    // base point, vertex 1 on the reference direction, `Space::seed`) to its place, composed
+    // in the working precision of the space (double-double in H², see [`Frame`]). A
+    // neighbour's frame is the parent's frame composed with the relative placement, which is
+    // computed near the base point from the metric alone; positions are frames applied to
+    // canonical triangles. So no direction is ever taken from the difference of two nearby
+    // far-away points (in the Poincaré disk those lose ~1e-16·e^r / l of accuracy).
+    let mut frame: Vec<S::Frame> = vec![S::Frame::identity(); nf];
+    let parent_frame = |frame: &[S::Frame], i: usize| {
+        let f = mesh.he_face(mesh.he_twin(w.steps[i].1));
+        frame[f as usize].compose(&rels[i]).normalized()
+    };
+    for level in &w.levels {
+        if level.len() < 64 {
+            for &i in level {
+                frame[w.steps[i as usize].0 as usize] = parent_frame(&frame, i as usize);
+            }
+            continue;
+        }
+        let new: Vec<S::Frame> = level
+            .par_iter()
+            .map(|&i| parent_frame(&frame, i as usize))
+            .collect();
+        for (&i, fg) in level.iter().zip(new) {
+            frame[w.steps[i as usize].0 as usize] = fg;
+        }
+    }
+    let mut pos: Vec<ExtPoint<S>> = vec![S::Frame::ext(S::base_point(), None); mesh.n_vertices()];
+    let tri = canon(seed);
+    for (i, &v) in mesh.face(seed).iter().enumerate() {
+        pos[v as usize] = tri[i];
+    }
+    // The third vertex k of the face that placed it, in that face's frame.
+    let placed: Vec<ExtPoint<S>> = w
+        .placements
+        .par_iter()
+        .map(|&(_, i)| {
+            let (g, t) = w.steps[i as usize];
+            let ti = (t % 3) as usize;
+            frame[g as usize].apply(canon(g)[(ti + 2) % 3])
+        })
+        .collect();
+    for (&(k, _), p) in w.placements.iter().zip(placed) {
+        pos[k as usize] = p;
+    }
+    (pos, w.depth)
+}
+
+/// The order of [`layout_from`]'s walk.
+struct Walk {
+    /// `(g, t)`: face `g` placed from its parent across `t` (a half-edge of `g`; the parent
+    /// is the face of its twin), parents first.
+    steps: Vec<(u32, u32)>,
+    /// The indices in `steps` of the faces at each depth of the tree (depth 1 first: faces
+    /// whose parent is the seed).
+    levels: Vec<Vec<u32>>,
+    /// `(k, i)`: vertex `k` placed by the face of `steps[i]` (its corner opposite `t`).
+    placements: Vec<(u32, u32)>,
+    /// The largest breadth-first depth of a vertex.
+    depth: u32,
+}
+
+/// The walk of [`layout_from`] from `seed`. Error-growth estimate per vertex: placing k from
+/// the edge (i, j) multiplies the error of the edge's direction by about max(l_ik, l_jk)/l_ij,
+/// so needles (e.g. from refinement fans) are crossed along their length, not across; the
+/// order is a Dijkstra on cost = Σ ln(1 + max(l_ik, l_jk)/l_ij), i.e. breadth first on
+/// well-shaped meshes. Each vertex is placed by the first face that reaches it.
+fn walk(mesh: &Mesh, lengths: &[f64], seed: u32) -> Walk {
     use std::cmp::Reverse;
     use std::collections::BinaryHeap;
     let nv = mesh.n_vertices();
     let nf = mesh.n_faces();
     let len = |h: u32| lengths[mesh.he_edge(h) as usize];
-    let mut pos: Vec<ExtPoint<S>> = vec![S::Frame::ext(S::base_point(), None); nv];
     let mut placed = vec![false; nv];
-    // Error-growth estimate per vertex: placing k from the edge (i, j) multiplies the error
-    // of the edge's direction by about max(l_ik, l_jk)/l_ij, so needles (e.g. from refinement
-    // fans) are crossed along their length, not across; the order is a Dijkstra on
-    // cost = Σ ln(1 + max(l_ik, l_jk)/l_ij), i.e. breadth first on well-shaped meshes.
     let mut cost = vec![f64::INFINITY; nv];
     let mut vdepth = vec![0u32; nv];
+    let mut done = vec![false; nf];
+    let mut level = vec![0u32; nf];
     let mut heap: BinaryHeap<(Reverse<u64>, u32, u32)> = BinaryHeap::with_capacity(nf);
-    // Every face gets a frame: the isometry taking its canonical triangle (vertex 0 at the
-    // base point, vertex 1 on the reference direction, `Space::seed`) to its place. A
-    // neighbour's frame is the parent's frame composed with the relative placement, which is
-    // computed near the base point from the metric alone; positions are frames applied to
-    // canonical triangles. So no direction is ever taken from the difference of two nearby
-    // far-away points (in the Poincaré disk those lose ~1e-16·e^r / l of accuracy).
-    let canon = |f: u32| canonical[f as usize];
-    // Frames are composed in the working precision of the space (double-double in H²,
-    // see [`Frame`]); the relative placements are computed near the base point in double
-    // precision, where that is accurate to the last digit.
-    let mut frame: Vec<Option<S::Frame>> = vec![None; nf];
-    frame[seed as usize] = Some(S::Frame::identity());
-    let tri = canon(seed);
-    let fv = mesh.face(seed);
-    for i in 0..3 {
-        pos[fv[i] as usize] = tri[i];
-        placed[fv[i] as usize] = true;
-        cost[fv[i] as usize] = 0.0;
+    let mut w = Walk {
+        steps: Vec::with_capacity(nf),
+        levels: Vec::new(),
+        placements: Vec::with_capacity(nv),
+        depth: 0,
+    };
+    done[seed as usize] = true;
+    for v in mesh.face(seed) {
+        placed[v as usize] = true;
+        cost[v as usize] = 0.0;
     }
-    let mut depth = 0;
     // Heap entries: (cost, face g, half-edge t of g whose ends are placed); the parent is the
     // face across t.
-    let push = |f: u32,
-                heap: &mut BinaryHeap<(Reverse<u64>, u32, u32)>,
-                cost: &[f64],
-                frame: &[Option<S::Frame>]| {
-        for h in mesh.face_halfedges(f) {
-            let t = mesh.he_twin(h);
-            let g = mesh.he_face(t);
-            if g == NONE || frame[g as usize].is_some() {
-                continue;
-            }
-            let (i, j) = (mesh.he_origin(t), mesh.he_tip(t));
-            let amp =
-                len(mesh.he_next(t)).max(len(mesh.he_prev(t))) / len(t).max(f64::MIN_POSITIVE);
-            let c = cost[i as usize].max(cost[j as usize]) + (1.0 + amp).ln();
-            heap.push((Reverse(c.to_bits()), g, t));
-        }
-    };
-    push(seed, &mut heap, &cost, &frame);
-    while let Some((_, g, t)) = heap.pop() {
-        if frame[g as usize].is_some() {
-            continue;
-        }
-        let h = mesh.he_twin(t); // the parent's half-edge j → i
-        let f = mesh.he_face(h);
-        let ff = frame[f as usize].expect("parents have frames");
-        // Parent's canonical triangle; the shared edge in it.
-        let cf = canon(f);
-        // h runs j → i: its origin (corner h % 3) is j, its tip is i.
-        let (pj, pi) = (cf[(h % 3) as usize], cf[((h + 1) % 3) as usize]);
-        let (tn, tp) = (mesh.he_next(t), mesh.he_prev(t));
-        // g = (i, j, k) counter-clockwise with t = i → j. Relative placement: g's canonical
-        // triangle with its corners i, j onto (p_i, p_j) in f's frame.
-        let cg = canon(g);
-        let ti = (t % 3) as usize; // corner of i in g
-        let rel = match relatives[g as usize] {
-            (parent, Some(rel)) if parent == t => rel,
-            _ => {
-                let rel = S::relative(&cg, ti, pi, pj, [len(t), len(tn), len(tp)]);
-                relatives[g as usize] = (t, Some(rel));
-                rel
+    let push =
+        |f: u32, heap: &mut BinaryHeap<(Reverse<u64>, u32, u32)>, cost: &[f64], done: &[bool]| {
+            for h in mesh.face_halfedges(f) {
+                let t = mesh.he_twin(h);
+                let g = mesh.he_face(t);
+                if g == NONE || done[g as usize] {
+                    continue;
+                }
+                let (i, j) = (mesh.he_origin(t), mesh.he_tip(t));
+                let amp =
+                    len(mesh.he_next(t)).max(len(mesh.he_prev(t))) / len(t).max(f64::MIN_POSITIVE);
+                let c = cost[i as usize].max(cost[j as usize]) + (1.0 + amp).ln();
+                heap.push((Reverse(c.to_bits()), g, t));
             }
         };
-        let fg = ff.compose(&rel).normalized();
-        frame[g as usize] = Some(fg);
+    push(seed, &mut heap, &cost, &done);
+    while let Some((_, g, t)) = heap.pop() {
+        if done[g as usize] {
+            continue;
+        }
+        done[g as usize] = true;
+        let i = w.steps.len() as u32;
+        w.steps.push((g, t));
+        let lg = level[mesh.he_face(mesh.he_twin(t)) as usize] + 1;
+        level[g as usize] = lg;
+        if w.levels.len() < lg as usize {
+            w.levels.push(Vec::new());
+        }
+        w.levels[lg as usize - 1].push(i);
+        let tn = mesh.he_next(t);
         let k = mesh.he_tip(tn);
         if !placed[k as usize] {
-            let i = mesh.he_origin(t);
-            let j = mesh.he_tip(t);
-            pos[k as usize] = fg.apply(cg[(ti + 2) % 3]);
+            let (a, b) = (mesh.he_origin(t), mesh.he_tip(t));
             placed[k as usize] = true;
-            let amp = len(tn).max(len(tp)) / len(t).max(f64::MIN_POSITIVE);
-            cost[k as usize] = cost[i as usize].max(cost[j as usize]) + (1.0 + amp).ln();
-            vdepth[k as usize] = vdepth[i as usize].max(vdepth[j as usize]) + 1;
-            depth = depth.max(vdepth[k as usize]);
+            w.placements.push((k, i));
+            let amp = len(tn).max(len(mesh.he_prev(t))) / len(t).max(f64::MIN_POSITIVE);
+            cost[k as usize] = cost[a as usize].max(cost[b as usize]) + (1.0 + amp).ln();
+            vdepth[k as usize] = vdepth[a as usize].max(vdepth[b as usize]) + 1;
+            w.depth = w.depth.max(vdepth[k as usize]);
         }
-        push(g, &mut heap, &cost, &frame);
+        push(g, &mut heap, &cost, &done);
     }
-    measured_layout::<S>(mesh, lengths, &pos, seed, depth)
+    w
 }
 
 /// The [`Layout`] of the placed points `pos`, with its measurements: flipped and degenerate
