@@ -53,13 +53,27 @@ impl MobiusDd {
         a: Cdd::ONE,
         b: Cdd::ZERO,
     };
-    /// Rounded to a double-precision Möbius map (renormalized).
+    /// Rounded to a double-precision Möbius map, scaled onto `|a|² − |b|² = 1` with the
+    /// determinant formed in double-double (unchanged if it is not positive).
+    ///
+    /// Renormalizing the rounded entries in double precision, as [`Mobius::new`] does, forms
+    /// `|a|² − |b|² = 1` from two numbers of size `|a|²` and rescales the entries by
+    /// `1 ± 1e-16·|a|²`: a deck generator with `|a| ≈ 2·10³` (botijo's `a3` in the layout's
+    /// frame) lost 2e-9 of its translation length `2 acosh|Re a|` that way.
     pub fn round(&self) -> Mobius {
         let m = Mobius {
             a: self.a.hi() + self.a.lo(),
             b: self.b.hi() + self.b.lo(),
         };
-        Mobius::new(m.a, m.b).unwrap_or(m)
+        let det = (self.a.norm_sqr() - self.b.norm_sqr()).f64();
+        if !(det > 0.0) || !det.is_finite() {
+            return m;
+        }
+        let s = det.sqrt();
+        Mobius {
+            a: m.a / s,
+            b: m.b / s,
+        }
     }
     #[inline]
     pub fn compose(&self, o: &MobiusDd) -> MobiusDd {
@@ -326,5 +340,33 @@ mod tests {
         for i in 0..3 {
             assert!((l[i] - x[i]).abs() < 1e-20, "{l:?}");
         }
+    }
+
+    /// A hyperbolic element conjugated far out into the disk keeps its translation length
+    /// (a conjugation invariant) through the rounding to double precision: the axis of
+    /// `T⁻¹ R T` passes at distance 12 from the centre (`|a| ≈ cosh²6 ≈ 4·10⁴`), and the
+    /// rounded map's `2 acosh|Re a|` equals `R`'s to 1e-14; renormalizing the rounded entries
+    /// in double precision instead loses up to ~1e-16·|a|² of it.
+    #[test]
+    fn rounding_a_far_map_keeps_its_translation_length() {
+        let mut worst_old: f64 = 0.0;
+        for (len, angle) in [(1.06, 0.3), (0.91, 2.0), (5.6, -1.2), (2.0, 1.1)] {
+            let r = MobiusDd::from(Mobius::real_translation(len)).normalized();
+            let want = r.round().translation_length();
+            assert!((want - len).abs() < 1e-12, "{want} vs {len}");
+            let t = MobiusDd::to_origin(Complex::from_polar((6.0f64).tanh(), angle).into());
+            let g = t.inverse().compose(&r).compose(&t).normalized();
+            assert!(g.a.hi().norm() > 1e4, "{:?}", g.a.hi());
+            let got = g.round().translation_length();
+            assert!((got - want).abs() < 1e-14, "{got} vs {want}");
+            let old = Mobius::new(g.a.hi(), g.b.hi())
+                .unwrap()
+                .translation_length();
+            worst_old = worst_old.max((old - want).abs());
+        }
+        assert!(
+            worst_old > 1e-12,
+            "double renormalization lost only {worst_old:e}"
+        );
     }
 }
