@@ -20,23 +20,33 @@ pub fn obj_with_uv(
     for c in comments {
         let _ = writeln!(s, "# {c}");
     }
+    use crate::numeric::float_text::push_exp;
     for p in positions {
-        let _ = writeln!(s, "v {:e} {:e} {:e}", p[0], p[1], p[2]);
+        s.push('v');
+        for &x in p {
+            s.push(' ');
+            push_exp(&mut s, x);
+        }
+        s.push('\n');
     }
     for t in uv {
-        let _ = writeln!(s, "vt {:e} {:e}", t[0], t[1]);
+        s.push_str("vt");
+        for &x in t {
+            s.push(' ');
+            push_exp(&mut s, x);
+        }
+        s.push('\n');
     }
+    let mut int = itoa::Buffer::new();
     for (f, t) in faces.iter().zip(uv_faces) {
-        let _ = writeln!(
-            s,
-            "f {}/{} {}/{} {}/{}",
-            f[0] + 1,
-            t[0] + 1,
-            f[1] + 1,
-            t[1] + 1,
-            f[2] + 1,
-            t[2] + 1
-        );
+        s.push('f');
+        for i in 0..3 {
+            s.push(' ');
+            s.push_str(int.format(f[i] as u64 + 1));
+            s.push('/');
+            s.push_str(int.format(t[i] as u64 + 1));
+        }
+        s.push('\n');
     }
     s
 }
