@@ -4,9 +4,36 @@
 //! crate, already built for `serde_json`) instead of `core::fmt`: the same bytes, several
 //! times faster on the millions of coordinates of a large mesh.
 
+/// Whether two shortest digit strings may be equally near `x`, where `core::fmt` rounds half
+/// up and Schubfach to even: only when the exact decimal value of `x` has at most 18
+/// significant digits (the tie is a 5 right after the digits). With `x = m·2⁻ⁿ`, `m` odd, that
+/// value has the digits of `m·5ⁿ`, so it needs `m·5ⁿ < 10¹⁸`: short mantissas (quantized
+/// coordinates such as `k/2¹⁶`) and integers. Those `core::fmt` writes (zero too).
+fn may_tie(x: f64) -> bool {
+    let bits = x.to_bits();
+    let (exponent, fraction) = (((bits >> 52) & 0x7ff) as i32, bits & ((1u64 << 52) - 1));
+    let (mut m, mut e) = if exponent == 0 {
+        (fraction, -1074)
+    } else {
+        (fraction | 1u64 << 52, exponent - 1075)
+    };
+    if m == 0 {
+        return true;
+    }
+    let tz = m.trailing_zeros();
+    m >>= tz;
+    e += tz as i32;
+    if e >= 0 {
+        return true;
+    }
+    // log₂(m·5ⁿ) ≥ bits(m) − 1 + n·log₂5; 10¹⁸ = 2^59.79.
+    let n = -e as f64;
+    f64::from(64 - m.leading_zeros()) + n * 2.321_928 < 61.0
+}
+
 /// Append `x` to `out` exactly as `write!(out, "{:e}", x)` would.
 pub fn push_exp(out: &mut String, x: f64) {
-    if !x.is_finite() {
+    if !x.is_finite() || may_tie(x) {
         use std::fmt::Write;
         let _ = write!(out, "{x:e}");
         return;
@@ -82,6 +109,13 @@ mod tests {
             f64::INFINITY,
             f64::NEG_INFINITY,
         ];
+        // Short mantissas (k / 2^j) and large integers: exact values with few digits.
+        for j in 0..64 {
+            for k in 1..2000u64 {
+                xs.push(k as f64 / (1u64 << j) as f64);
+                xs.push(-((k << j) as f64) - 0.5);
+            }
+        }
         for k in -320..=308 {
             xs.push(10f64.powi(k));
             xs.push(1.5 * 10f64.powi(k));
