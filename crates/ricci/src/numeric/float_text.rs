@@ -64,21 +64,28 @@ pub fn push_exp(out: &mut String, x: f64) {
     while n > 0 && digits[n - 1] == b'0' {
         n -= 1;
     }
+    // The text in a byte buffer, pushed once: `-d.ddde-x`.
+    let mut text = [0u8; 64];
+    let mut len = 0;
+    let mut put = |bytes: &[u8]| {
+        text[len..len + bytes.len()].copy_from_slice(bytes);
+        len += bytes.len();
+    };
     if negative {
-        out.push('-');
+        put(b"-");
     }
     if n == 0 {
-        out.push_str("0e0");
-        return;
+        put(b"0e0");
+    } else {
+        put(&digits[..1]);
+        if n > 1 {
+            put(b".");
+            put(&digits[1..n]);
+        }
+        put(b"e");
+        put(itoa::Buffer::new().format(point - 1).as_bytes());
     }
-    out.push(digits[0] as char);
-    if n > 1 {
-        out.push('.');
-        out.extend(digits[1..n].iter().map(|&d| d as char));
-    }
-    out.push('e');
-    let mut ibuf = itoa::Buffer::new();
-    out.push_str(ibuf.format(point - 1));
+    out.push_str(std::str::from_utf8(&text[..len]).unwrap_or_default());
 }
 
 #[cfg(test)]
