@@ -195,6 +195,8 @@ struct GrowingPattern {
     symbolic_count: usize,
     /// Nonzeros of the factor of the last analysis with a new AMD ordering.
     amd_factor_nnz: usize,
+    /// Length of the triangulation's `flip_log` at the last [`GrowingPattern::cover`].
+    covered_flips: usize,
 }
 
 /// Most growth of the factor's nonzeros, relative to the last AMD analysis, accepted with a
@@ -220,6 +222,7 @@ impl GrowingPattern {
             solver: None,
             symbolic_count: 0,
             amd_factor_nnz: 0,
+            covered_flips: 0,
         }
     }
     fn n(&self) -> usize {
@@ -234,9 +237,17 @@ impl GrowingPattern {
     }
     /// Make sure every vertex pair joined by an edge of `tri` is in the pattern; redo the
     /// symbolic factorization if the pattern grew.
+    ///
+    /// Only an edge flipped since the last call can join a new pair (the others kept their
+    /// ends, whose pairs were covered then): those are `tri.flip_log` after the length it had.
     fn cover(&mut self, tri: &IntrinsicTriangulation) -> Result<()> {
         let mut missing: Vec<(u32, u32)> = Vec::new();
-        for e in 0..tri.n_edges() as u32 {
+        let flipped = match tri.flip_log.get(self.covered_flips..) {
+            Some(tail) if self.solver.is_some() => tail.to_vec(),
+            _ => (0..tri.n_edges() as u32).collect(),
+        };
+        self.covered_flips = tri.flip_log.len();
+        for e in flipped {
             let [a, b] = tri.edge_vertices(e);
             let (ia, ib) = (self.free_index[a as usize], self.free_index[b as usize]);
             if a == b || ia == NONE || ib == NONE {

@@ -21,11 +21,22 @@ pub fn obj_with_uv(
     for c in comments {
         let _ = writeln!(s, "# {c}");
     }
+    use crate::numeric::float_text::push_exp;
     lines(&mut s, positions, |s, p| {
-        let _ = writeln!(s, "v {:e} {:e} {:e}", p[0], p[1], p[2]);
+        s.push('v');
+        for &x in p {
+            s.push(' ');
+            push_exp(s, x);
+        }
+        s.push('\n');
     });
     lines(&mut s, uv, |s, t| {
-        let _ = writeln!(s, "vt {:e} {:e}", t[0], t[1]);
+        s.push_str("vt");
+        for &x in t {
+            s.push(' ');
+            push_exp(s, x);
+        }
+        s.push('\n');
     });
     let corners: Vec<([u32; 3], [u32; 3])> = faces
         .iter()
@@ -33,16 +44,15 @@ pub fn obj_with_uv(
         .zip(uv_faces.iter().copied())
         .collect();
     lines(&mut s, &corners, |s, (f, t)| {
-        let _ = writeln!(
-            s,
-            "f {}/{} {}/{} {}/{}",
-            f[0] + 1,
-            t[0] + 1,
-            f[1] + 1,
-            t[1] + 1,
-            f[2] + 1,
-            t[2] + 1
-        );
+        let mut int = itoa::Buffer::new();
+        s.push('f');
+        for i in 0..3 {
+            s.push(' ');
+            s.push_str(int.format(f[i] as u64 + 1));
+            s.push('/');
+            s.push_str(int.format(t[i] as u64 + 1));
+        }
+        s.push('\n');
     });
     s
 }

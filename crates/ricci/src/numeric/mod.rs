@@ -14,6 +14,7 @@
 
 pub mod dd;
 pub(crate) mod dijkstra;
+pub mod float_text;
 pub(crate) mod simd;
 pub(crate) mod sparse;
 pub mod vec3;

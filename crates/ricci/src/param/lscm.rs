@@ -122,124 +122,154 @@ impl Bundle {
 }
 
 /// The wedges of `mesh` opened along `cut` (module docs) in classes linked by the seam
-/// rotations of `uv`, the classes of `cones`, of vertices not `movable` and of the boundary
-/// pinned (and at least two pinned in all); per corner, its wedge's root and rotation.
-fn wedge_classes(
-    mesh: &Mesh,
-    cut: &[bool],
-    cones: &[u32],
-    uv: &[C],
-    movable: &[bool],
-) -> Result<(Bundle, Vec<(u32, C)>)> {
-    let nc = mesh.n_corners();
-    // Wedges: one per (vertex, sector between cut or boundary edges).
-    let mut ids: HashMap<(u32, u32), u32> = HashMap::with_capacity(nc / 5);
+/// rotations of `uv`, with the classes of the cones and of the boundary pinned: what every
+/// round of [`improve`] shares (only the pins of the vertices that do not move change).
+struct Wedges {
+    bundle: Bundle,
+    /// Per corner, its wedge's root and rotation (`δ_corner = ρ δ_root`).
+    roots: Vec<(u32, C)>,
+}
+
+/// Wedge ids `0, 1, …` in the order of the corners that first meet them (a wedge is a vertex
+/// with a sector between cut or boundary edges, named by [`super::seams::wedge_keys`]). Most
+/// vertices have one wedge: a vertex's first wedge is kept beside it, further ones (seam
+/// vertices) in a map.
+fn wedge_ids(mesh: &Mesh, cut: &[bool]) -> (Vec<u32>, usize) {
     let keys = super::seams::wedge_keys(mesh, cut);
-    let wedge: Vec<u32> = (0..nc as u32)
+    let mut first: Vec<(u32, u32)> = vec![(u32::MAX, u32::MAX); mesh.n_vertices()];
+    let mut more: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut n = 0u32;
+    let ids = (0..mesh.n_corners() as u32)
         .map(|h| {
-            let key = (mesh.he_origin(h), keys[h as usize]);
-            let n = ids.len() as u32;
-            *ids.entry(key).or_insert(n)
+            let (v, k) = (mesh.he_origin(h) as usize, keys[h as usize]);
+            let f = &mut first[v];
+            if f.1 == u32::MAX {
+                *f = (k, n);
+            } else if f.0 != k {
+                return *more.entry((v as u32, k)).or_insert_with(|| {
+                    n += 1;
+                    n - 1
+                });
+            } else {
+                return f.1;
+            }
+            n += 1;
+            n - 1
         })
         .collect();
-    let nw = ids.len();
-    let mut b = Bundle::new(nw);
-    // Longest seam edges first: their rotation is measured best and defines the classes.
-    let mut seam: Vec<(f64, u32)> = (0..mesh.n_edges() as u32)
-        .filter(|&e| cut[e as usize] && !mesh.is_boundary_edge(e))
-        .map(|e| {
+    (ids, n as usize)
+}
+
+impl Wedges {
+    /// The classes of the wedges of `mesh` opened along `cut`, linked by the seam rotations
+    /// of `uv`; the classes of `cones` and of the boundary pinned.
+    fn new(mesh: &Mesh, cut: &[bool], cones: &[u32], uv: &[C]) -> Result<Wedges> {
+        let nc = mesh.n_corners();
+        let (wedge, nw) = wedge_ids(mesh, cut);
+        let mut b = Bundle::new(nw);
+        // Longest seam edges first: their rotation is measured best and defines the classes.
+        let mut seam: Vec<(f64, u32)> = (0..mesh.n_edges() as u32)
+            .filter(|&e| cut[e as usize] && !mesh.is_boundary_edge(e))
+            .map(|e| {
+                let h = mesh.edge_halfedge(e);
+                let d = sub(uv[mesh.he_next(h) as usize], uv[h as usize]);
+                (d[0].hypot(d[1]), e)
+            })
+            .collect();
+        seam.sort_by(|x, y| y.0.total_cmp(&x.0));
+        for &(_, e) in &seam {
             let h = mesh.edge_halfedge(e);
-            let d = sub(uv[mesh.he_next(h) as usize], uv[h as usize]);
-            (d[0].hypot(d[1]), e)
-        })
-        .collect();
-    seam.sort_by(|x, y| y.0.total_cmp(&x.0));
-    for &(_, e) in &seam {
-        let h = mesh.edge_halfedge(e);
-        let g = mesh.he_twin(h);
-        let (hn, gn) = (mesh.he_next(h), mesh.he_next(g));
-        // h: a → b on side 1; g: b → a on side 2.
-        let d1 = sub(uv[hn as usize], uv[h as usize]);
-        let d2 = sub(uv[g as usize], uv[gn as usize]);
-        if !(d1[0].hypot(d1[1]) > 0.0 && d2[0].hypot(d2[1]) > 0.0) {
-            return Err(Error::numerical("a seam edge has zero length in the map"));
-        }
-        let r = unit(div(d2, d1));
-        b.link(wedge[h as usize], wedge[gn as usize], r);
-        b.link(wedge[hn as usize], wedge[g as usize], r);
-    }
-    let mut is_cone = vec![false; mesh.n_vertices()];
-    for &c in cones {
-        is_cone[c as usize] = true;
-    }
-    for h in 0..nc as u32 {
-        let v = mesh.he_origin(h) as usize;
-        if is_cone[v] || !movable[v] {
-            let (r, _) = b.find(wedge[h as usize]);
-            b.pinned[r as usize] = true;
-        }
-    }
-    // The boundary of the opened surface keeps its place (module docs).
-    for e in 0..mesh.n_edges() as u32 {
-        if mesh.is_boundary_edge(e) {
-            let mut h = mesh.edge_halfedge(e);
-            if mesh.is_boundary_halfedge(h) {
-                h = mesh.he_twin(h);
+            let g = mesh.he_twin(h);
+            let (hn, gn) = (mesh.he_next(h), mesh.he_next(g));
+            // h: a → b on side 1; g: b → a on side 2.
+            let d1 = sub(uv[hn as usize], uv[h as usize]);
+            let d2 = sub(uv[g as usize], uv[gn as usize]);
+            if !(d1[0].hypot(d1[1]) > 0.0 && d2[0].hypot(d2[1]) > 0.0) {
+                return Err(Error::numerical("a seam edge has zero length in the map"));
             }
-            for c in [h, mesh.he_next(h)] {
-                let (r, _) = b.find(wedge[c as usize]);
-                b.pinned[r as usize] = true;
+            let r = unit(div(d2, d1));
+            b.link(wedge[h as usize], wedge[gn as usize], r);
+            b.link(wedge[hn as usize], wedge[g as usize], r);
+        }
+        let roots: Vec<(u32, C)> = (0..nc as u32).map(|h| b.find(wedge[h as usize])).collect();
+        let mut is_cone = vec![false; mesh.n_vertices()];
+        for &c in cones {
+            is_cone[c as usize] = true;
+        }
+        for h in 0..nc {
+            if is_cone[mesh.he_origin(h as u32) as usize] {
+                b.pinned[roots[h].0 as usize] = true;
             }
         }
-    }
-    let roots: Vec<(u32, C)> = (0..nc as u32).map(|h| b.find(wedge[h as usize])).collect();
-    // Fewer than two pinned points: pin the corner farthest from the first pinned one (or
-    // from corner 0) until there are two.
-    for _ in 0..2 {
-        let pinned: Vec<usize> = (0..nc).filter(|&h| b.pinned[roots[h].0 as usize]).collect();
-        let classes = {
-            let mut r: Vec<u32> = pinned.iter().map(|&h| roots[h].0).collect();
-            r.sort_unstable();
-            r.dedup();
-            r.len()
-        };
-        if classes >= 2 {
-            break;
+        // The boundary of the opened surface keeps its place (module docs).
+        for e in 0..mesh.n_edges() as u32 {
+            if mesh.is_boundary_edge(e) {
+                let mut h = mesh.edge_halfedge(e);
+                if mesh.is_boundary_halfedge(h) {
+                    h = mesh.he_twin(h);
+                }
+                for c in [h, mesh.he_next(h)] {
+                    b.pinned[roots[c as usize].0 as usize] = true;
+                }
+            }
         }
-        let from = pinned.first().map_or(uv[0], |&h| uv[h]);
-        let far = (0..nc)
-            .filter(|&h| !b.pinned[roots[h].0 as usize])
-            .max_by(|&x, &y| {
-                let dx = sub(uv[x], from);
-                let dy = sub(uv[y], from);
-                dx[0].hypot(dx[1]).total_cmp(&dy[0].hypot(dy[1]))
-            });
-        let Some(far) = far else { break };
-        b.pinned[roots[far].0 as usize] = true;
+        Ok(Wedges { bundle: b, roots })
     }
-    Ok((b, roots))
+
+    /// Per wedge, whether its class is pinned when only the `movable` vertices move: the
+    /// cones, the boundary, the vertices not `movable`, and at least two pinned in all.
+    fn pinned(&self, mesh: &Mesh, uv: &[C], movable: &[bool]) -> Vec<bool> {
+        let nc = mesh.n_corners();
+        let roots = &self.roots;
+        let mut pinned = self.bundle.pinned.clone();
+        for h in 0..nc {
+            if !movable[mesh.he_origin(h as u32) as usize] {
+                pinned[roots[h].0 as usize] = true;
+            }
+        }
+        // Fewer than two pinned points: pin the corner farthest from the first pinned one (or
+        // from corner 0) until there are two.
+        for _ in 0..2 {
+            let mut on = (0..nc).filter(|&h| pinned[roots[h].0 as usize]);
+            let first = on.next();
+            if first.is_some_and(|f| on.any(|h| roots[h].0 != roots[f].0)) {
+                break;
+            }
+            let from = first.map_or(uv[0], |h| uv[h]);
+            let far = (0..nc)
+                .filter(|&h| !pinned[roots[h].0 as usize])
+                .max_by(|&x, &y| {
+                    let dx = sub(uv[x], from);
+                    let dy = sub(uv[y], from);
+                    dx[0].hypot(dx[1]).total_cmp(&dy[0].hypot(dy[1]))
+                });
+            let Some(far) = far else { break };
+            pinned[roots[far].0 as usize] = true;
+        }
+        pinned
+    }
 }
 
 /// The least-squares conformal refinement (module docs) of the corner UVs `uv[3f + i]` of
-/// `mesh` (3D `positions`) opened along `cut`, with the wedges of `cones` and of vertices not
-/// `movable` pinned, face `f`'s energy multiplied by `boost[f]`. Returns the new corner UVs;
-/// the caller checks them for folds.
+/// `mesh` (3D `positions`) with the wedge classes `wedges` of its cut, the wedges of vertices
+/// not `movable` pinned, face `f`'s energy multiplied by `boost[f]`. Returns the new corner
+/// UVs; the caller checks them for folds.
 fn refine(
     positions: &[[f64; 3]],
     mesh: &Mesh,
-    cut: &[bool],
-    cones: &[u32],
+    wedges: &Wedges,
     uv: &[C],
     movable: &[bool],
     boost: &[f64],
 ) -> Result<Vec<C>> {
     let nc = mesh.n_corners();
-    let (b, roots) = wedge_classes(mesh, cut, cones, uv, movable)?;
-    let nw = b.parent.len();
+    let pinned = wedges.pinned(mesh, uv, movable);
+    let (parent, roots) = (&wedges.bundle.parent, &wedges.roots);
+    let nw = parent.len();
     let mut col = vec![u32::MAX; nw];
     let mut n = 0usize;
     for (w, c) in col.iter_mut().enumerate() {
-        if b.parent[w] == w as u32 && !b.pinned[w] {
+        if parent[w] == w as u32 && !pinned[w] {
             *c = n as u32;
             n += 1;
         }
@@ -393,6 +423,7 @@ pub(super) fn improve(
     folds: usize,
 ) -> Option<Vec<C>> {
     let faces = mesh.faces();
+    let wedges = Wedges::new(mesh, cut, cones, uv).ok()?;
     let d = face_distortions(positions, faces, uv);
     let mut boost = vec![1.0; faces.len()];
     if folds > 0 {
@@ -401,7 +432,7 @@ pub(super) fn improve(
         let mut stalled = 0;
         for round in 1..=ROUNDS {
             let movable = grow(mesh, &bad, RINGS * round);
-            let cand = refine(positions, mesh, cut, cones, uv, &movable, &boost).ok()?;
+            let cand = refine(positions, mesh, &wedges, uv, &movable, &boost).ok()?;
             let left = unresolved_flags(faces, &cand);
             let unresolved = left.iter().filter(|&&x| x).count();
             if unresolved == 0 {
@@ -425,7 +456,7 @@ pub(super) fn improve(
     let before = stats(&d).qc_p95;
     let top: Vec<bool> = d.iter().map(|x| x.qc() > before).collect();
     let movable = grow(mesh, &top, RINGS);
-    let cand = refine(positions, mesh, cut, cones, uv, &movable, &boost).ok()?;
+    let cand = refine(positions, mesh, &wedges, uv, &movable, &boost).ok()?;
     let after = uv_stats(positions, faces, &cand).qc_p95;
     let left = unresolved_flags(faces, &cand)
         .iter()
