@@ -206,6 +206,8 @@ pub fn domain_spline(
         fit_seconds,
         t0,
     );
+    // shared_keys says 0 (the per-cylinder fit has none)
+    report["t_junctions"] = json!(fit.mesh.n_t_junctions());
     Ok(DomainSpline {
         fit,
         patches,

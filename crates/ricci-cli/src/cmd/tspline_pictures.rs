@@ -18,6 +18,8 @@ const EDGE: [f32; 3] = [0.12, 0.12, 0.16];
 const STRIP: [f32; 3] = [0.05, 0.2, 0.75];
 /// Colour of the rings around the zeros (domain mesh).
 const ZERO: [f32; 3] = [1.0, 0.5, 0.0];
+/// T-junctions of the domain mesh (issue 18: "the T-mesh on the surface with T-junctions in red").
+const T_JUNCTION: [f32; 3] = [0.85, 0.05, 0.05];
 /// At most about this many cell sides are drawn: on a finer mesh only every `stride`-th knot
 /// line (the strips' sides always).
 const DRAWN_CELLS: usize = 2000;
@@ -62,19 +64,32 @@ pub struct DomainPictures {
     pub segments_per_cell_side: usize,
     pub triangles: usize,
     pub zeros: usize,
+    pub t_junctions: usize,
 }
 
 /// The domain-mesh spline as one welded triangle mesh: every cell's Bézier patch on a
 /// `k × k` grid, points shared by two patches merged (the spline is C⁰, so they agree up to
 /// rounding: merged when equal to `1e-9` of `scale`); and, per domain-mesh vertex that is a
-/// zero, its index in the tessellation.
-fn tessellate(fit: &DomainFit, k: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<u32>) {
+/// zero, its index in the tessellation, then the same per T-junction.
+type Tessellation = (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<u32>, Vec<u32>);
+
+fn tessellate(fit: &DomainFit, k: usize) -> Tessellation {
     let mesh = &fit.mesh;
     let eps = 1e-9 * fit.scale.max(f64::MIN_POSITIVE);
     let mut index: HashMap<[i64; 3], u32> = HashMap::new();
     let mut positions = Vec::new();
     let mut triangles = Vec::with_capacity(2 * k * k * mesh.n_cells());
     let mut zeros: HashMap<u32, u32> = HashMap::new();
+    let mut tees: HashMap<u32, u32> = HashMap::new();
+    let tee_cells: HashMap<u32, ()> = mesh
+        .tjunctions
+        .iter()
+        .flat_map(|t| &t.junctions)
+        .map(|&(r, i, j, _)| {
+            let rc = &mesh.rects[r as usize];
+            ((rc.first_cell + j as usize * rc.m + i as usize) as u32, ())
+        })
+        .collect();
     let mut ids = vec![0u32; (k + 1) * (k + 1)];
     for c in 0..mesh.n_cells() as u32 {
         let p = mesh.patch(c, &fit.control, 0.0, 0.0);
@@ -108,24 +123,36 @@ fn tessellate(fit: &DomainFit, k: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<u
                 zeros.entry(v).or_insert(ids[at[q]]);
             }
         }
+        if tee_cells.contains_key(&c) {
+            tees.insert(c, ids[0]);
+        }
     }
     let mut z: Vec<(u32, u32)> = zeros.into_iter().collect();
     z.sort_unstable();
+    let mut t: Vec<(u32, u32)> = tees.into_iter().collect();
+    t.sort_unstable();
     (
         positions,
         triangles,
         z.into_iter().map(|(_, i)| i).collect(),
+        t.into_iter().map(|(_, i)| i).collect(),
     )
 }
 
 /// The images of the cells' left and bottom sides (each side once: every side is the left or
 /// the bottom side of a cell) on every `stride`-th knot line of each strip and on the strips'
-/// sides, with `per_side` segments each; the strips' sides in their own colour.
+/// sides, with `per_side` segments each; the strips' sides in their own colour; sides on no
+/// line of the T-mesh (a graded line past its T-junction) left out.
 fn cell_sides(fit: &DomainFit, stride: usize, per_side: usize) -> Vec<Polyline> {
     let mesh = &fit.mesh;
     let mut out = Vec::new();
     for c in 0..mesh.n_cells() as u32 {
-        let (_, i, j) = mesh.cell_at[c as usize];
+        let (r, i, j) = mesh.cell_at[c as usize];
+        let (r, iu, ju) = (r as usize, i as usize, j as usize);
+        let on = [
+            mesh.on_line_v(r, iu, ju) && mesh.on_line_v(r, iu, ju + 1),
+            mesh.on_line_u(r, iu, ju) && mesh.on_line_u(r, iu + 1, ju),
+        ];
         let p = mesh.patch(c, &fit.control, 0.0, 0.0);
         let along = |vertical: bool| -> Vec<[f64; 3]> {
             (0..=per_side)
@@ -139,7 +166,10 @@ fn cell_sides(fit: &DomainFit, stride: usize, per_side: usize) -> Vec<Polyline> 
                 })
                 .collect()
         };
-        for (k, vertical) in [(i as usize, true), (j as usize, false)] {
+        for (k, vertical) in [(iu, true), (ju, false)] {
+            if !on[usize::from(!vertical)] {
+                continue;
+            }
             if k == 0 {
                 out.push(line(along(vertical), STRIP, 1.8, false));
             } else if k % stride == 0 {
@@ -163,11 +193,16 @@ pub fn domain_pictures(
     let budget = ((TRIANGLES / (2 * cells)) as f64).sqrt().floor() as usize;
     let k = per_side.min(budget).max(1);
     let stride = ((cells as f64 / DRAWN_CELLS as f64).sqrt().ceil() as usize).max(1);
-    let (positions, triangles, zeros) = tessellate(fit, k);
+    let (positions, triangles, zeros, tees) = tessellate(fit, k);
     let mut polylines = cell_sides(fit, stride, 4);
     for &z in &zeros {
         let mut ring = crate::util::ring_marker(&positions, &triangles, z, 0.02, ZERO);
         ring.width = 3.0;
+        polylines.push(ring);
+    }
+    for &t in &tees {
+        let mut ring = crate::util::ring_marker(&positions, &triangles, t, 0.012, T_JUNCTION);
+        ring.width = 2.5;
         polylines.push(ring);
     }
     let (net, zebra) = render_net_and_zebra(&positions, &triangles, polylines, opts)?;
@@ -176,6 +211,7 @@ pub fn domain_pictures(
         segments_per_cell_side: k,
         triangles: triangles.len(),
         zeros: zeros.len(),
+        t_junctions: tees.len(),
     };
     Ok((net, zebra, info))
 }
@@ -191,8 +227,13 @@ pub fn domain_caption(info: &DomainPictures, cells: usize) -> String {
         format!("the sides of all {cells} cells")
     };
     format!(
-        "The domain mesh on the surface: {lines} mapped through the spline in dark grey, the strips' sides (critical horizontal trajectories of the 1-form and the vertical sides through its zeros) in blue, and the {} zeros of the form — the extraordinary points, where the spline is C⁰ — ringed in orange. The mesh is conforming: no T-junctions.",
-        info.zeros
+        "The domain mesh on the surface: {lines} mapped through the spline in dark grey, the strips' sides (critical horizontal trajectories of the 1-form and the vertical sides through its zeros) in blue, and the {} zeros of the form — the extraordinary points, where the spline is C⁰ — ringed in orange. {}",
+        info.zeros,
+        if info.t_junctions > 0 {
+            format!("The graded lines at the zeros end in the {} T-junctions ringed in red (the T-mesh; its sides only are drawn).", info.t_junctions)
+        } else {
+            "The mesh is conforming: no T-junctions.".to_string()
+        }
     )
 }
 

@@ -13,7 +13,9 @@
 //! are the free values of the mesh's [`super::domain_mesh::Reduction`]: the fitted net is G¹ at
 //! every zero ([`DomainFitOptions::g1_at_zeros`]), and the graded lines end in T-junctions
 //! [`T_MARGIN`] cells beyond the corner blocks ([`DomainFitOptions::t_junctions`],
-//! [`DomainMesh::with_t_junctions`]): the control points are the T-mesh's anchors.
+//! [`DomainMesh::with_t_junctions`]): the control points are the T-mesh's anchors. While a
+//! point beside a graded line past its T-junction ([`DomainMesh::past_t_junction`]) is beyond
+//! the tolerance, the lines are extended by two cells (instead of a finer spacing).
 
 use super::cylinder_fit::GenusStep;
 use super::domain_mesh::DomainMesh;
@@ -228,13 +230,12 @@ fn solve(
 fn domain_mesh(
     domain: &GenusDomain,
     gluing: &Gluing,
-    spacing: f64,
-    levels: usize,
+    (spacing, levels, margin): (f64, usize, usize),
     opts: &DomainFitOptions,
 ) -> Result<DomainMesh> {
     let mesh = DomainMesh::graded(domain, gluing, spacing, levels).map_err(Error::numerical)?;
     if opts.t_junctions && opts.g1_at_zeros && levels > 0 {
-        mesh.with_t_junctions(T_MARGIN).map_err(Error::numerical)
+        mesh.with_t_junctions(margin).map_err(Error::numerical)
     } else {
         Ok(mesh)
     }
@@ -246,8 +247,7 @@ fn domain_mesh(
 fn fill_budget(
     domain: &GenusDomain,
     gluing: &Gluing,
-    spacing: f64,
-    levels: usize,
+    (spacing, levels, margin): (f64, usize, usize),
     count: usize,
     opts: &DomainFitOptions,
 ) -> Result<Option<DomainMesh>> {
@@ -257,7 +257,8 @@ fn fill_budget(
     }
     let base = spacing * (count as f64 / budget as f64).sqrt();
     for k in 0..6 {
-        let mesh = domain_mesh(domain, gluing, base * (1.0 + 0.03 * k as f64), levels, opts)?;
+        let at = (base * (1.0 + 0.03 * k as f64), levels, margin);
+        let mesh = domain_mesh(domain, gluing, at, opts)?;
         let n = mesh.n_control_points();
         if n <= count {
             return Ok(None);
@@ -437,9 +438,9 @@ pub fn fit_domain_mesh_on_triangles(
     let mut last: Option<DomainFit> = None;
     let refine = opts.refine.clamp(0.1, 0.95);
     let mut filled = false;
-    let (mut levels, mut previous_spacing) = (0, spacing);
+    let (mut levels, mut previous_spacing, mut margin) = (0, spacing, T_MARGIN);
     for _ in 0..opts.max_iterations.max(1) {
-        let mut mesh = domain_mesh(domain, gluing, spacing, levels, opts)?;
+        let mut mesh = domain_mesh(domain, gluing, (spacing, levels, margin), opts)?;
         if let Some(prev) = last
             .as_ref()
             .filter(|_| mesh.n_control_points() > opts.max_control_points)
@@ -448,8 +449,7 @@ pub fn fit_domain_mesh_on_triangles(
             match fill_budget(
                 domain,
                 gluing,
-                previous_spacing,
-                levels,
+                (previous_spacing, levels, margin),
                 prev.mesh.n_control_points(),
                 opts,
             )? {
@@ -511,11 +511,13 @@ pub fn fit_domain_mesh_on_triangles(
         });
         let converged = max <= opts.tolerance * scale;
         // where the tolerance is exceeded: next to a zero, elsewhere
-        let (mut near, mut far) = (false, false);
+        let (mut near, mut far, mut extend) = (false, false, false);
         for (&(c, _, _), &e) in located.iter().zip(&errors) {
             if e > opts.tolerance * scale {
                 if opts.local_refinement && levels < MAX_LEVELS && mesh.near_zero(c) {
                     near = true;
+                } else if mesh.past_t_junction(c) {
+                    extend = true;
                 } else {
                     far = true;
                 }
@@ -541,6 +543,9 @@ pub fn fit_domain_mesh_on_triangles(
         }
         if near {
             levels += 1;
+        }
+        if extend {
+            margin += 2;
         }
     }
     last.ok_or_else(|| Error::numerical("domain mesh fit: no iteration ran"))

@@ -321,6 +321,21 @@ impl DomainMesh {
             .map_or(self.n_vertices(), |t| t.anchors.len())
     }
 
+    /// Whether cell `c` lies beside a graded line where it is cut (past its T-junction): an
+    /// error there asks for longer lines, not for a finer mesh.
+    pub fn past_t_junction(&self, c: u32) -> bool {
+        let (r, i, j) = self.cell_at[c as usize];
+        let (r, i, j) = (r as usize, i as usize, j as usize);
+        let Some(k) = self.reach(r) else {
+            return false;
+        };
+        let rc = &self.rects[r];
+        let l = rc.levels;
+        let band_u = (i <= l || i + l + 1 >= rc.m) && 2 * k + 2 <= rc.n && j >= k && j + k < rc.n;
+        let band_v = (j <= l || j + l + 1 >= rc.n) && 2 * k + 2 <= rc.m && i >= k && i + k < rc.m;
+        band_u || band_v
+    }
+
     /// The number of T-junctions (0 on a conforming mesh).
     pub fn n_t_junctions(&self) -> usize {
         self.tjunctions.as_ref().map_or(0, |t| t.junctions.len())
