@@ -346,6 +346,19 @@ fn measure(m: &DomainMesh, control: &[[f64; 3]]) -> ([[f64; 3]; 3], f64) {
     (worst, normal)
 }
 
+/// Chart independent and C² on every side not at a zero (classes 1 and 2 of [`measure`]), the
+/// normals' angle at the zeros at most 1e-6°.
+fn c2_off_the_zeros_and_g1_at_them(name: &str, worst: &[[f64; 3]; 3], normal: f64) {
+    for w in &worst[1..] {
+        assert!(
+            w[0] <= 1e-10 && w[1] <= 1e-9 && w[2] <= 1e-9,
+            "{name}: {}",
+            e3(*w)
+        );
+    }
+    assert!(normal <= 1e-6, "{name}: {normal}°");
+}
+
 /// G¹ at the zeros (issue 18): nets built from random free values of the mesh's reduction are
 /// C¹ in the translation chart across every side at a zero — so the two normals agree along
 /// it — and still C² on every other side; a random net that is not (every control point
@@ -397,14 +410,7 @@ fn domain_mesh_nets_of_the_reduction_are_g1_at_the_zeros_and_c2_elsewhere() {
             "{name}: {}",
             e3(worst[0])
         );
-        for w in &worst[1..] {
-            assert!(
-                w[0] <= 1e-10 && w[1] <= 1e-9 && w[2] <= 1e-9,
-                "{name}: {}",
-                e3(*w)
-            );
-        }
-        assert!(normal <= 1e-6, "{name}: {normal}°");
+        c2_off_the_zeros_and_g1_at_them(&name, &worst, normal);
         assert!(lib.normal_angle_at_zeros <= 1e-6, "{name}: {lib:?}");
         assert!(
             lib.normal_comparisons >= 5 * lib.sides[0],
@@ -648,7 +654,7 @@ fn domain_mesh_fit_errors_and_control_points() {
             eprintln!(
                 "{name} at {:.1} %: domain mesh {} control points, L∞ {:.4} % (recomputed {:.4} %), rms {:.4} %, converged {}, steps {:?}; per-cylinder fit {} control points, L∞ {:.4} %, converged {}",
                 100.0 * tolerance,
-                f.mesh.n_vertices(),
+                f.mesh.n_control_points(),
                 f.steps.last().unwrap().max_error_percent,
                 100.0 * max / side,
                 f.steps.last().unwrap().rms_error_percent,
@@ -684,23 +690,330 @@ fn domain_mesh_fit_errors_and_control_points() {
             eprintln!(
                 "{name} at {:.1} %: local refinement {} control points ({} levels at the zeros, L∞ {:.4} %), uniform {} (L∞ {:.4} %, converged {})",
                 100.0 * tolerance,
-                f.mesh.n_vertices(),
+                f.mesh.n_control_points(),
                 f.levels,
                 f.steps.last().unwrap().max_error_percent,
-                uniform.mesh.n_vertices(),
+                uniform.mesh.n_control_points(),
                 uniform.steps.last().unwrap().max_error_percent,
                 uniform.converged
             );
             assert!(100.0 * max / side <= 100.0 * tolerance, "{name}");
             assert!(
-                f.mesh.n_vertices() < uniform.mesh.n_vertices() || !uniform.converged,
+                f.mesh.n_control_points() < uniform.mesh.n_control_points() || !uniform.converged,
+                "{name} at {tolerance}"
+            );
+            // T-junctions against the conforming grading (whole mesh lines), same tolerance
+            let conforming = fit_domain_mesh(
+                &d,
+                &g,
+                &s.positions,
+                &DomainFitOptions {
+                    t_junctions: false,
+                    ..opts
+                },
+            )
+            .unwrap();
+            eprintln!(
+                "{name} at {:.1} %: T-junctions {} control points ({} T-junctions, {} levels, L∞ {:.4} %), conforming grading {} ({} levels, L∞ {:.4} %, converged {})",
+                100.0 * tolerance,
+                f.mesh.n_control_points(),
+                f.mesh.n_t_junctions(),
+                f.levels,
+                f.steps.last().unwrap().max_error_percent,
+                conforming.mesh.n_control_points(),
+                conforming.levels,
+                conforming.steps.last().unwrap().max_error_percent,
+                conforming.converged
+            );
+            assert_eq!(conforming.mesh.n_t_junctions(), 0, "{name}");
+            if f.levels > 0 {
+                assert!(f.mesh.n_t_junctions() > 0, "{name} at {tolerance}");
+            }
+            assert!(
+                f.mesh.n_control_points() < conforming.mesh.n_control_points()
+                    || !conforming.converged
+                    || f.levels == 0,
                 "{name} at {tolerance}"
             );
             // issue 18's budget: within 20 000 control points at 1 % and 0.5 %
             assert!(
-                f.converged && f.mesh.n_vertices() <= 20_000,
+                f.converged && f.mesh.n_control_points() <= 20_000,
                 "{name} at {tolerance}"
             );
+        }
+    }
+}
+
+/// Knot insertion (Boehm): the coarse cubic B-spline is the combination of the fine ones,
+/// evaluated here by Cox–de Boor on both sides.
+#[test]
+fn knot_insertion_writes_the_coarse_b_spline_in_the_fine_ones() {
+    use ricci::spline::tspline::domain_mesh::knot_insertion;
+    let mut rng = Rng(0xda942042e4dd58b5);
+    for _ in 0..50 {
+        let mut xi = [0.0; 5];
+        for k in 1..5 {
+            xi[k] = xi[k - 1] + 0.1 + rng.next();
+        }
+        let mut t: Vec<(f64, bool)> = xi.iter().map(|&x| (x, false)).collect();
+        for _ in 0..1 + (rng.next() * 6.0) as usize {
+            t.push((xi[0] + rng.next() * (xi[4] - xi[0]), true));
+        }
+        t.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap());
+        let (knots, new): (Vec<f64>, Vec<bool>) = t.into_iter().unzip();
+        let a = knot_insertion(xi, &knots, &new);
+        assert_eq!(a.len(), knots.len() - 4);
+        let mut worst = 0.0f64;
+        for s in 0..200 {
+            let x = xi[0] + (s as f64 + 0.5) / 200.0 * (xi[4] - xi[0]);
+            let fine: f64 = (0..a.len())
+                .map(|k| a[k] * bspline(&std::array::from_fn(|q| knots[k + q]), x))
+                .sum();
+            worst = worst.max((fine - bspline(&xi, x)).abs());
+        }
+        assert!(worst <= 1e-12, "{xi:?} {knots:?}: {worst:e}");
+    }
+}
+
+/// The T-mesh of a strip from the library's lines: per point `(i, j)`, whether a line along
+/// `v` / along `u` passes; edges between neighbouring points on one line.
+struct StripLines {
+    m: usize,
+    n: usize,
+    on_v: Vec<Vec<bool>>,
+    on_u: Vec<Vec<bool>>,
+}
+
+impl StripLines {
+    fn new(m: &DomainMesh, r: usize) -> Self {
+        let rc = &m.rects[r];
+        StripLines {
+            m: rc.m,
+            n: rc.n,
+            on_v: (0..=rc.m)
+                .map(|i| (0..=rc.n).map(|j| m.on_line_v(r, i, j)).collect())
+                .collect(),
+            on_u: (0..=rc.m)
+                .map(|i| (0..=rc.n).map(|j| m.on_line_u(r, i, j)).collect())
+                .collect(),
+        }
+    }
+
+    /// The edge along `v` from `(i, j)` to `(i, j + 1)`, along `u` from `(i, j)` to `(i + 1, j)`.
+    fn edge_v(&self, i: usize, j: usize) -> bool {
+        self.on_v[i][j] && self.on_v[i][j + 1]
+    }
+
+    fn edge_u(&self, i: usize, j: usize) -> bool {
+        self.on_u[i][j] && self.on_u[i + 1][j]
+    }
+
+    /// T-junctions inside the strip: `(i, j, along_v)` where a line ends on a crossing line.
+    fn t_junctions(&self) -> Vec<(usize, usize, bool)> {
+        let mut out = Vec::new();
+        for i in 1..self.m {
+            for j in 1..self.n {
+                let v = [self.edge_v(i, j - 1), self.edge_v(i, j)];
+                let u = [self.edge_u(i - 1, j), self.edge_u(i, j)];
+                let count = v.iter().chain(&u).filter(|&&e| e).count();
+                if count == 3 {
+                    out.push((i, j, v[0] != v[1]));
+                }
+            }
+        }
+        out
+    }
+
+    /// The extension of a T-junction (Li et al. 2012 §3, cubic): two crossing lines ahead into
+    /// the faces, one behind along the edge; `(line, from, to)` in point indices, clipped to
+    /// the strip.
+    fn extension(&self, i: usize, j: usize, along_v: bool) -> (usize, usize, usize) {
+        let (line, at, len) = if along_v {
+            (i, j, self.n)
+        } else {
+            (j, i, self.m)
+        };
+        let crossed = |k: usize| {
+            if along_v {
+                self.on_u[i][k]
+            } else {
+                self.on_v[k][j]
+            }
+        };
+        let edge = |k: usize| {
+            if along_v {
+                self.edge_v(i, k)
+            } else {
+                self.edge_u(k, j)
+            }
+        };
+        // the missing edge is ahead (up / right) when the one from `at` is absent
+        let ahead_missing = !edge(at);
+        let walk = |forward: bool, count: usize| {
+            let (mut k, mut seen) = (at as isize, 0);
+            while seen < count {
+                k += if forward { 1 } else { -1 };
+                if k <= 0 || k >= len as isize {
+                    return k.clamp(0, len as isize) as usize;
+                }
+                if crossed(k as usize) {
+                    seen += 1;
+                }
+            }
+            k as usize
+        };
+        let (face, edge_end) = (walk(ahead_missing, 2), walk(!ahead_missing, 1));
+        (line, face.min(edge_end), face.max(edge_end))
+    }
+}
+
+/// The T-spline knots of the anchor at `(i, j)` of a strip along one direction by ray casting
+/// in the strip (`None` if a ray leaves it): the first two lines crossed each way.
+fn local_knots(at: usize, len: usize, crossed: impl Fn(usize) -> bool) -> Option<[usize; 5]> {
+    let mut back = Vec::new();
+    let mut k = at;
+    while back.len() < 2 {
+        k = k.checked_sub(1)?;
+        if crossed(k) {
+            back.push(k);
+        }
+    }
+    let mut ahead = Vec::new();
+    let mut k = at;
+    while ahead.len() < 2 {
+        k += 1;
+        if k > len {
+            return None;
+        }
+        if crossed(k) {
+            ahead.push(k);
+        }
+    }
+    Some([back[1], back[0], at, ahead[0], ahead[1]])
+}
+
+/// Graded lines ending in T-junctions (issue 18): the T-mesh is analysis-suitable (checked
+/// here from its lines), its blending functions — from the library's Bézier extraction through
+/// the reduction — are the products of the cubic B-splines on knots found here by ray casting
+/// (Cox–de Boor), sum to one, and every T-spline net is chart independent, C² across every
+/// side not at a zero and G¹ at the zeros; with fewer control points than the full mesh.
+#[test]
+fn domain_mesh_with_t_junctions_is_an_analysis_suitable_t_spline() {
+    let mut rng = Rng(0x6a09e667f3bcc909);
+    for (name, s) in genus_two_cases() {
+        let h = forms(&s);
+        let d = best_genus_domain(&h, s.positions.len()).unwrap();
+        let g = gluing(&d).unwrap();
+        let l = d
+            .cylinders
+            .iter()
+            .map(|c| c.circumference)
+            .fold(0.0, f64::max);
+        for (k, levels, margin) in [(12.0, 2, 1), (12.0, 3, 0), (25.0, 3, 1)] {
+            let full = DomainMesh::graded(&d, &g, l / k, levels).unwrap();
+            let nv = full.n_vertices();
+            let m = full.with_t_junctions(margin).unwrap();
+            let name = format!("{name} at L/{k}, {levels} levels, margin {margin}");
+            let tj = m.tjunctions.clone().unwrap();
+            // analysis-suitable: no extension along u meets one along v (strip by strip)
+            let mut found = 0;
+            for r in 0..m.rects.len() {
+                let lines = StripLines::new(&m, r);
+                let ts = lines.t_junctions();
+                found += ts.len();
+                let ext: Vec<_> = ts
+                    .iter()
+                    .map(|&(i, j, v)| (v, lines.extension(i, j, v)))
+                    .collect();
+                for &(va, (la, a0, a1)) in &ext {
+                    for &(vb, (lb, b0, b1)) in &ext {
+                        if va && !vb {
+                            // along v: column la, rows a0..a1; along u: row lb, columns b0..b1
+                            let meet = (b0..=b1).contains(&la) && (a0..=a1).contains(&lb);
+                            assert!(!meet, "{name}: strip {r}: extensions meet");
+                        }
+                    }
+                }
+            }
+            eprintln!(
+                "{name}: {} anchors of {nv} vertices ({} modified), {} T-junctions ({found} found here), {} free values",
+                m.n_control_points(),
+                tj.modified,
+                m.n_t_junctions(),
+                m.reduction.free
+            );
+            assert_eq!(found, m.n_t_junctions(), "{name}");
+            assert!(found > 0 && m.n_control_points() < nv, "{name}");
+            // partition of unity through the reduction
+            let mut pu = 0.0f64;
+            for c in 0..m.n_cells() as u32 {
+                let (a, b) = (rng.next(), rng.next());
+                let sum: f64 = m.reduce(&m.blending(c, a, b)).iter().map(|x| x.1).sum();
+                pu = pu.max((sum - 1.0).abs());
+            }
+            assert!(pu <= 1e-10, "{name}: |Σ B − 1| = {pu:e}");
+            // blending functions of the modified anchors against the test's own
+            let mut lower_left = vec![u32::MAX; m.n_vertices()];
+            for (c, q) in m.corners.iter().enumerate().rev() {
+                lower_left[q[0] as usize] = c as u32;
+            }
+            let (mut checked, mut worst) = (0, 0.0f64);
+            for &(v, f) in &tj.anchors {
+                if f == u32::MAX || m.is_zero(v) {
+                    continue;
+                }
+                let (r, i, j) = m.cell_at[lower_left[v as usize] as usize];
+                let (r, i, j) = (r as usize, i as usize, j as usize);
+                let rc = &m.rects[r];
+                let lines = StripLines::new(&m, r);
+                let (Some(ku), Some(kv)) = (
+                    local_knots(i, rc.m, |x| lines.on_v[x][j]),
+                    local_knots(j, rc.n, |y| lines.on_u[i][y]),
+                ) else {
+                    continue;
+                };
+                // only anchors some of whose rays skip a point of the full mesh
+                if ku[4] - ku[0] == 4 && kv[4] - kv[0] == 4 {
+                    continue;
+                }
+                checked += 1;
+                let xu = ku.map(|x| rc.x(x));
+                let yv = kv.map(|y| rc.y(y));
+                for ci in ku[0].saturating_sub(1)..(ku[4] + 1).min(rc.m) {
+                    for cj in kv[0].saturating_sub(1)..(kv[4] + 1).min(rc.n) {
+                        let cell = (rc.first_cell + cj * rc.m + ci) as u32;
+                        for _ in 0..3 {
+                            let (a, b) = (rng.next(), rng.next());
+                            let x = rc.x(ci) + a * (rc.x(ci + 1) - rc.x(ci));
+                            let y = rc.y(cj) + b * (rc.y(cj + 1) - rc.y(cj));
+                            let want = bspline(&xu, x) * bspline(&yv, y);
+                            let got: f64 = m
+                                .reduce(&m.blending(cell, a, b))
+                                .iter()
+                                .filter(|e| e.0 == f)
+                                .map(|e| e.1)
+                                .sum();
+                            worst = worst.max((got - want).abs());
+                        }
+                    }
+                }
+            }
+            eprintln!("{name}: {checked} modified anchors' blending functions, largest difference {worst:e}");
+            assert!(checked > 0 && worst <= 1e-10, "{name}: {checked} {worst:e}");
+            // random T-spline nets: chart independent, C² off the zeros, G¹ at them
+            let free: Vec<[f64; 3]> = (0..m.reduction.free)
+                .map(|_| [rng.next(), rng.next(), rng.next()])
+                .collect();
+            let net = m.expand(&free);
+            let (worst, normal) = measure(&m, &net);
+            eprintln!(
+                "{name}: T-spline net: jumps at the zeros {}, one interval {}, farther {}, normal angle at the zeros {normal:.2e}°",
+                e3(worst[0]),
+                e3(worst[1]),
+                e3(worst[2])
+            );
+            assert!(worst[0][0] <= 1e-10 && worst[0][1] <= 1e-9, "{name}");
+            c2_off_the_zeros_and_g1_at_them(&name, &worst, normal);
         }
     }
 }

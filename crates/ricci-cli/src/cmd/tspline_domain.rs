@@ -2,7 +2,9 @@
 //! mesh of knot intervals over the whole domain manifold (the strips of the cylinders of a
 //! holomorphic 1-form glued by translations; `ricci::spline::tspline::{domain_mesh,
 //! domain_fit, domain_continuity}`, paper 003 §2–3), fitted by least squares, refined at the
-//! zeros (a conforming mesh graded towards them) while the error there exceeds the tolerance
+//! zeros (graded towards them, the graded lines ending in T-junctions a cell beyond the zeros'
+//! corner blocks: JSON `t_junctions`, `control_points` = the T-mesh's vertices; `spline.json`'s
+//! `control` is the net of the full graded mesh they span) while the error there exceeds the tolerance
 //! and uniformly while it is exceeded elsewhere. Two fits: the input vertices only, and with
 //! points on the input triangles (centroid, edge midpoints) too; the one nearer the triangles
 //! between the vertices is kept (JSON `max_deviation_between_vertices_percent`,
@@ -181,7 +183,9 @@ pub fn domain_spline(
         "filled_loops": filled_json(filled),
         "strips": strips,
         "cells": mesh.n_cells(),
-        "control_points": mesh.n_vertices(),
+        "control_points": mesh.n_control_points(),
+        "t_junctions": mesh.n_t_junctions(),
+        "mesh_vertices": mesh.n_vertices(),
         "bezier_patches": patches.len(),
         "continuity": continuity,
         "gluing_mismatch": gluing.mismatch,
@@ -202,6 +206,8 @@ pub fn domain_spline(
         fit_seconds,
         t0,
     );
+    // shared_keys says 0 (the per-cylinder fit has none)
+    report["t_junctions"] = json!(fit.mesh.n_t_junctions());
     Ok(DomainSpline {
         fit,
         patches,

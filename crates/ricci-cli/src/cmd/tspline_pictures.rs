@@ -18,6 +18,8 @@ const EDGE: [f32; 3] = [0.12, 0.12, 0.16];
 const STRIP: [f32; 3] = [0.05, 0.2, 0.75];
 /// Colour of the rings around the zeros (domain mesh).
 const ZERO: [f32; 3] = [1.0, 0.5, 0.0];
+/// T-junctions of the domain mesh (issue 18: "the T-mesh on the surface with T-junctions in red").
+const T_JUNCTION: [f32; 3] = [0.85, 0.05, 0.05];
 /// At most about this many cell sides are drawn: on a finer mesh only every `stride`-th knot
 /// line (the strips' sides always).
 const DRAWN_CELLS: usize = 2000;
@@ -62,12 +64,13 @@ pub struct DomainPictures {
     pub segments_per_cell_side: usize,
     pub triangles: usize,
     pub zeros: usize,
+    pub t_junctions: usize,
 }
 
 /// The domain-mesh spline as one welded triangle mesh: every cell's Bézier patch on a
 /// `k × k` grid, points shared by two patches merged (the spline is C⁰, so they agree up to
 /// rounding: merged when equal to `1e-9` of `scale`); and, per domain-mesh vertex that is a
-/// zero, its index in the tessellation.
+/// zero, its index in the tessellation, then the same per T-junction.
 fn tessellate(fit: &DomainFit, k: usize) -> Tessellation {
     let mesh = &fit.mesh;
     let eps = 1e-9 * fit.scale.max(f64::MIN_POSITIVE);
@@ -75,6 +78,16 @@ fn tessellate(fit: &DomainFit, k: usize) -> Tessellation {
     let mut positions = Vec::new();
     let mut triangles = Vec::with_capacity(2 * k * k * mesh.n_cells());
     let mut zeros: HashMap<u32, u32> = HashMap::new();
+    let mut tees: HashMap<u32, u32> = HashMap::new();
+    let tee_cells: HashMap<u32, ()> = mesh
+        .tjunctions
+        .iter()
+        .flat_map(|t| &t.junctions)
+        .map(|&(r, i, j, _)| {
+            let rc = &mesh.rects[r as usize];
+            ((rc.first_cell + j as usize * rc.m + i as usize) as u32, ())
+        })
+        .collect();
     let mut ids = vec![0u32; (k + 1) * (k + 1)];
     let mut sides = Vec::with_capacity(mesh.n_cells());
     for c in 0..mesh.n_cells() as u32 {
@@ -113,23 +126,30 @@ fn tessellate(fit: &DomainFit, k: usize) -> Tessellation {
                 zeros.entry(v).or_insert(ids[at[q]]);
             }
         }
+        if tee_cells.contains_key(&c) {
+            tees.insert(c, ids[0]);
+        }
     }
     let mut z: Vec<(u32, u32)> = zeros.into_iter().collect();
     z.sort_unstable();
+    let mut t: Vec<(u32, u32)> = tees.into_iter().collect();
+    t.sort_unstable();
     Tessellation {
         positions,
         triangles,
         zeros: z.into_iter().map(|(_, i)| i).collect(),
+        t_junctions: t.into_iter().map(|(_, i)| i).collect(),
         sides,
     }
 }
 
-/// The welded tessellation of [`tessellate`]: per domain-mesh zero its point, per cell the
+/// The welded tessellation of [`tessellate`]: per domain-mesh zero and T-junction its point, per cell the
 /// points of its left and bottom sides (`k + 1` each, bottom to top and left to right).
 struct Tessellation {
     positions: Vec<[f64; 3]>,
     triangles: Vec<[u32; 3]>,
     zeros: Vec<u32>,
+    t_junctions: Vec<u32>,
     sides: Vec<[Vec<u32>; 2]>,
 }
 
@@ -187,7 +207,8 @@ fn outward_normals(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<[f64; 
 /// The images of the cells' left and bottom sides (each side once: every side is the left or
 /// the bottom side of a cell) on every `stride`-th knot line of each strip and on the strips'
 /// sides, along the tessellation's points (the lines lie on the rendered surface), only their
-/// pieces facing the viewer ([`facing_pieces`]); the strips' sides in their own colour.
+/// pieces facing the viewer ([`facing_pieces`]); the strips' sides in their own colour; sides
+/// on no line of the T-mesh (a graded line past its T-junction) left out.
 fn cell_sides(
     fit: &DomainFit,
     t: &Tessellation,
@@ -197,8 +218,18 @@ fn cell_sides(
     let normals = outward_normals(&t.positions, &t.triangles);
     let mut out = Vec::new();
     for (c, sides) in t.sides.iter().enumerate() {
-        let (_, i, j) = fit.mesh.cell_at[c];
-        for (k, ids) in [(i as usize, &sides[0]), (j as usize, &sides[1])] {
+        let (r, i, j) = fit.mesh.cell_at[c];
+        let (r, iu, ju) = (r as usize, i as usize, j as usize);
+        let mesh = &fit.mesh;
+        // a side on no line of the T-mesh (a graded line past its T-junction) is left out
+        let on = [
+            mesh.on_line_v(r, iu, ju) && mesh.on_line_v(r, iu, ju + 1),
+            mesh.on_line_u(r, iu, ju) && mesh.on_line_u(r, iu + 1, ju),
+        ];
+        for (k, ids, on) in [(iu, &sides[0], on[0]), (ju, &sides[1], on[1])] {
+            if !on {
+                continue;
+            }
             let (color, width) = match k {
                 0 => (STRIP, 1.8),
                 k if k % stride == 0 => (EDGE, 0.8),
@@ -239,12 +270,18 @@ pub fn domain_pictures(
         ring.width = 3.0;
         polylines.push(ring);
     }
+    for &v in &t.t_junctions {
+        let mut ring = crate::util::ring_marker(&t.positions, &t.triangles, v, 0.012, T_JUNCTION);
+        ring.width = 2.5;
+        polylines.push(ring);
+    }
     let (net, zebra) = render_net_and_zebra(&t.positions, &t.triangles, polylines, opts)?;
     let info = DomainPictures {
         stride,
         segments_per_cell_side: k,
         triangles: t.triangles.len(),
         zeros: t.zeros.len(),
+        t_junctions: t.t_junctions.len(),
     };
     Ok((net, zebra, info))
 }
@@ -260,8 +297,13 @@ pub fn domain_caption(info: &DomainPictures, cells: usize) -> String {
         format!("the sides of all {cells} cells")
     };
     format!(
-        "The domain mesh on the surface: {lines} mapped through the spline in dark grey, the strips' sides (critical horizontal trajectories of the 1-form and the vertical sides through its zeros) in blue, and the {} zeros of the form — the extraordinary points, where the spline is G¹ — ringed in orange; lines on the far side of the surface are not drawn. The mesh is conforming: no T-junctions.",
-        info.zeros
+        "The domain mesh on the surface: {lines} mapped through the spline in dark grey, the strips' sides (critical horizontal trajectories of the 1-form and the vertical sides through its zeros) in blue, and the {} zeros of the form — the extraordinary points, where the spline is G¹ — ringed in orange; lines on the far side of the surface are not drawn. {}",
+        info.zeros,
+        if info.t_junctions > 0 {
+            format!("The graded lines at the zeros end in the {} T-junctions ringed in red (the T-mesh; its sides only are drawn).", info.t_junctions)
+        } else {
+            "The mesh is conforming: no T-junctions.".to_string()
+        }
     )
 }
 

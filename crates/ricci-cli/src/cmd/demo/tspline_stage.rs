@@ -107,7 +107,7 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
     }
     sec.headline = format!(
         "{} control points on {cells} cells, L∞ {max:.3}% / rms {rms:.3}%, {} at the {zeros} zeros, {} elsewhere",
-        r.fit.mesh.n_vertices(),
+        r.fit.mesh.n_control_points(),
         class("at_zeros"),
         class("elsewhere")
     );
@@ -119,8 +119,10 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
          divided into cells (knot intervals), the same number along every chain of glued \
          strips, so the cells form one conforming quad mesh of the closed surface (valence 4 \
          everywhere but at the zeros); near the zeros the cells are graded, halving towards \
-         them, so the mesh is fine only where the error asks for it. One cubic spline lives on it: \
-         one control point per mesh vertex, each cell a bicubic Bézier patch whose points are \
+         them, and the graded lines end in T-junctions a cell beyond the zeros' corner blocks \
+         ({} T-junctions), so the mesh is fine only where the error asks for it. One cubic \
+         T-spline lives on it: one control point per vertex of the T-mesh (local knot vectors \
+         by ray casting, knot insertion into the full graded mesh), each cell a bicubic Bézier patch whose points are \
          blossoms of the B-spline over the neighbouring intervals (at a zero: the mean of the \
          first side points around it). Its control points are fitted to the surface's vertices \
          by least squares plus thin-plate fairness, under linear conditions that make the \
@@ -129,6 +131,7 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         surface.positions.len(),
         domain.cylinders.len(),
         r.fit.mesh.rects.len(),
+        r.fit.mesh.n_t_junctions(),
         100.0 * tolerance,
         r.fit.steps.len(),
     ));
@@ -165,7 +168,7 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         } else {
             "the vertices are the only data"
         },
-        r.fit.mesh.n_vertices(),
+        r.fit.mesh.n_control_points(),
         surface.positions.len() as f64 / cells.max(1) as f64
     ));
     sec.tables.push(results_table(
@@ -184,6 +187,7 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "strips": r.fit.mesh.rects.len(),
         "control_points": rep["control_points"],
         "cells": rep["cells"],
+        "mesh_vertices": rep["mesh_vertices"],
         "bezier_patches": rep["bezier_patches"],
         "t_junctions": rep["t_junctions"],
         "iterations": rep["iterations"],
@@ -238,12 +242,12 @@ fn results_table(
                 "cylinders / strips",
                 format!("{cylinders} / {}", r.fit.mesh.rects.len()),
             ),
-            ("control points", r.fit.mesh.n_vertices().to_string()),
+            ("control points", r.fit.mesh.n_control_points().to_string()),
             (
                 "cells = Bézier patches",
                 format!("{cells} = {}", r.patches.len()),
             ),
-            ("T-junctions", "0".into()),
+            ("T-junctions", r.fit.mesh.n_t_junctions().to_string()),
             ("fit steps", r.fit.steps.len().to_string()),
             (
                 "error rms / L∞ (% of the longest side)",

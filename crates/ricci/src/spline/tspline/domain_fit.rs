@@ -11,7 +11,11 @@
 //! or the budget of control points is spent (the last refinement is cut to the largest mesh
 //! within the budget). By default the unknowns
 //! are the free values of the mesh's [`super::domain_mesh::Reduction`]: the fitted net is G¹ at
-//! every zero ([`DomainFitOptions::g1_at_zeros`]).
+//! every zero ([`DomainFitOptions::g1_at_zeros`]), and the graded lines end in T-junctions
+//! [`T_MARGIN`] cells beyond the corner blocks ([`DomainFitOptions::t_junctions`],
+//! [`DomainMesh::with_t_junctions`]): the control points are the T-mesh's anchors. While a
+//! point beside a graded line past its T-junction ([`DomainMesh::past_t_junction`]) is beyond
+//! the tolerance, the lines are extended by two cells (instead of a finer spacing).
 
 use super::cylinder_fit::GenusStep;
 use super::domain_mesh::DomainMesh;
@@ -66,7 +70,16 @@ pub struct DomainFitOptions {
     /// [`fit_domain_mesh_on_triangles`] adds to the least squares: they keep the surface near
     /// the mesh between the vertices, in cells without a vertex too. `0`: vertices only.
     pub between_vertices: f64,
+    /// End the graded lines at the zeros in T-junctions ([`DomainMesh::with_t_junctions`]);
+    /// only with [`Self::g1_at_zeros`] (the T-spline is a reduction of the full mesh's nets).
+    pub t_junctions: bool,
 }
+
+/// Cells beyond a corner block through which a graded line continues before its T-junction.
+/// (Measured: 0, 1, 2, 4 on eight and the generated genus-2 surface at 0.5 % and 1 %; 2 is the
+/// only one with fewer control points than the conforming grading in all four and the
+/// between-vertex distance not above it: BENCHMARKS "Session 15 (tj18)".)
+pub const T_MARGIN: usize = 2;
 
 /// The most levels of refinement at the zeros; beyond, errors there refine uniformly.
 pub const MAX_LEVELS: usize = 8;
@@ -83,6 +96,7 @@ impl Default for DomainFitOptions {
             g1_at_zeros: true,
             local_refinement: true,
             between_vertices: 0.1,
+            t_junctions: true,
         }
     }
 }
@@ -214,25 +228,41 @@ fn solve(
     Ok(out)
 }
 
-/// A mesh with more than `count` and at most `budget` vertices, finer than the one of
-/// `spacing` (which has `count`): the vertices grow about as `1 / spacing²`, so a few spacings
+/// The mesh of `spacing` graded `levels` times at the zeros, its graded lines ending in
+/// T-junctions if `opts` say so.
+fn domain_mesh(
+    domain: &GenusDomain,
+    gluing: &Gluing,
+    (spacing, levels, margin): (f64, usize, usize),
+    opts: &DomainFitOptions,
+) -> Result<DomainMesh> {
+    let mesh = DomainMesh::graded(domain, gluing, spacing, levels).map_err(Error::numerical)?;
+    if opts.t_junctions && opts.g1_at_zeros && levels > 0 {
+        mesh.with_t_junctions(margin).map_err(Error::numerical)
+    } else {
+        Ok(mesh)
+    }
+}
+
+/// A mesh with more than `count` and at most `budget` control points, finer than the one of
+/// `spacing` (which has `count`): they grow about as `1 / spacing²`, so a few spacings
 /// just above `spacing · √(count / budget)` are tried, coarsest last.
 fn fill_budget(
     domain: &GenusDomain,
     gluing: &Gluing,
-    spacing: f64,
-    levels: usize,
+    (spacing, levels, margin): (f64, usize, usize),
     count: usize,
-    budget: usize,
+    opts: &DomainFitOptions,
 ) -> Result<Option<DomainMesh>> {
+    let budget = opts.max_control_points;
     if count >= budget {
         return Ok(None);
     }
     let base = spacing * (count as f64 / budget as f64).sqrt();
     for k in 0..6 {
-        let mesh = DomainMesh::graded(domain, gluing, base * (1.0 + 0.03 * k as f64), levels)
-            .map_err(Error::numerical)?;
-        let n = mesh.n_vertices();
+        let at = (base * (1.0 + 0.03 * k as f64), levels, margin);
+        let mesh = domain_mesh(domain, gluing, at, opts)?;
+        let n = mesh.n_control_points();
         if n <= count {
             return Ok(None);
         }
@@ -411,22 +441,20 @@ pub fn fit_domain_mesh_on_triangles(
     let mut last: Option<DomainFit> = None;
     let refine = opts.refine.clamp(0.1, 0.95);
     let mut filled = false;
-    let (mut levels, mut previous_spacing) = (0, spacing);
+    let (mut levels, mut previous_spacing, mut margin) = (0, spacing, T_MARGIN);
     for _ in 0..opts.max_iterations.max(1) {
-        let mut mesh =
-            DomainMesh::graded(domain, gluing, spacing, levels).map_err(Error::numerical)?;
+        let mut mesh = domain_mesh(domain, gluing, (spacing, levels, margin), opts)?;
         if let Some(prev) = last
             .as_ref()
-            .filter(|_| mesh.n_vertices() > opts.max_control_points)
+            .filter(|_| mesh.n_control_points() > opts.max_control_points)
         {
             // the next refinement is over the budget: one last fit on the largest mesh within it
             match fill_budget(
                 domain,
                 gluing,
-                previous_spacing,
-                levels,
-                prev.mesh.n_vertices(),
-                opts.max_control_points,
+                (previous_spacing, levels, margin),
+                prev.mesh.n_control_points(),
+                opts,
             )? {
                 Some(m) => {
                     mesh = m;
@@ -480,17 +508,19 @@ pub fn fit_domain_mesh_on_triangles(
         let max = errors.iter().fold(0.0f64, |a, &b| a.max(b));
         let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len().max(1) as f64).sqrt();
         steps.push(GenusStep {
-            control_points: mesh.n_vertices(),
+            control_points: mesh.n_control_points(),
             rms_error_percent: 100.0 * rms / scale,
             max_error_percent: 100.0 * max / scale,
         });
         let converged = max <= opts.tolerance * scale;
         // where the tolerance is exceeded: next to a zero, elsewhere
-        let (mut near, mut far) = (false, false);
+        let (mut near, mut far, mut extend) = (false, false, false);
         for (&(c, _, _), &e) in located.iter().zip(&errors) {
             if e > opts.tolerance * scale {
                 if opts.local_refinement && levels < MAX_LEVELS && mesh.near_zero(c) {
                     near = true;
+                } else if mesh.past_t_junction(c) {
+                    extend = true;
                 } else {
                     far = true;
                 }
@@ -516,6 +546,9 @@ pub fn fit_domain_mesh_on_triangles(
         }
         if near {
             levels += 1;
+        }
+        if extend {
+            margin += 2;
         }
     }
     last.ok_or_else(|| Error::numerical("domain mesh fit: no iteration ran"))

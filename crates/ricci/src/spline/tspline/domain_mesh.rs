@@ -68,7 +68,9 @@ pub type Combination = Vec<(u32, f64)>;
 
 /// The quad mesh of knot intervals over the domain manifold and its Bézier extraction.
 mod g1;
+mod tjunctions;
 pub use g1::Reduction;
+pub use tjunctions::{knot_insertion, TJunctions};
 
 #[derive(Debug, Clone)]
 pub struct DomainMesh {
@@ -85,8 +87,11 @@ pub struct DomainMesh {
     pub valence: Vec<u32>,
     /// Per cell: its 16 Bézier points as combinations, `bezier[cell][i][j]`, `i` along `u`.
     pub bezier: Vec<[[Combination; 4]; 4]>,
-    /// The control nets that are G¹ at the zeros: every vertex as a combination of free values.
+    /// The control nets that are G¹ at the zeros: every vertex as a combination of free values
+    /// (with T-junctions: of the T-spline's, [`Self::with_t_junctions`]).
     pub reduction: Reduction,
+    /// The T-mesh when the graded lines end in T-junctions ([`Self::with_t_junctions`]).
+    pub tjunctions: Option<TJunctions>,
 }
 
 /// One strip of one cylinder, cut into `m × n` cells: the two first and the two last columns
@@ -491,6 +496,7 @@ impl DomainMesh {
             valence,
             bezier: Vec::new(),
             reduction: Reduction::default(),
+            tjunctions: None,
         };
         mesh.bezier = (0..cells).map(|c| mesh.extract(c)).collect();
         mesh.points_at_zeros();
