@@ -150,26 +150,10 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         class("elsewhere"),
         sides("elsewhere")
     ));
-    sec.paragraphs.push(format!(
-        "The tolerance is checked at the {} vertices; the surface between them is measured \
-         too: the spline at 16 points of every cell is within {:.2} % (max) and {:.3} % (rms) \
-         of the longest side of the input triangles ({}). With {} control points \
-         ({:.2} vertices per cell) the fairness shapes the cells without a vertex, and the \
-         zebra stripes show where.",
+    sec.paragraphs.push(between_vertices_paragraph(
+        &r,
         surface.positions.len(),
-        num(&r.report["max_deviation_between_vertices_percent"]),
-        num(&r.report["rms_deviation_between_vertices_percent"]),
-        if r.report["between_vertices_data"]
-            .as_str()
-            .unwrap_or("")
-            .starts_with("points")
-        {
-            "points on the triangles are data too"
-        } else {
-            "the vertices are the only data"
-        },
-        r.fit.mesh.n_control_points(),
-        surface.positions.len() as f64 / cells.max(1) as f64
+        cells,
     ));
     sec.tables.push(results_table(
         &r,
@@ -200,6 +184,32 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "seconds": t0.elapsed().as_secs_f64(),
     });
     Ok(sec)
+}
+
+/// The paragraph on the distance between the vertices (`vertices`: the input's; `cells`: the
+/// domain mesh's), from the report of `ricci tspline`.
+fn between_vertices_paragraph(r: &DomainSpline, vertices: usize, cells: usize) -> String {
+    format!(
+        "The tolerance is checked at the {} vertices; the surface between them is measured \
+         too: the spline at 16 points of every cell is within {:.2} % (max) and {:.3} % (rms) \
+         of the longest side of the input triangles ({}). With {} control points \
+         ({:.2} vertices per cell) the fairness shapes the cells without a vertex, and the \
+         zebra stripes show where.",
+        vertices,
+        num(&r.report["max_deviation_between_vertices_percent"]),
+        num(&r.report["rms_deviation_between_vertices_percent"]),
+        if r.report["between_vertices_data"]
+            .as_str()
+            .unwrap_or("")
+            .starts_with("points")
+        {
+            "points on the triangles are data too"
+        } else {
+            "the vertices are the only data"
+        },
+        r.fit.mesh.n_control_points(),
+        vertices as f64 / cells.max(1) as f64
+    )
 }
 
 /// The stage's table: the domain mesh, the fit and its measured continuity, from the report of
