@@ -19,7 +19,8 @@
 //! edge interval `E` at each end of every strip side is cut into `e, e, 2e, …, 2^{L−1} e`
 //! (`e = E / 2^L`): the cells at a zero shrink by `2^L` in both directions while the rest of
 //! the mesh keeps its size; each level adds two columns per strip and two rows per cylinder
-//! (mesh lines through the whole strip: the mesh stays conforming, no T-junction). The two
+//! (mesh lines through the whole strip; [`TJunctions`] then ends each of them in a T-junction
+//! just past the zero's corner block, the T-mesh the fit uses by default). The two
 //! intervals next to every zero stay equal (`e, e`), so everything said below holds as for
 //! `L = 0`.
 //!

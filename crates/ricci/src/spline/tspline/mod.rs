@@ -26,15 +26,17 @@
 //! * [`domain_mesh`] — genus ≥ 2: one conforming quad mesh of knot intervals over all the
 //!   strips glued by translations (the zeros its only irregular vertices) and its spline,
 //!   C² on every cell side not incident to a zero and G¹ at the zeros for the nets that keep
-//!   its linear conditions there, graded towards the zeros for local refinement;
+//!   its linear conditions there, graded towards the zeros for local refinement, the graded
+//!   lines ending in T-junctions past the zeros' corner blocks (`domain_mesh::TJunctions`:
+//!   an analysis-suitable T-mesh whose blending functions are folded into the reduction);
 //!   [`domain_fit`] fits on it (`ricci tspline`'s default for genus ≥ 2; the per-cylinder
 //!   [`cylinder_fit`] is the `--per-cylinder` option); [`domain_continuity`] measures its
 //!   derivative jumps and the normals' angle at the zeros across every cell side.
 //!
 //! Surfaces with boundary loops of genus ≥ 1 use the domain of the surface with its loops
 //! filled by fans ([`genus0::fill_boundary_loops`]; the fills carry no data). What is not here
-//! yet: for genus ≥ 2 T-junctions on the domain mesh (its local refinement is a conforming
-//! grading towards the zeros).
+//! yet: for genus ≥ 2, refinement away from the zeros by local blocks (it refines the whole
+//! mesh there); T-junctions are only where the grading towards the zeros ends.
 
 #![allow(clippy::needless_range_loop)]
 
