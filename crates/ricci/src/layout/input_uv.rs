@@ -37,9 +37,10 @@ pub struct InputUvs<P> {
 }
 
 /// The deck transformations [`face_uvs`] tries, in its order: the identity; the side
-/// pairings in both directions (a face straddling one seam); products of two of them and
-/// `Q_s Q_t⁻¹` for corner maps `Q` (faces at the polygon's corners, where several seams
-/// meet). The second value ends the three levels (identity; pairings; products).
+/// pairings in both directions (a face straddling one seam); products of two of them (not
+/// `x x⁻¹`) and `Q_s Q_t⁻¹` (`s ≠ t`) for corner maps `Q` (faces at the polygon's corners,
+/// where several seams meet). The second value ends the three levels (identity; pairings;
+/// products).
 pub fn candidate_maps<I: Isometry>(group: Option<&DeckGroup<I>>) -> (Vec<I>, [usize; 3]) {
     match group {
         None => (vec![I::identity()], [1, 1, 1]),
@@ -75,16 +76,22 @@ fn candidates<T: Copy>(
     let mut cands = vec![identity];
     let pairs: Vec<T> = pairings.iter().flat_map(|p| [*p, inverse(p)]).collect();
     let mut prods = Vec::new();
-    for x in &pairs {
-        for y in &pairs {
-            prods.push(compose(x, y));
+    // `pairs[2k + 1]` is `pairs[2k]⁻¹`: the products `x x⁻¹` and `Q_s Q_s⁻¹` are the identity
+    // (candidate 0) up to rounding and are left out — same list in every precision.
+    for (a, x) in pairs.iter().enumerate() {
+        for (b, y) in pairs.iter().enumerate() {
+            if b != a ^ 1 {
+                prods.push(compose(x, y));
+            }
         }
     }
     // Around the polygon's corners (copies of the base vertex) the sectors are related by
     // Q_s Q_t⁻¹ (corner maps: P_0 ↦ P_s), which can be long products of pairings.
-    for qs in corner_maps {
-        for qt in corner_maps {
-            prods.push(compose(qs, &inverse(qt)));
+    for (s, qs) in corner_maps.iter().enumerate() {
+        for (t, qt) in corner_maps.iter().enumerate() {
+            if s != t {
+                prods.push(compose(qs, &inverse(qt)));
+            }
         }
     }
     cands.extend(pairs);
