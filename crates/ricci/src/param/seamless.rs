@@ -21,11 +21,17 @@
 //! `π/2` is a holonomy that is one too.
 //!
 //! The constraints `F(x) = 0` (vertex rows but one, which Gauss–Bonnet implies, and the loop
-//! rows) are solved by Newton's method with least-norm steps `δ = Jᵀ (J Jᵀ)⁻¹ (−F)` in the log
-//! lengths `x_e = log ℓ_e` (CSZZ §5 solve the same underdetermined system), with
-//! `∂θ_i/∂x_i = cot θ_j + cot θ_k`, `∂θ_i/∂x_j = −cot θ_k` in a triangle with corners `i, j,
-//! k` and opposite edges `x_i, x_j, x_k`; the step is halved until every triangle is
-//! non-degenerate and `‖F‖` drops. Every transition across the cut graph is then a product of
+//! rows) are solved by Newton's method with weighted least-norm steps
+//! `δ = W Jᵀ (J W Jᵀ + μ d I)⁻¹ (−F)` in the log lengths `x_e = log ℓ_e` (CSZZ §5 solve the
+//! same underdetermined system), with `∂θ_i/∂x_i = cot θ_j + cot θ_k`, `∂θ_i/∂x_j = −cot θ_k`
+//! in a triangle with corners `i, j, k` and opposite edges `x_i, x_j, x_k`. The weight `W_e`
+//! is the least `sin³ θ` over the corners of the edge's two triangles: the plain least-norm
+//! step (`W = I`) piles the holonomy change onto the strip of triangles along each loop, whose
+//! thinnest triangles then degenerate before the targets are met (kitten, eight); weighted,
+//! the change moves to well-shaped triangles. `μ` (Levenberg–Marquardt, `d` the mean diagonal)
+//! is zero unless `J W Jᵀ` is numerically singular or no step along `δ` helps; then it is
+//! raised by 100 at a time. The step is halved until every triangle is non-degenerate and
+//! `‖F‖` drops. Every transition across the cut graph is then a product of
 //! loops around cones and of the basis loops: a rotation by a multiple of 90°.
 
 use crate::error::{Error, Result};
@@ -226,9 +232,28 @@ fn jacobian(mesh: &Mesh, theta: &[f64], loops: &[DualLoop]) -> Vec<Vec<(u32, f64
     rows
 }
 
-/// The least-norm Newton step `δ = Jᵀ (J Jᵀ)⁻¹ (−r)`.
-fn least_norm_step(rows: &[Vec<(u32, f64)>], r: &[f64], ne: usize) -> Result<Vec<f64>> {
-    let m = rows.len();
+/// Per edge, the weight of its log length in the step (module docs): the least `sin³` of the
+/// corner angles of its two triangles, so that edges of nearly degenerate triangles move least.
+fn edge_weights(mesh: &Mesh, theta: &[f64]) -> Vec<f64> {
+    let mut w = vec![1.0f64; mesh.n_edges()];
+    for f in 0..mesh.n_faces() {
+        let s = (0..3).fold(1.0f64, |m, i| m.min(theta[3 * f + i].sin().powi(3)));
+        for e in mesh.face_edges_opposite(f as u32) {
+            w[e as usize] = w[e as usize].min(s);
+        }
+    }
+    w
+}
+
+/// The weighted, damped least-norm Newton step `δ = W Jᵀ (J W Jᵀ + μ d I)⁻¹ (−r)`, `d` the
+/// mean diagonal of `J W Jᵀ`; `None` when that matrix is not numerically positive definite.
+fn least_norm_step(
+    rows: &[Vec<(u32, f64)>],
+    r: &[f64],
+    w: &[f64],
+    mu: f64,
+) -> Result<Option<Vec<f64>>> {
+    let (m, ne) = (rows.len(), w.len());
     let mut cols: Vec<Vec<(u32, f64)>> = vec![Vec::new(); ne];
     for (i, row) in rows.iter().enumerate() {
         for &(e, x) in row {
@@ -236,31 +261,41 @@ fn least_norm_step(rows: &[Vec<(u32, f64)>], r: &[f64], ne: usize) -> Result<Vec
         }
     }
     let mut trip = Vec::new();
-    for col in &cols {
+    let mut diag = vec![0.0; m];
+    for (col, &we) in cols.iter().zip(w) {
         for &(i, a) in col {
             for &(j, b) in col {
                 if j <= i {
-                    trip.push(Triplet::new(i as usize, j as usize, a * b));
+                    trip.push(Triplet::new(i as usize, j as usize, we * a * b));
+                }
+                if j == i {
+                    diag[i as usize] += we * a * b;
                 }
             }
         }
     }
+    if mu > 0.0 {
+        let d = mu * diag.iter().sum::<f64>() / m as f64;
+        trip.extend((0..m).map(|i| Triplet::new(i, i, d)));
+    }
     let a = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &trip)
         .map_err(|_| Error::numerical("seamless: the constraint matrix could not be assembled"))?;
-    let chol = crate::numeric::sparse::Cholesky::factor(a.as_ref()).map_err(|_| {
-        Error::numerical(
-            "seamless: the holonomy constraints are dependent (J Jᵀ is not positive definite)",
-        )
-    })?;
+    let Ok(chol) = crate::numeric::sparse::Cholesky::factor(a.as_ref()) else {
+        return Ok(None);
+    };
     let mut y: Vec<f64> = r.iter().map(|x| -x).collect();
     chol.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut y, m, 1));
     let mut delta = vec![0.0; ne];
     for (i, row) in rows.iter().enumerate() {
         for &(e, x) in row {
-            delta[e as usize] += x * y[i];
+            delta[e as usize] += w[e as usize] * x * y[i];
         }
     }
-    Ok(delta)
+    if delta.iter().all(|d| d.is_finite()) {
+        Ok(Some(delta))
+    } else {
+        Ok(None)
+    }
 }
 
 fn max_abs(r: &[f64]) -> f64 {
@@ -368,36 +403,64 @@ fn newton(
     let mut theta = corner_angles(mesh, Geometry::Euclidean, &l);
     let mut r = residuals(mesh, &theta, angle_sum, loops, targets);
     let mut iterations = 0;
+    // Levenberg–Marquardt damping `μ`: raised when no step along the direction lowers `‖r‖`
+    // (or `J W Jᵀ` is singular), lowered after every accepted step.
+    let mut mu = 0.0f64;
     while max_abs(&r) > tolerance && iterations < budget {
         iterations += 1;
         let rows = jacobian(mesh, &theta, loops);
-        let delta = least_norm_step(&rows, &r, mesh.n_edges())?;
+        let w = edge_weights(mesh, &theta);
         let norm0 = r.iter().map(|x| x * x).sum::<f64>();
-        let mut step = 1.0;
-        let accepted = loop {
-            let trial: Vec<f64> = l
-                .iter()
-                .zip(&delta)
-                .map(|(&x, &d)| x * (step * d).exp())
-                .collect();
-            if valid(mesh, &trial) {
-                let th = corner_angles(mesh, Geometry::Euclidean, &trial);
-                let rt = residuals(mesh, &th, angle_sum, loops, targets);
-                if rt.iter().map(|x| x * x).sum::<f64>() < norm0 {
-                    break Some((trial, th, rt));
-                }
+        let mut accepted = None;
+        for _ in 0..MU_TRIES {
+            if let Some(delta) = least_norm_step(&rows, &r, &w, mu)? {
+                accepted = line_search(mesh, &l, &delta, angle_sum, loops, targets, norm0);
             }
-            step *= 0.5;
-            if step < 1e-6 {
-                break None;
+            if accepted.is_some() {
+                break;
             }
-        };
+            mu = if mu == 0.0 { 1e-10 } else { mu * 100.0 };
+        }
         let Some((nl, th, rt)) = accepted else {
             break;
         };
         (l, theta, r) = (nl, th, rt);
+        mu = if mu < 1e-9 { 0.0 } else { mu / 10.0 };
     }
     Ok((l, theta, r, iterations))
+}
+
+/// Raising `μ` this many times (by 100 from 1e-10) at one Newton step at most.
+const MU_TRIES: usize = 10;
+
+/// Backtracking along `delta` (log lengths): the first of the steps `1, 1/2, …, 2⁻²⁰` that
+/// keeps every triangle valid and lowers `‖r‖²` below `norm0`.
+fn line_search(
+    mesh: &Mesh,
+    l: &[f64],
+    delta: &[f64],
+    angle_sum: &[f64],
+    loops: &[DualLoop],
+    targets: &[f64],
+    norm0: f64,
+) -> Option<(Vec<f64>, Vec<f64>, Vec<f64>)> {
+    let mut step = 1.0;
+    while step >= 1e-6 {
+        let trial: Vec<f64> = l
+            .iter()
+            .zip(delta)
+            .map(|(&x, &d)| x * (step * d).exp())
+            .collect();
+        if valid(mesh, &trial) {
+            let th = corner_angles(mesh, Geometry::Euclidean, &trial);
+            let rt = residuals(mesh, &th, angle_sum, loops, targets);
+            if rt.iter().map(|x| x * x).sum::<f64>() < norm0 {
+                return Some((trial, th, rt));
+            }
+        }
+        step *= 0.5;
+    }
+    None
 }
 
 /// Every face satisfies the strict triangle inequality.

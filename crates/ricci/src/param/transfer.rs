@@ -108,6 +108,23 @@ fn triangulation(r: &FlowResult) -> Result<&crate::flow::IntrinsicResult> {
         .ok_or_else(|| Error::numerical("the conformal flow returned no triangulation"))
 }
 
+/// The metric `lengths` of the flow's simplicial mesh (which may differ from the Δ-complex's
+/// own, e.g. after the `--seamless` holonomy fix) per edge of the Δ-complex `T`; `None` when
+/// edges were split (then the two meshes' edges differ).
+fn simplicial_lengths(tr: &crate::flow::IntrinsicResult, lengths: &[f64]) -> Option<Vec<f64>> {
+    let (t, m) = (&tr.triangulation, &tr.simplicial.mesh);
+    if tr.simplicial.splits > 0 || lengths.len() != m.n_edges() {
+        return None;
+    }
+    (0..t.n_edges() as u32)
+        .map(|e| {
+            let [a, b] = t.edge_vertices(e);
+            let h = m.halfedge_between(a, b)?;
+            Some(lengths[m.he_edge(h) as usize])
+        })
+        .collect()
+}
+
 /// UVs on the input's own faces: the input-edge cut (`None` when `needs_cut` is false) and
 /// one UV per input corner (unscaled layout units). Fails when the cut cannot avoid edges the
 /// flow flipped away.
@@ -170,7 +187,7 @@ pub(super) fn subdivision_route(
     let tr = triangulation(r)?;
     let mesh = &surface.mesh;
     let t = &tr.triangulation;
-    let t_len = super::unfold::lengths(t);
+    let t_len = simplicial_lengths(tr, &r.lengths).unwrap_or_else(|| super::unfold::lengths(t));
     let t_cut = if needs_cut {
         super::unfold::cut_edges(t, &t_len, cones)
     } else {
