@@ -50,17 +50,15 @@ fn transition_error(s: &Surface, p: &Parametrization) -> f64 {
         if !seam[e as usize] || m.is_boundary_edge(e) {
             continue;
         }
-        let h = m.edge_halfedge(e);
-        let g = m.he_twin(h);
-        let (pa, pb) = (uv[h as usize], uv[m.he_next(h) as usize]);
-        let (qb, qa) = (uv[g as usize], uv[m.he_next(g) as usize]);
-        let d1 = [pb[0] - pa[0], pb[1] - pa[1]];
-        let d2 = [qb[0] - qa[0], qb[1] - qa[1]];
-        let a = (d1[0] * d2[1] - d1[1] * d2[0]).atan2(d1[0] * d2[0] + d1[1] * d2[1]);
-        let q = a / (PI / 2.0);
+        // d₂/d₁ of the two sides' UV edge vectors: a rotation by a quarter turn, lengths equal
+        let r = crate::param_lscm::seam_ratio(m, uv, e);
+        let q = r[1].atan2(r[0]) / (PI / 2.0);
         err = err.max((q - q.round()).abs() * PI / 2.0);
-        let (l1, l2) = (d1[0].hypot(d1[1]), d2[0].hypot(d2[1]));
-        assert!((l1 - l2).abs() < 1e-8 * l1, "seam edge {e}: {l1} vs {l2}");
+        let ratio = r[0].hypot(r[1]);
+        assert!(
+            (ratio - 1.0).abs() < 1e-8,
+            "seam edge {e}: length ratio {ratio}"
+        );
     }
     err
 }
