@@ -128,6 +128,8 @@ mod subdivision_uv;
 mod teichmuller;
 #[path = "tspline.rs"]
 mod tspline;
+#[path = "tspline_bezier_elements.rs"]
+mod tspline_bezier_elements;
 #[path = "tspline_cylinders.rs"]
 mod tspline_cylinders;
 #[path = "tspline_domain_mesh.rs"]

@@ -35,8 +35,8 @@ use ricci::spline::tspline::fit::{
 use ricci::spline::tspline::genus0::{fill_boundary_loops, genus0_domain};
 use ricci::spline::tspline::half::Half;
 use ricci::spline::tspline::{
-    chart_independence, continuity, extract, BezierPatch, ChartIndependence, Continuity, Lattice,
-    TSpline,
+    chart_independence, continuity, extract_elements, BezierPatch, ChartIndependence, Continuity,
+    Lattice, TSpline,
 };
 use ricci_render::{Image, Polyline, RenderOptions, View};
 use serde_json::json;
@@ -414,7 +414,7 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
     let r = fit(&surface.positions, &uv, lattice, &opts, &mut bar)?;
     let fit_seconds = t0.elapsed().as_secs_f64();
     bar.0.set_message("Bézier extraction");
-    let patches = extract(&r.spline);
+    let (patches, merge) = extract_elements(&r.spline);
     let jumps = continuity(&patches, lattice, 3);
     let charts = chart_independence(&r.spline, lattice, 24);
     bar.0.finish_and_clear();
@@ -446,6 +446,7 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         "t_junctions": r.spline.basis.mesh.t_junctions().len(),
         "analysis_suitable": r.spline.basis.mesh.is_analysis_suitable(),
         "bezier_patches": patches.len(),
+        "bezier_elements": merge,
         "rms_error_percent": rms,
         "rms_error_percent_area_weighted": area_weighted_rms(&surface, &r.errors)
             .map(|x| 100.0 * x / r.scale),

@@ -17,8 +17,9 @@
 //! Surfaces with boundary loops: the loops are filled by fans for the domain and the fills
 //! carry no data (JSON `filled_loops`).
 //!
-//! Writes `tspline.step`, `tspline.igs` (one Bézier patch per cell, the strips side by side in
-//! the parameter plane), `surface.obj` (per-patch tessellation), `samples.json` (our
+//! Writes `tspline.step`, `tspline.igs` (one Bézier patch per Bézier element — the cells of a
+//! strip merged where the spline is one polynomial, JSON `patches` next to `cells` and
+//! `bezier_elements`; the strips side by side in the parameter plane), `surface.obj` (per-patch tessellation), `samples.json` (our
 //! evaluation from the blending functions), `tmesh-surface.png` and `zebra.png` (the domain
 //! mesh on the surface and reflection lines: `tspline_pictures`; not with `--no-pictures`)
 //! and `tspline.json`.
@@ -33,6 +34,9 @@ use crate::util::write_atomic;
 use ricci::analysis::forms::HolomorphicForms;
 use ricci::mesh::Surface;
 use ricci::progress::Progress;
+use ricci::spline::tspline::bezier_elements::{
+    domain_elements, spline_point, strip_cells, DomainElement,
+};
 use ricci::spline::tspline::domain_continuity::{side_continuity, SideContinuity};
 use ricci::spline::tspline::domain_fit::{
     deviation_between_vertices, fit_domain_mesh, fit_domain_mesh_on_triangles, DomainFit,
@@ -80,23 +84,32 @@ const SIDE_SAMPLES: usize = 5;
 /// Points per cell side at which the distance to the input triangles is measured.
 const BETWEEN_SAMPLES: usize = 4;
 
-/// Samples of our own evaluation (the blending functions, not the patches) for the CAD check.
-fn samples_json(fit: &DomainFit, patches: &[BezierPatch]) -> serde_json::Value {
-    let mut out = Vec::with_capacity(2 * patches.len());
-    for (c, p) in patches.iter().enumerate() {
+/// Samples of our own evaluation (the blending functions of the cell under each sample, not
+/// the patches) for the CAD check: two per exported Bézier element.
+fn samples_json(fit: &DomainFit, elements: &[DomainElement]) -> serde_json::Value {
+    let ids = strip_cells(&fit.mesh);
+    let offsets = fit.mesh.export_offsets();
+    let mut out = Vec::with_capacity(2 * elements.len());
+    for e in elements {
+        let p = &e.patch;
         for (a, b) in [(0.31, 0.67), (0.73, 0.22)] {
-            let x = fit.mesh.point(c as u32, a, b, &fit.control);
             let (u, v) = (p.u0 + a * (p.u1 - p.u0), p.v0 + b * (p.v1 - p.v0));
+            let x = spline_point(&fit.mesh, &ids, &offsets, e.strip, (u, v), &fit.control);
             out.push(json!([u, v, x[0], x[1], x[2]]));
         }
     }
-    let bounds: Vec<[f64; 4]> = patches.iter().map(|p| [p.u0, p.u1, p.v0, p.v1]).collect();
+    let bounds: Vec<[f64; 4]> = elements
+        .iter()
+        .map(|e| [e.patch.u0, e.patch.u1, e.patch.v0, e.patch.v1])
+        .collect();
     json!({"samples": out, "patches": bounds, "samples_per_patch": 2})
 }
 
 /// A fitted domain-mesh spline and its report (the JSON of `ricci tspline --json` but `out`).
 pub struct DomainSpline {
     pub fit: DomainFit,
+    /// The Bézier elements (cells merged where the spline is one polynomial).
+    pub elements: Vec<DomainElement>,
     pub patches: Vec<BezierPatch>,
     pub report: serde_json::Value,
     pub max_iterations: usize,
@@ -159,7 +172,8 @@ pub fn domain_spline(
     };
     progress.report("tspline", None, "derivative jumps across every cell side");
     let sides = side_continuity(&fit.mesh, &fit.control, SIDE_SAMPLES);
-    let patches = fit.mesh.patches(&fit.control);
+    let (elements, merge) = domain_elements(&fit.mesh, &fit.control);
+    let patches: Vec<BezierPatch> = elements.iter().map(|e| e.patch).collect();
     let mesh = &fit.mesh;
     let continuity = continuity_json(&sides, domain.decomposition.zeros.len(), fit.scale);
     let offsets = mesh.export_offsets();
@@ -186,7 +200,9 @@ pub fn domain_spline(
         "control_points": mesh.n_control_points(),
         "t_junctions": mesh.n_t_junctions(),
         "mesh_vertices": mesh.n_vertices(),
+        "patches": patches.len(),
         "bezier_patches": patches.len(),
+        "bezier_elements": merge,
         "continuity": continuity,
         "gluing_mismatch": gluing.mismatch,
         "max_deviation_between_vertices_percent": between_max,
@@ -210,6 +226,7 @@ pub fn domain_spline(
     report["t_junctions"] = json!(fit.mesh.n_t_junctions());
     Ok(DomainSpline {
         fit,
+        elements,
         patches,
         report,
         max_iterations: opts.max_iterations,
@@ -227,6 +244,7 @@ pub fn run_domain(
 ) -> anyhow::Result<()> {
     let DomainSpline {
         fit,
+        elements,
         patches,
         report: mut out,
         max_iterations,
@@ -260,7 +278,7 @@ pub fn run_domain(
         });
     }
     bar.0.finish_and_clear();
-    write_files(a, &patches, || samples_json(&fit, &patches), &mut out, t0)?;
+    write_files(a, &patches, || samples_json(&fit, &elements), &mut out, t0)?;
     let mesh = &fit.mesh;
     print_report(a, &out, || {
         format!(

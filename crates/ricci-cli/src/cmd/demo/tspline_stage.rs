@@ -173,6 +173,7 @@ pub fn tspline(ctx: &mut Ctx, env: &mut Env) -> anyhow::Result<Section> {
         "cells": rep["cells"],
         "mesh_vertices": rep["mesh_vertices"],
         "bezier_patches": rep["bezier_patches"],
+        "patches": rep["patches"],
         "t_junctions": rep["t_junctions"],
         "iterations": rep["iterations"],
         "rms_error_percent": rep["rms_error_percent"],
@@ -254,8 +255,8 @@ fn results_table(
             ),
             ("control points", r.fit.mesh.n_control_points().to_string()),
             (
-                "cells = Bézier patches",
-                format!("{cells} = {}", r.patches.len()),
+                "cells / Bézier patches (elements: cells merged where one polynomial)",
+                format!("{cells} / {}", r.patches.len()),
             ),
             ("T-junctions", r.fit.mesh.n_t_junctions().to_string()),
             ("fit steps", r.fit.steps.len().to_string()),

@@ -7,9 +7,12 @@
 //! extensions). The patch of an element is found by interpolating the T-spline at the 4×4
 //! tensor nodes `x ∈ {0.05, 0.35, 0.65, 0.95}` of the element — exact up to rounding because the
 //! T-spline restricted to the element is a bicubic polynomial; the extraction test checks it.
-//! Patches also measure the continuity of the surface: the jumps of the partial derivatives of
+//! Cells of one face on which the spline (not only every blending function) is one polynomial
+//! are merged into maximal rectangles, the exported Bézier elements
+//! ([`super::bezier_elements`]). Patches also measure the continuity of the surface: the jumps of the partial derivatives of
 //! neighbouring patches across their common side, per order.
 
+use super::bezier_elements::{merge_grid, MergeStats};
 use super::surface::{TBasis, TSpline};
 
 /// A bicubic Bézier patch over `[u0, u1] × [v0, v1]`; `control[i][j]`: `i` along `u`.
@@ -60,6 +63,68 @@ impl BezierPatch {
     pub fn point(&self, u: f64, v: f64) -> [f64; 3] {
         self.partial(u, v, 0, 0)
     }
+
+    /// The same polynomial as a patch over `[u0, u1] × [v0, v1]` (subdivision by blossoming:
+    /// the new Bézier points are the blossom at the new ends, `u` then `v`).
+    pub fn restrict(&self, u0: f64, u1: f64, v0: f64, v1: f64) -> BezierPatch {
+        let (su, eu) = (
+            (u0 - self.u0) / (self.u1 - self.u0),
+            (u1 - self.u0) / (self.u1 - self.u0),
+        );
+        let (sv, ev) = (
+            (v0 - self.v0) / (self.v1 - self.v0),
+            (v1 - self.v0) / (self.v1 - self.v0),
+        );
+        let mut along_u = [[[0.0; 3]; 4]; 4];
+        for j in 0..4 {
+            let c = [
+                self.control[0][j],
+                self.control[1][j],
+                self.control[2][j],
+                self.control[3][j],
+            ];
+            let d = restrict_cubic(c, su, eu);
+            for i in 0..4 {
+                along_u[i][j] = d[i];
+            }
+        }
+        let mut control = [[[0.0; 3]; 4]; 4];
+        for i in 0..4 {
+            control[i] = restrict_cubic(along_u[i], sv, ev);
+        }
+        BezierPatch {
+            u0,
+            u1,
+            v0,
+            v1,
+            control,
+        }
+    }
+}
+
+/// The blossom of the cubic with Bézier points `c` (over `[0, 1]`) at `t`: de Casteljau with
+/// one parameter per level.
+fn blossom(c: [[f64; 3]; 4], t: [f64; 3]) -> [f64; 3] {
+    let mut p = c;
+    for (level, &x) in t.iter().enumerate() {
+        for k in 0..3 - level {
+            for d in 0..3 {
+                p[k][d] = (1.0 - x) * p[k][d] + x * p[k + 1][d];
+            }
+        }
+    }
+    p[0]
+}
+
+/// The Bézier points over `[s, e]` (local parameters) of the cubic with points `c` over
+/// `[0, 1]`: `f(s, s, s)`, `f(s, s, e)`, `f(s, e, e)`, `f(e, e, e)`.
+fn restrict_cubic(c: [[f64; 3]; 4], s: f64, e: f64) -> [[f64; 3]; 4] {
+    [
+        blossom(c, [s, s, s]),
+        blossom(c, [s, s, e]),
+        blossom(c, [s, e, e]),
+        blossom(c, [e, e, e]),
+    ]
 }
 
 const NODES: [f64; 4] = [0.05, 0.35, 0.65, 0.95];
@@ -99,8 +164,23 @@ fn collocation_inverse() -> [[f64; 4]; 4] {
     inv
 }
 
-/// The Bézier elements `[u0, u1, v0, v1]` of the T-spline's domain.
+/// The cells `[u0, u1, v0, v1]` of the T-spline's domain on which every blending function is
+/// one polynomial ([`face_grids`] flattened).
 pub fn elements(basis: &TBasis) -> Vec<[f64; 4]> {
+    let mut out = Vec::new();
+    for (us, vs) in face_grids(basis) {
+        for j in 0..vs.len() - 1 {
+            for i in 0..us.len() - 1 {
+                out.push([us[i], us[i + 1], vs[j], vs[j + 1]]);
+            }
+        }
+    }
+    out
+}
+
+/// Per T-mesh face, the knots `us`, `vs` (increasing, the face's sides first and last) of the
+/// tensor grid that cuts it along the knot lines of the anchors whose supports meet it.
+pub fn face_grids(basis: &TBasis) -> Vec<(Vec<f64>, Vec<f64>)> {
     let mut out = Vec::new();
     for f in basis.mesh.faces() {
         let mut us = vec![f.u0, f.u1];
@@ -131,11 +211,7 @@ pub fn elements(basis: &TBasis) -> Vec<[f64; 4]> {
             xs.sort_by(f64::total_cmp);
             xs.dedup_by(|a, b| (*a - *b).abs() <= eps);
         }
-        for j in 0..vs.len() - 1 {
-            for i in 0..us.len() - 1 {
-                out.push([us[i], us[i + 1], vs[j], vs[j + 1]]);
-            }
-        }
+        out.push((us, vs));
     }
     out
 }
@@ -179,12 +255,39 @@ pub fn interpolate_patch(
     }
 }
 
-/// Extract one bicubic Bézier patch per element.
+/// Extract the Bézier elements: one bicubic patch per maximal rectangle on which the
+/// T-spline is one polynomial ([`extract_elements`]).
 pub fn extract(ts: &TSpline) -> Vec<BezierPatch> {
-    elements(&ts.basis)
-        .into_iter()
-        .map(|[u0, u1, v0, v1]| interpolate_patch(u0, u1, v0, v1, |u, v| ts.point(u, v)))
-        .collect()
+    extract_elements(ts).0
+}
+
+/// The Bézier elements of the T-spline: every T-mesh face's grid of [`face_grids`] extracted
+/// cell by cell, the cells merged where they are one polynomial
+/// ([`super::bezier_elements::merge_grid`]); and what the merging did.
+pub fn extract_elements(ts: &TSpline) -> (Vec<BezierPatch>, MergeStats) {
+    let mut stats = MergeStats::default();
+    let mut out = Vec::new();
+    for (us, vs) in face_grids(&ts.basis) {
+        let (nu, nv) = (us.len() - 1, vs.len() - 1);
+        let mut cells = Vec::with_capacity(nu * nv);
+        for j in 0..nv {
+            for i in 0..nu {
+                cells.push(interpolate_patch(
+                    us[i],
+                    us[i + 1],
+                    vs[j],
+                    vs[j + 1],
+                    |u, v| ts.point(u, v),
+                ));
+            }
+        }
+        out.extend(
+            merge_grid(nu, nv, &cells, &mut stats)
+                .into_iter()
+                .map(|e| e.patch),
+        );
+    }
+    (out, stats)
 }
 
 /// Jumps of the partial derivatives across patch sides, per order 0..=3.

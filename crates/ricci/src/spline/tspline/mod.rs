@@ -8,6 +8,8 @@
 //! * [`surface`] — blending functions `B_i = N[u⃗_i](u) N[v⃗_i](v)` summed over lattice
 //!   translates, T-spline surfaces with derivatives up to order two;
 //! * [`bezier`] — Bézier extraction to bicubic patches, continuity across patch sides;
+//! * [`bezier_elements`] — the Bézier elements (maximal rectangles on which the spline is one
+//!   polynomial) from a finer grid of patches, for every genus's export;
 //! * [`correction`] — parameter correction (feet of perpendiculars) between fits;
 //! * [`cylinders`] — genus ≥ 2: the cylinders cut out by the critical horizontal trajectories
 //!   of a holomorphic 1-form with integer imaginary periods (paper 003 §2, Fig. 2);
@@ -42,6 +44,7 @@
 
 pub(crate) mod basis;
 pub(crate) mod bezier;
+pub mod bezier_elements;
 pub(crate) mod charts;
 pub(crate) mod correction;
 pub mod curves;
@@ -61,7 +64,8 @@ pub(crate) mod surface;
 pub(crate) mod system;
 pub(crate) mod tmesh;
 
-pub use bezier::{continuity, extract, BezierPatch, Continuity};
+pub use bezier::{continuity, extract, extract_elements, BezierPatch, Continuity};
+pub use bezier_elements::MergeStats;
 pub use charts::{chart_independence, ChartIndependence};
 pub use surface::{TBasis, TSpline};
 pub use tmesh::{Anchor, Lattice, TMesh};

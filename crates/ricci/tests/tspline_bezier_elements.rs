@@ -1,0 +1,231 @@
+//! The exported Bézier elements of the genus ≥ 2 domain-mesh spline (issue 18): the cells of
+//! every strip merged where the spline is one bicubic polynomial. Checked against things
+//! computed elsewhere: the spline's own evaluation from its blending functions
+//! (`DomainMesh::point`) at points of every cell an element covers, the T-mesh's lines (no
+//! element crosses one: the spline is only C² there), the derivatives of neighbouring elements
+//! on both sides of every element side, and an extrapolation of one element into its
+//! neighbour (two neighbours that are one polynomial would have been merged).
+
+mod ricci_meshes;
+mod tspline_cases;
+
+use tspline_cases::{forms, genus_two_cases};
+
+use ricci::spline::tspline::bezier_elements::{domain_elements, strip_cells, SAME_POLYNOMIAL};
+use ricci::spline::tspline::domain_mesh::DomainMesh;
+use ricci::spline::tspline::genus_domain::best_genus_domain;
+use ricci::spline::tspline::glue::gluing;
+
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    dist(a, [0.0; 3])
+}
+
+/// Graded meshes whose graded lines end in T-junctions, and a T-spline net on each (random free
+/// values expanded by the reduction: G¹ at the zeros, in the T-mesh's spline space).
+fn cases() -> Vec<(String, DomainMesh, Vec<[f64; 3]>)> {
+    let mut rng = Rng(0x2545f4914f6cdd1d);
+    let mut out = Vec::new();
+    for (name, s) in genus_two_cases() {
+        let h = forms(&s);
+        let d = best_genus_domain(&h, s.positions.len()).unwrap();
+        let g = gluing(&d).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let l = d
+            .cylinders
+            .iter()
+            .map(|c| c.circumference)
+            .fold(0.0, f64::max);
+        for (k, levels, margin) in [(25.0, 2, 1), (40.0, 3, 2)] {
+            let m = DomainMesh::graded(&d, &g, l / k, levels)
+                .and_then(|m| m.with_t_junctions(margin))
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let free: Vec<[f64; 3]> = (0..m.reduction.free)
+                .map(|_| [rng.next(), rng.next(), rng.next()])
+                .collect();
+            let control = m.expand(&free);
+            out.push((
+                format!("{name} at L/{k}, {levels} levels, margin {margin}"),
+                m,
+                control,
+            ));
+        }
+    }
+    out
+}
+
+#[test]
+fn bezier_elements_are_the_spline_merged_only_inside_t_mesh_faces_and_meet_c2() {
+    let mut merged_somewhere = false;
+    for (name, m, control) in cases() {
+        let (elements, stats) = domain_elements(&m, &control);
+        let ids = strip_cells(&m);
+        let offsets = m.export_offsets();
+        let scale = {
+            let mut lo = [f64::INFINITY; 3];
+            let mut hi = [f64::NEG_INFINITY; 3];
+            for c in &control {
+                for d in 0..3 {
+                    lo[d] = lo[d].min(c[d]);
+                    hi[d] = hi[d].max(c[d]);
+                }
+            }
+            dist(lo, hi)
+        };
+        eprintln!(
+            "{name}: {} cells, {} T-junctions, {} Bézier elements; {stats:?}",
+            m.n_cells(),
+            m.n_t_junctions(),
+            elements.len()
+        );
+        assert!(m.n_t_junctions() > 0, "{name}: no T-junction to test");
+        // every cell in exactly one element
+        let mut owner = vec![usize::MAX; m.n_cells()];
+        for (e, el) in elements.iter().enumerate() {
+            let [i0, i1, j0, j1] = el.cells;
+            for j in j0..j1 {
+                for i in i0..i1 {
+                    let c = ids[el.strip][j * m.rects[el.strip].m + i] as usize;
+                    assert_eq!(owner[c], usize::MAX, "{name}: cell {c} in two elements");
+                    owner[c] = e;
+                }
+            }
+        }
+        assert!(
+            owner.iter().all(|&e| e != usize::MAX),
+            "{name}: a cell in no element"
+        );
+        assert_eq!(stats.elements, elements.len());
+        assert_eq!(stats.cells, m.n_cells());
+        assert!(stats.worst_merged <= SAME_POLYNOMIAL, "{name}: {stats:?}");
+        // the T-junctions' lines end inside strips: the cells there are fewer polynomials
+        assert!(elements.len() < m.n_cells(), "{name}: nothing merged");
+        merged_somewhere = true;
+
+        // every element is the spline (its blending functions) at points of every cell it covers
+        let mut worst = 0.0f64;
+        for (c, &e) in owner.iter().enumerate() {
+            let el = &elements[e];
+            let [u0, u1, v0, v1] = m.cell_box(c as u32);
+            for (s, t) in [(0.0, 0.0), (0.2, 0.7), (0.9, 0.35), (1.0, 1.0)] {
+                let x = m.point(c as u32, s, t, &control);
+                let (u, v) = (offsets[el.strip] + u0 + s * (u1 - u0), v0 + t * (v1 - v0));
+                worst = worst.max(dist(el.patch.point(u, v), x));
+            }
+        }
+        eprintln!(
+            "{name}: elements vs blending functions ≤ {:e} of the size",
+            worst / scale
+        );
+        assert!(worst <= 1e-12 * scale, "{name}: {:e}", worst / scale);
+
+        // no element crosses a line of the T-mesh (an edge between two of its mesh points)
+        for el in &elements {
+            let r = &m.rects[el.strip];
+            let [i0, i1, j0, j1] = el.cells;
+            for i in i0 + 1..i1 {
+                for j in j0..j1 {
+                    let edge = m.on_line_v(el.strip, i, j) && m.on_line_v(el.strip, i, j + 1);
+                    assert!(!edge, "{name}: element {:?} of strip {} crosses the T-mesh line x({i}) ({} columns)", el.cells, el.strip, r.m);
+                }
+            }
+            for j in j0 + 1..j1 {
+                for i in i0..i1 {
+                    let edge = m.on_line_u(el.strip, i, j) && m.on_line_u(el.strip, i + 1, j);
+                    assert!(
+                        !edge,
+                        "{name}: element {:?} of strip {} crosses the T-mesh line y({j})",
+                        el.cells, el.strip
+                    );
+                }
+            }
+        }
+
+        // neighbouring elements across every cell side between two of them: C⁰ everywhere, C²
+        // on sides with no zero at an end; and not one polynomial (else they would be merged)
+        let mut jumps = [0.0f64; 3];
+        let mut at_zeros = 0.0f64;
+        let mut magnitude = [0.0f64; 3];
+        let mut closest = f64::INFINITY;
+        let mut rng = Rng(7);
+        for (c, side, zero) in m.sides() {
+            let nb = m.across(c, side);
+            let (ea, eb) = (owner[c as usize], owner[nb as usize]);
+            if ea == eb {
+                continue;
+            }
+            let (a, b) = (&elements[ea], &elements[eb]);
+            let (ba, bb) = (m.cell_box(c), m.cell_box(nb));
+            let (oa, ob) = (offsets[a.strip], offsets[b.strip]);
+            for t in [0.25, 0.5, 0.75] {
+                // the same point of the surface in the two cells' charts (glued by translation)
+                let (pa, pb) = if side == 0 {
+                    let va = ba[2] + t * (ba[3] - ba[2]);
+                    let vb = bb[2] + t * (bb[3] - bb[2]);
+                    ((oa + ba[1], va), (ob + bb[0], vb))
+                } else {
+                    let ua = ba[0] + t * (ba[1] - ba[0]);
+                    let ub = bb[0] + t * (bb[1] - bb[0]);
+                    ((oa + ua, ba[3]), (ob + ub, bb[2]))
+                };
+                for order in 0..3 {
+                    for i in 0..=order {
+                        let x = a.patch.partial(pa.0, pa.1, i, order - i);
+                        let y = b.patch.partial(pb.0, pb.1, i, order - i);
+                        magnitude[order] = magnitude[order].max(norm(x));
+                        if order == 0 || !zero {
+                            jumps[order] = jumps[order].max(dist(x, y));
+                        }
+                        if order == 0 && zero {
+                            at_zeros = at_zeros.max(dist(x, y));
+                        }
+                    }
+                }
+            }
+            // b's polynomial at points of the cell of a, translated into b's chart
+            let (du, dv) = if side == 0 {
+                (ob + bb[0] - oa - ba[1], bb[2] - ba[2])
+            } else {
+                (ob + bb[0] - oa - ba[0], bb[2] - ba[3])
+            };
+            let mut gap = 0.0f64;
+            for _ in 0..3 {
+                let (s, t) = (rng.next(), rng.next());
+                let (u, v) = (
+                    oa + ba[0] + s * (ba[1] - ba[0]),
+                    ba[2] + t * (ba[3] - ba[2]),
+                );
+                gap = gap.max(dist(a.patch.point(u, v), b.patch.point(u + du, v + dv)));
+            }
+            closest = closest.min(gap / scale);
+        }
+        let rel: Vec<f64> = (0..3).map(|k| jumps[k] / magnitude[k]).collect();
+        eprintln!(
+            "{name}: element sides: C⁰ jump {:e} (at zeros {:e}), C¹ {:e}, C² {:e} relative; nearest neighbouring polynomials {closest:e}",
+            rel[0],
+            at_zeros / magnitude[0],
+            rel[1],
+            rel[2]
+        );
+        assert!(jumps[0] <= 1e-12 * scale, "{name}: C⁰ {rel:?}");
+        assert!(rel[1] <= 1e-10 && rel[2] <= 1e-9, "{name}: {rel:?}");
+        assert!(
+            closest > 1e-8,
+            "{name}: two neighbouring elements are one polynomial ({closest:e})"
+        );
+    }
+    assert!(merged_somewhere);
+}
