@@ -28,7 +28,7 @@ use crate::cmd::layout::spinner;
 use crate::cmd::tspline_pictures::{line, render_net_and_zebra};
 use crate::util::{print_json, read_surface, write_atomic, write_json_atomic, UsageError};
 use ricci::spline::tspline::curves::{tmesh_on_surface, torus_tessellation};
-use ricci::spline::tspline::export::{iges, obj, step, torus_obj};
+use ricci::spline::tspline::export::{iges, obj, obj_with_breaks, step, torus_obj};
 use ricci::spline::tspline::fit::{
     area_weighted_rms, counted, fit, flat_torus_domain, vertex_areas, FitOptions, FitResult,
 };
@@ -559,11 +559,14 @@ fn write_outputs(
 }
 
 /// `tspline.step`, `tspline.igs` (one face per Bézier patch) and `surface.obj` (tessellated
-/// patch by patch): the files of every domain whose patches are not a closed torus grid.
+/// patch by patch, `a.tessellation` segments between consecutive `breaks` of each patch when
+/// given, else along each whole side): the files of every domain whose patches are not a
+/// closed torus grid.
 pub(crate) fn write_patch_files(
     dir: &std::path::Path,
     a: &Args,
     patches: &[BezierPatch],
+    breaks: Option<&[(Vec<f64>, Vec<f64>)]>,
 ) -> anyhow::Result<()> {
     write_atomic(
         &dir.join("tspline.step"),
@@ -575,7 +578,11 @@ pub(crate) fn write_patch_files(
     )?;
     write_atomic(
         &dir.join("surface.obj"),
-        obj(patches, a.tessellation).as_bytes(),
+        match breaks {
+            Some(b) => obj_with_breaks(patches, b, a.tessellation),
+            None => obj(patches, a.tessellation),
+        }
+        .as_bytes(),
     )
 }
 
@@ -587,7 +594,7 @@ fn write_half_outputs(
     r: &FitResult,
     patches: &[BezierPatch],
 ) -> anyhow::Result<()> {
-    write_patch_files(dir, a, patches)?;
+    write_patch_files(dir, a, patches, None)?;
     write_atomic(
         &dir.join("samples.json"),
         serde_json::to_string(&samples_json(&r.spline, patches))?.as_bytes(),

@@ -19,7 +19,9 @@
 //!
 //! Writes `tspline.step`, `tspline.igs` (one Bézier patch per Bézier element — the cells of a
 //! strip merged where the spline is one polynomial, JSON `patches` next to `cells` and
-//! `bezier_elements`; the strips side by side in the parameter plane), `surface.obj` (per-patch tessellation), `samples.json` (our
+//! `bezier_elements`; the strips side by side in the parameter plane), `surface.obj` (per-patch
+//! tessellation, `--tessellation` segments per cell side: neighbouring patches' tessellations
+//! meet vertex to vertex), `samples.json` (our
 //! evaluation from the blending functions), `tmesh-surface.png` and `zebra.png` (the domain
 //! mesh on the surface and reflection lines: `tspline_pictures`; not with `--no-pictures`)
 //! and `tspline.json`.
@@ -278,7 +280,20 @@ pub fn run_domain(
         });
     }
     bar.0.finish_and_clear();
-    write_files(a, &patches, || samples_json(&fit, &elements), &mut out, t0)?;
+    // the OBJ tessellated cell by cell inside every element: watertight where the cells are
+    let offsets = fit.mesh.export_offsets();
+    let breaks: Vec<_> = elements
+        .iter()
+        .map(|e| e.breaks(&fit.mesh, &offsets))
+        .collect();
+    write_files(
+        a,
+        &patches,
+        Some(&breaks),
+        || samples_json(&fit, &elements),
+        &mut out,
+        t0,
+    )?;
     let mesh = &fit.mesh;
     print_report(a, &out, || {
         format!(

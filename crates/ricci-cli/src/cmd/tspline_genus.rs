@@ -139,11 +139,13 @@ pub(crate) fn warn_not_converged(a: &Args, max: f64, tolerance: f64, max_iterati
     );
 }
 
-/// With `--out`: the STEP, IGES, OBJ (per-patch tessellation), samples and report files of a
-/// genus ≥ 2 fit; the report gets `out` and the final `seconds`.
+/// With `--out`: the STEP, IGES, OBJ (per-patch tessellation; `breaks`: see
+/// `write_patch_files`), samples and report files of a genus ≥ 2 fit; the report gets `out`
+/// and the final `seconds`.
 pub(crate) fn write_files(
     a: &Args,
     patches: &[BezierPatch],
+    breaks: Option<&[(Vec<f64>, Vec<f64>)]>,
     samples: impl FnOnce() -> serde_json::Value,
     out: &mut serde_json::Value,
     t0: Instant,
@@ -151,7 +153,7 @@ pub(crate) fn write_files(
     let Some(dir) = &a.out else {
         return Ok(());
     };
-    crate::cmd::tspline::write_patch_files(dir, a, patches)?;
+    crate::cmd::tspline::write_patch_files(dir, a, patches, breaks)?;
     write_atomic(
         &dir.join("samples.json"),
         serde_json::to_string(&samples())?.as_bytes(),
@@ -339,7 +341,14 @@ pub fn run_genus(a: &Args, surface: &Surface, tolerance: f64, t0: Instant) -> an
     if !fit.converged {
         warn_not_converged(a, max, tolerance, opts.max_iterations);
     }
-    write_files(a, &patches, || samples_json(&fit, &patches), &mut out, t0)?;
+    write_files(
+        a,
+        &patches,
+        None,
+        || samples_json(&fit, &patches),
+        &mut out,
+        t0,
+    )?;
     print_report(a, &out, || {
         format!(
             "{}: {} cylinders, {} control points, {} Bézier patches, error rms {:.3}% max {:.3}% of the longest side, {} iterations, {} inside cylinders (C0 on the knot lines), {} across the critical trajectories (gap {:.2e}%, normals up to {:.2}°), {:.2} s",

@@ -237,6 +237,18 @@ pub struct DomainElement {
     pub cells: [usize; 4],
 }
 
+impl DomainElement {
+    /// The cells' sides it covers along `u` (exported parameters, `offsets` from
+    /// [`DomainMesh::export_offsets`]) and along `v`, its first and last parameters included.
+    pub fn breaks(&self, mesh: &DomainMesh, offsets: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let r = &mesh.rects[self.strip];
+        let [i0, i1, j0, j1] = self.cells;
+        let us = (i0..=i1).map(|i| offsets[self.strip] + r.x(i)).collect();
+        let vs = (j0..=j1).map(|j| r.y(j)).collect();
+        (us, vs)
+    }
+}
+
 /// Per strip, its cells by `(i, j)`: `ids[strip][j * m + i]`.
 pub fn strip_cells(mesh: &DomainMesh) -> Vec<Vec<u32>> {
     let mut ids: Vec<Vec<u32>> = mesh

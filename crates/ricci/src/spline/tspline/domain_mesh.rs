@@ -731,7 +731,8 @@ impl DomainMesh {
     }
 
     /// Every cell's Bézier patch (cell order) over its box in the exported parameters
-    /// ([`Self::export_offsets`]): one bicubic patch per cell, for STEP, IGES and OBJ.
+    /// ([`Self::export_offsets`]): one bicubic patch per cell (merged into Bézier elements for
+    /// export by [`super::bezier_elements::domain_elements`]).
     pub fn patches(&self, control: &[[f64; 3]]) -> Vec<BezierPatch> {
         let offsets = self.export_offsets();
         (0..self.n_cells() as u32)

@@ -311,26 +311,54 @@ pub fn iges(patches: &[BezierPatch], name: &str) -> String {
 /// The patches tessellated on a `k × k` grid each, as OBJ (vertices not shared between
 /// patches; see [`torus_obj`] for one closed welded mesh).
 pub fn obj(patches: &[BezierPatch], k: usize) -> String {
+    let whole: Vec<(Vec<f64>, Vec<f64>)> = patches
+        .iter()
+        .map(|p| (vec![p.u0, p.u1], vec![p.v0, p.v1]))
+        .collect();
+    obj_with_breaks(patches, &whole, k)
+}
+
+/// The points `k` segments apart in every interval of the increasing `breaks`.
+fn tessellation_params(breaks: &[f64], k: usize) -> Vec<f64> {
+    let mut out = Vec::with_capacity(k * breaks.len());
+    for w in breaks.windows(2) {
+        for s in 0..k {
+            out.push(w[0] + (w[1] - w[0]) * s as f64 / k as f64);
+        }
+    }
+    out.extend(breaks.last());
+    out
+}
+
+/// The patches tessellated with `k` segments between consecutive breaks of each,
+/// `breaks[p] = (us, vs)` from the patch's first to its last parameter: with the cells a Bézier
+/// element covers as its breaks, neighbouring elements have the same tessellation points
+/// along their common sides (the OBJ welds into one closed surface where the cells do).
+pub fn obj_with_breaks(
+    patches: &[BezierPatch],
+    breaks: &[(Vec<f64>, Vec<f64>)],
+    k: usize,
+) -> String {
     let k = k.max(1);
     let mut out = String::from("# ricci T-spline tessellation (per patch)\n");
     let mut base = 1usize;
-    for p in patches {
-        for j in 0..=k {
-            for i in 0..=k {
-                let u = p.u0 + (p.u1 - p.u0) * i as f64 / k as f64;
-                let v = p.v0 + (p.v1 - p.v0) * j as f64 / k as f64;
+    for (p, (bu, bv)) in patches.iter().zip(breaks) {
+        let (us, vs) = (tessellation_params(bu, k), tessellation_params(bv, k));
+        for &v in &vs {
+            for &u in &us {
                 let x = p.point(u, v);
                 let _ = writeln!(out, "v {} {} {}", x[0], x[1], x[2]);
             }
         }
-        for j in 0..k {
-            for i in 0..k {
-                let a = base + j * (k + 1) + i;
-                let (b, c, d) = (a + 1, a + k + 2, a + k + 1);
+        let n = us.len();
+        for j in 0..vs.len() - 1 {
+            for i in 0..n - 1 {
+                let a = base + j * n + i;
+                let (b, c, d) = (a + 1, a + n + 1, a + n);
                 let _ = writeln!(out, "f {a} {b} {c}\nf {a} {c} {d}");
             }
         }
-        base += (k + 1) * (k + 1);
+        base += n * vs.len();
     }
     out
 }
