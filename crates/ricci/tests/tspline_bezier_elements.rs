@@ -1,6 +1,7 @@
 //! The exported Bézier elements of the genus ≥ 2 domain-mesh spline (issue 18): the cells of
 //! every strip merged where the spline is one bicubic polynomial. Checked against things
-//! computed elsewhere: the spline's own evaluation from its blending functions
+//! computed elsewhere: the faces of the extended T-mesh (from the T-mesh's lines and
+//! T-junctions, Li et al. 2012 §3: every element is one face), the spline's own evaluation from its blending functions
 //! (`DomainMesh::point`) at points of every cell an element covers, the T-mesh's lines (no
 //! element crosses one: the spline is only C² there), the derivatives of neighbouring elements
 //! on both sides of every element side, and an extrapolation of one element into its
@@ -67,6 +68,84 @@ fn cases() -> Vec<(String, DomainMesh, Vec<[f64; 3]>)> {
     out
 }
 
+/// The faces of the extended T-mesh of strip `r` (Li, Zheng, Sederberg, Hughes, Scott 2012
+/// §3: every T-junction's line extended ahead until it has crossed two perpendicular edges) as
+/// a component number per cell `j * m + i`, computed from the T-mesh's lines alone.
+fn extended_t_mesh_faces(mesh: &DomainMesh, r: usize) -> Vec<usize> {
+    let rc = &mesh.rects[r];
+    let (m, n) = (rc.m, rc.n);
+    // vb[i * n + j]: the edge of column line i between rows j and j + 1; hb[j * m + i]: the
+    // edge of row line j between columns i and i + 1
+    let mut vb: Vec<bool> = (0..=m)
+        .flat_map(|i| (0..n).map(move |j| (i, j)))
+        .map(|(i, j)| mesh.on_line_v(r, i, j) && mesh.on_line_v(r, i, j + 1))
+        .collect();
+    let mut hb: Vec<bool> = (0..=n)
+        .flat_map(|j| (0..m).map(move |i| (i, j)))
+        .map(|(i, j)| mesh.on_line_u(r, i, j) && mesh.on_line_u(r, i + 1, j))
+        .collect();
+    let (v0, h0) = (vb.clone(), hb.clone());
+    let junctions = &mesh.tjunctions.as_ref().unwrap().junctions;
+    for &(jr, i, j, along_v) in junctions {
+        if jr as usize != r {
+            continue;
+        }
+        let (i, j) = (i as usize, j as usize);
+        if along_v {
+            // the line of column i ends at row j; ahead is where its edge is missing
+            let up = j > 0 && v0[i * n + j - 1];
+            let crosses = |jj: usize| (i > 0 && h0[jj * m + i - 1]) || (i < m && h0[jj * m + i]);
+            let mut crossed = 0;
+            let mut jj = j;
+            while crossed < 2 && jj > 0 && jj < n {
+                let k = if up { jj } else { jj - 1 };
+                vb[i * n + k] = true;
+                jj = if up { jj + 1 } else { jj - 1 };
+                crossed += crosses(jj) as usize;
+            }
+        } else {
+            let right = i > 0 && h0[j * m + i - 1];
+            let crosses = |ii: usize| (j > 0 && v0[ii * n + j - 1]) || (j < n && v0[ii * n + j]);
+            let mut crossed = 0;
+            let mut ii = i;
+            while crossed < 2 && ii > 0 && ii < m {
+                let k = if right { ii } else { ii - 1 };
+                hb[j * m + k] = true;
+                ii = if right { ii + 1 } else { ii - 1 };
+                crossed += crosses(ii) as usize;
+            }
+        }
+    }
+    // cells joined across every side that is no edge of the extended T-mesh
+    let mut parent: Vec<usize> = (0..m * n).collect();
+    fn root(p: &mut [usize], mut x: usize) -> usize {
+        while p[x] != x {
+            p[x] = p[p[x]];
+            x = p[x];
+        }
+        x
+    }
+    for j in 0..n {
+        for i in 0..m {
+            if i + 1 < m && !vb[(i + 1) * n + j] {
+                let (a, b) = (
+                    root(&mut parent, j * m + i),
+                    root(&mut parent, j * m + i + 1),
+                );
+                parent[a] = b;
+            }
+            if j + 1 < n && !hb[(j + 1) * m + i] {
+                let (a, b) = (
+                    root(&mut parent, j * m + i),
+                    root(&mut parent, (j + 1) * m + i),
+                );
+                parent[a] = b;
+            }
+        }
+    }
+    (0..m * n).map(|c| root(&mut parent, c)).collect()
+}
+
 #[test]
 fn bezier_elements_are_the_spline_merged_only_inside_t_mesh_faces_and_meet_c2() {
     let mut merged_somewhere = false;
@@ -114,6 +193,35 @@ fn bezier_elements_are_the_spline_merged_only_inside_t_mesh_faces_and_meet_c2() 
         // the T-junctions' lines end inside strips: the cells there are fewer polynomials
         assert!(elements.len() < m.n_cells(), "{name}: nothing merged");
         merged_somewhere = true;
+
+        // the elements are the faces of the extended T-mesh, strip by strip
+        let mut faces = 0;
+        for r in 0..m.rects.len() {
+            let face = extended_t_mesh_faces(&m, r);
+            let mut count = std::collections::HashMap::new();
+            for f in &face {
+                *count.entry(*f).or_insert(0usize) += 1;
+            }
+            faces += count.len();
+            let mr = m.rects[r].m;
+            for el in elements.iter().filter(|e| e.strip == r) {
+                let [i0, i1, j0, j1] = el.cells;
+                let f = face[j0 * mr + i0];
+                for j in j0..j1 {
+                    for i in i0..i1 {
+                        assert_eq!(face[j * mr + i], f, "{name}: element {:?} of strip {r} spans two faces of the extended T-mesh", el.cells);
+                    }
+                }
+                assert_eq!(
+                    count[&f],
+                    (i1 - i0) * (j1 - j0),
+                    "{name}: element {:?} of strip {r} is not a whole face of the extended T-mesh",
+                    el.cells
+                );
+            }
+        }
+        eprintln!("{name}: {faces} faces of the extended T-mesh");
+        assert_eq!(faces, elements.len(), "{name}");
 
         // every element is the spline (its blending functions) at points of every cell it covers
         let mut worst = 0.0f64;
