@@ -337,3 +337,103 @@ fn bezier_elements_are_the_spline_merged_only_inside_t_mesh_faces_and_meet_c2() 
     }
     assert!(merged_somewhere);
 }
+
+/// Genus 1 (and 0): the exported elements of a T-spline over the flat torus, on analysis-
+/// suitable T-meshes with T-junctions, are the faces of the extended T-mesh: per T-mesh face,
+/// the rectangles cut by the face extensions that cross it (`TMesh::extensions`, in any
+/// lattice translate); and each evaluates as the T-spline at points of its sub-rectangles.
+#[test]
+fn torus_bezier_elements_are_the_faces_of_the_extended_t_mesh() {
+    use ricci::spline::tspline::{extract_elements, Lattice, TBasis, TMesh, TSpline};
+    let mut rng = Rng(0x9e3779b97f4a7c15);
+    for shift in [0.0, 2.5] {
+        let lat = Lattice {
+            width: 8.0,
+            height: 8.0,
+            shift,
+        };
+        let mut m = TMesh::uniform(lat, 8, 8).unwrap();
+        for (u, v, quad) in [
+            (3.5, 3.5, true),
+            (4.5, 4.5, true),
+            (1.5, 6.5, false),
+            (6.2, 1.3, true),
+        ] {
+            let f = m.locate(u, v).unwrap();
+            m.refine_face(f, quad);
+        }
+        m.make_analysis_suitable(1000).unwrap();
+        assert!(m.is_analysis_suitable() && !m.t_junctions().is_empty());
+        let extensions: Vec<_> = m
+            .extensions()
+            .into_iter()
+            .filter(|e| e.b - e.a > 0.0)
+            .collect();
+        let faces = m.faces().to_vec();
+        let basis = TBasis::new(m).unwrap();
+        let control = basis
+            .anchors
+            .iter()
+            .map(|a| {
+                let (t, p) = (
+                    a.u / 8.0 * std::f64::consts::TAU,
+                    a.v / 8.0 * std::f64::consts::TAU,
+                );
+                let r = 2.0 + 0.7 * p.cos() + 0.1 * rng.next();
+                [r * t.cos(), r * t.sin(), 0.7 * p.sin() + 0.1 * rng.next()]
+            })
+            .collect();
+        let ts = TSpline { basis, control };
+        // expected: per face, (distinct cuts along u + 1)(distinct cuts along v + 1)
+        let mut expected = 0;
+        for f in &faces {
+            let eps = 1e-9 * (f.u1 - f.u0).min(f.v1 - f.v0);
+            let (mut us, mut vs) = (Vec::new(), Vec::new());
+            for e in &extensions {
+                for k in -2i32..=2 {
+                    for l in -2i32..=2 {
+                        let (du, dv) = (
+                            k as f64 * lat.width + l as f64 * lat.shift,
+                            l as f64 * lat.height,
+                        );
+                        if e.horizontal {
+                            let (y, a, b) = (e.at + dv, e.a + du, e.b + du);
+                            if y > f.v0 + eps && y < f.v1 - eps && a < f.u1 - eps && b > f.u0 + eps
+                            {
+                                vs.push(y);
+                            }
+                        } else {
+                            let (x, a, b) = (e.at + du, e.a + dv, e.b + dv);
+                            if x > f.u0 + eps && x < f.u1 - eps && a < f.v1 - eps && b > f.v0 + eps
+                            {
+                                us.push(x);
+                            }
+                        }
+                    }
+                }
+            }
+            for xs in [&mut us, &mut vs] {
+                xs.sort_by(f64::total_cmp);
+                xs.dedup_by(|a, b| (*a - *b).abs() <= eps);
+            }
+            expected += (us.len() + 1) * (vs.len() + 1);
+        }
+        let (patches, stats) = extract_elements(&ts);
+        eprintln!(
+            "shift {shift}: {} T-mesh faces, {} extensions, {} faces of the extended T-mesh, {} exported elements; {stats:?}",
+            faces.len(),
+            extensions.len(),
+            expected,
+            patches.len()
+        );
+        assert_eq!(patches.len(), expected, "shift {shift}: {stats:?}");
+        let mut worst = 0.0f64;
+        for p in &patches {
+            for (s, t) in [(0.1, 0.2), (0.5, 0.5), (0.93, 0.71)] {
+                let (u, v) = (p.u0 + s * (p.u1 - p.u0), p.v0 + t * (p.v1 - p.v0));
+                worst = worst.max(dist(p.point(u, v), ts.point(u, v)));
+            }
+        }
+        assert!(worst < 1e-12 * 6.0, "shift {shift}: {worst:e}");
+    }
+}
