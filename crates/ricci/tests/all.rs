@@ -76,6 +76,8 @@ mod metric_derivatives;
 mod param;
 #[path = "param_boundary_cones.rs"]
 mod param_boundary_cones;
+#[path = "param_cone_scale_bound.rs"]
+mod param_cone_scale_bound;
 #[path = "param_develop.rs"]
 mod param_develop;
 #[path = "param_free.rs"]

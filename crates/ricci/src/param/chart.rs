@@ -7,6 +7,7 @@
 use super::boundary::{cones_carrying_the_interior, fixed_angle_targets};
 use super::cones::{
     correct_cone_curvatures, greedy_cones_with, round_to_quarter_turns, ConeBudget,
+    CONE_SCALE_CEILING,
 };
 use super::develop::input_map;
 use super::free::{free_seam_target, held_boundary_cones, homology_disk, HomologyDisk};
@@ -53,7 +54,8 @@ struct ConePlan {
 
 /// Target of a chart with boundary: flat inside, or — with cones asked for (`--cones
 /// N|auto|V=K,…`) — cones inside, given or placed and curved by the greedy with the boundary
-/// held ([`held_boundary_cones`]: least-squares curvatures), and on the boundary the condition
+/// held ([`held_boundary_cones`]: least-squares curvatures, the cones' linearised log scale
+/// bounded above by [`CONE_SCALE_CEILING`]), and on the boundary the condition
 /// of `opts` ([`super::boundary`]): `free` holds `u = 0`; `round` puts each loop on a circle
 /// carrying `2πχ − Σ K̄` (genus 0: the longest loop `2π − Σ K̄`, holes `−2π`); `fixed-angles`
 /// keeps the boundary's geodesic curvature, greedy cones moved to carry the interior's
@@ -79,8 +81,9 @@ fn boundary_target(
             ))
         };
         let n = piece.vertices.len();
+        let ceiling = Some(CONE_SCALE_CEILING);
         let (_, cones, source, history) =
-            held_boundary_cones(piece, n, &opts.cones, opts, progress, &on_boundary)?;
+            held_boundary_cones(piece, n, &opts.cones, opts, progress, &on_boundary, ceiling)?;
         (cones, source, history)
     } else {
         (Vec::new(), "none".to_string(), Vec::new())

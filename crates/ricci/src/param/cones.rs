@@ -256,18 +256,33 @@ pub fn free_boundary_least_squares(
     let lap = laplacian(mesh, metric.lengths())?;
     let k0 = angle_defects(mesh, metric);
     let mut basis = held_basis(mesh, &lap, &k0)?;
-    basis.least_squares(cones)
+    basis.least_squares(cones, None)
 }
+
+/// The bound `β` of [`free_boundary_cones`]' least-squares curvatures on a surface with a
+/// boundary: no cone's linearised log scale `u(c)` above `ū + β sd(u)`. The least-squares
+/// rule weighs `u` by area, so it is free to give a cone whose small neighbourhood carries
+/// little area a curvature far beyond the greedy's (camelhead, 8 cones: 2.86 where `u = 0`
+/// gives 1.61, `u(c)` 7 sd above the mean); the map is then far from linear in the first
+/// rings around it and those faces set the qc p95 (camelhead 1.1033, above Boundary First
+/// Flattening's 1.0979). With `β = 3`: 1.0961, σ(log area) 0.371 → 0.391 (BFF 0.572);
+/// bunny 1.0552 → 1.0549, σ 0.745 → 0.749; face and beetle unchanged (BENCHMARKS.md,
+/// session 16 cq16). Not used on the disk of free seams, where it raised kitten's σ
+/// (0.426 → 0.51, BFF 0.489) for little qc.
+pub const CONE_SCALE_CEILING: f64 = 3.0;
 
 /// The greedy with the boundary held ([`greedy_cones`] on a surface with boundary) and the
 /// curvatures at its positions by `rule` (`Dirichlet`: the greedy's own, `u = 0` at the
-/// cones; `LeastSquares`: [`free_boundary_least_squares`]), from one factorization of the
-/// Laplacian (submodule `held`) — what `--seams free` places on its disk.
+/// cones; `LeastSquares`: [`free_boundary_least_squares`], with the cones' linearised `u`
+/// held at most `ceiling` standard deviations above its mean when `ceiling` is given, see
+/// [`CONE_SCALE_CEILING`]), from one factorization of the Laplacian (submodule `held`) —
+/// what `--seams free` places on its disk and `--boundary …` inside a surface with boundary.
 pub fn free_boundary_cones(
     mesh: &Mesh,
     metric: &IntrinsicMetric,
     budget: ConeBudget,
     rule: CurvatureRule,
+    ceiling: Option<f64>,
 ) -> Result<ConePlacement> {
     let lap = laplacian(mesh, metric.lengths())?;
     let k0 = angle_defects(mesh, metric);
@@ -275,7 +290,7 @@ pub fn free_boundary_cones(
     let mut p = basis.greedy(budget)?;
     if rule == CurvatureRule::LeastSquares {
         let at: Vec<u32> = p.cones.iter().map(|c| c.0).collect();
-        p.cones = basis.least_squares(&at)?.0;
+        p.cones = basis.least_squares(&at, ceiling)?.0;
     }
     Ok(p)
 }

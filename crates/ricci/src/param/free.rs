@@ -132,6 +132,7 @@ pub(super) fn free_seam_target(
         opts,
         progress,
         &on_seam,
+        None,
     )
 }
 
@@ -140,8 +141,10 @@ pub(super) fn free_seam_target(
 /// cones): given cones by input vertex among the piece's first `named` vertices (`on_boundary`
 /// names the error of one on the boundary), or the greedy of Ben-Chen–Gotsman–Bunin with the
 /// boundary held ([`free_boundary_cones`]) and the curvatures of
-/// [`ParamOptions::free_cone_rule`]. The target is `FreeBoundaryCones`; the source `given`,
-/// `greedy` or `none`.
+/// [`ParamOptions::free_cone_rule`] (least squares: the cones' linearised log scale at most
+/// `ceiling` standard deviations above its mean when given,
+/// [`super::cones::CONE_SCALE_CEILING`]). The target is `FreeBoundaryCones`; the source
+/// `given`, `greedy` or `none`.
 pub(super) fn held_boundary_cones(
     piece: &Piece,
     named: usize,
@@ -149,6 +152,7 @@ pub(super) fn held_boundary_cones(
     opts: &ParamOptions,
     progress: &mut dyn Progress,
     on_boundary: &dyn Fn(u32) -> Error,
+    ceiling: Option<f64>,
 ) -> Result<FreePlan> {
     let mesh = &piece.surface.mesh;
     let budget = match spec {
@@ -191,7 +195,7 @@ pub(super) fn held_boundary_cones(
             // The greedy's positions; curvatures for the least linearised σ(2u) by default
             // (the greedy's own, u = 0 at the cones, are one candidate of that least-squares
             // problem, so this is never worse in the linear model).
-            let p = free_boundary_cones(mesh, &metric, b, opts.free_cone_rule)?;
+            let p = free_boundary_cones(mesh, &metric, b, opts.free_cone_rule, ceiling)?;
             (p.cones, p.distortion_history)
         }
         None => (Vec::new(), Vec::new()),

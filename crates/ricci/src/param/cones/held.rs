@@ -216,8 +216,15 @@ impl<'a> HeldBasis<'a> {
 
     /// Curvatures at `cones` of least area-weighted variance of `u = u₀ + Σ_c K̄_c g_c`
     /// (both shifted to zero area mean), cone angles kept positive (`K̄ ≤ 2π − 0.05`), and the
-    /// linearised area-weighted `σ(2u)`.
-    pub fn least_squares(&mut self, cones: &[u32]) -> Result<(Vec<(u32, f64)>, f64)> {
+    /// linearised area-weighted `σ(2u)`. With `ceiling = Some(β)`, no cone's linearised `u(c)`
+    /// lies above `ū + β sd(u)` (mean and deviation of the unbounded solution): such cones
+    /// are held there and the others' curvatures are least-squares under that condition
+    /// (see [`super::CONE_SCALE_CEILING`]).
+    pub fn least_squares(
+        &mut self,
+        cones: &[u32],
+        ceiling: Option<f64>,
+    ) -> Result<(Vec<(u32, f64)>, f64)> {
         let lap: &'a Laplacian = self.lap;
         let n = lap.n;
         if let Some(&c) = cones
@@ -242,10 +249,11 @@ impl<'a> HeldBasis<'a> {
             .map(|i| (0..k).map(|j| dot(&g[i], &g[j])).collect())
             .collect();
         let b: Vec<f64> = (0..k).map(|i| -dot(&g[i], &u0)).collect();
-        let x: Vec<f64> = dense_solve(m, &b, "cone curvatures")?
-            .into_iter()
-            .map(|x| x.min(2.0 * PI - 0.05))
-            .collect();
+        let mut x = dense_solve(m.clone(), &b, "cone curvatures")?;
+        if let Some(beta) = ceiling {
+            x = self.held_below(cones, &m, &b, x, beta)?;
+        }
+        let x: Vec<f64> = x.into_iter().map(|x| x.min(2.0 * PI - 0.05)).collect();
         let mut u = u0;
         for (gc, xc) in g.iter().zip(&x) {
             for v in 0..n {
@@ -254,5 +262,67 @@ impl<'a> HeldBasis<'a> {
         }
         let sigma = 2.0 * (dot(&u, &u) / total).sqrt();
         Ok((cones.iter().copied().zip(x).collect(), sigma))
+    }
+
+    /// The least-squares curvatures `x` (normal equations `m x = b`) with every cone whose
+    /// linearised `u(c)` lies above `ū + β sd(u)` of the unbounded `x` held there: the normal
+    /// equations with those conditions as constraints (a KKT system), until no cone is above
+    /// (each round holds at least one more, so at most `|C|` rounds).
+    fn held_below(
+        &self,
+        cones: &[u32],
+        m: &[Vec<f64>],
+        b: &[f64],
+        mut x: Vec<f64>,
+        beta: f64,
+    ) -> Result<Vec<f64>> {
+        let (n, k) = (self.lap.n, cones.len());
+        let area = &self.lap.area;
+        // u(c) = u₀(c) + Σ_j K̄_j g_j(c), uncentred (the held boundary's u = 0).
+        let rows: Vec<Vec<f64>> = cones
+            .iter()
+            .map(|&c| cones.iter().map(|d| self.columns[d][c as usize]).collect())
+            .collect();
+        let u_at = |x: &[f64], i: usize| {
+            self.u0[cones[i] as usize] + rows[i].iter().zip(x).map(|(a, y)| a * y).sum::<f64>()
+        };
+        let mut u = self.u0.clone();
+        for (c, xc) in cones.iter().zip(&x) {
+            for (y, gv) in u.iter_mut().zip(&self.columns[c]) {
+                *y += xc * gv;
+            }
+        }
+        let mean = (0..n).map(|v| u[v] * area[v]).sum::<f64>() / self.total_area;
+        let var = (0..n).map(|v| (u[v] - mean).powi(2) * area[v]).sum::<f64>() / self.total_area;
+        let ceiling = mean + beta * var.sqrt();
+        let mut hold = vec![false; k];
+        for _ in 0..k {
+            let above: Vec<usize> = (0..k)
+                .filter(|&i| !hold[i] && u_at(&x, i) > ceiling)
+                .collect();
+            if above.is_empty() {
+                break;
+            }
+            for i in above {
+                hold[i] = true;
+            }
+            let held: Vec<usize> = (0..k).filter(|&i| hold[i]).collect();
+            let size = k + held.len();
+            let mut a = vec![vec![0.0; size]; size];
+            let mut rhs = b.to_vec();
+            for (row, mi) in a.iter_mut().zip(m) {
+                row[..k].copy_from_slice(mi);
+            }
+            for (r, &i) in held.iter().enumerate() {
+                for j in 0..k {
+                    a[k + r][j] = rows[i][j];
+                    a[j][k + r] = rows[i][j];
+                }
+                rhs.push(ceiling - self.u0[cones[i] as usize]);
+            }
+            x = dense_solve(a, &rhs, "bounded cone curvatures")?;
+            x.truncate(k);
+        }
+        Ok(x)
     }
 }
