@@ -23,7 +23,9 @@
 //!
 //! **Linear algebra.** Sparse Cholesky (faer) on a lower-triangular pattern that only grows:
 //! the symbolic factorization is redone only when flips create a vertex pair that the pattern
-//! lacks (entries of vanished pairs are stored as zeros).
+//! lacks (entries of vanished pairs are stored as zeros), beside the Hessian's assembly (two
+//! threads). Every edge keeps the slot of its two ends' entry; a flip renews its edge's slot,
+//! a grown pattern moves the others.
 //!
 //! **Targets.** Per-vertex `K̄` from [`super::target`]; fixed vertices (free boundary) keep
 //! `u = 0`; round boundaries re-evaluate `K̄` from the current boundary lengths (boundary edges
