@@ -23,7 +23,9 @@
 //!
 //! **Linear algebra.** Sparse Cholesky (faer) on a lower-triangular pattern that only grows:
 //! the symbolic factorization is redone only when flips create a vertex pair that the pattern
-//! lacks (entries of vanished pairs are stored as zeros).
+//! lacks (entries of vanished pairs are stored as zeros), beside the Hessian's assembly (two
+//! threads). Every edge keeps the slot of its two ends' entry; a flip renews its edge's slot,
+//! a grown pattern moves the others.
 //!
 //! **Targets.** Per-vertex `K̄` from [`super::target`]; fixed vertices (free boundary) keep
 //! `u = 0`; round boundaries re-evaluate `K̄` from the current boundary lengths (boundary edges
@@ -43,8 +45,8 @@ use crate::error::{Error, Result};
 use crate::mesh::NONE;
 use crate::metric::intrinsic::{length_of_lambda, IntrinsicTriangulation};
 use crate::metric::kernel::angle_derivatives;
-use crate::metric::{Euclidean, Geometry, HessianPattern, Hyperbolic, Spherical};
-use crate::numeric::sparse::SymmetricSolver;
+use crate::metric::{Euclidean, Geometry, Hyperbolic, Spherical};
+use crate::numeric::sparse::{LowerCsc, SymmetricSolver};
 use crate::progress::Progress;
 use std::f64::consts::PI;
 use std::time::Instant;
@@ -190,6 +192,9 @@ struct GrowingPattern {
     free_vertex: Vec<u32>,
     col_ptr: Vec<u32>,
     row_idx: Vec<u32>,
+    /// Slot of every edge of the triangulation: its two ends' entry (the diagonal for a
+    /// loop), `NONE` when an end is held. Kept by [`GrowingPattern::cover`].
+    edge_slot: Vec<u32>,
     solver: Option<SymmetricSolver>,
     /// Symbolic factorizations computed.
     symbolic_count: usize,
@@ -219,6 +224,7 @@ impl GrowingPattern {
             free_vertex,
             col_ptr: (0..=n as u32).collect(),
             row_idx: (0..n as u32).collect(),
+            edge_slot: Vec::new(),
             solver: None,
             symbolic_count: 0,
             amd_factor_nnz: 0,
@@ -235,19 +241,31 @@ impl GrowingPattern {
         );
         self.row_idx[s..t].binary_search(&r).ok().map(|k| s + k)
     }
-    /// Make sure every vertex pair joined by an edge of `tri` is in the pattern; redo the
-    /// symbolic factorization if the pattern grew.
+    /// The pattern's entry of the two ends of edge `e` (`NONE`: an end is held, or the pair
+    /// is not in the pattern).
+    fn edge_entry(&self, tri: &IntrinsicTriangulation, e: u32) -> u32 {
+        let [a, b] = tri.edge_vertices(e);
+        let (ia, ib) = (self.free_index[a as usize], self.free_index[b as usize]);
+        if ia == NONE || ib == NONE {
+            return NONE;
+        }
+        self.slot(ia.min(ib), ia.max(ib)).map_or(NONE, |s| s as u32)
+    }
+    /// Make sure every vertex pair joined by an edge of `tri` is in the pattern, with the
+    /// edges' slots; true when the pattern is new or grew and needs a new symbolic
+    /// factorization ([`GrowingPattern::analysis`]).
     ///
     /// Only an edge flipped since the last call can join a new pair (the others kept their
     /// ends, whose pairs were covered then): those are `tri.flip_log` after the length it had.
-    fn cover(&mut self, tri: &IntrinsicTriangulation) -> Result<()> {
-        let mut missing: Vec<(u32, u32)> = Vec::new();
-        let flipped = match tri.flip_log.get(self.covered_flips..) {
-            Some(tail) if self.solver.is_some() => tail.to_vec(),
+    fn cover(&mut self, tri: &IntrinsicTriangulation) -> bool {
+        let full = self.solver.is_none() || self.edge_slot.len() != tri.n_edges();
+        let flipped: Vec<u32> = match tri.flip_log.get(self.covered_flips..) {
+            Some(tail) if !full => tail.to_vec(),
             _ => (0..tri.n_edges() as u32).collect(),
         };
         self.covered_flips = tri.flip_log.len();
-        for e in flipped {
+        let mut missing: Vec<(u32, u32)> = Vec::new();
+        for &e in &flipped {
             let [a, b] = tri.edge_vertices(e);
             let (ia, ib) = (self.free_index[a as usize], self.free_index[b as usize]);
             if a == b || ia == NONE || ib == NONE {
@@ -258,34 +276,65 @@ impl GrowingPattern {
                 missing.push((c, r));
             }
         }
-        if missing.is_empty() && self.solver.is_some() {
-            return Ok(());
+        let grew = !missing.is_empty();
+        if grew {
+            let moved = self.grow(missing);
+            if !full {
+                for s in self.edge_slot.iter_mut().filter(|s| **s != NONE) {
+                    *s = moved[*s as usize];
+                }
+            }
         }
+        if full {
+            self.edge_slot = (0..tri.n_edges() as u32)
+                .map(|e| self.edge_entry(tri, e))
+                .collect();
+        } else {
+            for e in flipped {
+                self.edge_slot[e as usize] = self.edge_entry(tri, e);
+            }
+        }
+        grew || self.solver.is_none()
+    }
+    /// Merge the pairs `missing` (column, row; not in the pattern) into the pattern, columns
+    /// kept sorted; returns the new slot of every old entry.
+    fn grow(&mut self, mut missing: Vec<(u32, u32)>) -> Vec<u32> {
+        missing.sort_unstable();
+        missing.dedup();
         let n = self.n();
-        let mut cols: Vec<Vec<u32>> = (0..n)
-            .map(|c| self.row_idx[self.col_ptr[c] as usize..self.col_ptr[c + 1] as usize].to_vec())
-            .collect();
-        for (c, r) in missing {
-            cols[c as usize].push(r);
-        }
         let mut col_ptr = Vec::with_capacity(n + 1);
-        let mut row_idx = Vec::new();
+        let mut row_idx = Vec::with_capacity(self.row_idx.len() + missing.len());
+        let mut moved = Vec::with_capacity(self.row_idx.len());
         col_ptr.push(0u32);
-        for mut col in cols {
-            col.sort_unstable();
-            col.dedup();
-            row_idx.extend_from_slice(&col);
+        let mut new = missing.into_iter().peekable();
+        for c in 0..n as u32 {
+            let (s, t) = (
+                self.col_ptr[c as usize] as usize,
+                self.col_ptr[c as usize + 1] as usize,
+            );
+            for &r in &self.row_idx[s..t] {
+                while let Some((_, x)) = new.next_if(|&(nc, nr)| nc == c && nr < r) {
+                    row_idx.push(x);
+                }
+                moved.push(row_idx.len() as u32);
+                row_idx.push(r);
+            }
+            while let Some((_, x)) = new.next_if(|&(nc, _)| nc == c) {
+                row_idx.push(x);
+            }
             col_ptr.push(row_idx.len() as u32);
         }
         self.col_ptr = col_ptr;
         self.row_idx = row_idx;
-        let pattern = HessianPattern {
-            free_index: self.free_index.clone(),
-            free_vertex: self.free_vertex.clone(),
-            col_ptr: self.col_ptr.clone(),
-            row_idx: self.row_idx.clone(),
-            diag_slot: Vec::new(),
-            edge_slot: Vec::new(),
+        moved
+    }
+    /// The symbolic factorization of the current pattern, and the factor size when it comes
+    /// with a new AMD ordering.
+    fn analysis(&self) -> Result<(SymmetricSolver, Option<usize>)> {
+        let pattern = LowerCsc {
+            n: self.n(),
+            col_ptr: &self.col_ptr,
+            row_idx: &self.row_idx,
         };
         // A grown pattern keeps the fill-reducing ordering of the last AMD analysis while
         // the factor stays within `REUSED_ORDERING_FILL` of that analysis' factor: flips add
@@ -296,22 +345,20 @@ impl GrowingPattern {
         let ordering = self.solver.as_ref().and_then(|s| s.ordering());
         let reused = match ordering {
             Some((forward, inverse)) => {
-                let s = SymmetricSolver::with_ordering(&pattern, &forward, &inverse)?;
+                let s = SymmetricSolver::with_ordering(pattern, &forward, &inverse)?;
                 let limit = REUSED_ORDERING_FILL * self.amd_factor_nnz as f64;
                 (s.factor_nnz as f64 <= limit).then_some(s)
             }
             None => None,
         };
-        self.solver = Some(match reused {
-            Some(s) => s,
+        Ok(match reused {
+            Some(s) => (s, None),
             None => {
-                let s = SymmetricSolver::new(&pattern)?;
-                self.amd_factor_nnz = s.factor_nnz;
-                s
+                let s = SymmetricSolver::new(pattern)?;
+                let nnz = s.factor_nnz;
+                (s, Some(nnz))
             }
-        });
-        self.symbolic_count += 1;
-        Ok(())
+        })
     }
     /// Lower-triangle values of `H = ∂K/∂u` (free vertices) from the state's Jacobians.
     fn assemble(&self, tri: &IntrinsicTriangulation, st: &ConformalState, values: &mut Vec<f64>) {
@@ -319,6 +366,8 @@ impl GrowingPattern {
         values.resize(self.row_idx.len(), 0.0);
         for f in 0..tri.n_faces() {
             let vs = tri.face(f as u32);
+            // Half-edge 3f + k joins corners k and k + 1.
+            let es = [tri.edge[3 * f], tri.edge[3 * f + 1], tri.edge[3 * f + 2]];
             for m in 0..3 {
                 let r = self.free_index[vs[m] as usize];
                 if r == NONE {
@@ -329,8 +378,14 @@ impl GrowingPattern {
                     if c == NONE || c > r {
                         continue;
                     }
-                    if let Some(s) = self.slot(c, r) {
-                        values[s] -= st.jac[9 * f + 3 * m + n];
+                    let s = if m == n {
+                        // The diagonal comes first in its column (rows ≥ the column).
+                        self.col_ptr[r as usize]
+                    } else {
+                        self.edge_slot[es[if n == (m + 1) % 3 { m } else { n }] as usize]
+                    };
+                    if s != NONE {
+                        values[s as usize] -= st.jac[9 * f + 3 * m + n];
                     }
                 }
             }
@@ -576,10 +631,23 @@ impl<'a> ConformalNewton<'a> {
         true
     }
 
-    /// The Hessian of the current triangulation at `u` into `values`.
+    /// The Hessian of the current triangulation at `u` into `values`, and the pattern's
+    /// symbolic factorization when it grew (the two in parallel: they share only the
+    /// pattern).
     fn assemble(&mut self) -> Result<()> {
-        self.pattern.cover(self.tri)?;
-        self.pattern.assemble(self.tri, &self.st, &mut self.values);
+        if !self.pattern.cover(self.tri) {
+            self.pattern.assemble(self.tri, &self.st, &mut self.values);
+            return Ok(());
+        }
+        let (pattern, tri, st, values) = (&self.pattern, &*self.tri, &self.st, &mut self.values);
+        let (analysis, ()) =
+            rayon::join(|| pattern.analysis(), || pattern.assemble(tri, st, values));
+        let (solver, amd_nnz) = analysis?;
+        if let Some(nnz) = amd_nnz {
+            self.pattern.amd_factor_nnz = nnz;
+        }
+        self.pattern.solver = Some(solver);
+        self.pattern.symbolic_count += 1;
         Ok(())
     }
 
@@ -884,4 +952,120 @@ pub fn hessian_triplets(tri: &IntrinsicTriangulation, st: &ConformalState) -> Ve
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::Mesh;
+    use std::collections::HashMap;
+
+    /// The growing pattern's slots (kept across flips and growth) against the Hessian summed
+    /// here from [`hessian_triplets`] by vertex pair: every entry, after every evaluation of
+    /// a sequence of scale factors that flips edges and grows the pattern.
+    #[test]
+    fn growing_pattern_assembles_the_hessian_of_every_triangulation() {
+        // A jittered 12 × 12 grid of the unit square, split along one diagonal.
+        let k = 12usize;
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut rand = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut pts = Vec::new();
+        for j in 0..=k {
+            for i in 0..=k {
+                let inner = i > 0 && i < k && j > 0 && j < k;
+                let jitter = if inner { 0.3 / k as f64 } else { 0.0 };
+                pts.push([
+                    i as f64 / k as f64 + jitter * (2.0 * rand() - 1.0),
+                    j as f64 / k as f64 + jitter * (2.0 * rand() - 1.0),
+                ]);
+            }
+        }
+        let id = |i: usize, j: usize| (j * (k + 1) + i) as u32;
+        let mut faces = Vec::new();
+        for j in 0..k {
+            for i in 0..k {
+                faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                faces.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let mesh = Mesh::from_triangles(pts.len(), faces).unwrap();
+        let lengths: Vec<f64> = (0..mesh.n_edges() as u32)
+            .map(|e| {
+                let [a, b] = mesh.edge_vertices(e).map(|v| pts[v as usize]);
+                ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
+            })
+            .collect();
+        let mut tri =
+            IntrinsicTriangulation::from_mesh(&mesh, Geometry::Euclidean, &lengths).unwrap();
+        tri.make_delaunay_isometric(Geometry::Euclidean, 100_000);
+        // Boundary vertices held, as the free boundary of `ricci param`.
+        let held: Vec<bool> = (0..pts.len())
+            .map(|v| {
+                let p = pts[v];
+                p[0] <= 0.0 || p[0] >= 1.0 || p[1] <= 0.0 || p[1] >= 1.0
+            })
+            .collect();
+        let mut pattern = GrowingPattern::new(&held);
+        let mut st = ConformalState::default();
+        let mut values = Vec::new();
+        let (mut grown, mut flips) = (0, 0);
+        for step in 0..6 {
+            let amplitude = 0.4 * step as f64;
+            let u: Vec<f64> = (0..pts.len())
+                .map(|v| {
+                    let p = pts[v];
+                    amplitude * (3.0 * p[0] + 5.0 * p[1] * p[1]).sin()
+                })
+                .collect();
+            assert!(evaluate(
+                &mut tri,
+                Geometry::Euclidean,
+                &u,
+                100_000,
+                &mut st
+            ));
+            flips += st.flips;
+            if pattern.cover(&tri) {
+                grown += 1;
+                pattern.solver = Some(pattern.analysis().unwrap().0);
+            }
+            pattern.assemble(&tri, &st, &mut values);
+            let mut want: HashMap<(u32, u32), f64> = HashMap::new();
+            for (a, b, x) in hessian_triplets(&tri, &st) {
+                let (r, c) = (
+                    pattern.free_index[a as usize],
+                    pattern.free_index[b as usize],
+                );
+                if r != NONE && c != NONE && c <= r {
+                    *want.entry((c, r)).or_default() += x;
+                }
+            }
+            for c in 0..pattern.n() as u32 {
+                for s in
+                    pattern.col_ptr[c as usize] as usize..pattern.col_ptr[c as usize + 1] as usize
+                {
+                    let r = pattern.row_idx[s];
+                    let w = want.remove(&(c, r)).unwrap_or(0.0);
+                    assert!(
+                        (values[s] - w).abs() <= 1e-12 * w.abs().max(1.0),
+                        "step {step}: entry ({c}, {r}) is {} instead of {w}",
+                        values[s]
+                    );
+                }
+            }
+            assert!(
+                want.is_empty(),
+                "step {step}: pairs missing from the pattern: {want:?}"
+            );
+        }
+        assert!(
+            flips > 0 && grown > 1,
+            "flips {flips}, pattern grew {grown} times"
+        );
+    }
 }

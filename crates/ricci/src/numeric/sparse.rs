@@ -3,7 +3,9 @@
 //! * [`SymmetricSolver`] — symmetric matrices with a fixed pattern (lower triangle, CSC,
 //!   [`LowerCsc`]): AMD ordering and the symbolic Cholesky factorization are computed once
 //!   and reused for every numeric factorization (LLᵀ for positive definite matrices such as
-//!   the E² and H² Hessians of the flows, LDLᵀ for the indefinite S² Hessian).
+//!   the E² and H² Hessians of the flows, LDLᵀ for the indefinite S² Hessian). The pattern
+//!   in the factor's order is built once per analysis (`Permuted`), so a numeric
+//!   factorization only scatters the values into it.
 //!   Single-threaded factorization (docs/DESIGN.md §2 measured no gain from two threads on this
 //!   machine).
 //! * [`SparseLu`] — general square matrices assembled from triplets with the same pattern at
@@ -22,8 +24,8 @@ use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky,
-    SymmetricOrdering,
+    factorize_symbolic_cholesky, supernodal, CholeskySymbolicParams, LdltRef, LltRef,
+    SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
@@ -69,12 +71,76 @@ fn lower<'a>(
 /// BENCHMARKS.md, session 14 spd16). Both are exact factorizations of the same matrix.
 const SUPERNODAL_THRESHOLD: SupernodalThreshold = SupernodalThreshold::FORCE_SUPERNODAL;
 
+/// The lower triangle of the permuted matrix `P A Pᵀ` in the factor's order (columns with
+/// unsorted rows, as the supernodal factorization reads them), and where each of `A`'s
+/// lower-triangle values goes in it: built once per pattern, so a factorization only scatters
+/// the values (faer's own route permutes the whole pattern every time).
+struct Permuted {
+    col_ptr: Vec<u32>,
+    row_idx: Vec<u32>,
+    /// `slot[k]`: position in `values` of `A`'s `k`-th stored value.
+    slot: Vec<u32>,
+    values: Vec<f64>,
+}
+
+impl Permuted {
+    /// `inverse[i]`: the position of original index `i` (identity when `None`).
+    fn new(n: usize, col_ptr: &[u32], row_idx: &[u32], inverse: Option<&[u32]>) -> Permuted {
+        let at = |i: u32| inverse.map_or(i, |p| p[i as usize]);
+        let nnz = row_idx.len();
+        // Entry (r, c) of the lower triangle goes to column min(P r, P c), row max.
+        let mut count = vec![0u32; n + 1];
+        for c in 0..n {
+            let pc = at(c as u32);
+            for &r in &row_idx[col_ptr[c] as usize..col_ptr[c + 1] as usize] {
+                count[pc.min(at(r)) as usize + 1] += 1;
+            }
+        }
+        for j in 0..n {
+            count[j + 1] += count[j];
+        }
+        let out_ptr = count.clone();
+        let mut out_row = vec![0u32; nnz];
+        let mut slot = vec![0u32; nnz];
+        for c in 0..n {
+            let pc = at(c as u32);
+            for k in col_ptr[c] as usize..col_ptr[c + 1] as usize {
+                let pr = at(row_idx[k]);
+                let j = pc.min(pr) as usize;
+                let s = count[j];
+                count[j] += 1;
+                out_row[s as usize] = pc.max(pr);
+                slot[k] = s;
+            }
+        }
+        Permuted {
+            col_ptr: out_ptr,
+            row_idx: out_row,
+            slot,
+            values: vec![0.0; nnz],
+        }
+    }
+
+    /// The permuted matrix with `A`'s lower-triangle `values` (in `A`'s pattern order).
+    fn matrix(&mut self, n: usize, values: &[f64]) -> SparseColMatRef<'_, u32, f64> {
+        for (&s, &v) in self.slot.iter().zip(values) {
+            self.values[s as usize] = v;
+        }
+        SparseColMatRef::new(
+            SymbolicSparseColMatRef::new_unsorted_checked(n, n, &self.col_ptr, None, &self.row_idx),
+            &self.values,
+        )
+    }
+}
+
 /// A reusable sparse symmetric factorization for one sparsity pattern (lower triangle).
 pub struct SymmetricSolver {
     n: usize,
     col_ptr: Vec<u32>,
     row_idx: Vec<u32>,
     symbolic: SymbolicCholesky<u32>,
+    /// The pattern in the factor's order (supernodal analyses; `None`: faer's own route).
+    permuted: Option<Permuted>,
     l_values: Vec<f64>,
     mem: MemBuffer,
     factored: Factored,
@@ -162,11 +228,21 @@ impl SymmetricSolver {
         let mem = MemBuffer::try_new(req)
             .map_err(|_| Error::numerical("out of memory for the Cholesky workspace"))?;
         let len = symbolic.len_val();
+        let permuted = match symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(_) => Some(Permuted::new(
+                n,
+                &col_ptr,
+                &row_idx,
+                symbolic.perm().map(|p| p.arrays().1),
+            )),
+            SymbolicCholeskyRaw::Simplicial(_) => None,
+        };
         Ok(SymmetricSolver {
             n,
             col_ptr,
             row_idx,
             symbolic,
+            permuted,
             l_values: vec![0.0; len],
             mem,
             factored: Factored::None,
@@ -182,20 +258,33 @@ impl SymmetricSolver {
             self.factored = Factored::None;
             return false;
         }
-        let a = lower(self.n, &self.col_ptr, &self.row_idx, values);
         let stack = MemStack::new(&mut self.mem);
-        let ok = self
-            .symbolic
-            .factorize_numeric_llt(
-                &mut self.l_values,
-                a,
-                Side::Lower,
-                LltRegularization::default(),
-                Par::Seq,
-                stack,
-                Default::default(),
-            )
-            .is_ok();
+        let ok = match (&mut self.permuted, self.symbolic.raw()) {
+            (Some(p), SymbolicCholeskyRaw::Supernodal(sym)) => {
+                supernodal::factorize_supernodal_numeric_llt(
+                    &mut self.l_values,
+                    p.matrix(self.n, values),
+                    LltRegularization::default(),
+                    sym,
+                    Par::Seq,
+                    stack,
+                    Default::default(),
+                )
+                .is_ok()
+            }
+            _ => self
+                .symbolic
+                .factorize_numeric_llt(
+                    &mut self.l_values,
+                    lower(self.n, &self.col_ptr, &self.row_idx, values),
+                    Side::Lower,
+                    LltRegularization::default(),
+                    Par::Seq,
+                    stack,
+                    Default::default(),
+                )
+                .is_ok(),
+        };
         super::simd::clear_upper_state_here();
         self.factored = if ok { Factored::Llt } else { Factored::None };
         ok
@@ -208,20 +297,33 @@ impl SymmetricSolver {
             self.factored = Factored::None;
             return false;
         }
-        let a = lower(self.n, &self.col_ptr, &self.row_idx, values);
         let stack = MemStack::new(&mut self.mem);
-        let ok = self
-            .symbolic
-            .factorize_numeric_ldlt(
-                &mut self.l_values,
-                a,
-                Side::Lower,
-                LdltRegularization::default(),
-                Par::Seq,
-                stack,
-                Default::default(),
-            )
-            .is_ok();
+        let ok = match (&mut self.permuted, self.symbolic.raw()) {
+            (Some(p), SymbolicCholeskyRaw::Supernodal(sym)) => {
+                supernodal::factorize_supernodal_numeric_ldlt(
+                    &mut self.l_values,
+                    p.matrix(self.n, values),
+                    LdltRegularization::default(),
+                    sym,
+                    Par::Seq,
+                    stack,
+                    Default::default(),
+                )
+                .is_ok()
+            }
+            _ => self
+                .symbolic
+                .factorize_numeric_ldlt(
+                    &mut self.l_values,
+                    lower(self.n, &self.col_ptr, &self.row_idx, values),
+                    Side::Lower,
+                    LdltRegularization::default(),
+                    Par::Seq,
+                    stack,
+                    Default::default(),
+                )
+                .is_ok(),
+        };
         super::simd::clear_upper_state_here();
         self.factored = if ok { Factored::Ldlt } else { Factored::None };
         ok && self.l_values.iter().all(|x| x.is_finite())
