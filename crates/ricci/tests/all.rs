@@ -130,6 +130,8 @@ mod teichmuller;
 mod tspline;
 #[path = "tspline_cylinders.rs"]
 mod tspline_cylinders;
+#[path = "tspline_domain_blocks.rs"]
+mod tspline_domain_blocks;
 #[path = "tspline_domain_mesh.rs"]
 mod tspline_domain_mesh;
 #[path = "tspline_genus.rs"]

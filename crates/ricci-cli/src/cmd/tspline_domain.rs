@@ -157,6 +157,9 @@ pub fn domain_spline(
     } else {
         (vertices_only, a_dev)
     };
+    for line in &fit.refinements {
+        progress.report("tspline", None, line);
+    }
     progress.report("tspline", None, "derivative jumps across every cell side");
     let sides = side_continuity(&fit.mesh, &fit.control, SIDE_SAMPLES);
     let patches = fit.mesh.patches(&fit.control);
@@ -186,6 +189,9 @@ pub fn domain_spline(
         "control_points": mesh.n_control_points(),
         "t_junctions": mesh.n_t_junctions(),
         "mesh_vertices": mesh.n_vertices(),
+        "blocks": mesh.blocks.len(),
+        "block_cells": mesh.blocks.iter().map(|b| b.cells()).sum::<usize>(),
+        "refinements": fit.refinements,
         "bezier_patches": patches.len(),
         "continuity": continuity,
         "gluing_mismatch": gluing.mismatch,
