@@ -16,9 +16,7 @@ use ricci::spline::tspline::domain_fit::{
 };
 use ricci::spline::tspline::domain_mesh::blocks::{place_blocks, CLEAR};
 use ricci::spline::tspline::domain_mesh::DomainMesh;
-use ricci::spline::tspline::genus_domain::best_genus_domain;
-use ricci::spline::tspline::glue::gluing;
-use tspline_cases::{forms, genus_two_cases};
+use tspline_cases::{genus_two_cases, glued_domain};
 
 /// Anchors a block of `a × b` cells inside a strip adds: `a` lines along `v` over the box's
 /// `b` rows and one row beyond each end (`b + 3` crossings of the old rows, `b` of the new
@@ -35,14 +33,7 @@ fn blocks_split_cells_2x2_in_an_analysis_suitable_t_spline() {
     let mut rng = Rng(0xbb67ae8584caa73b);
     let mut tested = 0;
     for (name, s) in genus_two_cases() {
-        let h = forms(&s);
-        let d = best_genus_domain(&h, s.positions.len()).unwrap();
-        let g = gluing(&d).unwrap();
-        let l = d
-            .cylinders
-            .iter()
-            .map(|c| c.circumference)
-            .fold(0.0, f64::max);
+        let (d, g, l) = glued_domain(&s);
         for (k, levels, margin) in [(25.0, 0, 2), (25.0, 2, 2), (40.0, 2, 2)] {
             let spacing = l / k;
             let base = DomainMesh::graded(&d, &g, spacing, levels).unwrap();
@@ -128,9 +119,7 @@ fn blocks_split_cells_2x2_in_an_analysis_suitable_t_spline() {
 fn blocks_fit_the_tolerance_with_fewer_control_points_than_refining_everywhere() {
     let (mut fewer, mut cases) = (0, 0);
     for (name, s) in genus_two_cases() {
-        let h = forms(&s);
-        let d = best_genus_domain(&h, s.positions.len()).unwrap();
-        let g = gluing(&d).unwrap();
+        let (d, g, _) = glued_domain(&s);
         let side = {
             let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
             for p in &s.positions {

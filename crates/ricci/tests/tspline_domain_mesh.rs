@@ -901,14 +901,7 @@ fn local_knots(at: usize, len: usize, crossed: impl Fn(usize) -> bool) -> Option
 fn domain_mesh_with_t_junctions_is_an_analysis_suitable_t_spline() {
     let mut rng = Rng(0x6a09e667f3bcc909);
     for (name, s) in genus_two_cases() {
-        let h = forms(&s);
-        let d = best_genus_domain(&h, s.positions.len()).unwrap();
-        let g = gluing(&d).unwrap();
-        let l = d
-            .cylinders
-            .iter()
-            .map(|c| c.circumference)
-            .fold(0.0, f64::max);
+        let (d, g, l) = tspline_cases::glued_domain(&s);
         for (k, levels, margin) in [(12.0, 2, 1), (12.0, 3, 0), (25.0, 3, 1)] {
             let full = DomainMesh::graded(&d, &g, l / k, levels).unwrap();
             let nv = full.n_vertices();

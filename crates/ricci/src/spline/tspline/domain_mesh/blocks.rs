@@ -159,7 +159,7 @@ impl DomainMesh {
     pub(super) fn block_line_v(&self, r: usize, i: usize, j: usize) -> Option<bool> {
         let rc = &self.rects[r];
         let a = rc.u_half[i];
-        if a % 2 == 0 {
+        if a.is_multiple_of(2) {
             return None;
         }
         let (col, y) = (a / 2, rc.v_half[j]);
@@ -176,7 +176,7 @@ impl DomainMesh {
     pub(super) fn block_line_u(&self, r: usize, i: usize, j: usize) -> Option<bool> {
         let rc = &self.rects[r];
         let a = rc.v_half[j];
-        if a % 2 == 0 {
+        if a.is_multiple_of(2) {
             return None;
         }
         let (row, x) = (a / 2, rc.u_half[i]);

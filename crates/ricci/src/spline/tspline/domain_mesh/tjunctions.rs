@@ -55,12 +55,12 @@ impl Rect {
     /// Whether column line `i` is one of the grading's (module doc of the parent).
     fn graded_u(&self, i: usize) -> bool {
         let h = self.u_half[i];
-        h % 2 == 0 && graded(h / 2, self.base_m, self.levels)
+        h.is_multiple_of(2) && graded(h / 2, self.base_m, self.levels)
     }
 
     fn graded_v(&self, j: usize) -> bool {
         let h = self.v_half[j];
-        h % 2 == 0 && graded(h / 2, self.base_n, self.levels)
+        h.is_multiple_of(2) && graded(h / 2, self.base_n, self.levels)
     }
 }
 
