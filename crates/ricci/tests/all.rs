@@ -134,6 +134,8 @@ mod tspline;
 mod tspline_bezier_elements;
 #[path = "tspline_cylinders.rs"]
 mod tspline_cylinders;
+#[path = "tspline_domain_blocks.rs"]
+mod tspline_domain_blocks;
 #[path = "tspline_domain_mesh.rs"]
 mod tspline_domain_mesh;
 #[path = "tspline_genus.rs"]

@@ -16,10 +16,10 @@ use ricci::spline::tspline::genus_domain::best_genus_domain;
 use ricci::spline::tspline::glue::gluing;
 use ricci::spline::tspline::BezierPatch;
 
-struct Rng(u64);
+pub(crate) struct Rng(pub u64);
 
 impl Rng {
-    fn next(&mut self) -> f64 {
+    pub(crate) fn next(&mut self) -> f64 {
         self.0 ^= self.0 << 13;
         self.0 ^= self.0 >> 7;
         self.0 ^= self.0 << 17;
@@ -901,119 +901,132 @@ fn local_knots(at: usize, len: usize, crossed: impl Fn(usize) -> bool) -> Option
 fn domain_mesh_with_t_junctions_is_an_analysis_suitable_t_spline() {
     let mut rng = Rng(0x6a09e667f3bcc909);
     for (name, s) in genus_two_cases() {
-        let h = forms(&s);
-        let d = best_genus_domain(&h, s.positions.len()).unwrap();
-        let g = gluing(&d).unwrap();
-        let l = d
-            .cylinders
-            .iter()
-            .map(|c| c.circumference)
-            .fold(0.0, f64::max);
+        let (d, g, l) = tspline_cases::glued_domain(&s);
         for (k, levels, margin) in [(12.0, 2, 1), (12.0, 3, 0), (25.0, 3, 1)] {
             let full = DomainMesh::graded(&d, &g, l / k, levels).unwrap();
             let nv = full.n_vertices();
             let m = full.with_t_junctions(margin).unwrap();
             let name = format!("{name} at L/{k}, {levels} levels, margin {margin}");
-            let tj = m.tjunctions.clone().unwrap();
-            // analysis-suitable: no extension along u meets one along v (strip by strip)
-            let mut found = 0;
-            for r in 0..m.rects.len() {
-                let lines = StripLines::new(&m, r);
-                let ts = lines.t_junctions();
-                found += ts.len();
-                let ext: Vec<_> = ts
-                    .iter()
-                    .map(|&(i, j, v)| (v, lines.extension(i, j, v)))
-                    .collect();
-                for &(va, (la, a0, a1)) in &ext {
-                    for &(vb, (lb, b0, b1)) in &ext {
-                        if va && !vb {
-                            // along v: column la, rows a0..a1; along u: row lb, columns b0..b1
-                            let meet = (b0..=b1).contains(&la) && (a0..=a1).contains(&lb);
-                            assert!(!meet, "{name}: strip {r}: extensions meet");
-                        }
-                    }
-                }
-            }
-            eprintln!(
-                "{name}: {} anchors of {nv} vertices ({} modified), {} T-junctions ({found} found here), {} free values",
-                m.n_control_points(),
-                tj.modified,
-                m.n_t_junctions(),
-                m.reduction.free
-            );
-            assert_eq!(found, m.n_t_junctions(), "{name}");
-            assert!(found > 0 && m.n_control_points() < nv, "{name}");
-            // partition of unity through the reduction
-            let mut pu = 0.0f64;
-            for c in 0..m.n_cells() as u32 {
-                let (a, b) = (rng.next(), rng.next());
-                let sum: f64 = m.reduce(&m.blending(c, a, b)).iter().map(|x| x.1).sum();
-                pu = pu.max((sum - 1.0).abs());
-            }
-            assert!(pu <= 1e-10, "{name}: |Σ B − 1| = {pu:e}");
-            // blending functions of the modified anchors against the test's own
-            let mut lower_left = vec![u32::MAX; m.n_vertices()];
-            for (c, q) in m.corners.iter().enumerate().rev() {
-                lower_left[q[0] as usize] = c as u32;
-            }
-            let (mut checked, mut worst) = (0, 0.0f64);
-            for &(v, f) in &tj.anchors {
-                if f == u32::MAX || m.is_zero(v) {
-                    continue;
-                }
-                let (r, i, j) = m.cell_at[lower_left[v as usize] as usize];
-                let (r, i, j) = (r as usize, i as usize, j as usize);
-                let rc = &m.rects[r];
-                let lines = StripLines::new(&m, r);
-                let (Some(ku), Some(kv)) = (
-                    local_knots(i, rc.m, |x| lines.on_v[x][j]),
-                    local_knots(j, rc.n, |y| lines.on_u[i][y]),
-                ) else {
-                    continue;
-                };
-                // only anchors some of whose rays skip a point of the full mesh
-                if ku[4] - ku[0] == 4 && kv[4] - kv[0] == 4 {
-                    continue;
-                }
-                checked += 1;
-                let xu = ku.map(|x| rc.x(x));
-                let yv = kv.map(|y| rc.y(y));
-                for ci in ku[0].saturating_sub(1)..(ku[4] + 1).min(rc.m) {
-                    for cj in kv[0].saturating_sub(1)..(kv[4] + 1).min(rc.n) {
-                        let cell = (rc.first_cell + cj * rc.m + ci) as u32;
-                        for _ in 0..3 {
-                            let (a, b) = (rng.next(), rng.next());
-                            let x = rc.x(ci) + a * (rc.x(ci + 1) - rc.x(ci));
-                            let y = rc.y(cj) + b * (rc.y(cj + 1) - rc.y(cj));
-                            let want = bspline(&xu, x) * bspline(&yv, y);
-                            let got: f64 = m
-                                .reduce(&m.blending(cell, a, b))
-                                .iter()
-                                .filter(|e| e.0 == f)
-                                .map(|e| e.1)
-                                .sum();
-                            worst = worst.max((got - want).abs());
-                        }
-                    }
-                }
-            }
-            eprintln!("{name}: {checked} modified anchors' blending functions, largest difference {worst:e}");
-            assert!(checked > 0 && worst <= 1e-10, "{name}: {checked} {worst:e}");
-            // random T-spline nets: chart independent, C² off the zeros, G¹ at them
-            let free: Vec<[f64; 3]> = (0..m.reduction.free)
-                .map(|_| [rng.next(), rng.next(), rng.next()])
-                .collect();
-            let net = m.expand(&free);
-            let (worst, normal) = measure(&m, &net);
-            eprintln!(
-                "{name}: T-spline net: jumps at the zeros {}, one interval {}, farther {}, normal angle at the zeros {normal:.2e}°",
-                e3(worst[0]),
-                e3(worst[1]),
-                e3(worst[2])
-            );
-            assert!(worst[0][0] <= 1e-10 && worst[0][1] <= 1e-9, "{name}");
-            c2_off_the_zeros_and_g1_at_them(&name, &worst, normal);
+            check_t_spline(&name, &m, nv, &mut rng);
         }
     }
+}
+
+/// The checks of a T-mesh `m` (from a full mesh of `nv` vertices): analysis-suitable (checked
+/// here from its lines, strip by strip: the T-junctions inside a strip), the blending functions
+/// of the modified anchors against ray casting + Cox–de Boor here, partition of unity; random
+/// T-spline nets chart independent, C² off the zeros, G¹ at them. Shared with
+/// `tspline_domain_blocks.rs`.
+pub(crate) fn check_t_spline(name: &str, m: &DomainMesh, nv: usize, rng: &mut Rng) {
+    let tj = m.tjunctions.clone().unwrap();
+    // analysis-suitable: no extension along u meets one along v (strip by strip)
+    let mut found = 0;
+    for r in 0..m.rects.len() {
+        let lines = StripLines::new(m, r);
+        let ts = lines.t_junctions();
+        found += ts.len();
+        let ext: Vec<_> = ts
+            .iter()
+            .map(|&(i, j, v)| (v, lines.extension(i, j, v)))
+            .collect();
+        for &(va, (la, a0, a1)) in &ext {
+            for &(vb, (lb, b0, b1)) in &ext {
+                if va && !vb {
+                    // along v: column la, rows a0..a1; along u: row lb, columns b0..b1
+                    let meet = (b0..=b1).contains(&la) && (a0..=a1).contains(&lb);
+                    assert!(!meet, "{name}: strip {r}: extensions meet");
+                }
+            }
+        }
+    }
+    eprintln!(
+        "{name}: {} anchors of {nv} vertices ({} modified), {} T-junctions ({found} found here), {} free values",
+        m.n_control_points(),
+        tj.modified,
+        m.n_t_junctions(),
+        m.reduction.free
+    );
+    // the library's T-junctions inside the strips (those on a strip's side are not seen here)
+    let inside = tj
+        .junctions
+        .iter()
+        .filter(|&&(r, i, j, _)| {
+            let rc = &m.rects[r as usize];
+            i > 0 && (i as usize) < rc.m && j > 0 && (j as usize) < rc.n
+        })
+        .count();
+    assert_eq!(found, inside, "{name}");
+    assert!(found > 0 && m.n_control_points() < nv, "{name}");
+    // partition of unity through the reduction
+    let mut pu = 0.0f64;
+    for c in 0..m.n_cells() as u32 {
+        let (a, b) = (rng.next(), rng.next());
+        let sum: f64 = m.reduce(&m.blending(c, a, b)).iter().map(|x| x.1).sum();
+        pu = pu.max((sum - 1.0).abs());
+    }
+    assert!(pu <= 1e-10, "{name}: |Σ B − 1| = {pu:e}");
+    // blending functions of the modified anchors against the test's own
+    let mut lower_left = vec![u32::MAX; m.n_vertices()];
+    for (c, q) in m.corners.iter().enumerate().rev() {
+        lower_left[q[0] as usize] = c as u32;
+    }
+    let (mut checked, mut worst) = (0, 0.0f64);
+    for &(v, f) in &tj.anchors {
+        if f == u32::MAX || m.is_zero(v) {
+            continue;
+        }
+        let (r, i, j) = m.cell_at[lower_left[v as usize] as usize];
+        let (r, i, j) = (r as usize, i as usize, j as usize);
+        let rc = &m.rects[r];
+        let lines = StripLines::new(m, r);
+        let (Some(ku), Some(kv)) = (
+            local_knots(i, rc.m, |x| lines.on_v[x][j]),
+            local_knots(j, rc.n, |y| lines.on_u[i][y]),
+        ) else {
+            continue;
+        };
+        // only anchors some of whose rays skip a point of the full mesh
+        if ku[4] - ku[0] == 4 && kv[4] - kv[0] == 4 {
+            continue;
+        }
+        checked += 1;
+        let xu = ku.map(|x| rc.x(x));
+        let yv = kv.map(|y| rc.y(y));
+        for ci in ku[0].saturating_sub(1)..(ku[4] + 1).min(rc.m) {
+            for cj in kv[0].saturating_sub(1)..(kv[4] + 1).min(rc.n) {
+                let cell = (rc.first_cell + cj * rc.m + ci) as u32;
+                for _ in 0..3 {
+                    let (a, b) = (rng.next(), rng.next());
+                    let x = rc.x(ci) + a * (rc.x(ci + 1) - rc.x(ci));
+                    let y = rc.y(cj) + b * (rc.y(cj + 1) - rc.y(cj));
+                    let want = bspline(&xu, x) * bspline(&yv, y);
+                    let got: f64 = m
+                        .reduce(&m.blending(cell, a, b))
+                        .iter()
+                        .filter(|e| e.0 == f)
+                        .map(|e| e.1)
+                        .sum();
+                    worst = worst.max((got - want).abs());
+                }
+            }
+        }
+    }
+    eprintln!(
+        "{name}: {checked} modified anchors' blending functions, largest difference {worst:e}"
+    );
+    assert!(checked > 0 && worst <= 1e-10, "{name}: {checked} {worst:e}");
+    // random T-spline nets: chart independent, C² off the zeros, G¹ at them
+    let free: Vec<[f64; 3]> = (0..m.reduction.free)
+        .map(|_| [rng.next(), rng.next(), rng.next()])
+        .collect();
+    let net = m.expand(&free);
+    let (worst, normal) = measure(m, &net);
+    eprintln!(
+        "{name}: T-spline net: jumps at the zeros {}, one interval {}, farther {}, normal angle at the zeros {normal:.2e}°",
+        e3(worst[0]),
+        e3(worst[1]),
+        e3(worst[2])
+    );
+    assert!(worst[0][0] <= 1e-10 && worst[0][1] <= 1e-9, "{name}");
+    c2_off_the_zeros_and_g1_at_them(name, &worst, normal);
 }

@@ -172,6 +172,9 @@ pub fn domain_spline(
     } else {
         (vertices_only, a_dev)
     };
+    for line in &fit.refinements {
+        progress.report("tspline", None, line);
+    }
     progress.report("tspline", None, "derivative jumps across every cell side");
     let sides = side_continuity(&fit.mesh, &fit.control, SIDE_SAMPLES);
     let (elements, merge) = domain_elements(&fit.mesh, &fit.control);
@@ -203,6 +206,9 @@ pub fn domain_spline(
         "t_junctions": mesh.n_t_junctions(),
         "mesh_vertices": mesh.n_vertices(),
         "patches": patches.len(),
+        "blocks": mesh.blocks.len(),
+        "block_cells": mesh.blocks.iter().map(|b| b.cells()).sum::<usize>(),
+        "refinements": fit.refinements,
         "bezier_patches": patches.len(),
         "bezier_elements": merge,
         "continuity": continuity,

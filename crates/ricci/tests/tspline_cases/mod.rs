@@ -35,3 +35,23 @@ pub fn genus_two_cases() -> Vec<(&'static str, Surface)> {
     }
     cases
 }
+
+/// The domain manifold of `s` (its best genus domain, the strips glued) and its longest
+/// circumference.
+pub fn glued_domain(
+    s: &Surface,
+) -> (
+    ricci::spline::tspline::genus_domain::GenusDomain,
+    ricci::spline::tspline::glue::Gluing,
+    f64,
+) {
+    let d = ricci::spline::tspline::genus_domain::best_genus_domain(&forms(s), s.positions.len())
+        .unwrap();
+    let g = ricci::spline::tspline::glue::gluing(&d).unwrap();
+    let l = d
+        .cylinders
+        .iter()
+        .map(|c| c.circumference)
+        .fold(0.0, f64::max);
+    (d, g, l)
+}

@@ -7,7 +7,12 @@
 //! the zeros. Refinement is local where it can be: while a point of a cell next to a zero
 //! ([`DomainMesh::near_zero`]) is beyond the tolerance, the mesh is refined once more at the
 //! zeros ([`DomainMesh::graded`]: two columns and rows per strip); while a point elsewhere is,
-//! the spacing shrinks (by 1/√2, everywhere); until the largest error is below the tolerance
+//! the cells around it are split 2×2 in blocks whose lines end in T-junctions
+//! ([`super::domain_mesh::blocks`], [`DomainFitOptions::blocks`]) — or, when no block can be
+//! placed (the point's cell is split already, or within [`super::domain_mesh::blocks::CLEAR`]
+//! cells of two sides of its strip), the blocks would cover more than [`BLOCK_SHARE`] of the
+//! cells, or their T-mesh is not analysis-suitable, the spacing shrinks (by 1/√2, everywhere;
+//! [`DomainFit::refinements`] says which and why); until the largest error is below the tolerance
 //! or the budget of control points is spent (the last refinement is cut to the largest mesh
 //! within the budget). By default the unknowns
 //! are the free values of the mesh's [`super::domain_mesh::Reduction`]: the fitted net is G¹ at
@@ -18,7 +23,8 @@
 //! the tolerance, the lines are extended by two cells (instead of a finer spacing).
 
 use super::cylinder_fit::GenusStep;
-use super::domain_mesh::DomainMesh;
+use super::domain_mesh::blocks::place_blocks;
+use super::domain_mesh::{Block, DomainMesh};
 use super::fit::bbox_scale;
 use super::genus_domain::GenusDomain;
 use super::glue::Gluing;
@@ -43,6 +49,9 @@ pub struct DomainFit {
     pub scale: f64,
     /// Levels of refinement at the zeros of the last mesh.
     pub levels: usize,
+    /// Per refinement (between two steps): what was refined, and why the spacing shrank
+    /// everywhere when it did.
+    pub refinements: Vec<String>,
 }
 
 /// Options of [`fit_domain_mesh`].
@@ -73,7 +82,16 @@ pub struct DomainFitOptions {
     /// End the graded lines at the zeros in T-junctions ([`DomainMesh::with_t_junctions`]);
     /// only with [`Self::g1_at_zeros`] (the T-spline is a reduction of the full mesh's nets).
     pub t_junctions: bool,
+    /// Refine the cells with errors away from the zeros in blocks split 2×2
+    /// ([`super::domain_mesh::blocks`]; only with [`Self::t_junctions`]) rather than by a finer
+    /// spacing everywhere (which stays the fallback when a block cannot be placed).
+    pub blocks: bool,
 }
+
+/// Blocks splitting more than this share of the graded mesh's cells: a finer spacing
+/// everywhere instead (blocks split cells 2×2 — four times the control points there — where the
+/// spacing's step doubles them).
+pub const BLOCK_SHARE: f64 = 0.5;
 
 /// Cells beyond a corner block through which a graded line continues before its T-junction.
 /// (Measured: 0, 1, 2, 4 on eight and the generated genus-2 surface at 0.5 % and 1 %; 2 is the
@@ -97,6 +115,7 @@ impl Default for DomainFitOptions {
             local_refinement: true,
             between_vertices: 0.1,
             t_junctions: true,
+            blocks: true,
         }
     }
 }
@@ -228,16 +247,18 @@ fn solve(
     Ok(out)
 }
 
-/// The mesh of `spacing` graded `levels` times at the zeros, its graded lines ending in
-/// T-junctions if `opts` say so.
+/// The mesh of `spacing` graded `levels` times at the zeros with the cells of `blocks` split,
+/// its graded lines ending in T-junctions if `opts` say so.
 fn domain_mesh(
     domain: &GenusDomain,
     gluing: &Gluing,
     (spacing, levels, margin): (f64, usize, usize),
+    blocks: &[Block],
     opts: &DomainFitOptions,
 ) -> Result<DomainMesh> {
-    let mesh = DomainMesh::graded(domain, gluing, spacing, levels).map_err(Error::numerical)?;
-    if opts.t_junctions && opts.g1_at_zeros && levels > 0 {
+    let mesh =
+        DomainMesh::refined(domain, gluing, spacing, levels, blocks).map_err(Error::numerical)?;
+    if opts.t_junctions && opts.g1_at_zeros && (levels > 0 || !blocks.is_empty()) {
         mesh.with_t_junctions(margin).map_err(Error::numerical)
     } else {
         Ok(mesh)
@@ -261,7 +282,7 @@ fn fill_budget(
     let base = spacing * (count as f64 / budget as f64).sqrt();
     for k in 0..6 {
         let at = (base * (1.0 + 0.03 * k as f64), levels, margin);
-        let mesh = domain_mesh(domain, gluing, at, opts)?;
+        let mesh = domain_mesh(domain, gluing, at, &[], opts)?;
         let n = mesh.n_control_points();
         if n <= count {
             return Ok(None);
@@ -442,12 +463,39 @@ pub fn fit_domain_mesh_on_triangles(
     let refine = opts.refine.clamp(0.1, 0.95);
     let mut filled = false;
     let (mut levels, mut previous_spacing, mut margin) = (0, spacing, T_MARGIN);
+    let mut blocks: Vec<Block> = Vec::new();
+    let mut refinements = Vec::new();
+    let use_blocks = opts.blocks && opts.t_junctions && opts.g1_at_zeros;
     for _ in 0..opts.max_iterations.max(1) {
-        let mut mesh = domain_mesh(domain, gluing, (spacing, levels, margin), opts)?;
+        let mut mesh = domain_mesh(domain, gluing, (spacing, levels, margin), &blocks, opts)?;
+        if !blocks.is_empty() {
+            if let Some(v) = mesh.extensions_meet().map_err(Error::numerical)? {
+                // not analysis-suitable: the spacing instead
+                refinements.push(format!(
+                    "the blocks' T-mesh is not analysis-suitable (extensions meet at vertex {v}): the spacing × 1/√2 everywhere instead"
+                ));
+                blocks.clear();
+                spacing *= refine;
+                mesh = domain_mesh(domain, gluing, (spacing, levels, margin), &blocks, opts)?;
+            }
+        }
         if let Some(prev) = last
             .as_ref()
             .filter(|_| mesh.n_control_points() > opts.max_control_points)
         {
+            if !blocks.is_empty() {
+                // blocks over the budget: the last fit stands
+                refinements.push(format!(
+                    "{} control points with {} blocks: over the budget of {}, stopped",
+                    mesh.n_control_points(),
+                    blocks.len(),
+                    opts.max_control_points
+                ));
+                if let Some(l) = last.as_mut() {
+                    l.refinements = refinements;
+                }
+                break;
+            }
             // the next refinement is over the budget: one last fit on the largest mesh within it
             match fill_budget(
                 domain,
@@ -514,7 +562,8 @@ pub fn fit_domain_mesh_on_triangles(
         });
         let converged = max <= opts.tolerance * scale;
         // where the tolerance is exceeded: next to a zero, elsewhere
-        let (mut near, mut far, mut extend) = (false, false, false);
+        let (mut near, mut extend) = (false, false);
+        let mut far = Vec::new();
         for (&(c, _, _), &e) in located.iter().zip(&errors) {
             if e > opts.tolerance * scale {
                 if opts.local_refinement && levels < MAX_LEVELS && mesh.near_zero(c) {
@@ -522,7 +571,7 @@ pub fn fit_domain_mesh_on_triangles(
                 } else if mesh.past_t_junction(c) {
                     extend = true;
                 } else {
-                    far = true;
+                    far.push(c);
                 }
             }
         }
@@ -536,20 +585,82 @@ pub fn fit_domain_mesh_on_triangles(
             converged,
             scale,
             levels: mesh_levels,
+            refinements: refinements.clone(),
         });
         if converged || filled {
             break;
         }
         previous_spacing = spacing;
-        if far {
-            spacing *= refine;
-        }
+        let mut what = Vec::new();
+        let old_levels = levels;
         if near {
             levels += 1;
+            what.push(format!("{levels} levels at the zeros"));
         }
         if extend {
             margin += 2;
+            what.push(format!(
+                "graded lines {margin} cells past the corner blocks"
+            ));
         }
+        let placed = match (use_blocks, far.is_empty(), last.as_ref()) {
+            (_, true, _) => Ok(blocks.clone()),
+            (false, _, _) => Err("blocks are off".to_string()),
+            (true, false, Some(fit)) => place_blocks(&fit.mesh, &far),
+            (true, false, None) => Err("no mesh".to_string()),
+        };
+        // in the indices of the next graded mesh (one more level: one more column and row
+        // at each end)
+        let d = levels - old_levels;
+        let shifted = placed.map(|bs| {
+            bs.into_iter()
+                .map(|b| Block {
+                    i0: b.i0 + d,
+                    i1: b.i1 + d,
+                    j0: b.j0 + d,
+                    j1: b.j1 + d,
+                    ..b
+                })
+                .collect::<Vec<_>>()
+        });
+        let cells: usize = last.as_ref().map_or(0, |f| {
+            f.mesh.rects.iter().map(|r| r.base_m * r.base_n).sum()
+        });
+        match shifted {
+            Ok(bs) if far.is_empty() => blocks = bs,
+            Ok(bs)
+                if bs.iter().map(Block::cells).sum::<usize>() as f64
+                    > BLOCK_SHARE * cells as f64 =>
+            {
+                spacing *= refine;
+                blocks.clear();
+                what.push(format!(
+                    "the spacing × 1/√2 everywhere (blocks would cover more than {:.0} % of the cells)",
+                    100.0 * BLOCK_SHARE
+                ));
+            }
+            Ok(bs) => {
+                what.push(format!(
+                    "{} blocks split 2×2 ({} cells in their boxes; {} points beyond the tolerance away from the zeros)",
+                    bs.len(),
+                    bs.iter().map(Block::cells).sum::<usize>(),
+                    far.len()
+                ));
+                blocks = bs;
+            }
+            Err(why) => {
+                spacing *= refine;
+                blocks.clear();
+                what.push(format!("the spacing × 1/√2 everywhere (no block: {why})"));
+            }
+        }
+        refinements.push(format!(
+            "step {}: {} control points, L∞ {:.3} %; next: {}",
+            steps.len(),
+            steps.last().map_or(0, |s| s.control_points),
+            steps.last().map_or(f64::NAN, |s| s.max_error_percent),
+            what.join(", ")
+        ));
     }
     last.ok_or_else(|| Error::numerical("domain mesh fit: no iteration ran"))
 }

@@ -68,8 +68,11 @@ use super::glue::Gluing;
 pub type Combination = Vec<(u32, f64)>;
 
 /// The quad mesh of knot intervals over the domain manifold and its Bézier extraction.
+pub mod blocks;
 mod g1;
+mod suitability;
 mod tjunctions;
+pub use blocks::Block;
 pub use g1::Reduction;
 pub use tjunctions::{knot_insertion, TJunctions};
 
@@ -93,13 +96,15 @@ pub struct DomainMesh {
     pub reduction: Reduction,
     /// The T-mesh when the graded lines end in T-junctions ([`Self::with_t_junctions`]).
     pub tjunctions: Option<TJunctions>,
+    /// The boxes of cells split 2×2 by lines ending in T-junctions ([`blocks`]).
+    pub blocks: Vec<Block>,
 }
 
 /// One strip of one cylinder, cut into `m × n` cells: the two first and the two last columns
 /// are `edge_u` wide, the two first and two last rows `edge_v` high (the same in every strip:
 /// every cell within two knot intervals of a zero has the same size, so the blossoms there
 /// need no replaced interval), the others share the rest equally.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Rect {
     pub cylinder: usize,
     pub strip: usize,
@@ -112,6 +117,17 @@ pub struct Rect {
     /// Levels of refinement at the zeros (the same in every strip; see the module doc).
     pub levels: usize,
     pub first_cell: usize,
+    /// Columns and rows of the graded mesh before the blocks ([`Block`]) split some of them.
+    pub base_m: usize,
+    pub base_n: usize,
+    /// The knots along `u` (`m + 1`) and along `v` (`n + 1`): the graded mesh's and the
+    /// blocks' midpoints ([`blocks`]).
+    pub xs: Vec<f64>,
+    pub ys: Vec<f64>,
+    /// Per knot of `xs` / `ys`: `2 b` for knot `b` of the graded mesh, `2 b + 1` for the
+    /// midpoint of its interval `b` (a block's line).
+    pub u_half: Vec<usize>,
+    pub v_half: Vec<usize>,
 }
 
 /// The least number of cells along a strip side: two edge cells at each end and one between.
@@ -152,32 +168,34 @@ impl Knots {
     }
 }
 
-/// The interval of `x` (clamped to `[0, len]`) and the local coordinate in it.
-fn interval(kn: Knots, x: f64) -> (usize, f64) {
-    let x = x.clamp(0.0, kn.len);
-    let (mut lo, mut hi) = (0, kn.k);
+/// The interval of `x` among the increasing `knots` (clamped to their range) and the local
+/// coordinate in it.
+fn interval(knots: &[f64], x: f64) -> (usize, f64) {
+    let k = knots.len() - 1;
+    let x = x.clamp(knots[0], knots[k]);
+    let (mut lo, mut hi) = (0, k);
     while hi - lo > 1 {
         let mid = (lo + hi) / 2;
-        if kn.knot(mid) <= x {
+        if knots[mid] <= x {
             lo = mid;
         } else {
             hi = mid;
         }
     }
-    let (a, b) = (kn.knot(lo), kn.knot(lo + 1));
+    let (a, b) = (knots[lo], knots[lo + 1]);
     (lo, ((x - a) / (b - a)).clamp(0.0, 1.0))
 }
 
 impl Rect {
     /// The start of column `i` (`i = m`: the strip's length).
     pub fn x(&self, i: usize) -> f64 {
-        self.knots_u().knot(i)
+        self.xs[i]
     }
 
     fn knots_u(&self) -> Knots {
         Knots {
             len: self.length,
-            k: self.m,
+            k: self.base_m,
             e: self.edge_u,
             levels: self.levels,
         }
@@ -186,32 +204,41 @@ impl Rect {
     fn knots_v(&self) -> Knots {
         Knots {
             len: self.height,
-            k: self.n,
+            k: self.base_n,
             e: self.edge_v,
             levels: self.levels,
         }
     }
 
-    /// Whether cell `(i, j)` is in a corner block (the refined cells around a zero: the first or
-    /// last `levels + 2` columns and rows).
+    /// Whether cell `(i, j)` of the graded mesh (before the blocks) is in a corner block (the
+    /// refined cells around a zero: the first or last `levels + 2` columns and rows).
     pub fn near_corner(&self, i: usize, j: usize) -> bool {
         let g = self.levels + 2;
-        (i < g || i + g >= self.m) && (j < g || j + g >= self.n)
+        (i < g || i + g >= self.base_m) && (j < g || j + g >= self.base_n)
     }
 
     /// The start of row `j` (`j = n`: the height).
     pub fn y(&self, j: usize) -> f64 {
-        self.knots_v().knot(j)
+        self.ys[j]
     }
 
     /// The column of `x` along the strip and the local coordinate in it.
     pub fn column(&self, x: f64) -> (usize, f64) {
-        interval(self.knots_u(), x)
+        interval(&self.xs, x)
     }
 
     /// The row of `y` and the local coordinate in it.
     pub fn row(&self, y: f64) -> (usize, f64) {
-        interval(self.knots_v(), y)
+        interval(&self.ys, y)
+    }
+
+    /// The knots of the graded mesh (before the blocks) along `u` and along `v`.
+    fn base_knots(&self) -> (Vec<f64>, Vec<f64>) {
+        let (ku, kv) = (self.knots_u(), self.knots_v());
+        (
+            (0..=self.base_m).map(|i| ku.knot(i)).collect(),
+            (0..=self.base_n).map(|j| kv.knot(j)).collect(),
+        )
     }
 }
 
@@ -302,9 +329,8 @@ fn find(p: &mut [u32], mut x: u32) -> u32 {
 /// Give every strip the same edge cells — the two first and two last columns of width `edge_u`,
 /// the two first and two last rows of height `edge_v`, the smallest uniform cell size of any
 /// strip (so the middle cells of every strip are at least as large), each end's first one
-/// refined `levels` times (`m`, `n` count the refined cells: `2 levels` more) — and number the
-/// cells strip by strip; the number of cells.
-fn size_edge_cells(rects: &mut [Rect], levels: usize) -> Result<usize, String> {
+/// refined `levels` times (`m`, `n` count the refined cells: `2 levels` more).
+fn size_edge_cells(rects: &mut [Rect], levels: usize) -> Result<(), String> {
     let fine = (1u64 << levels) as f64;
     let edge_u = rects
         .iter()
@@ -319,15 +345,12 @@ fn size_edge_cells(rects: &mut [Rect], levels: usize) -> Result<usize, String> {
             "a strip has no positive length or height (edge cells {edge_u} × {edge_v})"
         ));
     }
-    let mut cells = 0;
     for r in rects.iter_mut() {
         r.edge_u = edge_u;
         r.edge_v = edge_v;
         r.levels = levels;
-        r.first_cell = cells;
-        cells += r.m * r.n;
     }
-    Ok(cells)
+    Ok(())
 }
 
 /// The number of columns `m` of every strip: the same along every chain of strips glued top to
@@ -377,6 +400,18 @@ impl DomainMesh {
         spacing: f64,
         levels: usize,
     ) -> Result<Self, String> {
+        Self::refined(domain, gluing, spacing, levels, &[])
+    }
+
+    /// The mesh of [`Self::graded`] whose full mesh also has the lines of `blocks` (through
+    /// whole strips; [`Self::with_t_junctions`] keeps them only in their blocks).
+    pub fn refined(
+        domain: &GenusDomain,
+        gluing: &Gluing,
+        spacing: f64,
+        levels: usize,
+        blocks: &[Block],
+    ) -> Result<Self, String> {
         if !(spacing > 0.0) {
             return Err(format!("spacing {spacing} must be positive"));
         }
@@ -404,6 +439,12 @@ impl DomainMesh {
                     edge_v: 0.0,
                     levels,
                     first_cell: 0,
+                    base_m: 0,
+                    base_n: 0,
+                    xs: Vec::new(),
+                    ys: Vec::new(),
+                    u_half: Vec::new(),
+                    v_half: Vec::new(),
                 });
             }
         }
@@ -425,7 +466,8 @@ impl DomainMesh {
             ));
         }
         columns_per_chain(&mut rects, &top, spacing, levels)?;
-        let cells = size_edge_cells(&mut rects, levels)?;
+        size_edge_cells(&mut rects, levels)?;
+        let cells = blocks::split_knots(&mut rects, &top, blocks)?;
         let right_rect = |r: usize| {
             let (c, s) = (rects[r].cylinder, rects[r].strip);
             let k = gluing.layouts[c].lines.len();
@@ -498,6 +540,7 @@ impl DomainMesh {
             bezier: Vec::new(),
             reduction: Reduction::default(),
             tjunctions: None,
+            blocks: blocks.to_vec(),
         };
         mesh.bezier = (0..cells).map(|c| mesh.extract(c)).collect();
         mesh.points_at_zeros();
@@ -515,8 +558,8 @@ impl DomainMesh {
 
     /// Whether cell `c` is in the refined block around a zero ([`Rect::near_corner`]).
     pub fn near_zero(&self, c: u32) -> bool {
-        let (r, i, j) = self.cell_at[c as usize];
-        self.rects[r as usize].near_corner(i as usize, j as usize)
+        let (r, i, j) = self.base_cell(c);
+        self.rects[r].near_corner(i, j)
     }
 
     /// Whether vertex `v` is a zero (valence ≠ 4).

@@ -46,14 +46,21 @@ pub struct TJunctions {
     pub junctions: Vec<(u32, u32, u32, bool)>,
 }
 
+/// Whether knot `b` of `k` intervals (of the graded mesh) is one of the grading's.
+fn graded(b: usize, k: usize, levels: usize) -> bool {
+    (1..=levels).contains(&b) || (b + levels >= k && b < k)
+}
+
 impl Rect {
     /// Whether column line `i` is one of the grading's (module doc of the parent).
     fn graded_u(&self, i: usize) -> bool {
-        (1..=self.levels).contains(&i) || (i + self.levels >= self.m && i < self.m)
+        let h = self.u_half[i];
+        h.is_multiple_of(2) && graded(h / 2, self.base_m, self.levels)
     }
 
     fn graded_v(&self, j: usize) -> bool {
-        (1..=self.levels).contains(&j) || (j + self.levels >= self.n && j < self.n)
+        let h = self.v_half[j];
+        h.is_multiple_of(2) && graded(h / 2, self.base_n, self.levels)
     }
 }
 
@@ -102,25 +109,34 @@ impl DomainMesh {
     /// Whether the T-mesh has a line along `v` through the point `(x(i), y(j))` of strip `r`.
     pub fn on_line_v(&self, r: usize, i: usize, j: usize) -> bool {
         let rc = &self.rects[r];
-        match self.reach(r) {
-            None => true,
-            // a gap of at least two intervals, else the line stays whole
-            Some(k) => !rc.graded_u(i) || 2 * k + 2 > rc.n || j <= k || j + k >= rc.n,
+        let Some(k) = self.reach(r) else {
+            return true;
+        };
+        if let Some(on) = self.block_line_v(r, i, j) {
+            return on;
         }
+        // a gap of at least two intervals, else the line stays whole (indices of the graded
+        // mesh, in halves: blocks split some intervals)
+        let (h, n) = (rc.v_half[j], rc.base_n);
+        !rc.graded_u(i) || 2 * k + 2 > n || h <= 2 * k || h >= 2 * (n - k)
     }
 
     /// Whether the T-mesh has a line along `u` through the point `(x(i), y(j))` of strip `r`.
     pub fn on_line_u(&self, r: usize, i: usize, j: usize) -> bool {
         let rc = &self.rects[r];
-        match self.reach(r) {
-            None => true,
-            Some(k) => !rc.graded_v(j) || 2 * k + 2 > rc.m || i <= k || i + k >= rc.m,
+        let Some(k) = self.reach(r) else {
+            return true;
+        };
+        if let Some(on) = self.block_line_u(r, i, j) {
+            return on;
         }
+        let (h, m) = (rc.u_half[i], rc.base_m);
+        !rc.graded_v(j) || 2 * k + 2 > m || h <= 2 * k || h >= 2 * (m - k)
     }
 
     /// Whether the vertex at the lower-left corner of cell `c` has a T-mesh line across
     /// `axis` (a line along the other direction) through it.
-    fn crossed(&self, c: u32, axis: Axis) -> bool {
+    pub(super) fn crossed(&self, c: u32, axis: Axis) -> bool {
         let (r, i, j) = self.cell_at[c as usize];
         let (r, i, j) = (r as usize, i as usize, j as usize);
         match axis {
@@ -243,22 +259,12 @@ impl DomainMesh {
         let mut junctions = Vec::new();
         for v in 0..nv as u32 {
             let c = lower_left[v as usize];
-            let (r, i, j) = self.cell_at[c as usize];
-            let (r, i, j) = (r as usize, i as usize, j as usize);
-            let (on_v, on_u) = (self.on_line_v(r, i, j), self.on_line_u(r, i, j));
-            if !(on_v && on_u) {
+            if !(self.crossed(c, Axis::U) && self.crossed(c, Axis::V)) {
                 continue;
             }
-            if !self.is_zero(v) {
-                let k = self.reach(r).unwrap_or(0);
-                let rc = &self.rects[r];
-                // a graded line ends here when the one beyond in its direction is absent
-                if rc.graded_u(i) && 2 * k + 2 <= rc.n && (j == k || j + k == rc.n) {
-                    junctions.push((r as u32, i as u32, j as u32, true));
-                }
-                if rc.graded_v(j) && 2 * k + 2 <= rc.m && (i == k || i + k == rc.m) {
-                    junctions.push((r as u32, i as u32, j as u32, false));
-                }
+            if let Some(along_v) = self.t_junction(c) {
+                let (r, i, j) = self.cell_at[c as usize];
+                junctions.push((r, i, j, along_v));
             }
             let a = anchors.len() as u32;
             anchors.push(v);
@@ -324,15 +330,14 @@ impl DomainMesh {
     /// Whether cell `c` lies beside a graded line where it is cut (past its T-junction): an
     /// error there asks for longer lines, not for a finer mesh.
     pub fn past_t_junction(&self, c: u32) -> bool {
-        let (r, i, j) = self.cell_at[c as usize];
-        let (r, i, j) = (r as usize, i as usize, j as usize);
+        let (r, i, j) = self.base_cell(c);
         let Some(k) = self.reach(r) else {
             return false;
         };
         let rc = &self.rects[r];
-        let l = rc.levels;
-        let band_u = (i <= l || i + l + 1 >= rc.m) && 2 * k + 2 <= rc.n && j >= k && j + k < rc.n;
-        let band_v = (j <= l || j + l + 1 >= rc.n) && 2 * k + 2 <= rc.m && i >= k && i + k < rc.m;
+        let (l, m, n) = (rc.levels, rc.base_m, rc.base_n);
+        let band_u = (i <= l || i + l + 1 >= m) && 2 * k + 2 <= n && j >= k && j + k < n;
+        let band_v = (j <= l || j + l + 1 >= n) && 2 * k + 2 <= m && i >= k && i + k < m;
         band_u || band_v
     }
 
