@@ -82,7 +82,7 @@ fn carrier(s: &Surface, p: &Parametrization) -> Carrier {
 }
 
 #[derive(Clone, Copy, PartialEq, Debug)]
-enum Mode {
+pub(crate) enum Mode {
     Round,
     FixedAngles,
     Seamless,
@@ -90,16 +90,16 @@ enum Mode {
 
 /// The largest errors of one map (module docs), asserted by the caller.
 #[derive(Debug, Default)]
-struct Errors {
-    cone: f64,
-    flat: f64,
-    gauss_bonnet: f64,
-    circle: f64,
-    corner: f64,
-    quarter: f64,
+pub(crate) struct Errors {
+    pub cone: f64,
+    pub flat: f64,
+    pub gauss_bonnet: f64,
+    pub circle: f64,
+    pub corner: f64,
+    pub quarter: f64,
 }
 
-fn measure(s: &Surface, p: &Parametrization, mode: Mode) -> Errors {
+pub(crate) fn measure(s: &Surface, p: &Parametrization, mode: Mode) -> Errors {
     let c = carrier(s, p);
     let (m, uv) = (&c.mesh, &c.uv);
     let n = m.n_vertices();
@@ -267,8 +267,8 @@ fn fixed_angles_with_cones() {
     check(&MESHES, Mode::FixedAngles, BoundaryMode::FixedAngles, false);
 }
 
-/// Seamless on the disks: beetle (11 boundary loops) and bunny (5) put each hole's −2π of
-/// turning on four quarter-turn corners, which folds triangles with or without cones.
+/// Seamless on the disks (beetle and bunny, with and without cones, and the seam
+/// transitions: `param_seamless_boundary`).
 #[test]
 fn seamless_with_boundary_and_cones() {
     check(
