@@ -26,13 +26,13 @@ use std::f64::consts::PI;
 
 const MESHES: [&str; 4] = ["face.off", "camelhead.off", "beetle.off", "bunny.off"];
 
-fn angle2(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+pub(crate) fn angle2(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
     let u = [b[0] - a[0], b[1] - a[1]];
     let v = [c[0] - a[0], c[1] - a[1]];
     (u[0] * v[1] - u[1] * v[0]).atan2(u[0] * v[0] + u[1] * v[1])
 }
 
-fn angle3(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+pub(crate) fn angle3(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
     let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
     let cr = [

@@ -22,29 +22,11 @@
 #[path = "ricci_meshes/mod.rs"]
 mod ricci_meshes;
 
-use crate::param_boundary_cones::{measure, Mode};
+use crate::param_boundary_cones::{angle2, angle3, measure, Mode};
 use ricci::mesh::Surface;
 use ricci::param::{parametrize, ConeSpec, ParamOptions, Parametrization};
 use ricci::progress::NoProgress;
 use std::f64::consts::PI;
-
-fn angle3(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
-    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-    let cr = [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ];
-    let n = (cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]).sqrt();
-    n.atan2(u[0] * v[0] + u[1] * v[1] + u[2] * v[2])
-}
-
-fn angle2(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
-    let u = [b[0] - a[0], b[1] - a[1]];
-    let v = [c[0] - a[0], c[1] - a[1]];
-    (u[0] * v[1] - u[1] * v[0]).atan2(u[0] * v[0] + u[1] * v[1])
-}
 
 /// Largest distance of a seam transition from a quarter-turn rotation (radians) and of its
 /// length ratio from 1, on the carrier.

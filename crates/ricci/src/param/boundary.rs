@@ -11,6 +11,9 @@ use crate::mesh::Mesh;
 use crate::metric::IntrinsicMetric;
 use std::f64::consts::PI;
 
+/// Per-vertex targets and the cones `(vertex, K̄)` they were made with.
+type TargetsAndCones = (Vec<f64>, Vec<(u32, f64)>);
+
 /// Per-vertex targets of `fixed-angles` with cones `(vertex, K̄)` at interior vertices (module
 /// docs): the cones keep theirs, the boundary vertex `i` takes `κ_i + ρ ℓ*_i / Σ ℓ*` with
 /// `ρ = 2πχ − Σκ − Σ K̄` and `ℓ*` the dual boundary lengths (`ρ = 0` when the cones carry
@@ -24,7 +27,7 @@ pub(crate) fn fixed_angle_targets(
     lengths: &[f64],
     cones: &[(u32, f64)],
     seamless: bool,
-) -> Result<(Vec<f64>, Vec<(u32, f64)>)> {
+) -> Result<TargetsAndCones> {
     let k = super::cones::angle_defects(mesh, &IntrinsicMetric::euclidean(lengths.to_vec()));
     let n = mesh.n_vertices();
     let chi = crate::metric::euler_characteristic(mesh) as f64;
@@ -114,15 +117,16 @@ fn quarter_turn_boundary(mesh: &Mesh, t: &[f64], weight: &[f64], total: f64) -> 
             .iter()
             .map(|&v| (t[v as usize] + (m as f64 * q - sum) * weight[v as usize] / w) / q)
             .collect();
-        for (&v, k) in l.iter().zip(spread_quarters(&x, m, &l.iter().map(|&v| bounds(v)).collect::<Vec<_>>())
-            .ok_or_else(|| {
-                Error::input(format!(
-                    "--seamless: the boundary loop through vertex {} ({} vertices) cannot turn                      by {m} quarter turns with every corner angle between π/2 and 2π",
-                    l[0],
-                    l.len()
-                ))
-            })?)
-        {
+        let b: Vec<(i64, i64)> = l.iter().map(|&v| bounds(v)).collect();
+        let k = spread_quarters(&x, m, &b).ok_or_else(|| {
+            Error::input(format!(
+                "--seamless: a boundary loop of {} vertices cannot turn by {m} quarter turns \
+                 with every corner angle between π/2 and 2π (and π/2 at a vertex with one \
+                 triangle)",
+                l.len()
+            ))
+        })?;
+        for (&v, k) in l.iter().zip(k) {
             out[v as usize] = k as f64 * q;
         }
     }
