@@ -90,6 +90,10 @@ mod param_lscm;
 mod param_placement;
 #[path = "param_seamless.rs"]
 mod param_seamless;
+#[path = "param_seamless_boundary.rs"]
+mod param_seamless_boundary;
+#[path = "param_seamless_distortion.rs"]
+mod param_seamless_distortion;
 #[path = "param_sphere.rs"]
 mod param_sphere;
 #[path = "roundtrip.rs"]

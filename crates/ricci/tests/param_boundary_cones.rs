@@ -26,13 +26,13 @@ use std::f64::consts::PI;
 
 const MESHES: [&str; 4] = ["face.off", "camelhead.off", "beetle.off", "bunny.off"];
 
-fn angle2(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+pub(crate) fn angle2(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
     let u = [b[0] - a[0], b[1] - a[1]];
     let v = [c[0] - a[0], c[1] - a[1]];
     (u[0] * v[1] - u[1] * v[0]).atan2(u[0] * v[0] + u[1] * v[1])
 }
 
-fn angle3(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+pub(crate) fn angle3(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
     let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
     let cr = [
@@ -82,7 +82,7 @@ fn carrier(s: &Surface, p: &Parametrization) -> Carrier {
 }
 
 #[derive(Clone, Copy, PartialEq, Debug)]
-enum Mode {
+pub(crate) enum Mode {
     Round,
     FixedAngles,
     Seamless,
@@ -90,16 +90,16 @@ enum Mode {
 
 /// The largest errors of one map (module docs), asserted by the caller.
 #[derive(Debug, Default)]
-struct Errors {
-    cone: f64,
-    flat: f64,
-    gauss_bonnet: f64,
-    circle: f64,
-    corner: f64,
-    quarter: f64,
+pub(crate) struct Errors {
+    pub cone: f64,
+    pub flat: f64,
+    pub gauss_bonnet: f64,
+    pub circle: f64,
+    pub corner: f64,
+    pub quarter: f64,
 }
 
-fn measure(s: &Surface, p: &Parametrization, mode: Mode) -> Errors {
+pub(crate) fn measure(s: &Surface, p: &Parametrization, mode: Mode) -> Errors {
     let c = carrier(s, p);
     let (m, uv) = (&c.mesh, &c.uv);
     let n = m.n_vertices();
@@ -267,8 +267,8 @@ fn fixed_angles_with_cones() {
     check(&MESHES, Mode::FixedAngles, BoundaryMode::FixedAngles, false);
 }
 
-/// Seamless on the disks: beetle (11 boundary loops) and bunny (5) put each hole's −2π of
-/// turning on four quarter-turn corners, which folds triangles with or without cones.
+/// Seamless on the disks (beetle and bunny, with and without cones, and the seam
+/// transitions: `param_seamless_boundary`).
 #[test]
 fn seamless_with_boundary_and_cones() {
     check(

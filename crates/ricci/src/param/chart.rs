@@ -101,7 +101,7 @@ fn boundary_target(
             if opts.boundary == BoundaryMode::FixedAngles && source == "greedy" {
                 cones = cones_carrying_the_interior(mesh, lengths, &cones, component)?;
             }
-            let (t, used) = fixed_angle_targets(mesh, lengths, &cones, opts.seamless);
+            let (t, used) = fixed_angle_targets(mesh, lengths, &cones, opts.seamless)?;
             cones = used;
             TargetSpec::PerVertex(t)
         }

@@ -25,7 +25,9 @@
 //!    common amount to carry the interior's curvature (given cones keep theirs and the
 //!    rest goes to the boundary as without cones). `--seamless` on a chart with boundary is
 //!    `fixed-angles` with the cones rounded to quarter turns and then the boundary's turning
-//!    to quarter turns with the total the cones leave.
+//!    to quarter turns with the total the cones leave, loop by loop: each loop's total
+//!    rounded, then its running sum, so the corners are spread along the loop
+//!    (`boundary::quarter_turn_boundary`).
 //!
 //!    Closed surfaces of genus ≥ 1 with [`SeamMode::Free`] (`--seams free`): cut along the
 //!    homology generators into a disk, which is flattened as above with `free` (`u = 0` on
