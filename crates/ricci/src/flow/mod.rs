@@ -36,6 +36,7 @@ pub mod adaptive;
 pub mod conformal;
 pub mod double;
 pub(crate) mod error;
+mod hessian_pattern;
 pub(crate) mod newton;
 pub mod polish;
 mod solver;

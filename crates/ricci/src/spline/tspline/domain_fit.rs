@@ -432,6 +432,125 @@ pub fn fit_domain_mesh(
     fit_domain_mesh_on_triangles(domain, gluing, positions, &[], opts)
 }
 
+/// One least-squares solve of [`fit_domain_mesh_on_triangles`]'s loop on `mesh`: the input
+/// vertices located in its cells, the fitted control net, and the spline's distance to every
+/// input vertex.
+#[allow(clippy::type_complexity)]
+fn fit_on_mesh(
+    mesh: &DomainMesh,
+    gluing: &Gluing,
+    domain: &GenusDomain,
+    (targets, weights, n_vertices): (&[[f64; 3]], &[f64], usize),
+    extra: &[(usize, f64, f64, [f64; 3], f64)],
+    opts: &DomainFitOptions,
+) -> Result<(Vec<(u32, f64, f64)>, Vec<[f64; 3]>, Vec<f64>)> {
+    let mut located = Vec::with_capacity(targets.len());
+    for p in &domain.points {
+        let x = locate(mesh, gluing, domain, p.cylinder, p.u, p.v).ok_or_else(|| {
+            Error::numerical(format!(
+                "domain mesh fit: vertex {} (cylinder {}) is in no strip",
+                p.vertex, p.cylinder
+            ))
+        })?;
+        located.push(x);
+    }
+    let mut data = located.clone();
+    let mut data_targets = targets[..n_vertices].to_vec();
+    let mut data_weights = weights[..n_vertices].to_vec();
+    for (e, (&t, &w)) in extra
+        .iter()
+        .zip(targets[n_vertices..].iter().zip(&weights[n_vertices..]))
+    {
+        if let Some(x) = locate(mesh, gluing, domain, e.0, e.1, e.2) {
+            data.push(x);
+            data_targets.push(t);
+            data_weights.push(w);
+        }
+    }
+    let control = solve(
+        mesh,
+        &data,
+        &data_targets,
+        &data_weights,
+        n_vertices,
+        opts.smoothing,
+        opts.g1_at_zeros,
+    )?;
+    let errors: Vec<f64> = located
+        .iter()
+        .zip(&targets[..n_vertices])
+        .map(|(&(c, s, t), q)| {
+            let p = mesh.patch(c, &control, 0.0, 0.0);
+            let [u0, u1, v0, v1] = [p.u0, p.u1, p.v0, p.v1];
+            let x = p.point(u0 + s * (u1 - u0), v0 + t * (v1 - v0));
+            ((x[0] - q[0]).powi(2) + (x[1] - q[1]).powi(2) + (x[2] - q[2]).powi(2)).sqrt()
+        })
+        .collect();
+    Ok((located, control, errors))
+}
+
+/// The blocks of the next step of [`fit_domain_mesh_on_triangles`]: the boxes around the
+/// points `far` beyond the tolerance away from the zeros (in the indices of the next graded mesh,
+/// `d` more levels), or — when no block can be placed or they would cover more than
+/// [`BLOCK_SHARE`] of the cells — none, and the spacing times `refine` everywhere; `what` says
+/// which.
+fn next_blocks(
+    (use_blocks, far, last, d): (bool, &[u32], Option<&DomainFit>, usize),
+    blocks: &mut Vec<Block>,
+    (spacing, refine): (&mut f64, f64),
+    what: &mut Vec<String>,
+) {
+    let placed = match (use_blocks, far.is_empty(), last) {
+        (_, true, _) => Ok(blocks.clone()),
+        (false, _, _) => Err("blocks are off".to_string()),
+        (true, false, Some(fit)) => place_blocks(&fit.mesh, far),
+        (true, false, None) => Err("no mesh".to_string()),
+    };
+    // in the indices of the next graded mesh (one more level: one more column and row
+    // at each end)
+    let shifted = placed.map(|bs| {
+        bs.into_iter()
+            .map(|b| Block {
+                i0: b.i0 + d,
+                i1: b.i1 + d,
+                j0: b.j0 + d,
+                j1: b.j1 + d,
+                ..b
+            })
+            .collect::<Vec<_>>()
+    });
+    let cells: usize = last.map_or(0, |f| {
+        f.mesh.rects.iter().map(|r| r.base_m * r.base_n).sum()
+    });
+    match shifted {
+        Ok(bs) if far.is_empty() => *blocks = bs,
+        Ok(bs)
+            if bs.iter().map(Block::cells).sum::<usize>() as f64 > BLOCK_SHARE * cells as f64 =>
+        {
+            *spacing *= refine;
+            blocks.clear();
+            what.push(format!(
+                "the spacing × 1/√2 everywhere (blocks would cover more than {:.0} % of the cells)",
+                100.0 * BLOCK_SHARE
+            ));
+        }
+        Ok(bs) => {
+            what.push(format!(
+                "{} blocks split 2×2 ({} cells in their boxes; {} points beyond the tolerance away from the zeros)",
+                bs.len(),
+                bs.iter().map(Block::cells).sum::<usize>(),
+                far.len()
+            ));
+            *blocks = bs;
+        }
+        Err(why) => {
+            *spacing *= refine;
+            blocks.clear();
+            what.push(format!("the spacing × 1/√2 everywhere (no block: {why})"));
+        }
+    }
+}
+
 /// [`fit_domain_mesh`] with points on the input `triangles` as data too
 /// ([`DomainFitOptions::between_vertices`]); the tolerance is still checked at the vertices.
 pub fn fit_domain_mesh_on_triangles(
@@ -511,48 +630,14 @@ pub fn fit_domain_mesh_on_triangles(
                 None => break,
             }
         }
-        let mut located = Vec::with_capacity(targets.len());
-        for p in &domain.points {
-            let x = locate(&mesh, gluing, domain, p.cylinder, p.u, p.v).ok_or_else(|| {
-                Error::numerical(format!(
-                    "domain mesh fit: vertex {} (cylinder {}) is in no strip",
-                    p.vertex, p.cylinder
-                ))
-            })?;
-            located.push(x);
-        }
-        let mut data = located.clone();
-        let mut data_targets = targets[..n_vertices].to_vec();
-        let mut data_weights = weights[..n_vertices].to_vec();
-        for (e, (&t, &w)) in extra
-            .iter()
-            .zip(targets[n_vertices..].iter().zip(&weights[n_vertices..]))
-        {
-            if let Some(x) = locate(&mesh, gluing, domain, e.0, e.1, e.2) {
-                data.push(x);
-                data_targets.push(t);
-                data_weights.push(w);
-            }
-        }
-        let control = solve(
+        let (located, control, errors) = fit_on_mesh(
             &mesh,
-            &data,
-            &data_targets,
-            &data_weights,
-            n_vertices,
-            opts.smoothing,
-            opts.g1_at_zeros,
+            gluing,
+            domain,
+            (&targets, &weights, n_vertices),
+            &extra,
+            opts,
         )?;
-        let errors: Vec<f64> = located
-            .iter()
-            .zip(&targets[..n_vertices])
-            .map(|(&(c, s, t), q)| {
-                let p = mesh.patch(c, &control, 0.0, 0.0);
-                let [u0, u1, v0, v1] = [p.u0, p.u1, p.v0, p.v1];
-                let x = p.point(u0 + s * (u1 - u0), v0 + t * (v1 - v0));
-                ((x[0] - q[0]).powi(2) + (x[1] - q[1]).powi(2) + (x[2] - q[2]).powi(2)).sqrt()
-            })
-            .collect();
         let max = errors.iter().fold(0.0f64, |a, &b| a.max(b));
         let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len().max(1) as f64).sqrt();
         steps.push(GenusStep {
@@ -592,7 +677,6 @@ pub fn fit_domain_mesh_on_triangles(
         }
         previous_spacing = spacing;
         let mut what = Vec::new();
-        let old_levels = levels;
         if near {
             levels += 1;
             what.push(format!("{levels} levels at the zeros"));
@@ -603,57 +687,12 @@ pub fn fit_domain_mesh_on_triangles(
                 "graded lines {margin} cells past the corner blocks"
             ));
         }
-        let placed = match (use_blocks, far.is_empty(), last.as_ref()) {
-            (_, true, _) => Ok(blocks.clone()),
-            (false, _, _) => Err("blocks are off".to_string()),
-            (true, false, Some(fit)) => place_blocks(&fit.mesh, &far),
-            (true, false, None) => Err("no mesh".to_string()),
-        };
-        // in the indices of the next graded mesh (one more level: one more column and row
-        // at each end)
-        let d = levels - old_levels;
-        let shifted = placed.map(|bs| {
-            bs.into_iter()
-                .map(|b| Block {
-                    i0: b.i0 + d,
-                    i1: b.i1 + d,
-                    j0: b.j0 + d,
-                    j1: b.j1 + d,
-                    ..b
-                })
-                .collect::<Vec<_>>()
-        });
-        let cells: usize = last.as_ref().map_or(0, |f| {
-            f.mesh.rects.iter().map(|r| r.base_m * r.base_n).sum()
-        });
-        match shifted {
-            Ok(bs) if far.is_empty() => blocks = bs,
-            Ok(bs)
-                if bs.iter().map(Block::cells).sum::<usize>() as f64
-                    > BLOCK_SHARE * cells as f64 =>
-            {
-                spacing *= refine;
-                blocks.clear();
-                what.push(format!(
-                    "the spacing × 1/√2 everywhere (blocks would cover more than {:.0} % of the cells)",
-                    100.0 * BLOCK_SHARE
-                ));
-            }
-            Ok(bs) => {
-                what.push(format!(
-                    "{} blocks split 2×2 ({} cells in their boxes; {} points beyond the tolerance away from the zeros)",
-                    bs.len(),
-                    bs.iter().map(Block::cells).sum::<usize>(),
-                    far.len()
-                ));
-                blocks = bs;
-            }
-            Err(why) => {
-                spacing *= refine;
-                blocks.clear();
-                what.push(format!("the spacing × 1/√2 everywhere (no block: {why})"));
-            }
-        }
+        next_blocks(
+            (use_blocks, &far, last.as_ref(), usize::from(near)),
+            &mut blocks,
+            (&mut spacing, refine),
+            &mut what,
+        );
         refinements.push(format!(
             "step {}: {} control points, L∞ {:.3} %; next: {}",
             steps.len(),
