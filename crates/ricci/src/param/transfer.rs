@@ -70,7 +70,12 @@ fn cut_layout(mesh: &Mesh, lengths: &[f64], cut: &[bool]) -> Result<Vec<[f64; 2]
     for h in 0..disk.n_corners() as u32 {
         dl[disk.he_edge(h) as usize] = lengths[mesh.he_edge(h) as usize];
     }
-    let lay = layout::<Euclidean>(&disk, &IntrinsicMetric::euclidean(dl), None)?;
+    // One walk from the disk's central face: the flat layout's rounding grows only linearly
+    // with the distance from the seed, so the second walk from the boundary's minimax centre
+    // that `layout` adds for a disk (for the hyperbolic plane's exponential growth) would only
+    // move the chart rigidly (the packing orients it anyway).
+    let seed = crate::layout::place::central_face(&disk);
+    let lay = layout::<Euclidean>(&disk, &IntrinsicMetric::euclidean(dl), Some(seed))?;
     Ok((0..disk.n_corners() as u32)
         .map(|h| {
             let p = lay.positions[disk.he_origin(h) as usize];
