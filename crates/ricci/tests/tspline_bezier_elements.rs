@@ -10,23 +10,11 @@
 mod ricci_meshes;
 mod tspline_cases;
 
-use tspline_cases::{forms, genus_two_cases};
+use crate::tspline_domain_mesh::Rng;
+use tspline_cases::{genus_two_cases, glued_domain};
 
 use ricci::spline::tspline::bezier_elements::{domain_elements, strip_cells, SAME_POLYNOMIAL};
 use ricci::spline::tspline::domain_mesh::DomainMesh;
-use ricci::spline::tspline::genus_domain::best_genus_domain;
-use ricci::spline::tspline::glue::gluing;
-
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
@@ -42,14 +30,7 @@ fn cases() -> Vec<(String, DomainMesh, Vec<[f64; 3]>)> {
     let mut rng = Rng(0x2545f4914f6cdd1d);
     let mut out = Vec::new();
     for (name, s) in genus_two_cases() {
-        let h = forms(&s);
-        let d = best_genus_domain(&h, s.positions.len()).unwrap();
-        let g = gluing(&d).unwrap_or_else(|e| panic!("{name}: {e}"));
-        let l = d
-            .cylinders
-            .iter()
-            .map(|c| c.circumference)
-            .fold(0.0, f64::max);
+        let (d, g, l) = glued_domain(&s);
         for (k, levels, margin) in [(25.0, 2, 1), (40.0, 3, 2)] {
             let m = DomainMesh::graded(&d, &g, l / k, levels)
                 .and_then(|m| m.with_t_junctions(margin))

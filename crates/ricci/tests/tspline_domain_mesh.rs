@@ -7,7 +7,7 @@
 mod ricci_meshes;
 mod tspline_cases;
 
-use tspline_cases::{forms, genus_two_cases};
+use tspline_cases::{forms, genus_two_cases, glued_domain};
 
 use ricci::mesh::Surface;
 use ricci::spline::tspline::domain_continuity::side_continuity;
@@ -32,14 +32,7 @@ impl Rng {
 fn meshes() -> Vec<(String, Surface, DomainMesh)> {
     let mut out = Vec::new();
     for (name, s) in genus_two_cases() {
-        let h = forms(&s);
-        let d = best_genus_domain(&h, s.positions.len()).unwrap();
-        let g = gluing(&d).unwrap_or_else(|e| panic!("{name}: {e}"));
-        let l = d
-            .cylinders
-            .iter()
-            .map(|c| c.circumference)
-            .fold(0.0, f64::max);
+        let (d, g, l) = glued_domain(&s);
         for k in [12.0, 25.0] {
             let m = DomainMesh::new(&d, &g, l / k).unwrap_or_else(|e| panic!("{name}: {e}"));
             out.push((format!("{name} at L/{k}"), s.clone(), m));
