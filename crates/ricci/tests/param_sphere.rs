@@ -92,6 +92,18 @@ fn maxplanck_and_horse_on_the_sphere() {
     };
     for f in ["maxplanck.nf25k.off", "horse.ply"] {
         let s = ricci::mesh::io::read_surface(&dir.join(f)).unwrap().0;
-        check(&s, f);
+        let m = check(&s, f);
+        // The same two names as the plane map's `uv_faces` (README: "input" or
+        // "common_subdivision"); horse needs the subdivision on the sphere.
+        assert!(
+            ["input", "common_subdivision"].contains(&m.uv_faces.as_str()),
+            "{f}: {}",
+            m.uv_faces
+        );
+        assert_eq!(
+            m.subdivision.is_some(),
+            m.uv_faces == "common_subdivision",
+            "{f}"
+        );
     }
 }

@@ -40,9 +40,9 @@ pub struct SphereMap {
     #[serde(skip)]
     pub positions: Vec<[f64; 3]>,
     /// `"input"` (the input's faces are all positively oriented on the sphere) or
-    /// `"common-subdivision"` (see the module docs).
+    /// `"common_subdivision"` (see the module docs).
     pub uv_faces: String,
-    /// With `uv_faces = "common-subdivision"`: its points on the input surface, its points
+    /// With `uv_faces = "common_subdivision"`: its points on the input surface, its points
     /// on the sphere and its triangles (counter-clockwise seen from outside).
     #[serde(skip)]
     pub subdivision: Option<Subdivision>,
@@ -158,7 +158,7 @@ pub fn sphere_map(surface: &Surface, progress: &mut dyn Progress) -> Result<Sphe
         )?;
         let d = chord_distortion(&s.positions, &s.sphere_points, &s.triangles);
         let sub = (s.positions, s.sphere_points, s.triangles);
-        ("common-subdivision", Some(sub), stats(&d))
+        ("common_subdivision", Some(sub), stats(&d))
     };
     Ok(SphereMap {
         centroid_norm: centroid_norm(surface, &x),
