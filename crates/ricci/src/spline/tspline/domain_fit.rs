@@ -535,7 +535,7 @@ fn next_blocks(
         }
         Ok(bs) => {
             what.push(format!(
-                "{} blocks split 2×2 ({} levels, {} graded cells in their boxes; {} points beyond the tolerance away from the zeros)",
+                "{} blocks split 2×2, or across one direction where the other is near a strip's end ({} levels, {} graded cells in their boxes; {} points beyond the tolerance away from the zeros)",
                 bs.len(),
                 bs.iter().map(|b| b.level).max().unwrap_or(0),
                 graded_cells(&bs),
