@@ -14,7 +14,8 @@ use crate::tspline_domain_mesh::{check_t_spline, local_knots, Rng, StripLines};
 use ricci::spline::tspline::domain_fit::{fit_domain_mesh, DomainFitOptions};
 use ricci::spline::tspline::domain_mesh::blocks::{place_blocks, Block, CLEAR, FINE};
 use ricci::spline::tspline::domain_mesh::DomainMesh;
-use tspline_cases::{genus_two_cases, glued_domain};
+use ricci::spline::tspline::fit::bbox_scale;
+use tspline_cases::{genus_two_cases, glued_domain, max_vertex_error};
 
 /// Anchors a block of `a × b` cells (of its level) inside a uniform part of the T-mesh adds: `a`
 /// lines along `v` over the box's `b` rows and one row beyond each end (`b + 3` crossings of
@@ -219,16 +220,7 @@ fn a_fit_that_needs_two_levels_of_blocks_nests_them() {
         return;
     };
     let (d, g, _) = glued_domain(&s);
-    let side = {
-        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for p in &s.positions {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
-        (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)
-    };
+    let side = bbox_scale(&s.positions);
     let tolerance = 0.005;
     let fit = |blocks: bool| {
         let opts = DomainFitOptions {
@@ -239,13 +231,7 @@ fn a_fit_that_needs_two_levels_of_blocks_nests_them() {
         fit_domain_mesh(&d, &g, &s.positions, &opts).unwrap()
     };
     let (f, global) = (fit(true), fit(false));
-    let mut max = 0.0f64;
-    for (p, &(c, a, b)) in d.points.iter().zip(&f.located) {
-        let q = f.mesh.patch(c, &f.control, 0.0, 0.0);
-        let x = q.point(q.u0 + a * (q.u1 - q.u0), q.v0 + b * (q.v1 - q.v0));
-        let y = s.positions[p.vertex as usize];
-        max = max.max((0..3).map(|k| (x[k] - y[k]).powi(2)).sum::<f64>().sqrt());
-    }
+    let max = max_vertex_error(&d, &f, &s.positions);
     let deepest = f.mesh.blocks.iter().map(|b| b.level).max().unwrap_or(0);
     eprintln!(
         "eight 0.5 %: {} control points ({} blocks, deepest level {deepest}, L∞ {:.4} %), spacing everywhere {}; {:#?}",
