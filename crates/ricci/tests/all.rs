@@ -142,6 +142,8 @@ mod tspline_cylinders;
 mod tspline_domain_blocks;
 #[path = "tspline_domain_mesh.rs"]
 mod tspline_domain_mesh;
+#[path = "tspline_domain_nested.rs"]
+mod tspline_domain_nested;
 #[path = "tspline_genus.rs"]
 mod tspline_genus;
 #[path = "tspline_genus0.rs"]

@@ -16,7 +16,8 @@ use ricci::spline::tspline::domain_fit::{
 };
 use ricci::spline::tspline::domain_mesh::blocks::{place_blocks, CLEAR};
 use ricci::spline::tspline::domain_mesh::DomainMesh;
-use tspline_cases::{genus_two_cases, glued_domain};
+use ricci::spline::tspline::fit::bbox_scale;
+use tspline_cases::{genus_two_cases, glued_domain, max_vertex_error};
 
 /// Anchors a block of `a × b` cells inside a strip adds: `a` lines along `v` over the box's
 /// `b` rows and one row beyond each end (`b + 3` crossings of the old rows, `b` of the new
@@ -120,16 +121,7 @@ fn blocks_fit_the_tolerance_with_fewer_control_points_than_refining_everywhere()
     let (mut fewer, mut cases) = (0, 0);
     for (name, s) in genus_two_cases() {
         let (d, g, _) = glued_domain(&s);
-        let side = {
-            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-            for p in &s.positions {
-                for k in 0..3 {
-                    lo[k] = lo[k].min(p[k]);
-                    hi[k] = hi[k].max(p[k]);
-                }
-            }
-            (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)
-        };
+        let side = bbox_scale(&s.positions);
         let triangles = s.mesh.faces();
         for tolerance in [0.01, 0.005] {
             for on_triangles in [false, true] {
@@ -157,14 +149,7 @@ fn blocks_fit_the_tolerance_with_fewer_control_points_than_refining_everywhere()
                     }
                 );
                 // L∞ at the vertices, from the patches
-                let mut max = 0.0f64;
-                for (p, &(c, a, b)) in d.points.iter().zip(&f.located) {
-                    let q = f.mesh.patch(c, &f.control, 0.0, 0.0);
-                    let x = q.point(q.u0 + a * (q.u1 - q.u0), q.v0 + b * (q.v1 - q.v0));
-                    let y = s.positions[p.vertex as usize];
-                    let e = (0..3).map(|k| (x[k] - y[k]).powi(2)).sum::<f64>().sqrt();
-                    max = max.max(e);
-                }
+                let max = max_vertex_error(&d, &f, &s.positions);
                 let between = deviation_between_vertices(&f, &s.positions, triangles, 4);
                 let between_global =
                     deviation_between_vertices(&global, &s.positions, triangles, 4);

@@ -770,15 +770,15 @@ fn knot_insertion_writes_the_coarse_b_spline_in_the_fine_ones() {
 
 /// The T-mesh of a strip from the library's lines: per point `(i, j)`, whether a line along
 /// `v` / along `u` passes; edges between neighbouring points on one line.
-struct StripLines {
+pub(crate) struct StripLines {
     m: usize,
     n: usize,
-    on_v: Vec<Vec<bool>>,
-    on_u: Vec<Vec<bool>>,
+    pub(crate) on_v: Vec<Vec<bool>>,
+    pub(crate) on_u: Vec<Vec<bool>>,
 }
 
 impl StripLines {
-    fn new(m: &DomainMesh, r: usize) -> Self {
+    pub(crate) fn new(m: &DomainMesh, r: usize) -> Self {
         let rc = &m.rects[r];
         StripLines {
             m: rc.m,
@@ -862,7 +862,11 @@ impl StripLines {
 
 /// The T-spline knots of the anchor at `(i, j)` of a strip along one direction by ray casting
 /// in the strip (`None` if a ray leaves it): the first two lines crossed each way.
-fn local_knots(at: usize, len: usize, crossed: impl Fn(usize) -> bool) -> Option<[usize; 5]> {
+pub(crate) fn local_knots(
+    at: usize,
+    len: usize,
+    crossed: impl Fn(usize) -> bool,
+) -> Option<[usize; 5]> {
     let mut back = Vec::new();
     let mut k = at;
     while back.len() < 2 {

@@ -445,6 +445,8 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         "faces": r.spline.basis.mesh.faces().len(),
         "t_junctions": r.spline.basis.mesh.t_junctions().len(),
         "analysis_suitable": r.spline.basis.mesh.is_analysis_suitable(),
+        "cells": merge.cells,
+        "patches": patches.len(),
         "bezier_patches": patches.len(),
         "bezier_elements": merge,
         "rms_error_percent": rms,

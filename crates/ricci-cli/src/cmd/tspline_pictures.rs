@@ -300,7 +300,7 @@ pub fn domain_caption(info: &DomainPictures, cells: usize) -> String {
         "The domain mesh on the surface: {lines} mapped through the spline in dark grey, the strips' sides (critical horizontal trajectories of the 1-form and the vertical sides through its zeros) in blue, and the {} zeros of the form — the extraordinary points, where the spline is G¹ — ringed in orange; lines on the far side of the surface are not drawn. {}",
         info.zeros,
         if info.t_junctions > 0 {
-            format!("The graded lines at the zeros end in the {} T-junctions ringed in red (the T-mesh; its sides only are drawn).", info.t_junctions)
+            format!("The graded lines at the zeros and the lines of any blocks (cells split 2×2 where the error was beyond the tolerance, nested where it stayed) end in the {} T-junctions ringed in red (the T-mesh; its sides only are drawn).", info.t_junctions)
         } else {
             "The mesh is conforming: no T-junctions.".to_string()
         }

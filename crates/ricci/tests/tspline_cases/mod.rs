@@ -55,3 +55,20 @@ pub fn glued_domain(
         .fold(0.0, f64::max);
     (d, g, l)
 }
+
+/// The largest distance of the domain-mesh fit `f` of `d` — evaluated here from its Bézier
+/// patches — to the input vertices `positions`.
+pub fn max_vertex_error(
+    d: &ricci::spline::tspline::genus_domain::GenusDomain,
+    f: &ricci::spline::tspline::domain_fit::DomainFit,
+    positions: &[[f64; 3]],
+) -> f64 {
+    let mut max = 0.0f64;
+    for (p, &(c, a, b)) in d.points.iter().zip(&f.located) {
+        let q = f.mesh.patch(c, &f.control, 0.0, 0.0);
+        let x = q.point(q.u0 + a * (q.u1 - q.u0), q.v0 + b * (q.v1 - q.v0));
+        let y = positions[p.vertex as usize];
+        max = max.max((0..3).map(|k| (x[k] - y[k]).powi(2)).sum::<f64>().sqrt());
+    }
+    max
+}

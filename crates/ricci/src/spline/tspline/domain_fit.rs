@@ -8,9 +8,10 @@
 //! ([`DomainMesh::near_zero`]) is beyond the tolerance, the mesh is refined once more at the
 //! zeros ([`DomainMesh::graded`]: two columns and rows per strip); while a point elsewhere is,
 //! the cells around it are split 2×2 in blocks whose lines end in T-junctions
-//! ([`super::domain_mesh::blocks`], [`DomainFitOptions::blocks`]) — or, when no block can be
-//! placed (the point's cell is split already, or within [`super::domain_mesh::blocks::CLEAR`]
-//! cells of two sides of its strip), the blocks would cover more than [`BLOCK_SHARE`] of the
+//! ([`super::domain_mesh::blocks`], [`DomainFitOptions::blocks`]; a cell split already by
+//! blocks nested in the deepest block that split it) — or, when no block can be placed (the
+//! point's cell is within [`super::domain_mesh::blocks::CLEAR`] cells of two sides of its
+//! strip, or no cell would be split that is not already), the blocks would cover more than [`BLOCK_SHARE`] of the
 //! cells, or their T-mesh is not analysis-suitable, the spacing shrinks (by 1/√2, everywhere;
 //! [`DomainFit::refinements`] says which and why); until the largest error is below the tolerance
 //! or the budget of control points is spent (the last refinement is cut to the largest mesh
@@ -489,6 +490,16 @@ fn fit_on_mesh(
     Ok((located, control, errors))
 }
 
+/// The graded cells in the boxes of `blocks` (nested boxes lie inside their parents'; counted
+/// once).
+pub fn graded_cells(blocks: &[Block]) -> usize {
+    blocks
+        .iter()
+        .filter(|b| b.level == 1)
+        .map(Block::cells)
+        .sum()
+}
+
 /// The blocks of the next step of [`fit_domain_mesh_on_triangles`]: the boxes around the
 /// points `far` beyond the tolerance away from the zeros (in the indices of the next graded mesh,
 /// `d` more levels), or — when no block can be placed or they would cover more than
@@ -508,25 +519,13 @@ fn next_blocks(
     };
     // in the indices of the next graded mesh (one more level: one more column and row
     // at each end)
-    let shifted = placed.map(|bs| {
-        bs.into_iter()
-            .map(|b| Block {
-                i0: b.i0 + d,
-                i1: b.i1 + d,
-                j0: b.j0 + d,
-                j1: b.j1 + d,
-                ..b
-            })
-            .collect::<Vec<_>>()
-    });
+    let shifted = placed.map(|bs| bs.iter().map(|b| b.shifted(d)).collect::<Vec<_>>());
     let cells: usize = last.map_or(0, |f| {
         f.mesh.rects.iter().map(|r| r.base_m * r.base_n).sum()
     });
     match shifted {
         Ok(bs) if far.is_empty() => *blocks = bs,
-        Ok(bs)
-            if bs.iter().map(Block::cells).sum::<usize>() as f64 > BLOCK_SHARE * cells as f64 =>
-        {
+        Ok(bs) if graded_cells(&bs) as f64 > BLOCK_SHARE * cells as f64 => {
             *spacing *= refine;
             blocks.clear();
             what.push(format!(
@@ -536,9 +535,10 @@ fn next_blocks(
         }
         Ok(bs) => {
             what.push(format!(
-                "{} blocks split 2×2 ({} cells in their boxes; {} points beyond the tolerance away from the zeros)",
+                "{} blocks split 2×2, or across one direction where the other is near a strip's end ({} levels, {} graded cells in their boxes; {} points beyond the tolerance away from the zeros)",
                 bs.len(),
-                bs.iter().map(Block::cells).sum::<usize>(),
+                bs.iter().map(|b| b.level).max().unwrap_or(0),
+                graded_cells(&bs),
                 far.len()
             ));
             *blocks = bs;

@@ -124,10 +124,11 @@ pub struct Rect {
     /// blocks' midpoints ([`blocks`]).
     pub xs: Vec<f64>,
     pub ys: Vec<f64>,
-    /// Per knot of `xs` / `ys`: `2 b` for knot `b` of the graded mesh, `2 b + 1` for the
-    /// midpoint of its interval `b` (a block's line).
-    pub u_half: Vec<usize>,
-    pub v_half: Vec<usize>,
+    /// Per knot of `xs` / `ys`: its position in units of `1 / FINE` of a graded interval
+    /// (`FINE b` for knot `b` of the graded mesh; a block's line of level `ℓ` at an odd
+    /// multiple of `FINE / 2^ℓ`: [`blocks::FINE`], [`blocks::knot_level`]).
+    pub u_fine: Vec<usize>,
+    pub v_fine: Vec<usize>,
 }
 
 /// The least number of cells along a strip side: two edge cells at each end and one between.
@@ -443,8 +444,8 @@ impl DomainMesh {
                     base_n: 0,
                     xs: Vec::new(),
                     ys: Vec::new(),
-                    u_half: Vec::new(),
-                    v_half: Vec::new(),
+                    u_fine: Vec::new(),
+                    v_fine: Vec::new(),
                 });
             }
         }

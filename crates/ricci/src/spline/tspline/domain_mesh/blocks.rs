@@ -1,92 +1,170 @@
 //! Error-driven local refinement away from the zeros (issue 18; paper 003 §3.3: "insert
 //! control points — local knot insertion, T-junctions — where the error exceeds the
-//! tolerance"). A **block** is a box of cells of one strip of the graded mesh whose cells are
+//! tolerance"). A **block** of level `ℓ ≥ 1` is a box of cells of the level-`ℓ − 1` mesh of one
+//! strip (level 0: the graded mesh; level `ℓ`: its intervals halved `ℓ` times) whose cells are
 //! split 2×2: new lines at the midpoints of its columns, kept in the T-mesh from one row below
 //! the box to one row above it, and at the midpoints of its rows, kept across its columns;
-//! the new lines end in T-junctions (inside the strip, or on its sides). In the full mesh
+//! the new lines end in T-junctions (inside the strip, or on its sides). A block of level
+//! `ℓ ≥ 2` is **nested**: it lies in the split part of a block of level `ℓ − 1`, one cell of its
+//! level in from every side (its lines along `v` end on that block's lines along `u`, and the
+//! extensions of that block's T-junctions, one crossing back, miss its lines), and the
+//! fit places it where an error remains in cells split already. In the full mesh
 //! ([`DomainMesh::refined`]) the same knots run through the whole chain of strips glued top to
-//! bottom (columns) or the whole cylinder (rows): it stays a per-strip tensor grid, its Bézier
-//! extraction unchanged, and the T-spline is written in it by knot insertion exactly as for the
-//! graded lines ([`super::tjunctions`]; the T-mesh is [`DomainMesh::on_line_u`] /
-//! [`DomainMesh::on_line_v`]).
+//! bottom (columns) or the whole cylinder (rows): it stays a per-strip tensor grid — every knot
+//! is a dyadic point of a graded interval, at `Rect::u_fine` / `Rect::v_fine` in units of
+//! `1 / FINE` of it — its Bézier extraction unchanged, and the T-spline is written in it by knot
+//! insertion exactly as for the graded lines ([`super::tjunctions`]; the T-mesh is
+//! [`DomainMesh::on_line_u`] / [`DomainMesh::on_line_v`]). Nesting keeps this design: a level
+//! only adds knots, and a knot's level is read off its dyadic position.
 //!
-//! **The zeros.** Only columns and rows at least [`CLEAR`] intervals from the strip's ends are
-//! split: the two intervals next to every zero keep their size (its rules and the G¹
+//! **The zeros.** Only columns and rows at least [`CLEAR`] graded intervals from the strip's
+//! ends are split: the two intervals next to every zero keep their size (its rules and the G¹
 //! conditions unchanged), and an anchor whose ray meets a zero — it keeps the full mesh's
 //! blending function, whose knots reach two intervals past its second crossing — meets no
 //! block's knot in the full mesh that the T-mesh lacks. A box at a strip's side splits only
-//! across it (the rows at a vertical side, the columns at a horizontal one).
+//! across it (the rows at a vertical side, the columns at a horizontal one), and so does the
+//! part of a box within [`CLEAR`] of an end; a box nested where its parent splits one direction
+//! only ([`Block::split`]) takes the parent's whole extent along the other and halves only that
+//! one again, its lines ending where the parent's do.
 //!
 //! **Analysis-suitable** (Li, Zheng, Sederberg, Hughes, Scott 2012 §3). Within a block the lines
 //! along `v` run one row beyond the box and those along `u` stop at its sides, so their
 //! extensions (two crossings ahead, one back) do not meet: the extension of a line along `v`
 //! ends one row beyond the box, where no line along `u` of the block reaches (had both stopped
 //! at the box's sides, the extensions of its first column and row lines would meet at its first
-//! inner point). Boxes of one strip closer than [`GAP`] cells in both directions are merged into
-//! their bounding box, repeatedly (the closure of [`place_blocks`]), so the extensions of two
-//! blocks stay apart too. Near the strip sides and the graded lines the fit checks the whole
-//! T-mesh ([`DomainMesh::extensions_meet`]) and refines the spacing instead if it is not.
+//! inner point). Inside a block the mesh of its level is uniform, so a nested block sees what a
+//! first-level one sees. Boxes of one strip, one level and one parent closer than [`GAP`] cells
+//! (of their level) in both directions are merged into their bounding box, repeatedly (the
+//! closure of [`place_blocks`]), so the extensions of two blocks stay apart too. Near the strip
+//! sides, the graded lines and a parent's sides the fit checks the whole T-mesh
+//! ([`DomainMesh::extensions_meet`]) and refines the spacing instead if it is not.
 
 use super::*;
 
-/// A box of cells of strip `rect` of the graded mesh — columns `i0..i1`, rows `j0..j1`, in the
-/// indices of [`DomainMesh::graded`] — split 2×2 where it is [`CLEAR`] of the strip's ends
-/// (module doc).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// A box of cells of strip `rect` of the level-`level − 1` mesh — columns `i0..i1`, rows
+/// `j0..j1`, in the indices of [`DomainMesh::graded`] with every interval halved `level − 1`
+/// times — split 2×2 where it is [`CLEAR`] of the strip's ends (module doc).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct Block {
     pub rect: usize,
     pub i0: usize,
     pub i1: usize,
     pub j0: usize,
     pub j1: usize,
+    /// 1 for a box of graded cells; `ℓ` for a box inside a block of level `ℓ − 1`.
+    pub level: usize,
+    /// Whether it splits its columns (along `u`) and its rows (along `v`): both for a block of
+    /// level 1 and one nested where its parent splits both; one for a block nested where its
+    /// parent splits only that one (module doc).
+    pub split: [bool; 2],
 }
 
 /// Boxes of one strip closer than this many cells along `u` and along `v` are merged.
 pub const GAP: isize = 3;
 
-/// The intervals at each end of a strip side that no block splits (module doc).
+/// The graded intervals at each end of a strip side that no block splits (module doc).
 pub const CLEAR: usize = 4;
 
-/// The part of `lo..hi` at least [`CLEAR`] from both ends of `0..len` (maybe empty).
-fn clear_of_ends(lo: usize, hi: usize, len: usize) -> std::ops::Range<usize> {
-    let lo = lo.max(CLEAR);
-    lo..hi.min(len.saturating_sub(CLEAR)).max(lo)
+/// The most levels of blocks (each halves the intervals of the cells it splits).
+pub const MAX_BLOCK_LEVEL: usize = 6;
+
+/// A graded interval in units of the finest blocks' knots: `Rect::u_fine` and `Rect::v_fine`
+/// count in `1 / FINE` of it.
+pub const FINE: usize = 1 << MAX_BLOCK_LEVEL;
+
+/// The level of a knot at `a` (units of `1 / FINE` of a graded interval): 0 for the graded
+/// mesh's, `ℓ` for the midpoint of an interval of the level-`ℓ − 1` mesh.
+pub fn knot_level(a: usize) -> usize {
+    if a.is_multiple_of(FINE) {
+        0
+    } else {
+        MAX_BLOCK_LEVEL - a.trailing_zeros() as usize
+    }
 }
 
 impl Block {
-    fn contains(&self, i: usize, j: usize) -> bool {
-        (self.i0..self.i1).contains(&i) && (self.j0..self.j1).contains(&j)
+    /// The size of a cell of its box (a cell of the level-`level − 1` mesh) in units of
+    /// `1 / FINE` of a graded interval.
+    pub fn cell_fine(&self) -> usize {
+        FINE >> (self.level - 1)
     }
 
-    /// The columns it splits, of a strip of `m` columns.
+    /// The columns it splits, of a strip of `m` graded columns (in its level's indices).
     pub fn split_u(&self, m: usize) -> std::ops::Range<usize> {
-        clear_of_ends(self.i0, self.i1, m)
+        let r = self.clear_of_ends(self.i0, self.i1, m);
+        if self.split[0] {
+            r
+        } else {
+            r.start..r.start
+        }
     }
 
-    /// The rows it splits, of a strip of `n` rows.
+    /// The rows it splits, of a strip of `n` graded rows (in its level's indices).
     pub fn split_v(&self, n: usize) -> std::ops::Range<usize> {
-        clear_of_ends(self.j0, self.j1, n)
+        let r = self.clear_of_ends(self.j0, self.j1, n);
+        if self.split[1] {
+            r
+        } else {
+            r.start..r.start
+        }
     }
 
-    /// The cells of the box.
+    /// The part of `lo..hi` at least [`CLEAR`] graded intervals from both ends of a side of
+    /// `len` graded intervals, in its level's indices (maybe empty).
+    fn clear_of_ends(&self, lo: usize, hi: usize, len: usize) -> std::ops::Range<usize> {
+        let k = self.level - 1;
+        let lo = lo.max(CLEAR << k);
+        lo..hi.min((len << k).saturating_sub(CLEAR << k)).max(lo)
+    }
+
+    /// Whether the cell `[u0, u1, v0, v1]` (units of `1 / FINE` of a graded interval) of a strip
+    /// of `m × n` graded cells lies in its box, in columns it splits (`.0`) and in rows it
+    /// splits (`.1`).
+    fn splits(&self, cell: [usize; 4], m: usize, n: usize) -> (bool, bool) {
+        let s = self.cell_fine();
+        let inside = |lo: usize, hi: usize, r: std::ops::Range<usize>| {
+            !r.is_empty() && r.start * s <= lo && hi <= r.end * s
+        };
+        let in_box = inside(cell[0], cell[1], self.i0..self.i1)
+            && inside(cell[2], cell[3], self.j0..self.j1);
+        (
+            in_box && inside(cell[0], cell[1], self.split_u(m)),
+            in_box && inside(cell[2], cell[3], self.split_v(n)),
+        )
+    }
+
+    /// The cells of the box (of its level).
     pub fn cells(&self) -> usize {
         (self.i1 - self.i0) * (self.j1 - self.j0)
     }
-}
 
-/// The knots with the midpoints of the intervals `split` inserted, and per knot twice its index
-/// in `knots` (plus one for a midpoint).
-fn interleave(knots: &[f64], split: &[bool]) -> (Vec<f64>, Vec<usize>) {
-    let (mut xs, mut half) = (Vec::new(), Vec::new());
-    for (b, &x) in knots.iter().enumerate() {
-        xs.push(x);
-        half.push(2 * b);
-        if split.get(b).copied().unwrap_or(false) {
-            xs.push(0.5 * (x + knots[b + 1]));
-            half.push(2 * b + 1);
+    /// The same block in the indices of a graded mesh with `d` more levels at the zeros (one
+    /// more graded column and row at each end per level).
+    pub fn shifted(&self, d: usize) -> Block {
+        let d = d << (self.level - 1);
+        Block {
+            i0: self.i0 + d,
+            i1: self.i1 + d,
+            j0: self.j0 + d,
+            j1: self.j1 + d,
+            ..*self
         }
     }
-    (xs, half)
+}
+
+/// The knots at the dyadic positions `at` (units of `1 / FINE` of the intervals of `knots`,
+/// increasing).
+fn knots_at(knots: &[f64], at: &[usize]) -> Vec<f64> {
+    at.iter()
+        .map(|&a| {
+            let (b, f) = (a / FINE, (a % FINE) as f64 / FINE as f64);
+            if f == 0.0 {
+                knots[b]
+            } else {
+                knots[b] + f * (knots[b + 1] - knots[b])
+            }
+        })
+        .collect()
 }
 
 /// Give every strip its knots — the graded mesh's, with the midpoints of every column split by
@@ -97,26 +175,38 @@ pub(super) fn split_knots(
     top: &[usize],
     blocks: &[Block],
 ) -> Result<usize, String> {
+    use std::collections::BTreeSet;
     let nr = rects.len();
     for r in rects.iter_mut() {
         r.base_m = r.m;
         r.base_n = r.n;
     }
-    let mut split_u: Vec<Vec<bool>> = rects.iter().map(|r| vec![false; r.m]).collect();
-    let mut split_v: Vec<Vec<bool>> = rects.iter().map(|r| vec![false; r.n]).collect();
+    let mut at_u: Vec<BTreeSet<usize>> = rects
+        .iter()
+        .map(|r| (0..=r.m).map(|b| b * FINE).collect())
+        .collect();
+    let mut at_v: Vec<BTreeSet<usize>> = rects
+        .iter()
+        .map(|r| (0..=r.n).map(|b| b * FINE).collect())
+        .collect();
     for b in blocks {
         let ok = b.rect < nr
+            && (1..=MAX_BLOCK_LEVEL).contains(&b.level)
             && b.i0 < b.i1
-            && b.i1 <= rects[b.rect].m
+            && b.i1 <= rects[b.rect].m << (b.level - 1)
             && b.j0 < b.j1
-            && b.j1 <= rects[b.rect].n;
+            && b.j1 <= rects[b.rect].n << (b.level - 1);
         if !ok {
-            return Err(format!("block {b:?} is not a box of cells of a strip"));
+            return Err(format!(
+                "block {b:?} is not a box of cells of a strip (at most {MAX_BLOCK_LEVEL} levels)"
+            ));
         }
+        let s = b.cell_fine();
+        let mids = |range: std::ops::Range<usize>| range.map(move |k| k * s + s / 2);
         let (su, sv) = (b.split_u(rects[b.rect].m), b.split_v(rects[b.rect].n));
         let mut r = b.rect;
         for _ in 0..nr {
-            split_u[r][su.clone()].iter_mut().for_each(|x| *x = true);
+            at_u[r].extend(mids(su.clone()));
             r = top[r];
             if r == b.rect {
                 break;
@@ -125,15 +215,17 @@ pub(super) fn split_knots(
         let c = rects[b.rect].cylinder;
         for (r, rc) in rects.iter().enumerate() {
             if rc.cylinder == c {
-                split_v[r][sv.clone()].iter_mut().for_each(|x| *x = true);
+                at_v[r].extend(mids(sv.clone()));
             }
         }
     }
     let mut cells = 0;
     for (r, rc) in rects.iter_mut().enumerate() {
         let (bu, bv) = rc.base_knots();
-        (rc.xs, rc.u_half) = interleave(&bu, &split_u[r]);
-        (rc.ys, rc.v_half) = interleave(&bv, &split_v[r]);
+        rc.u_fine = at_u[r].iter().copied().collect();
+        rc.v_fine = at_v[r].iter().copied().collect();
+        rc.xs = knots_at(&bu, &rc.u_fine);
+        rc.ys = knots_at(&bv, &rc.v_fine);
         rc.m = rc.xs.len() - 1;
         rc.n = rc.ys.len() - 1;
         rc.first_cell = cells;
@@ -149,8 +241,8 @@ impl DomainMesh {
         let rc = &self.rects[r as usize];
         (
             r as usize,
-            rc.u_half[i as usize] / 2,
-            rc.v_half[j as usize] / 2,
+            rc.u_fine[i as usize] / FINE,
+            rc.v_fine[j as usize] / FINE,
         )
     }
 
@@ -158,16 +250,26 @@ impl DomainMesh {
     /// that block line at row knot `j` (from one row below its block to one row above).
     pub(super) fn block_line_v(&self, r: usize, i: usize, j: usize) -> Option<bool> {
         let rc = &self.rects[r];
-        let a = rc.u_half[i];
-        if a.is_multiple_of(2) {
+        let a = rc.u_fine[i];
+        let level = knot_level(a);
+        if level == 0 {
             return None;
         }
-        let (col, y) = (a / 2, rc.v_half[j]);
+        let y = rc.v_fine[j];
         Some(self.blocks.iter().any(|b| {
+            let s = b.cell_fine();
+            // one row of its level beyond the box; one graded row for a box that splits no
+            // row (at a strip's side: its nested boxes take the parent's rows)
+            let beyond = if !b.split[1] || b.split_v(rc.base_n).is_empty() {
+                FINE
+            } else {
+                s
+            };
             b.rect == r
-                && b.split_u(rc.base_m).contains(&col)
-                && y + 2 >= 2 * b.j0
-                && y <= 2 * b.j1 + 2
+                && b.level == level
+                && b.split_u(rc.base_m).contains(&(a / s))
+                && y + beyond >= s * b.j0
+                && y <= s * b.j1 + beyond
         }))
     }
 
@@ -175,14 +277,42 @@ impl DomainMesh {
     /// that block line at column knot `i` (across its block's columns).
     pub(super) fn block_line_u(&self, r: usize, i: usize, j: usize) -> Option<bool> {
         let rc = &self.rects[r];
-        let a = rc.v_half[j];
-        if a.is_multiple_of(2) {
+        let a = rc.v_fine[j];
+        let level = knot_level(a);
+        if level == 0 {
             return None;
         }
-        let (row, x) = (a / 2, rc.u_half[i]);
+        let x = rc.u_fine[i];
         Some(self.blocks.iter().any(|b| {
-            b.rect == r && b.split_v(rc.base_n).contains(&row) && x >= 2 * b.i0 && x <= 2 * b.i1
+            let s = b.cell_fine();
+            b.rect == r
+                && b.level == level
+                && b.split_v(rc.base_n).contains(&(a / s))
+                && x >= s * b.i0
+                && x <= s * b.i1
         }))
+    }
+
+    /// The deepest block that splits cell `c` — it lies in its box, in columns or rows it
+    /// splits — its index in [`DomainMesh::blocks`], and whether it lies in split columns and in
+    /// split rows; if any.
+    pub fn block_of_cell(&self, c: u32) -> Option<(usize, (bool, bool))> {
+        let (r, i, j) = self.cell_at[c as usize];
+        let rc = &self.rects[r as usize];
+        let (i, j) = (i as usize, j as usize);
+        let cell = [
+            rc.u_fine[i],
+            rc.u_fine[i + 1],
+            rc.v_fine[j],
+            rc.v_fine[j + 1],
+        ];
+        self.blocks
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| b.rect == r as usize)
+            .map(|(k, b)| (k, b.splits(cell, rc.base_m, rc.base_n)))
+            .filter(|(_, (u, v))| *u || *v)
+            .max_by_key(|(k, _)| self.blocks[*k].level)
     }
 }
 
@@ -194,46 +324,123 @@ fn close(a: [usize; 4], b: [usize; 4]) -> bool {
     gap(a[0], a[1], b[0], b[1]) < GAP && gap(a[2], a[3], b[2], b[3]) < GAP
 }
 
+/// Boxes of one strip, one level, one parent block (index in the mesh's blocks, or none) and
+/// the directions they split.
+type Group = (usize, usize, Option<usize>, [bool; 2]);
+
+/// The box a marked cell asks for: the cell of the level-`ℓ − 1` mesh that contains it and its
+/// neighbours, inside the strip (level 1) or inside the split part of the parent block, one
+/// cell in from its sides (module doc), and its group; `None` when the cell is in the first or
+/// last row or column of its block (a nested box there would end its lines where the T-mesh
+/// has none, or meet the extensions of the parent's T-junctions), or why no box can be placed.
+fn box_around(mesh: &DomainMesh, c: u32) -> Result<Option<(Group, [usize; 4])>, String> {
+    let (r, bi, bj) = mesh.base_cell(c);
+    let rc = &mesh.rects[r];
+    let (m, n) = (rc.base_m, rc.base_n);
+    let found = mesh.block_of_cell(c);
+    let parent = found.map(|f| f.0);
+    let level = parent.map_or(0, |p| mesh.blocks[p].level) + 1;
+    let at = || {
+        format!(
+            "cell ({bi}, {bj}) of strip {} of cylinder {} ({m} × {n} graded cells)",
+            rc.strip, rc.cylinder
+        )
+    };
+    if level > MAX_BLOCK_LEVEL {
+        return Err(format!("{} is split {MAX_BLOCK_LEVEL} times already", at()));
+    }
+    let (_, i, j) = mesh.cell_at[c as usize];
+    let s = FINE >> (level - 1);
+    let (ci, cj) = (rc.u_fine[i as usize] / s, rc.v_fine[j as usize] / s);
+    // per direction: the range the box may take, and whether it takes all of it
+    let mut split = [true, true];
+    let (u, v) = match parent {
+        None => {
+            let clear = |k: usize, len: usize| k >= CLEAR && k + CLEAR < len;
+            if !clear(bi, m) && !clear(bj, n) {
+                return Err(format!("{} is within {CLEAR} cells of two sides", at()));
+            }
+            ((0, m, false), (0, n, false))
+        }
+        Some(p) => {
+            let b = &mesh.blocks[p];
+            let (in_u, in_v) = found.map_or((false, false), |f| f.1);
+            // one cell of its level in from every side of the parent's split part: its
+            // lines along `v` end on the parent's lines along `u`, and the extensions of the
+            // parent's T-junctions, one crossing back into the parent, meet none of its lines.
+            // In a part the parent splits along one direction only (columns within `CLEAR` of
+            // the strip's ends, or a box at a strip's side) the nested box splits only that
+            // direction too, across the parent's whole box: its lines end where the parent's do
+            let within = |split: std::ops::Range<usize>, lo: usize, hi: usize, inside: bool| {
+                if inside {
+                    (2 * split.start + 1, 2 * split.end - 1, false)
+                } else {
+                    (2 * lo, 2 * hi, true)
+                }
+            };
+            split = [in_u, in_v];
+            (
+                within(b.split_u(m), b.i0, b.i1, in_u),
+                within(b.split_v(n), b.j0, b.j1, in_v),
+            )
+        }
+    };
+    let span = |c: usize, (lo, hi, whole): (usize, usize, bool)| {
+        if whole {
+            (lo, hi)
+        } else {
+            (c.saturating_sub(1).max(lo), (c + 2).min(hi))
+        }
+    };
+    let ((lo_i, hi_i), (lo_j, hi_j)) = ((u.0, u.1), (v.0, v.1));
+    let (bu, bv) = (span(ci, u), span(cj, v));
+    let bx = [bu.0, bu.1, bv.0, bv.1];
+    let outside = ci < lo_i || ci >= hi_i || cj < lo_j || cj >= hi_j;
+    if bx[0] >= bx[1] || bx[2] >= bx[3] || outside {
+        return Ok(None);
+    }
+    Ok(Some(((r, level, parent, split), bx)))
+}
+
 /// The blocks that split the cells `marked` of `mesh` (and their neighbours) with those it
-/// has, closed (module doc), in the indices of `mesh`'s graded mesh; or why a block cannot be
-/// placed: a marked cell is in a block already, or no column or row of it can be split.
+/// has, closed (module doc), in the indices of `mesh`'s graded mesh: a marked cell split
+/// already asks for a block nested in the deepest block that split it; or why a block cannot
+/// be placed: a marked cell is within [`CLEAR`] cells of two sides of its strip or split
+/// [`MAX_BLOCK_LEVEL`] times, or no cell would be split that is not already (a marked cell
+/// in the first or last row of its block places no nested box).
 pub fn place_blocks(mesh: &DomainMesh, marked: &[u32]) -> Result<Vec<Block>, String> {
-    let nr = mesh.rects.len();
-    let mut boxes: Vec<Vec<[usize; 4]>> = vec![Vec::new(); nr];
+    use std::collections::BTreeMap;
+    let mut groups: BTreeMap<Group, Vec<[usize; 4]>> = BTreeMap::new();
     for b in &mesh.blocks {
-        boxes[b.rect].push([b.i0, b.i1, b.j0, b.j1]);
+        // its parent: the block one level up whose box (halved) holds its box
+        let parent = (b.level > 1)
+            .then(|| {
+                mesh.blocks.iter().position(|p| {
+                    p.rect == b.rect
+                        && p.level + 1 == b.level
+                        && 2 * p.i0 <= b.i0
+                        && b.i1 <= 2 * p.i1
+                        && 2 * p.j0 <= b.j0
+                        && b.j1 <= 2 * p.j1
+                })
+            })
+            .flatten();
+        groups
+            .entry((b.rect, b.level, parent, b.split))
+            .or_default()
+            .push([b.i0, b.i1, b.j0, b.j1]);
     }
     let mut seen = std::collections::HashSet::new();
     for &c in marked {
-        let (r, i, j) = mesh.base_cell(c);
-        if !seen.insert((r, i, j)) {
+        if !seen.insert(c) {
             continue;
         }
-        let rc = &mesh.rects[r];
-        let (m, n) = (rc.base_m, rc.base_n);
-        let at = || {
-            format!(
-                "cell ({i}, {j}) of strip {} of cylinder {} ({m} × {n} cells)",
-                rc.strip, rc.cylinder
-            )
-        };
-        if mesh.blocks.iter().any(|b| b.rect == r && b.contains(i, j)) {
-            return Err(format!("{} is split already", at()));
+        if let Some((g, bx)) = box_around(mesh, c)? {
+            groups.entry(g).or_default().push(bx);
         }
-        let clear = |k: usize, len: usize| k >= CLEAR && k + CLEAR < len;
-        if !clear(i, m) && !clear(j, n) {
-            return Err(format!("{} is within {CLEAR} cells of two sides", at()));
-        }
-        // the cell and its neighbours
-        boxes[r].push([
-            i.saturating_sub(1),
-            (i + 2).min(m),
-            j.saturating_sub(1),
-            (j + 2).min(n),
-        ]);
     }
     let mut out = Vec::new();
-    for (r, mut bs) in boxes.into_iter().enumerate() {
+    for ((r, level, _, split), mut bs) in groups {
         // every merge removes a box: at most `bs.len()` rounds
         for _ in 0..bs.len() {
             let pair = (0..bs.len())
@@ -257,7 +464,19 @@ pub fn place_blocks(mesh: &DomainMesh, marked: &[u32]) -> Result<Vec<Block>, Str
             i1: x[1],
             j0: x[2],
             j1: x[3],
+            level,
+            split,
         }));
+    }
+    let mut old = mesh.blocks.clone();
+    let mut new = out.clone();
+    old.sort();
+    new.sort();
+    if old == new {
+        return Err(format!(
+            "the {} cells beyond the tolerance are in their blocks already",
+            seen.len()
+        ));
     }
     Ok(out)
 }

@@ -28,6 +28,7 @@
 //! `v` (the test checks it from the mesh lines, independently). Hence the blending functions
 //! are linearly independent and sum to one (Li et al. 2012, Theorems 4.8, 6.2).
 
+use super::blocks::FINE;
 use super::*;
 
 /// The T-mesh of a graded domain mesh: which graded lines end in T-junctions, and its anchors.
@@ -54,13 +55,13 @@ fn graded(b: usize, k: usize, levels: usize) -> bool {
 impl Rect {
     /// Whether column line `i` is one of the grading's (module doc of the parent).
     fn graded_u(&self, i: usize) -> bool {
-        let h = self.u_half[i];
-        h.is_multiple_of(2) && graded(h / 2, self.base_m, self.levels)
+        let h = self.u_fine[i];
+        h.is_multiple_of(FINE) && graded(h / FINE, self.base_m, self.levels)
     }
 
     fn graded_v(&self, j: usize) -> bool {
-        let h = self.v_half[j];
-        h.is_multiple_of(2) && graded(h / 2, self.base_n, self.levels)
+        let h = self.v_fine[j];
+        h.is_multiple_of(FINE) && graded(h / FINE, self.base_n, self.levels)
     }
 }
 
@@ -116,9 +117,9 @@ impl DomainMesh {
             return on;
         }
         // a gap of at least two intervals, else the line stays whole (indices of the graded
-        // mesh, in halves: blocks split some intervals)
-        let (h, n) = (rc.v_half[j], rc.base_n);
-        !rc.graded_u(i) || 2 * k + 2 > n || h <= 2 * k || h >= 2 * (n - k)
+        // mesh, in units of `1 / FINE`: blocks split some intervals)
+        let (h, n) = (rc.v_fine[j], rc.base_n);
+        !rc.graded_u(i) || 2 * k + 2 > n || h <= FINE * k || h >= FINE * (n - k)
     }
 
     /// Whether the T-mesh has a line along `u` through the point `(x(i), y(j))` of strip `r`.
@@ -130,8 +131,8 @@ impl DomainMesh {
         if let Some(on) = self.block_line_u(r, i, j) {
             return on;
         }
-        let (h, m) = (rc.u_half[i], rc.base_m);
-        !rc.graded_v(j) || 2 * k + 2 > m || h <= 2 * k || h >= 2 * (m - k)
+        let (h, m) = (rc.u_fine[i], rc.base_m);
+        !rc.graded_v(j) || 2 * k + 2 > m || h <= FINE * k || h >= FINE * (m - k)
     }
 
     /// Whether the vertex at the lower-left corner of cell `c` has a T-mesh line across
