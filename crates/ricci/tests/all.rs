@@ -68,6 +68,8 @@ mod layout_nearest_images;
 mod layout_polish;
 #[path = "layout_synthetic.rs"]
 mod layout_synthetic;
+#[path = "mesh_edge_order.rs"]
+mod mesh_edge_order;
 #[path = "mesh_files.rs"]
 mod mesh_files;
 #[path = "metric_derivatives.rs"]
@@ -96,6 +98,8 @@ mod param_seamless_boundary;
 mod param_seamless_distortion;
 #[path = "param_sphere.rs"]
 mod param_sphere;
+#[path = "param_threads.rs"]
+mod param_threads;
 #[path = "roundtrip.rs"]
 mod roundtrip;
 #[path = "scalar_files.rs"]

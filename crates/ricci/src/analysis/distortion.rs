@@ -116,14 +116,16 @@ pub struct DistortionStats {
     pub log_area_max: f64,
 }
 
-/// Per-face distortion of corner UVs (`corner_uv[3f + i]` for corner `i` of face `f`).
+/// Per-face distortion of corner UVs (`corner_uv[3f + i]` for corner `i` of face `f`); the
+/// faces are measured in parallel (each independently, so the same values in face order).
 pub fn face_distortions(
     positions: &[[f64; 3]],
     faces: &[[u32; 3]],
     corner_uv: &[[f64; 2]],
 ) -> Vec<FaceDistortion> {
+    use rayon::prelude::*;
     faces
-        .iter()
+        .par_iter()
         .enumerate()
         .map(|(f, t)| {
             let p = [
@@ -139,6 +141,7 @@ pub fn face_distortions(
 
 /// [`DistortionStats`] of per-face distortions.
 pub fn stats(d: &[FaceDistortion]) -> DistortionStats {
+    use rayon::slice::ParallelSliceMut;
     let mut qc = Vec::with_capacity(d.len());
     let mut qc_area: Vec<(f64, f64)> = Vec::with_capacity(d.len());
     let mut flipped = 0;
@@ -167,7 +170,8 @@ pub fn stats(d: &[FaceDistortion]) -> DistortionStats {
             lmax = lmax.max(dl.abs());
         }
     }
-    qc.sort_by(f64::total_cmp);
+    // Values equal under `total_cmp` are the same bits: any sort gives the same order.
+    qc.par_sort_unstable_by(f64::total_cmp);
     let n = qc.len();
     let p95 = if n == 0 {
         f64::NAN
@@ -196,11 +200,12 @@ pub fn stats(d: &[FaceDistortion]) -> DistortionStats {
 /// Area-weighted mean and p95 of `(qc, area)` pairs (`total` their area): the p95 is the
 /// smallest qc such that the faces with qc at most it cover ≥ 95 % of the area.
 fn area_weighted_qc(qc_area: &mut [(f64, f64)], total: f64) -> (f64, f64) {
+    use rayon::slice::ParallelSliceMut;
     if qc_area.is_empty() || total <= 0.0 {
         return (f64::NAN, f64::NAN);
     }
     let mean = qc_area.iter().map(|&(q, a)| q * a).sum::<f64>() / total;
-    qc_area.sort_by(|a, b| a.0.total_cmp(&b.0));
+    qc_area.par_sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut acc = 0.0;
     for &(q, a) in qc_area.iter() {
         acc += a;

@@ -39,6 +39,40 @@ pub struct Mesh {
     pub(crate) vertex_he: Vec<u32>,
 }
 
+/// Directed half-edges `h = 3f + i` (from corner `i` of face `f` to corner `i + 1`) with their
+/// undirected key `lo << 32 | hi`, in the order of key, then `h` — the order in which
+/// [`Mesh::from_triangles`] pairs them and numbers the edges. A counting pass by `lo`, then
+/// each vertex's few entries sorted: the order of one sort of all `(key, h)`, in linear time.
+fn halfedges_by_pair(n_vertices: usize, faces: &[[u32; 3]]) -> Vec<(u64, u32)> {
+    let nh = 3 * faces.len();
+    let ends = |h: usize| {
+        let (a, b) = (faces[h / 3][h % 3], faces[h / 3][(h % 3 + 1) % 3]);
+        if a < b {
+            (a, b)
+        } else {
+            (b, a)
+        }
+    };
+    let mut start = vec![0usize; n_vertices + 1];
+    for h in 0..nh {
+        start[ends(h).0 as usize + 1] += 1;
+    }
+    for v in 0..n_vertices {
+        start[v + 1] += start[v];
+    }
+    let mut keyed: Vec<(u64, u32)> = vec![(0, 0); nh];
+    let mut fill = start.clone();
+    for h in 0..nh {
+        let (lo, hi) = ends(h);
+        keyed[fill[lo as usize]] = (((lo as u64) << 32) | hi as u64, h as u32);
+        fill[lo as usize] += 1;
+    }
+    for v in 0..n_vertices {
+        keyed[start[v]..start[v + 1]].sort_unstable();
+    }
+    keyed
+}
+
 impl Mesh {
     /// Build the connectivity from triangles that are already known to be consistently oriented
     /// and manifold. Use [`crate::mesh::build`] to validate arbitrary input; this function still
@@ -68,19 +102,8 @@ impl Mesh {
                 )));
             }
         }
-        // Sort directed half-edges by undirected key to pair them.
         let nh_int = 3 * nf;
-        let mut keyed: Vec<(u64, u32)> = (0..nh_int as u32)
-            .map(|h| {
-                let (a, b) = (
-                    faces[h as usize / 3][h as usize % 3],
-                    faces[h as usize / 3][(h as usize % 3 + 1) % 3],
-                );
-                let (lo, hi) = if a < b { (a, b) } else { (b, a) };
-                (((lo as u64) << 32) | hi as u64, h)
-            })
-            .collect();
-        keyed.sort_unstable();
+        let keyed = halfedges_by_pair(n_vertices, &faces);
         let origin = |h: u32| faces[h as usize / 3][h as usize % 3];
         let mut twin = vec![NONE; nh_int];
         let mut he_edge = vec![NONE; nh_int];

@@ -257,17 +257,22 @@ fn flow_with_corrections(
     let mesh = &piece.surface.mesh;
     let r = flow_once(mesh, lengths, plan.target.clone(), opts.tolerance, progress)
         .map_err(|e| Error::numerical(format!("component {component}: {e}")))?;
-    let mut sigma = log_scale_sigma(&piece.surface, &r.u);
+    let rounds = if plan.source == "greedy" && !opts.seamless && !mesh.has_boundary() {
+        opts.cone_corrections
+    } else {
+        0
+    };
+    // Measured only when a correction round will compare with it.
+    let mut sigma = if rounds > 0 {
+        log_scale_sigma(&piece.surface, &r.u)
+    } else {
+        0.0
+    };
     let mut kept = KeptFlow {
         r,
         cones: plan.cones.clone(),
         corrections: 0,
         runs: 1,
-    };
-    let rounds = if plan.source == "greedy" && !opts.seamless && !mesh.has_boundary() {
-        opts.cone_corrections
-    } else {
-        0
     };
     let metric = IntrinsicMetric::euclidean(lengths.to_vec());
     for _ in 0..rounds {

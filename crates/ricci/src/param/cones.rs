@@ -35,6 +35,7 @@ use crate::analysis::forms::harmonic::cotan_weights;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::metric::IntrinsicMetric;
+use crate::numeric::sparse::{LowerCsc, SymmetricSolver};
 use green::GreenBasis;
 use held::HeldBasis;
 use std::f64::consts::PI;
@@ -69,54 +70,107 @@ struct Laplacian {
     area: Vec<f64>,
 }
 
-fn laplacian(mesh: &Mesh, lengths: &[f64]) -> Result<Laplacian> {
+/// The cotangent Laplacian of `metric` ([`Laplacian`]), the angle defects
+/// ([`angle_defects`]) and the symbolic analysis of the Laplacian's pattern (fill-reducing
+/// ordering and supernodal structure) for the cone placement's one factorization. The
+/// analysis needs only the pattern (the mesh's edges), so it runs beside the cotangent
+/// weights, areas and defects on the second core (`rayon::join`); both halves are the same
+/// computations as one after the other.
+fn laplacian_system(
+    mesh: &Mesh,
+    metric: &IntrinsicMetric,
+) -> Result<(Laplacian, Vec<f64>, SymmetricSolver)> {
     let n = mesh.n_vertices();
-    // The edge weights (cot α + cot β)/2 of the analysis module (one definition in the crate).
-    let w = cotan_weights(mesh, lengths).map_err(|e| {
-        Error::numerical(format!("{e} in the input metric; cones cannot be placed"))
-    })?;
-    let mut area = vec![0.0; n];
-    for f in 0..mesh.n_faces() as u32 {
-        let l = mesh
-            .face_halfedges(f)
-            .map(|h| lengths[mesh.he_edge(h) as usize]);
-        let a = crate::numeric::vec3::heron(l);
-        for v in mesh.face(f) {
-            area[v as usize] += a / 3.0;
-        }
+    // Lower-CSC pattern: column `lo` holds the diagonal, then every edge (lo, hi), hi > lo,
+    // by row (a counting pass by column, then each column's few entries sorted).
+    let ne = mesh.n_edges();
+    let mut col_ptr = vec![0u32; n + 1];
+    for e in 0..ne as u32 {
+        let [a, b] = mesh.edge_vertices(e);
+        col_ptr[a.min(b) as usize + 1] += 1;
     }
-    let mut cols: Vec<Vec<(u32, f64)>> = vec![Vec::new(); n];
-    let mut d = vec![0.0; n];
-    for (e, &we) in w.iter().enumerate() {
-        let [a, b] = mesh.edge_vertices(e as u32);
+    for j in 0..n {
+        col_ptr[j + 1] += col_ptr[j] + 1;
+    }
+    let nnz = col_ptr[n] as usize;
+    let mut row_idx = vec![0u32; nnz];
+    // The edge of every off-diagonal entry (`NONE` on the diagonal).
+    let mut entry_edge = vec![crate::mesh::NONE; nnz];
+    let mut fill: Vec<u32> = col_ptr[..n].iter().map(|&p| p + 1).collect();
+    let diag: Vec<usize> = (0..n).map(|j| col_ptr[j] as usize).collect();
+    for (j, &d) in diag.iter().enumerate() {
+        row_idx[d] = j as u32;
+    }
+    for e in 0..ne as u32 {
+        let [a, b] = mesh.edge_vertices(e);
         let (lo, hi) = if a < b { (a, b) } else { (b, a) };
-        cols[lo as usize].push((hi, -we));
-        d[a as usize] += we;
-        d[b as usize] += we;
+        let at = fill[lo as usize] as usize;
+        fill[lo as usize] += 1;
+        row_idx[at] = hi;
+        entry_edge[at] = e;
     }
-    let mut col_ptr = vec![0u32];
-    let mut row_idx = Vec::new();
-    let mut values = Vec::new();
-    let mut diag = Vec::with_capacity(n);
-    for (j, c) in cols.iter_mut().enumerate() {
-        c.sort_by_key(|x| x.0);
-        diag.push(row_idx.len());
-        row_idx.push(j as u32);
-        values.push(d[j]);
-        for &(r, v) in c.iter() {
-            row_idx.push(r);
-            values.push(v);
+    let mut column: Vec<(u32, u32)> = Vec::new();
+    for j in 0..n {
+        let range = diag[j] + 1..col_ptr[j + 1] as usize;
+        column.clear();
+        column.extend(range.clone().map(|p| (row_idx[p], entry_edge[p])));
+        column.sort_unstable();
+        for (p, &(r, e)) in range.zip(&column) {
+            row_idx[p] = r;
+            entry_edge[p] = e;
         }
-        col_ptr.push(row_idx.len() as u32);
     }
-    Ok(Laplacian {
+    let pattern = LowerCsc {
+        n,
+        col_ptr: &col_ptr,
+        row_idx: &row_idx,
+    };
+    let (solver, values) = rayon::join(
+        || SymmetricSolver::new(pattern),
+        || -> Result<_> {
+            let lengths = metric.lengths();
+            // The edge weights (cot α + cot β)/2 of the analysis module (one definition in
+            // the crate).
+            let w = cotan_weights(mesh, lengths).map_err(|e| {
+                Error::numerical(format!("{e} in the input metric; cones cannot be placed"))
+            })?;
+            let mut area = vec![0.0; n];
+            for f in 0..mesh.n_faces() as u32 {
+                let l = mesh
+                    .face_halfedges(f)
+                    .map(|h| lengths[mesh.he_edge(h) as usize]);
+                let a = crate::numeric::vec3::heron(l);
+                for v in mesh.face(f) {
+                    area[v as usize] += a / 3.0;
+                }
+            }
+            let mut d = vec![0.0; n];
+            for (e, &we) in w.iter().enumerate() {
+                let [a, b] = mesh.edge_vertices(e as u32);
+                d[a as usize] += we;
+                d[b as usize] += we;
+            }
+            let values: Vec<f64> = entry_edge
+                .iter()
+                .zip(&row_idx)
+                .map(|(&e, &r)| match e {
+                    crate::mesh::NONE => d[r as usize],
+                    e => -w[e as usize],
+                })
+                .collect();
+            Ok((values, area, angle_defects(mesh, metric)))
+        },
+    );
+    let (values, area, k0) = values?;
+    let lap = Laplacian {
         n,
         col_ptr,
         row_idx,
         values,
         diag,
         area,
-    })
+    };
+    Ok((lap, k0, solver?))
 }
 
 /// Angle defects of the input metric (`2π − Σθ` inside, `π − Σθ` on the boundary).
@@ -183,20 +237,18 @@ pub fn greedy_cones_with(
     budget: ConeBudget,
     search: ConeSearch,
 ) -> Result<ConePlacement> {
-    let lengths = metric.lengths();
-    let lap = laplacian(mesh, lengths)?;
+    let (lap, k0, solver) = laplacian_system(mesh, metric)?;
     let n = lap.n;
-    let k0 = angle_defects(mesh, metric);
     let used: Vec<bool> = (0..n as u32).map(|v| !mesh.is_isolated(v)).collect();
     let boundary: Vec<bool> = (0..n as u32).map(|v| mesh.is_boundary_vertex(v)).collect();
     if !boundary.iter().any(|&b| b) {
         let chi = crate::metric::euler_characteristic(mesh) as f64;
-        let mut g = GreenBasis::new(&lap, &k0, chi, used.clone())?;
+        let mut g = GreenBasis::new(&lap, &k0, chi, used.clone(), solver)?;
         let mut p = closed::place_cones(&mut g, &k0, &used, budget, search == ConeSearch::Energy)?;
         keep_angles_positive(&mut p.cones, 2.0 * PI * chi);
         return Ok(p);
     }
-    HeldBasis::new(&lap, &k0, &boundary, &used)?.greedy(budget)
+    HeldBasis::new(&lap, &k0, &boundary, &used, solver)?.greedy(budget)
 }
 
 /// How cones at given positions get their curvatures (see [`cone_curvatures_at`]).
@@ -218,7 +270,7 @@ pub fn cone_curvatures_at(
     vertices: &[u32],
     rule: CurvatureRule,
 ) -> Result<(Vec<(u32, f64)>, f64)> {
-    let lap = laplacian(mesh, metric.lengths())?;
+    let (lap, k0, solver) = laplacian_system(mesh, metric)?;
     let n = lap.n;
     if let Some(&v) = vertices.iter().find(|&&v| v as usize >= n) {
         return Err(Error::input(format!(
@@ -230,10 +282,9 @@ pub fn cone_curvatures_at(
             "cone curvatures at given positions need a closed surface",
         ));
     }
-    let k0 = angle_defects(mesh, metric);
     let used: Vec<bool> = (0..n as u32).map(|v| !mesh.is_isolated(v)).collect();
     let chi = crate::metric::euler_characteristic(mesh) as f64;
-    let mut g = GreenBasis::new(&lap, &k0, chi, used)?;
+    let mut g = GreenBasis::new(&lap, &k0, chi, used, solver)?;
     let (k, u) = match rule {
         CurvatureRule::Dirichlet => g.dirichlet(vertices)?,
         CurvatureRule::LeastSquares => g.least_squares(vertices)?,
@@ -253,9 +304,8 @@ pub fn free_boundary_least_squares(
     metric: &IntrinsicMetric,
     cones: &[u32],
 ) -> Result<(Vec<(u32, f64)>, f64)> {
-    let lap = laplacian(mesh, metric.lengths())?;
-    let k0 = angle_defects(mesh, metric);
-    let mut basis = held_basis(mesh, &lap, &k0)?;
+    let (lap, k0, solver) = laplacian_system(mesh, metric)?;
+    let mut basis = held_basis(mesh, &lap, &k0, solver)?;
     basis.least_squares(cones, None)
 }
 
@@ -284,9 +334,8 @@ pub fn free_boundary_cones(
     rule: CurvatureRule,
     ceiling: Option<f64>,
 ) -> Result<ConePlacement> {
-    let lap = laplacian(mesh, metric.lengths())?;
-    let k0 = angle_defects(mesh, metric);
-    let mut basis = held_basis(mesh, &lap, &k0)?;
+    let (lap, k0, solver) = laplacian_system(mesh, metric)?;
+    let mut basis = held_basis(mesh, &lap, &k0, solver)?;
     let mut p = basis.greedy(budget)?;
     if rule == CurvatureRule::LeastSquares {
         let at: Vec<u32> = p.cones.iter().map(|c| c.0).collect();
@@ -296,7 +345,12 @@ pub fn free_boundary_cones(
 }
 
 /// [`HeldBasis`] of a mesh with boundary (boundary and isolated vertices held at `u = 0`).
-fn held_basis<'a>(mesh: &Mesh, lap: &'a Laplacian, k0: &'a [f64]) -> Result<HeldBasis<'a>> {
+fn held_basis<'a>(
+    mesh: &Mesh,
+    lap: &'a Laplacian,
+    k0: &'a [f64],
+    solver: SymmetricSolver,
+) -> Result<HeldBasis<'a>> {
     let n = lap.n;
     let boundary: Vec<bool> = (0..n as u32).map(|v| mesh.is_boundary_vertex(v)).collect();
     if !boundary.iter().any(|&b| b) {
@@ -305,7 +359,7 @@ fn held_basis<'a>(mesh: &Mesh, lap: &'a Laplacian, k0: &'a [f64]) -> Result<Held
         ));
     }
     let used: Vec<bool> = (0..n as u32).map(|v| !mesh.is_isolated(v)).collect();
-    HeldBasis::new(lap, k0, &boundary, &used)
+    HeldBasis::new(lap, k0, &boundary, &used, solver)
 }
 
 /// One Newton-type correction of cone curvatures on the *nonlinear* flow towards the least
@@ -326,12 +380,10 @@ pub fn correct_cone_curvatures(
     u: &[f64],
     damping: f64,
 ) -> Result<Vec<(u32, f64)>> {
-    let lengths = metric.lengths();
-    let lap = laplacian(mesh, lengths)?;
-    let k0 = angle_defects(mesh, metric);
+    let (lap, k0, solver) = laplacian_system(mesh, metric)?;
     let total: f64 = cones.iter().map(|c| c.1).sum();
     let used: Vec<bool> = (0..lap.n as u32).map(|v| !mesh.is_isolated(v)).collect();
-    let mut g = GreenBasis::new(&lap, &k0, total / (2.0 * PI), used)?;
+    let mut g = GreenBasis::new(&lap, &k0, total / (2.0 * PI), used, solver)?;
     let mean = g.mean(u);
     let r: Vec<f64> = u.iter().map(|x| x - mean).collect();
     let vertices: Vec<u32> = cones.iter().map(|c| c.0).collect();

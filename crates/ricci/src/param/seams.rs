@@ -20,6 +20,7 @@
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, NONE};
 use crate::numeric::dijkstra::Dijkstra;
+use rayon::slice::ParallelSliceMut;
 
 /// Cut edges (`cut[e]`) of `mesh` with `lengths`; `allowed[e]` says which edges may be cut;
 /// `cones` must all end up on the cut (or the boundary).
@@ -58,15 +59,14 @@ pub(crate) fn cut_graph(
     dj.run(
         |v| {
             mesh.outgoing(v)
-                .filter(|&h| !mesh.is_boundary_edge(mesh.he_edge(h)))
-                .map(|h| {
+                .filter(move |&h| !mesh.is_boundary_edge(mesh.he_edge(h)))
+                .map(move |h| {
                     let e = mesh.he_edge(h) as usize;
                     // Edges the cut may not use only where nothing else reaches (pruned
                     // away below unless a cone needs them).
                     let w = if allowed[e] { 0.0 } else { penalty };
                     (mesh.he_tip(h), lengths[e] + w)
                 })
-                .collect::<Vec<_>>()
         },
         |_, _| false,
     );
@@ -104,7 +104,8 @@ pub(crate) fn cut_graph(
             (w, e)
         })
         .collect();
-    order.sort_by(|x, y| y.0.total_cmp(&x.0));
+    // Heaviest first, ties by edge id (the order of a stable sort of the edges by weight).
+    order.par_sort_unstable_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
     let mut parent: Vec<u32> = (0..mesh.n_faces() as u32).collect();
     fn find(p: &mut [u32], mut x: u32) -> u32 {
         while p[x as usize] != x {

@@ -35,31 +35,56 @@ pub fn input_face_map(
     t_cut: &[bool],
     t_uv: &[[f64; 2]],
 ) -> Result<Vec<[f64; 2]>> {
+    let keys = (
+        seams::wedge_keys(t_mesh, t_cut),
+        seams::wedge_keys(input, cut),
+    );
+    map_wedges(input, t_mesh, &keys, t_uv)
+}
+
+/// [`input_face_map`] from the wedge keys ([`seams::wedge_keys`]) of `T`'s corners and of the
+/// input's corners: every input corner takes the position of the first corner of `T` (in
+/// corner order) at the same vertex and in the same wedge. Per vertex, the few wedges seen so
+/// far are a list (`head[v]`, then `next`), as in the OBJ writer — no hashing.
+fn map_wedges(
+    input: &Mesh,
+    t_mesh: &Mesh,
+    (t_keys, keys): &(Vec<u32>, Vec<u32>),
+    t_uv: &[[f64; 2]],
+) -> Result<Vec<[f64; 2]>> {
+    const END: u32 = u32::MAX;
     let nv = input.n_vertices();
-    let mut table: HashMap<(u32, u32), [f64; 2]> = HashMap::with_capacity(nv + nv / 4);
-    let t_keys = seams::wedge_keys(t_mesh, t_cut);
+    let mut head = vec![END; nv];
+    let mut wedges: Vec<(u32, [f64; 2], u32)> = Vec::with_capacity(nv + nv / 4);
+    let find = |wedges: &[(u32, [f64; 2], u32)], mut at: u32, key: u32| {
+        while at != END && wedges[at as usize].0 != key {
+            at = wedges[at as usize].2;
+        }
+        at
+    };
     for h in 0..t_mesh.n_corners() as u32 {
-        let v = t_mesh.he_origin(h);
-        if (v as usize) < nv {
+        let v = t_mesh.he_origin(h) as usize;
+        if v < nv {
             let key = t_keys[h as usize];
-            table.entry((v, key)).or_insert(t_uv[h as usize]);
+            if find(&wedges, head[v], key) == END {
+                wedges.push((key, t_uv[h as usize], head[v]));
+                head[v] = (wedges.len() - 1) as u32;
+            }
         }
     }
-    let mut out = Vec::with_capacity(input.n_corners());
-    let keys = seams::wedge_keys(input, cut);
-    for h in 0..input.n_corners() as u32 {
-        let v = input.he_origin(h);
-        let key = keys[h as usize];
-        let uv = table.get(&(v, key)).ok_or_else(|| {
-            Error::numerical(format!(
-                "input vertex {v} (face {}) has no position in the layout of the intrinsic \
-                 triangulation",
-                h / 3
-            ))
-        })?;
-        out.push(*uv);
-    }
-    Ok(out)
+    (0..input.n_corners() as u32)
+        .map(|h| {
+            let v = input.he_origin(h);
+            match find(&wedges, head[v as usize], keys[h as usize]) {
+                END => Err(Error::numerical(format!(
+                    "input vertex {v} (face {}) has no position in the layout of the intrinsic \
+                     triangulation",
+                    h / 3
+                ))),
+                at => Ok(wedges[at as usize].1),
+            }
+        })
+        .collect()
 }
 
 /// Flat layout of `mesh` (edge lengths `lengths`) opened along `cut`: the position of every
@@ -85,24 +110,39 @@ fn cut_layout(mesh: &Mesh, lengths: &[f64], cut: &[bool]) -> Result<Vec<[f64; 2]
 }
 
 /// Input edges the cut may use: never flipped by the flow and present once in `T`.
+///
+/// Edge ids survive flips, so an edge of `T` that was never flipped and still joins its input
+/// endpoints is that input edge, and no other input edge joins the same pair (the input's
+/// edges are its distinct vertex pairs). The pairs joined more than once are therefore found
+/// among the other edges of `T` alone (flipped, or new) — a few, where one table of all of
+/// `T`'s edges would hash every one.
 fn kept_input_edges(mesh: &Mesh, r: &FlowResult) -> Result<Vec<bool>> {
     let tr = triangulation(r)?;
     let t_mesh = &tr.simplicial.mesh;
-    let mut flipped = vec![false; mesh.n_edges()];
-    for &e in &tr.triangulation.flip_log {
+    let t = &tr.triangulation;
+    let ne = mesh.n_edges();
+    let mut flipped = vec![false; ne];
+    for &e in &t.flip_log {
         flipped[e as usize] = true;
     }
-    let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
-    for e in 0..tr.triangulation.n_edges() as u32 {
-        let [a, b] = tr.triangulation.edge_vertices(e);
-        *pairs.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+    let key = |[a, b]: [u32; 2]| (a.min(b), a.max(b));
+    // Edge e of T is the input edge e (unflipped, same endpoints).
+    let same = |e: u32| {
+        (e as usize) < ne.min(t.n_edges())
+            && !flipped[e as usize]
+            && key(t.edge_vertices(e)) == key(mesh.edge_vertices(e))
+    };
+    let mut others: HashMap<(u32, u32), u32> = HashMap::new();
+    for e in 0..t.n_edges() as u32 {
+        if !same(e) {
+            *others.entry(key(t.edge_vertices(e))).or_insert(0) += 1;
+        }
     }
-    Ok((0..mesh.n_edges() as u32)
+    Ok((0..ne as u32)
         .map(|e| {
-            let [a, b] = mesh.edge_vertices(e);
-            !flipped[e as usize]
-                && pairs.get(&(a.min(b), a.max(b))) == Some(&1)
-                && t_mesh.halfedge_between(a, b).is_some()
+            let pair = key(mesh.edge_vertices(e));
+            let count = same(e) as u32 + others.get(&pair).copied().unwrap_or(0);
+            !flipped[e as usize] && count == 1 && t_mesh.halfedge_between(pair.0, pair.1).is_some()
         })
         .collect())
 }
@@ -160,8 +200,17 @@ pub(super) fn input_route(
             t_cut[t_mesh.he_edge(h) as usize] = true;
         }
     }
-    let t_uv = cut_layout(t_mesh, &r.lengths, &t_cut)?;
-    let uv = input_face_map(mesh, &cut, t_mesh, &t_cut, &t_uv)?;
+    // The wedges of both meshes' corners depend only on the cuts: found beside the layout.
+    let (t_uv, keys) = rayon::join(
+        || cut_layout(t_mesh, &r.lengths, &t_cut),
+        || {
+            (
+                seams::wedge_keys(t_mesh, &t_cut),
+                seams::wedge_keys(mesh, &cut),
+            )
+        },
+    );
+    let uv = map_wedges(mesh, t_mesh, &keys, &t_uv?)?;
     Ok((cut, uv))
 }
 
@@ -192,20 +241,32 @@ pub(super) fn subdivision_route(
     let tr = triangulation(r)?;
     let mesh = &surface.mesh;
     let t = &tr.triangulation;
-    let t_len = simplicial_lengths(tr, &r.lengths).unwrap_or_else(|| super::unfold::lengths(t));
-    let t_cut = if needs_cut {
-        super::unfold::cut_edges(t, &t_len, cones)
-    } else {
-        vec![false; t.n_edges()]
-    };
-    let t_uv = super::unfold::unfold(t, &t_len, &t_cut)?;
-    let sub = CommonSubdivision::from_triangulation(
-        mesh,
-        Geometry::Euclidean,
-        lengths,
-        &tr.triangulation,
-        &r.u,
-    )?;
+    // The cut and layout of `T` and the overlay of the input with `T` do not depend on each
+    // other: the two run side by side (`rayon::join`).
+    let (unfolded, sub) = rayon::join(
+        || -> Result<_> {
+            let t_len =
+                simplicial_lengths(tr, &r.lengths).unwrap_or_else(|| super::unfold::lengths(t));
+            let t_cut = if needs_cut {
+                super::unfold::cut_edges(t, &t_len, cones)
+            } else {
+                vec![false; t.n_edges()]
+            };
+            let t_uv = super::unfold::unfold(t, &t_len, &t_cut)?;
+            Ok((t_cut, t_uv))
+        },
+        || {
+            CommonSubdivision::from_triangulation(
+                mesh,
+                Geometry::Euclidean,
+                lengths,
+                &tr.triangulation,
+                &r.u,
+            )
+        },
+    );
+    let (t_cut, t_uv) = unfolded?;
+    let sub = sub?;
     let corner_uv = sub.uv(Geometry::Euclidean, &r.u, &t_uv)?;
     let flipped = sub.flipped_triangles(Geometry::Euclidean, &corner_uv);
     let positions = sub.positions(mesh, &surface.positions)?;

@@ -17,7 +17,7 @@
 
 use super::Laplacian;
 use crate::error::{Error, Result};
-use crate::numeric::sparse::{LowerCsc, SymmetricSolver};
+use crate::numeric::sparse::SymmetricSolver;
 use std::collections::HashMap;
 use std::f64::consts::PI;
 
@@ -42,16 +42,17 @@ pub(super) struct GreenBasis {
 }
 
 impl GreenBasis {
-    /// Factorize `lap` with one vertex pinned; `k0` the input's angle defects, `chi` the Euler
+    /// Factorize `lap` with one vertex pinned (`solver`: the symbolic analysis of its
+    /// pattern, [`super::laplacian_system`]); `k0` the input's angle defects, `chi` the Euler
     /// characteristic, `used[v]` false for isolated vertices.
-    pub fn new(lap: &Laplacian, k0: &[f64], chi: f64, used: Vec<bool>) -> Result<GreenBasis> {
+    pub fn new(
+        lap: &Laplacian,
+        k0: &[f64],
+        chi: f64,
+        used: Vec<bool>,
+        mut solver: SymmetricSolver,
+    ) -> Result<GreenBasis> {
         let n = lap.n;
-        let pattern = LowerCsc {
-            n,
-            col_ptr: &lap.col_ptr,
-            row_idx: &lap.row_idx,
-        };
-        let mut solver = SymmetricSolver::new(pattern)?;
         let scale = lap.diag.iter().map(|&i| lap.values[i]).fold(0.0, f64::max);
         let penalty = 1e10 * scale.max(1e-300);
         let pin = (0..n).find(|&v| used[v]).unwrap_or(0);

@@ -17,7 +17,7 @@
 
 use super::{ConeBudget, ConePlacement, Laplacian};
 use crate::error::{Error, Result};
-use crate::numeric::sparse::{LowerCsc, SymmetricSolver};
+use crate::numeric::sparse::SymmetricSolver;
 use std::collections::HashMap;
 use std::f64::consts::PI;
 
@@ -67,20 +67,17 @@ fn dense_solve(mut a: Vec<Vec<f64>>, b: &[f64], what: &str) -> Result<Vec<f64>> 
 }
 
 impl<'a> HeldBasis<'a> {
-    /// Factorize `lap` with the vertices `held` (boundary) and `!used` (isolated) penalised.
+    /// Factorize `lap` with the vertices `held` (boundary) and `!used` (isolated) penalised;
+    /// `solver` holds the symbolic analysis of `lap`'s pattern ([`super::laplacian_system`]).
     pub fn new(
         lap: &'a Laplacian,
         k0: &'a [f64],
         held: &[bool],
         used: &[bool],
+        mut solver: SymmetricSolver,
     ) -> Result<HeldBasis<'a>> {
         let n = lap.n;
         let held: Vec<bool> = (0..n).map(|v| held[v] || !used[v]).collect();
-        let mut solver = SymmetricSolver::new(LowerCsc {
-            n,
-            col_ptr: &lap.col_ptr,
-            row_idx: &lap.row_idx,
-        })?;
         let scale = lap.diag.iter().map(|&i| lap.values[i]).fold(0.0, f64::max);
         let penalty = 1e10 * scale.max(1e-300);
         let mut vals = lap.values.clone();
