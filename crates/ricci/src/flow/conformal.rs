@@ -237,7 +237,6 @@ pub fn solve(
     let mut notes = Vec::new();
     let mut converged = false;
     let mut err;
-    let mut prev_err = f64::INFINITY;
     let mut it = 0;
     if !cn.evaluate_at_u() {
         return Err(Error::numerical(format!(
@@ -274,14 +273,7 @@ pub fn solve(
             break;
         }
         it += 1;
-        // Newton's quadratic phase solves inexactly with the last factor and defers a grown
-        // pattern's analysis (module doc).
-        let quadratic = cn.full_step && err <= QUADRATIC_PHASE * prev_err;
-        let inexact = (!dynamic && quadratic).then_some(InexactSolve {
-            floor: INEXACT.floor * settings.tolerance,
-            ..INEXACT
-        });
-        prev_err = err;
+        let inexact = cn.quadratic_phase(err, dynamic);
         cn.assemble(inexact.is_some())?;
         cn.newton_rhs(target);
         if dynamic {
@@ -333,14 +325,7 @@ pub fn solve(
     }
     let stop_reason =
         super::newton::stop_reason(converged, it, settings.max_iterations, err, &notes);
-    let inner = cn.pattern.inner;
-    if inner.solves + inner.missed > 0 {
-        notes.push(format!(
-            "{} Newton system(s) solved by CG preconditioned with an earlier factor \
-             ({} products; {} more missed the inner tolerance and were factorized)",
-            inner.solves, inner.iterations, inner.missed
-        ));
-    }
+    notes.extend(cn.pattern.inner.note());
     if dynamic {
         notes.push(format!(
             "round boundary: {exact_steps} exact Newton step(s) (Jacobian H − ∂K̄/∂u), \
@@ -382,15 +367,19 @@ const QUADRATIC_PHASE: f64 = 0.25;
 
 /// The inexact solve of the quadratic phase: forcing term `η = min(10⁻², ‖r‖₂)`; CG may
 /// take up to 4 products (a factorization costs about 6 solves) or 8 while the analysis of
-/// a grown pattern is deferred (analysis and factorization, about 10); no system is solved
-/// beyond `‖H δ − r‖₂ ≤ tolerance / 10`, which keeps the next curvature error below the
-/// tolerance.
+/// a grown pattern is deferred (analysis and factorization, about 10).
 const INEXACT: InexactSolve = InexactSolve {
     eta_max: 1e-2,
     max_iterations: 4,
     max_iterations_stale: 8,
-    floor: 0.1,
+    cap: f64::INFINITY,
 };
+
+/// The inner residual of the step expected to be the last, relative to the flow's
+/// tolerance: the final iterate then is as accurate as after an exact step (errors
+/// ~10⁻¹² for a tolerance of 10⁻⁹), which the layouts' seam-length and flatness checks
+/// need (a final error just below the tolerance fails them).
+const FINAL_INNER: f64 = 1e-3;
 
 /// The state of one Newton solve of [`solve`]: the triangulation, the iterate `u` and its
 /// evaluation `st`, trial points, the growing Hessian pattern and its values, the step.
@@ -414,6 +403,8 @@ struct ConformalNewton<'a> {
     last_step: f64,
     /// The last accepted step was the full Newton step (`t = 1`).
     full_step: bool,
+    /// The largest curvature error at the last [`ConformalNewton::quadratic_phase`].
+    last_error: f64,
     /// `E(u) − E(0)` as estimated by the accepted line searches.
     energy: f64,
 }
@@ -442,8 +433,28 @@ impl<'a> ConformalNewton<'a> {
             flips: 0,
             last_step: 0.0,
             full_step: false,
+            last_error: f64::INFINITY,
             energy: 0.0,
         }
+    }
+
+    /// The inexact solve of Newton's quadratic phase (module doc: CG preconditioned with the
+    /// last factor, a grown pattern's analysis deferred) at an iterate of largest error
+    /// `err`; `None` before that phase and for round boundaries.
+    fn quadratic_phase(&mut self, err: f64, dynamic: bool) -> Option<InexactSolve> {
+        let quadratic = self.full_step && err <= QUADRATIC_PHASE * self.last_error;
+        // Quadratic convergence e' ≈ M e² with M ≈ e / e_prev²: the step that should land
+        // below the tolerance is solved as accurately as an exact step would be.
+        let last = err * (err / self.last_error).powi(2) <= self.settings.tolerance;
+        self.last_error = err;
+        (!dynamic && quadratic).then_some(InexactSolve {
+            cap: if last {
+                FINAL_INNER * self.settings.tolerance
+            } else {
+                f64::INFINITY
+            },
+            ..INEXACT
+        })
     }
 
     /// Delaunay at `u` and its evaluation into `st`; false when the flip budget ran out.

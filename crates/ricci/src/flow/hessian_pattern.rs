@@ -53,16 +53,29 @@ pub(super) struct InnerCounts {
     pub(super) missed: usize,
 }
 
+impl InnerCounts {
+    /// A note for the solve's report, when there were inexact solves.
+    pub(super) fn note(&self) -> Option<String> {
+        (self.solves + self.missed > 0).then(|| {
+            format!(
+                "{} Newton system(s) solved by CG preconditioned with an earlier factor \
+                 ({} products; {} more missed the inner tolerance and were factorized)",
+                self.solves, self.iterations, self.missed
+            )
+        })
+    }
+}
+
 /// The inexact inner solve of a late Newton system: `η_max` of the forcing term
-/// `η = min(η_max, ‖r‖₂)`, CG iterations allowed, and the floor of the residual (in the
-/// curvature's units) below which no solve needs to go.
+/// `η = min(η_max, ‖r‖₂)`, the CG iterations allowed, and a cap on the residual
+/// `‖H δ − r‖₂` (in the curvature's units) for the last step.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct InexactSolve {
     pub(super) eta_max: f64,
     pub(super) max_iterations: usize,
     /// CG iterations allowed while the analysis is deferred (a miss costs it too).
     pub(super) max_iterations_stale: usize,
-    pub(super) floor: f64,
+    pub(super) cap: f64,
 }
 
 /// Most growth of the factor's nonzeros, relative to the last AMD analysis, accepted with a
@@ -257,7 +270,7 @@ impl GrowingPattern {
         if let (Some(ix), Some(solver)) = (inexact, self.solver.as_mut()) {
             if solver.is_factored() {
                 let norm = rhs.iter().map(|t| t * t).sum::<f64>().sqrt();
-                let tolerance = (ix.eta_max.min(norm) * norm).max(ix.floor);
+                let tolerance = (ix.eta_max.min(norm) * norm).min(ix.cap);
                 let budget = if self.stale {
                     ix.max_iterations_stale
                 } else {
