@@ -28,9 +28,9 @@
 //! a grown pattern moves the others. In Newton's quadratic phase (the last step full and the
 //! error cut at least fourfold) the system is solved by CG preconditioned with the last
 //! factor to the inexact Newton tolerance `‖H δ − r‖₂ ≤ min(10⁻², ‖r‖₂) ‖r‖₂` (Dembo–
-//! Eisenstat–Steihaug 1982), and a grown pattern's analysis waits until a factorization is
-//! needed ([`super::hessian_pattern`]): seahorse's last four iterations need no analysis
-//! and at most one factorization.
+//! Eisenstat–Steihaug 1982; the step expected to be the last to `10⁻³ ×` the tolerance),
+//! and a grown pattern's analysis waits until a factorization is needed
+//! ([`super::hessian_pattern`]).
 //!
 //! **Targets.** Per-vertex `K̄` from [`super::target`]; fixed vertices (free boundary) keep
 //! `u = 0`; round boundaries re-evaluate `K̄` from the current boundary lengths (boundary edges

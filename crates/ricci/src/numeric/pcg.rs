@@ -31,9 +31,8 @@ pub fn symmetric_product(a: LowerCsc<'_>, values: &[f64], x: &[f64], y: &mut [f6
         let (s, t) = (a.col_ptr[c] as usize, a.col_ptr[c + 1] as usize);
         let xc = x[c];
         let mut yc = 0.0;
-        for k in s..t {
-            let r = a.row_idx[k] as usize;
-            let v = values[k];
+        for (&r, &v) in a.row_idx[s..t].iter().zip(&values[s..t]) {
+            let r = r as usize;
             if r == c {
                 yc += v * xc;
             } else {
@@ -105,7 +104,8 @@ pub fn pcg(
             // Mean rate ρ = (‖r_j‖/‖r_0‖)^(1/j); ρ^m ‖r_j‖ ≤ tolerance needs m more.
             let rate = (norm / norm0).powf(1.0 / iterations as f64);
             let more = (tolerance / norm).ln() / rate.ln();
-            if !(rate < 1.0) || iterations as f64 + more > 1.5 * max_iterations as f64 {
+            let hopeless = rate.is_nan() || rate >= 1.0;
+            if hopeless || iterations as f64 + more > 1.5 * max_iterations as f64 {
                 break;
             }
         }
