@@ -25,12 +25,7 @@
 //! the symbolic factorization is redone only when flips create a vertex pair that the pattern
 //! lacks (entries of vanished pairs are stored as zeros), beside the Hessian's assembly (two
 //! threads). Every edge keeps the slot of its two ends' entry; a flip renews its edge's slot,
-//! a grown pattern moves the others. In Newton's quadratic phase (the last step full and the
-//! error cut at least fourfold) the system is solved by CG preconditioned with the last
-//! factor to the inexact Newton tolerance `‖H δ − r‖₂ ≤ min(10⁻², ‖r‖₂) ‖r‖₂` (Dembo–
-//! Eisenstat–Steihaug 1982; the step expected to be the last to `10⁻³ ×` the tolerance),
-//! and a grown pattern's analysis waits until a factorization is needed
-//! ([`super::hessian_pattern`]).
+//! a grown pattern moves the others.
 //!
 //! **Targets.** Per-vertex `K̄` from [`super::target`]; fixed vertices (free boundary) keep
 //! `u = 0`; round boundaries re-evaluate `K̄` from the current boundary lengths (boundary edges
@@ -43,7 +38,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
-use super::hessian_pattern::{GrowingPattern, InexactSolve};
+use super::hessian_pattern::GrowingPattern;
 use super::newton::max_error;
 use super::target::Target;
 use super::IterationRecord;
@@ -273,8 +268,7 @@ pub fn solve(
             break;
         }
         it += 1;
-        let inexact = cn.quadratic_phase(err, dynamic);
-        cn.assemble(inexact.is_some())?;
+        cn.assemble()?;
         cn.newton_rhs(target);
         if dynamic {
             // Exact Newton step on K(u) − K̄(u) = 0 with a residual line search; on failure a
@@ -289,9 +283,9 @@ pub fn solve(
                 notes.push(format!("iteration {it}: flip budget exceeded"));
                 break;
             }
-            cn.assemble(false)?;
+            cn.assemble()?;
         }
-        if !cn.newton_direction(inexact)? {
+        if !cn.newton_direction() {
             notes.push(format!(
                 "iteration {it}: the Hessian was not numerically positive definite; gradient step"
             ));
@@ -317,7 +311,6 @@ pub fn solve(
             std::mem::swap(&mut cn.st, &mut cn.trial_st);
         }
         cn.last_step = cn.delta.iter().map(|x| (t * x).abs()).fold(0.0, f64::max);
-        cn.full_step = t == 1.0;
         std::mem::swap(&mut cn.u, &mut cn.trial);
         if dynamic {
             update_round(cn.tri, &cn.u, target);
@@ -325,7 +318,6 @@ pub fn solve(
     }
     let stop_reason =
         super::newton::stop_reason(converged, it, settings.max_iterations, err, &notes);
-    notes.extend(cn.pattern.inner.note());
     if dynamic {
         notes.push(format!(
             "round boundary: {exact_steps} exact Newton step(s) (Jacobian H − ∂K̄/∂u), \
@@ -360,27 +352,6 @@ fn update_round(tri: &IntrinsicTriangulation, u: &[f64], target: &mut Target) {
 /// Armijo's constant of the line searches.
 const C_ARMIJO: f64 = 1e-4;
 
-/// Newton's quadratic phase, where a system is solved inexactly (CG preconditioned by the
-/// last factor, [`GrowingPattern::solve`]): the last step was the full Newton step and cut
-/// the largest curvature error at least by this factor.
-const QUADRATIC_PHASE: f64 = 0.25;
-
-/// The inexact solve of the quadratic phase: forcing term `η = min(10⁻², ‖r‖₂)`; CG may
-/// take up to 4 products (a factorization costs about 6 solves) or 8 while the analysis of
-/// a grown pattern is deferred (analysis and factorization, about 10).
-const INEXACT: InexactSolve = InexactSolve {
-    eta_max: 1e-2,
-    max_iterations: 4,
-    max_iterations_stale: 8,
-    cap: f64::INFINITY,
-};
-
-/// The inner residual of the step expected to be the last, relative to the flow's
-/// tolerance: the final iterate then is as accurate as after an exact step (errors
-/// ~10⁻¹² for a tolerance of 10⁻⁹), which the layouts' seam-length and flatness checks
-/// need (a final error just below the tolerance fails them).
-const FINAL_INNER: f64 = 1e-3;
-
 /// The state of one Newton solve of [`solve`]: the triangulation, the iterate `u` and its
 /// evaluation `st`, trial points, the growing Hessian pattern and its values, the step.
 struct ConformalNewton<'a> {
@@ -401,10 +372,6 @@ struct ConformalNewton<'a> {
     /// Ptolemy flips made so far.
     flips: usize,
     last_step: f64,
-    /// The last accepted step was the full Newton step (`t = 1`).
-    full_step: bool,
-    /// The largest curvature error at the last [`ConformalNewton::quadratic_phase`].
-    last_error: f64,
     /// `E(u) − E(0)` as estimated by the accepted line searches.
     energy: f64,
 }
@@ -432,29 +399,8 @@ impl<'a> ConformalNewton<'a> {
             mid_st: ConformalState::default(),
             flips: 0,
             last_step: 0.0,
-            full_step: false,
-            last_error: f64::INFINITY,
             energy: 0.0,
         }
-    }
-
-    /// The inexact solve of Newton's quadratic phase (module doc: CG preconditioned with the
-    /// last factor, a grown pattern's analysis deferred) at an iterate of largest error
-    /// `err`; `None` before that phase and for round boundaries.
-    fn quadratic_phase(&mut self, err: f64, dynamic: bool) -> Option<InexactSolve> {
-        let quadratic = self.full_step && err <= QUADRATIC_PHASE * self.last_error;
-        // Quadratic convergence e' ≈ M e² with M ≈ e / e_prev²: the step that should land
-        // below the tolerance is solved as accurately as an exact step would be.
-        let last = err * (err / self.last_error).powi(2) <= self.settings.tolerance;
-        self.last_error = err;
-        (!dynamic && quadratic).then_some(InexactSolve {
-            cap: if last {
-                FINAL_INNER * self.settings.tolerance
-            } else {
-                f64::INFINITY
-            },
-            ..INEXACT
-        })
     }
 
     /// Delaunay at `u` and its evaluation into `st`; false when the flip budget ran out.
@@ -479,28 +425,22 @@ impl<'a> ConformalNewton<'a> {
 
     /// The Hessian of the current triangulation at `u` into `values`, and the pattern's
     /// symbolic factorization when it grew (the two in parallel: they share only the
-    /// pattern) — unless `defer`: then a factored solver stays as the preconditioner of
-    /// the inexact solve and the analysis waits until a factorization needs it.
-    fn assemble(&mut self, defer: bool) -> Result<()> {
+    /// pattern).
+    fn assemble(&mut self) -> Result<()> {
         if !self.pattern.cover(self.tri) {
-            self.pattern.assemble(self.tri, &self.st, &mut self.values);
-            return Ok(());
-        }
-        if defer
-            && self
-                .pattern
-                .solver
-                .as_ref()
-                .is_some_and(|s| s.is_factored())
-        {
-            self.pattern.stale = true;
             self.pattern.assemble(self.tri, &self.st, &mut self.values);
             return Ok(());
         }
         let (pattern, tri, st, values) = (&self.pattern, &*self.tri, &self.st, &mut self.values);
         let (analysis, ()) =
             rayon::join(|| pattern.analysis(), || pattern.assemble(tri, st, values));
-        self.pattern.set_analysis(analysis)
+        let (solver, amd_nnz) = analysis?;
+        if let Some(nnz) = amd_nnz {
+            self.pattern.amd_factor_nnz = nnz;
+        }
+        self.pattern.solver = Some(solver);
+        self.pattern.symbolic_count += 1;
+        Ok(())
     }
 
     /// r = K̄ − K on the free vertices; with a scale pin the mean is removed (Gauss–Bonnet
@@ -566,19 +506,20 @@ impl<'a> ConformalNewton<'a> {
         false
     }
 
-    /// The Newton direction `H δ = r` into `delta` (sparse Cholesky, or CG preconditioned by
-    /// the last factor with `inexact`); when `H` does not factorize, the gradient direction
-    /// `δ = r` (false).
-    fn newton_direction(&mut self, inexact: Option<InexactSolve>) -> Result<bool> {
-        let mut step = vec![0.0; self.rhs.len()];
-        let solved = self
-            .pattern
-            .solve(&self.values, &self.rhs, &mut step, inexact)?;
+    /// The Newton direction `H δ = r` into `delta` (sparse Cholesky); when `H` does not
+    /// factorize, the gradient direction `δ = r` (false).
+    fn newton_direction(&mut self) -> bool {
+        let solver = self.pattern.solver.as_mut().expect("pattern covered");
+        let mut step = self.rhs.clone();
+        let factored = solver.factor_llt(&self.values);
+        if factored {
+            solver.solve(&mut step);
+        }
         self.delta.iter_mut().for_each(|x| *x = 0.0);
         for (c, &v) in self.pattern.free_vertex.iter().enumerate() {
             self.delta[v as usize] = step[c];
         }
-        Ok(solved)
+        factored
     }
 
     /// g(t) = (K(u + tδ) − K̄)·δ for the evaluation `s` at `u + tδ`.

@@ -3,21 +3,11 @@
 //! vertex pairs (entries of vanished pairs are kept as zeros), with the slot of every edge's
 //! entry and the symbolic factorization (faer supernodal Cholesky; AMD, or the last ordering
 //! reused while the factor's fill stays within [`REUSED_ORDERING_FILL`]).
-//!
-//! **Late Newton systems** ([`GrowingPattern::solve`]): near convergence the Hessian changes
-//! little from one iteration to the next, so its system is solved by conjugate gradients
-//! preconditioned with the last factor ([`crate::numeric::pcg`]) — no numeric factorization,
-//! and a pattern grown by a few flipped pairs needs no new symbolic analysis (its analysis is
-//! deferred: [`GrowingPattern::stale`]). The inner tolerance is the inexact Newton method's
-//! forcing term (Dembo–Eisenstat–Steihaug 1982; Eisenstat–Walker 1996): `‖H δ − r‖₂ ≤
-//! η ‖r‖₂` with `η = min(η_max, ‖r‖₂)`, which keeps Newton's quadratic convergence; CG that
-//! does not reach it within its budget falls back to a fresh factorization (and analysis).
 
 use super::conformal::ConformalState;
 use crate::error::Result;
 use crate::mesh::NONE;
 use crate::metric::intrinsic::IntrinsicTriangulation;
-use crate::numeric::pcg::pcg;
 use crate::numeric::sparse::{LowerCsc, SymmetricSolver};
 
 /// The lower-triangular Hessian pattern over the free vertices that only grows, with its
@@ -37,45 +27,6 @@ pub(super) struct GrowingPattern {
     pub(super) amd_factor_nnz: usize,
     /// Length of the triangulation's `flip_log` at the last [`GrowingPattern::cover`].
     pub(super) covered_flips: usize,
-    /// The solver's analysis is of an older, smaller pattern (its factor still
-    /// preconditions; a factorization needs [`GrowingPattern::analysis`] first).
-    pub(super) stale: bool,
-    /// Newton systems solved by preconditioned CG, their CG iterations, and the CG solves
-    /// that missed their tolerance (then factorized).
-    pub(super) inner: InnerCounts,
-}
-
-/// Counts of the inexact inner solves of [`GrowingPattern::solve`].
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct InnerCounts {
-    pub(super) solves: usize,
-    pub(super) iterations: usize,
-    pub(super) missed: usize,
-}
-
-impl InnerCounts {
-    /// A note for the solve's report, when there were inexact solves.
-    pub(super) fn note(&self) -> Option<String> {
-        (self.solves + self.missed > 0).then(|| {
-            format!(
-                "{} Newton system(s) solved by CG preconditioned with an earlier factor \
-                 ({} products; {} more missed the inner tolerance and were factorized)",
-                self.solves, self.iterations, self.missed
-            )
-        })
-    }
-}
-
-/// The inexact inner solve of a late Newton system: `η_max` of the forcing term
-/// `η = min(η_max, ‖r‖₂)`, the CG iterations allowed, and a cap on the residual
-/// `‖H δ − r‖₂` (in the curvature's units) for the last step.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct InexactSolve {
-    pub(super) eta_max: f64,
-    pub(super) max_iterations: usize,
-    /// CG iterations allowed while the analysis is deferred (a miss costs it too).
-    pub(super) max_iterations_stale: usize,
-    pub(super) cap: f64,
 }
 
 /// Most growth of the factor's nonzeros, relative to the last AMD analysis, accepted with a
@@ -103,8 +54,6 @@ impl GrowingPattern {
             symbolic_count: 0,
             amd_factor_nnz: 0,
             covered_flips: 0,
-            stale: false,
-            inner: InnerCounts::default(),
         }
     }
     pub(super) fn n(&self) -> usize {
@@ -235,69 +184,6 @@ impl GrowingPattern {
                 (s, Some(nnz))
             }
         })
-    }
-    /// Store the result of [`GrowingPattern::analysis`] as the solver.
-    pub(super) fn set_analysis(
-        &mut self,
-        analysis: Result<(SymmetricSolver, Option<usize>)>,
-    ) -> Result<()> {
-        let (solver, amd_nnz) = analysis?;
-        if let Some(nnz) = amd_nnz {
-            self.amd_factor_nnz = nnz;
-        }
-        self.solver = Some(solver);
-        self.symbolic_count += 1;
-        self.stale = false;
-        Ok(())
-    }
-    /// Solve `H x = r` for the Hessian `values` of the current pattern: with `inexact`, by CG
-    /// preconditioned with the last factor when there is one (module doc); otherwise, or
-    /// when CG misses its tolerance, by a fresh LLᵀ factorization (after the deferred
-    /// analysis of a stale pattern). Ok(false) when `H` is not numerically positive definite
-    /// (`x` is then `r`).
-    pub(super) fn solve(
-        &mut self,
-        values: &[f64],
-        rhs: &[f64],
-        x: &mut [f64],
-        inexact: Option<InexactSolve>,
-    ) -> Result<bool> {
-        let pattern = LowerCsc {
-            n: self.n(),
-            col_ptr: &self.col_ptr,
-            row_idx: &self.row_idx,
-        };
-        if let (Some(ix), Some(solver)) = (inexact, self.solver.as_mut()) {
-            if solver.is_factored() {
-                let norm = rhs.iter().map(|t| t * t).sum::<f64>().sqrt();
-                let tolerance = (ix.eta_max.min(norm) * norm).min(ix.cap);
-                let budget = if self.stale {
-                    ix.max_iterations_stale
-                } else {
-                    ix.max_iterations
-                };
-                let out = pcg(pattern, values, rhs, x, tolerance, budget, |r| {
-                    solver.solve(r)
-                });
-                self.inner.iterations += out.iterations;
-                if out.converged {
-                    self.inner.solves += 1;
-                    return Ok(true);
-                }
-                self.inner.missed += 1;
-            }
-        }
-        if self.stale || self.solver.is_none() {
-            let analysis = self.analysis();
-            self.set_analysis(analysis)?;
-        }
-        let solver = self.solver.as_mut().expect("analysed above");
-        x.copy_from_slice(rhs);
-        let factored = solver.factor_llt(values);
-        if factored {
-            solver.solve(x);
-        }
-        Ok(factored)
     }
     /// Lower-triangle values of `H = ∂K/∂u` (free vertices) from the state's Jacobians.
     pub(super) fn assemble(

@@ -6,8 +6,6 @@
 //! * [`sparse`] — sparse symmetric positive-definite (and indefinite) solves with faer: a
 //!   symbolic factorization reused across numeric refactorizations, LU with a reused symbolic
 //!   analysis, one-shot Cholesky; each leaves the vector registers clean ([`simd`]).
-//! * [`pcg`] — conjugate gradients preconditioned by the factor of a nearby matrix (the
-//!   flow's late Newton systems).
 //! * [`simd`] — `vzeroupper` after faer's AVX kernels (called inside [`sparse`] and after the dense products of the callers).
 //! * [`dijkstra`] — single- and multi-source shortest paths on a graph given by a neighbour
 //!   closure, with the tie-breaking every caller relies on (smaller distance, then smaller
@@ -17,7 +15,6 @@
 pub mod dd;
 pub(crate) mod dijkstra;
 pub mod float_text;
-pub(crate) mod pcg;
 pub(crate) mod simd;
 pub(crate) mod sparse;
 pub mod vec3;

@@ -329,12 +329,6 @@ impl SymmetricSolver {
         ok && self.l_values.iter().all(|x| x.is_finite())
     }
 
-    /// Whether the last numeric factorization succeeded (and [`SymmetricSolver::solve`]
-    /// applies its inverse).
-    pub fn is_factored(&self) -> bool {
-        self.factored != Factored::None
-    }
-
     /// Solve in place with the last factorization.
     pub fn solve(&mut self, rhs: &mut [f64]) {
         debug_assert_eq!(rhs.len(), self.n);
