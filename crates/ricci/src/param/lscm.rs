@@ -33,7 +33,7 @@
 //! map it replaces did not fold, its qc p95 is no larger.
 
 use super::ladder::{is_unresolved, unresolved_tolerance};
-use crate::analysis::distortion::{face_distortion, face_distortions, stats};
+use crate::analysis::distortion::{face_distortion, face_distortions, qc_p95};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::numeric::sparse::Cholesky;
@@ -734,7 +734,7 @@ fn improve_quasiconformality(
 ) -> Option<Vec<C>> {
     let faces = mesh.faces();
     let mut d = face_distortions(positions, faces, uv);
-    let before = stats(&d).qc_p95;
+    let before = qc_p95(&d);
     let top: Vec<u32> = (0..faces.len() as u32)
         .filter(|&f| d[f as usize].qc() > before)
         .collect();
@@ -753,7 +753,7 @@ fn improve_quasiconformality(
             [q[0], q[1], q[2]],
         );
     }
-    (stats(&d).qc_p95 <= before).then_some(trial.uv)
+    (qc_p95(&d) <= before).then_some(trial.uv)
 }
 
 #[cfg(test)]
