@@ -142,7 +142,7 @@ pub fn face_distortions(
 pub fn qc_p95(d: &[FaceDistortion]) -> f64 {
     let mut qc: Vec<f64> = d
         .iter()
-        .filter(|x| !(x.area_3d.is_nan() || x.area_3d <= 0.0) && !x.flipped())
+        .filter(|x| !(x.area_3d.is_nan() || x.area_3d <= 0.0 || x.flipped()))
         .map(|x| x.qc())
         .collect();
     let n = qc.len();

@@ -130,8 +130,10 @@ impl Bundle {
 /// round of [`improve`] shares (only the pins of the vertices that do not move change).
 struct Wedges {
     bundle: Bundle,
-    /// Per corner, its wedge's root and rotation (`δ_corner = ρ δ_root`).
-    roots: Vec<(u32, C)>,
+    /// Per corner, its wedge.
+    wedge: Vec<u32>,
+    /// Per wedge, its class's root and rotation (`δ_wedge = ρ δ_root`).
+    class: Vec<(u32, C)>,
 }
 
 /// Wedge ids `0, 1, …` in the order of the corners that first meet them (a wedge is a vertex
@@ -165,6 +167,11 @@ fn wedge_ids(mesh: &Mesh, cut: &[bool]) -> (Vec<u32>, usize) {
 }
 
 impl Wedges {
+    /// Corner `h`'s class root and rotation (`δ_h = ρ δ_root`).
+    fn root(&self, h: usize) -> (u32, C) {
+        self.class[self.wedge[h] as usize]
+    }
+
     /// The classes of the wedges of `mesh` opened along `cut`, linked by the seam rotations
     /// of `uv`; the classes of `cones` and of the boundary pinned.
     fn new(mesh: &Mesh, cut: &[bool], cones: &[u32], uv: &[C]) -> Result<Wedges> {
@@ -196,14 +203,14 @@ impl Wedges {
             b.link(wedge[hn as usize], wedge[g as usize], r);
         }
         let class: Vec<(u32, C)> = (0..nw as u32).map(|w| b.find(w)).collect();
-        let roots: Vec<(u32, C)> = wedge.iter().map(|&w| class[w as usize]).collect();
+        let roots = |h: usize| class[wedge[h] as usize];
         let mut is_cone = vec![false; mesh.n_vertices()];
         for &c in cones {
             is_cone[c as usize] = true;
         }
         for h in 0..nc {
             if is_cone[mesh.he_origin(h as u32) as usize] {
-                b.pinned[roots[h].0 as usize] = true;
+                b.pinned[roots(h).0 as usize] = true;
             }
         }
         // The boundary of the opened surface keeps its place (module docs).
@@ -214,42 +221,46 @@ impl Wedges {
                     h = mesh.he_twin(h);
                 }
                 for c in [h, mesh.he_next(h)] {
-                    b.pinned[roots[c as usize].0 as usize] = true;
+                    b.pinned[roots(c as usize).0 as usize] = true;
                 }
             }
         }
-        Ok(Wedges { bundle: b, roots })
+        Ok(Wedges {
+            bundle: b,
+            wedge,
+            class,
+        })
     }
 
     /// Per wedge, whether its class is pinned when only the `movable` vertices move: the
     /// cones, the boundary, the vertices not `movable`, and at least two pinned in all.
     fn pinned(&self, mesh: &Mesh, uv: &[C], movable: &[bool]) -> Vec<bool> {
         let nc = mesh.n_corners();
-        let roots = &self.roots;
+        let roots = |h: usize| self.root(h);
         let mut pinned = self.bundle.pinned.clone();
         for h in 0..nc {
             if !movable[mesh.he_origin(h as u32) as usize] {
-                pinned[roots[h].0 as usize] = true;
+                pinned[roots(h).0 as usize] = true;
             }
         }
         // Fewer than two pinned points: pin the corner farthest from the first pinned one (or
         // from corner 0) until there are two.
         for _ in 0..2 {
-            let mut on = (0..nc).filter(|&h| pinned[roots[h].0 as usize]);
+            let mut on = (0..nc).filter(|&h| pinned[roots(h).0 as usize]);
             let first = on.next();
-            if first.is_some_and(|f| on.any(|h| roots[h].0 != roots[f].0)) {
+            if first.is_some_and(|f| on.any(|h| roots(h).0 != roots(f).0)) {
                 break;
             }
             let from = first.map_or(uv[0], |h| uv[h]);
             let far = (0..nc)
-                .filter(|&h| !pinned[roots[h].0 as usize])
+                .filter(|&h| !pinned[roots(h).0 as usize])
                 .max_by(|&x, &y| {
                     let dx = sub(uv[x], from);
                     let dy = sub(uv[y], from);
                     dx[0].hypot(dx[1]).total_cmp(&dy[0].hypot(dy[1]))
                 });
             let Some(far) = far else { break };
-            pinned[roots[far].0 as usize] = true;
+            pinned[roots(far).0 as usize] = true;
         }
         pinned
     }
@@ -460,7 +471,7 @@ fn refine(
     region: &Region,
     boost: &[f64],
 ) -> Result<Vec<(u32, C)>> {
-    let roots = &wedges.roots;
+    let roots = |h: usize| wedges.root(h);
     // A class lies at one vertex (the seam links join copies of a vertex), so a moving
     // vertex's classes are pinned only by the cones and the boundary — unless fewer than two
     // vertices (with faces) stay, where [`Wedges::pinned`] adds pins.
@@ -479,7 +490,7 @@ fn refine(
         .collect();
     let corners = || corners.iter().copied();
     for h in corners() {
-        let r = roots[h as usize].0 as usize;
+        let r = roots(h as usize).0 as usize;
         if col[r] == u32::MAX && !pinned[r] {
             col[r] = 0;
             class.push(r as u32);
@@ -493,7 +504,7 @@ fn refine(
         col[r as usize] = k as u32;
     }
     let mut faces: Vec<u32> = corners()
-        .filter(|&h| col[roots[h as usize].0 as usize] != u32::MAX)
+        .filter(|&h| col[roots(h as usize).0 as usize] != u32::MAX)
         .map(|h| h / 3)
         .collect();
     faces.sort_unstable();
@@ -511,7 +522,7 @@ fn refine(
             let mut k = [u32::MAX; 3];
             let mut a = [[0.0, 0.0]; 3];
             for j in 0..3 {
-                let (r, rho) = roots[3 * f + j];
+                let (r, rho) = roots(3 * f + j);
                 k[j] = col[r as usize];
                 a[j] = mul(c[j], rho);
             }
@@ -521,7 +532,7 @@ fn refine(
     let delta = Normal::assemble(class.len(), &rows).solve()?;
     Ok(corners()
         .filter_map(|h| {
-            let (r, rho) = roots[h as usize];
+            let (r, rho) = roots(h as usize);
             let k = col[r as usize];
             (k != u32::MAX).then(|| {
                 let d = mul(rho, [delta[k as usize].re, delta[k as usize].im]);
@@ -646,9 +657,8 @@ fn flipped_faces(positions: &[[f64; 3]], faces: &[[u32; 3]], uv: &[C]) -> Vec<u3
             let shear = (vec3::dot(e1, e2) / vec3::dot(e1, e1)).abs();
             let scale =
                 u1.abs() * (v2.abs() + shear * v1.abs()) + (u2.abs() + shear * u1.abs()) * v1.abs();
-            let a2 = u1 * v2 - u2 * v1;
-            !(a2 > 1e-10 * scale)
-                && face_distortion([p(0), p(1), p(2)], [q[0], q[1], q[2]]).flipped()
+            let certainly_positive = u1 * v2 - u2 * v1 > 1e-10 * scale;
+            !certainly_positive && face_distortion([p(0), p(1), p(2)], [q[0], q[1], q[2]]).flipped()
         })
         .map(|f| f as u32)
         .collect()
@@ -770,7 +780,13 @@ mod tests {
         let s = crate::mesh::generate::pair_of_pants(16).unwrap();
         let (mesh, pos) = (&s.mesh, &s.positions);
         let nv = mesh.n_vertices();
-        let column = |v: u32| if v % 5 == 0 { u32::MAX } else { v - v / 5 - 1 };
+        let column = |v: u32| {
+            if v.is_multiple_of(5) {
+                u32::MAX
+            } else {
+                v - v / 5 - 1
+            }
+        };
         let n = (0..nv as u32).filter(|&v| column(v) != u32::MAX).count();
         let mut rows: Vec<Row> = Vec::new();
         for (f, t) in mesh.faces().iter().enumerate() {
@@ -823,8 +839,8 @@ mod tests {
         }
         let h = Normal::assemble(n, &rows);
         let mut dense = vec![vec![c64::new(0.0, 0.0); n]; n];
-        for j in 0..n {
-            for s in h.col_ptr[j]..h.col_ptr[j + 1] {
+        for (j, span) in h.col_ptr.windows(2).enumerate() {
+            for s in span[0]..span[1] {
                 let i = h.row_idx[s];
                 assert!(i >= j, "an entry above the diagonal");
                 dense[i][j] = h.values[s];
