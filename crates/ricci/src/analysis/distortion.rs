@@ -139,6 +139,22 @@ pub fn face_distortions(
         .collect()
 }
 
+/// [`DistortionStats::qc_p95`] of per-face distortions alone, by selection instead of a sort
+/// (the same order statistic: the qc at rank `round(0.95 (n − 1))` of the `n` faces measured).
+pub fn qc_p95(d: &[FaceDistortion]) -> f64 {
+    let mut qc: Vec<f64> = d
+        .iter()
+        .filter(|x| !(x.area_3d.is_nan() || x.area_3d <= 0.0 || x.flipped()))
+        .map(|x| x.qc())
+        .collect();
+    let n = qc.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    let k = ((0.95 * (n - 1) as f64).round() as usize).min(n - 1);
+    *qc.select_nth_unstable_by(k, f64::total_cmp).1
+}
+
 /// [`DistortionStats`] of per-face distortions.
 pub fn stats(d: &[FaceDistortion]) -> DistortionStats {
     use rayon::slice::ParallelSliceMut;
@@ -245,6 +261,30 @@ fn norm3(a: [f64; 3]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`qc_p95`] by selection equals [`stats`]' sorted one, with degenerate and flipped faces
+    /// among the measured ones (both skipped) and ties.
+    #[test]
+    fn qc_p95_by_selection_equals_the_sorted_one() {
+        let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.3, 0.8, 0.0]];
+        let d: Vec<FaceDistortion> = (0..203)
+            .map(|i| {
+                let s = 1.0 + ((i * 37) % 23) as f64 * 0.1;
+                let q = [
+                    [0.0, 0.0],
+                    [s, 0.0],
+                    [0.3, 0.8 * if i % 17 == 0 { -1.0 } else { 1.0 }],
+                ];
+                let flat = [p[0], p[1], if i % 29 == 0 { p[1] } else { p[2] }];
+                face_distortion(flat, q)
+            })
+            .collect();
+        assert!(d.iter().any(|x| x.flipped()) && d.iter().any(|x| x.area_3d == 0.0));
+        for len in [0, 1, 2, 50, 203] {
+            let (a, b) = (qc_p95(&d[..len]), stats(&d[..len]).qc_p95);
+            assert!(a == b || (a.is_nan() && b.is_nan()), "{len}: {a} vs {b}");
+        }
+    }
 
     /// Singular values against the eigenvalues of JᵀJ (closed form of a symmetric 2×2).
     #[test]

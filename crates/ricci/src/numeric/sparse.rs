@@ -394,25 +394,26 @@ impl SparseLu {
     }
 }
 
-/// A one-shot sparse Cholesky factorization LLᵀ of a symmetric positive definite matrix
-/// (faer's supernodal factorization, which may run dense kernels on the pool's threads).
-pub struct Cholesky {
-    llt: faer::sparse::linalg::solvers::Llt<usize, f64>,
+/// A one-shot sparse Cholesky factorization LLᵀ (LLᴴ for complex `T`) of a symmetric (Hermitian)
+/// positive definite matrix (faer's supernodal factorization, which may run dense kernels on
+/// the pool's threads).
+pub struct Cholesky<T: faer::traits::ComplexField = f64> {
+    llt: faer::sparse::linalg::solvers::Llt<usize, T>,
 }
 
-impl Cholesky {
+impl<T: faer::traits::ComplexField> Cholesky<T> {
     /// Factorize `a` (its lower triangle is read); the error is faer's, for the caller's
     /// message (the matrix is not numerically positive definite).
     pub fn factor(
-        a: faer::sparse::SparseColMatRef<'_, usize, f64>,
-    ) -> std::result::Result<Cholesky, faer::sparse::linalg::LltError> {
+        a: faer::sparse::SparseColMatRef<'_, usize, T>,
+    ) -> std::result::Result<Cholesky<T>, faer::sparse::linalg::LltError> {
         let llt = a.sp_cholesky(Side::Lower);
         super::simd::clear_upper_state();
         Ok(Cholesky { llt: llt? })
     }
 
     /// Solve in place for the columns of `rhs`.
-    pub fn solve_in_place(&self, rhs: faer::MatMut<'_, f64>) {
+    pub fn solve_in_place(&self, rhs: faer::MatMut<'_, T>) {
         use faer::linalg::solvers::Solve;
         self.llt.solve_in_place(rhs);
         super::simd::clear_upper_state();

@@ -48,6 +48,15 @@ pub(super) fn unresolved_triangles(triangles: &[[u32; 3]], uv: &[[f64; 2]]) -> u
 
 /// Per triangle: is it unresolved ([`unresolved_triangles`])?
 pub(super) fn unresolved_flags(triangles: &[[u32; 3]], uv: &[[f64; 2]]) -> Vec<bool> {
+    let tol = unresolved_tolerance(uv);
+    (0..triangles.len())
+        .map(|t| is_unresolved(&uv[3 * t..3 * t + 3], tol))
+        .collect()
+}
+
+/// The rounding tolerance of [`unresolved_triangles`] for the UVs `uv`: `4ε` times their
+/// size (bounding-box diagonal or largest coordinate).
+pub(super) fn unresolved_tolerance(uv: &[[f64; 2]]) -> f64 {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     let mut big = 0.0f64;
     for p in uv {
@@ -58,17 +67,21 @@ pub(super) fn unresolved_flags(triangles: &[[u32; 3]], uv: &[[f64; 2]]) -> Vec<b
         }
     }
     let size = (hi[0] - lo[0]).hypot(hi[1] - lo[1]).max(big);
-    let tol = 4.0 * f64::EPSILON * size;
-    (0..triangles.len())
-        .map(|t| {
-            let q = &uv[3 * t..3 * t + 3];
-            let e = |i: usize, j: usize| (q[j][0] - q[i][0]).hypot(q[j][1] - q[i][1]);
-            let longest = e(0, 1).max(e(1, 2)).max(e(2, 0));
-            let a2 = (q[1][0] - q[0][0]) * (q[2][1] - q[0][1])
-                - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
-            a2.is_nan() || a2 <= tol * longest
-        })
-        .collect()
+    4.0 * f64::EPSILON * size
+}
+
+/// Is the UV triangle `q` folded or within `tol` ([`unresolved_tolerance`]) of folding?
+/// A triangle whose doubled area exceeds twice `tol` times its longest edge's `|Δu| + |Δv|`
+/// (at least its length) is not, without the square roots.
+pub(super) fn is_unresolved(q: &[[f64; 2]], tol: f64) -> bool {
+    let a2 = (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
+    let taxicab = |i: usize, j: usize| (q[j][0] - q[i][0]).abs() + (q[j][1] - q[i][1]).abs();
+    if a2 > 2.0 * tol * taxicab(0, 1).max(taxicab(1, 2)).max(taxicab(2, 0)) {
+        return false;
+    }
+    let e = |i: usize, j: usize| (q[j][0] - q[i][0]).hypot(q[j][1] - q[i][1]);
+    let longest = e(0, 1).max(e(1, 2)).max(e(2, 0));
+    a2.is_nan() || a2 <= tol * longest
 }
 
 /// What a chart's options ask for, in words (`"free seams, 3 cones"`).
