@@ -127,6 +127,16 @@ def test_eight_step_and_iges_open_in_open_cascade(tmp_path):
         check_file(tmp_path / name, samples)
 
 
+def test_eight_nested_blocks_step_and_iges_open_in_open_cascade(tmp_path):
+    # The default tolerance (0.5 %): eight refines by a block nested in a block (session 17),
+    # so the files carry knots at quarter intervals and T-junctions inside a block.
+    rep, samples = run_tspline(shared("eight.off"), tmp_path)
+    check_genus_two(rep, samples, 0.5)
+    assert rep["block_levels"] >= 2, "eight at 0.5 % no longer nests blocks: pick another case"
+    for name in ("tspline.step", "tspline.igs"):
+        check_file(tmp_path / name, samples)
+
+
 def test_other_topologies_are_refused_naming_the_missing_domain(generated, tmp_path):
     # two closed components: no domain (a disk has one since session 10: genus 0)
     two = tmp_path / "two.off"
