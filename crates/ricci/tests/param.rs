@@ -510,7 +510,7 @@ fn maps_on_the_common_subdivision_are_valid() {
 
 /// Issue 16, must-show 1 on the heavy meshes (RICCI_MESHES), eight greedy cones each:
 /// seahorse2_100K and camel (the cut on kept input edges cannot reach every cone) and horse
-/// (seven input faces fold) — 0 flipped faces and a valid map on the common subdivision,
+/// — 0 flipped faces and a valid map (on the common subdivision where input faces would fold),
 /// checked by [`check_any`] from positions and UVs alone.
 #[test]
 fn heavy_meshes_with_eight_cones_have_no_flipped_faces() {

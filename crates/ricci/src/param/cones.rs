@@ -245,7 +245,7 @@ pub fn greedy_cones_with(
         let chi = crate::metric::euler_characteristic(mesh) as f64;
         let mut g = GreenBasis::new(&lap, &k0, chi, used.clone(), solver)?;
         let mut p = closed::place_cones(&mut g, &k0, &used, budget, search == ConeSearch::Energy)?;
-        keep_angles_positive(&mut p.cones, 2.0 * PI * chi);
+        bound_cone_angles(&mut p.cones, 2.0 * PI * chi);
         return Ok(p);
     }
     HeldBasis::new(&lap, &k0, &boundary, &used, solver)?.greedy(budget)
@@ -370,7 +370,7 @@ fn held_basis<'a>(
 /// minimises `‖u − ū + G δk‖²_M`, `G` the Green's functions of the input's cotangent
 /// Laplacian (submodule `green`), i.e. the linear response of the flow's `u` to moving curvature
 /// between the cones. `damping ∈ (0, 1]` scales the step. Returns the new `(vertex, K̄)`
-/// list; cone angles are kept positive (`K̄ ≤ 2π − 0.05`) and nothing else is clamped: a
+/// list; cone angles are kept at least [`MIN_CONE_ANGLE`] and nothing else is clamped: a
 /// strong negative cone is allowed, because a map whose input faces fold around it is written
 /// on the common subdivision.
 pub fn correct_cone_curvatures(
@@ -393,14 +393,24 @@ pub fn correct_cone_curvatures(
         .zip(&dk)
         .map(|(&(c, k), &d)| (c, k + damping * d))
         .collect();
-    keep_angles_positive(&mut out, total);
+    bound_cone_angles(&mut out, total);
     Ok(out)
 }
 
-/// Cone angles kept positive: curvatures above `2π − 0.05` are cut there and the excess goes
-/// to the other cones equally; then the last cone takes the rounding so that `Σ K̄ = total`.
-fn keep_angles_positive(out: &mut [(u32, f64)], total: f64) {
-    let limit = 2.0 * PI - 0.05;
+/// The smallest cone angle the placement on a closed surface gives (`K̄ ≤ 2π − π/8`). A cone
+/// of angle `θ` shrinks its neighbourhood like `r^{2π/θ − 1}`, so a near-zero angle makes the
+/// input faces around it fold in the flat map: horse with 8 cones had two hoof cones of 0.05
+/// and 0.17 rad, 9 input faces folding, the map on the common subdivision (qc p95 1.1587, by
+/// count, above Boundary First Flattening's 1.1448); with angles ≥ π/8 it is on the input faces,
+/// qc p95 1.074, σ(log area) 1.02 → 1.09 (BFF 2.30). No other mesh of the benchmarks has a
+/// cone below π/8 (BENCHMARKS.md, session 17 lead).
+pub const MIN_CONE_ANGLE: f64 = PI / 8.0;
+
+/// Cone angles kept at least [`MIN_CONE_ANGLE`]: curvatures above `2π − MIN_CONE_ANGLE` are
+/// cut there and the excess goes to the other cones equally; then the last cone takes the
+/// rounding so that `Σ K̄ = total`.
+fn bound_cone_angles(out: &mut [(u32, f64)], total: f64) {
+    let limit = 2.0 * PI - MIN_CONE_ANGLE;
     for _ in 0..8 {
         let excess: f64 = out.iter().map(|&(_, k)| (k - limit).max(0.0)).sum();
         for x in out.iter_mut() {
