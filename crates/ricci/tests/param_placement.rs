@@ -255,6 +255,18 @@ fn horse_eight_cones_keep_a_minimum_angle_and_beat_bff_on_its_faces() {
             2.0 * PI - c.curvature
         );
     }
+    // The chart's target names the cones by the horse's own vertices (the flow numbers its
+    // mesh in another order): the same list as `cones`, and usable as `--cones V=K,…`.
+    let listed = p.charts[0].target.strip_prefix("cone:").unwrap();
+    let parsed: Vec<(u32, f64)> = listed
+        .split(',')
+        .map(|x| {
+            let (v, k) = x.split_once('=').unwrap();
+            (v.parse().unwrap(), k.parse().unwrap())
+        })
+        .collect();
+    let named: Vec<(u32, f64)> = cones.iter().map(|c| (c.vertex, c.curvature)).collect();
+    assert_eq!(parsed, named, "{}", p.charts[0].target);
     eprintln!("horse, 8 cones: {} {:?}", p.uv_on(), p.stats);
     assert_eq!(p.uv_on(), "input");
     assert_eq!(p.stats.flipped_faces, 0);

@@ -351,6 +351,25 @@ fn input_cones(work: &Piece, cones: &[(u32, f64)]) -> Vec<Cone> {
         .collect()
 }
 
+/// The flow's target description (`cone:v=K,…`, `free-boundary+cone:…`, …: the flow's
+/// [`TargetSpec`] written out) with its cones named by their **input** vertices, as the JSON's
+/// `cones` and the `--cones V=K,…` option name them: the flow numbers the vertices of its own
+/// mesh (the component, or the disk cut open along free seams). The list is `cones` itself —
+/// the same curvatures in the same order; any other description is kept as it is.
+fn input_target_description(description: &str, cones: &[Cone]) -> String {
+    let Some((head, list)) = description.split_once("cone:") else {
+        return description.to_string();
+    };
+    if list.split(',').count() != cones.len() {
+        return description.to_string();
+    }
+    let named: Vec<String> = cones
+        .iter()
+        .map(|c| format!("{}={}", c.vertex, c.curvature))
+        .collect();
+    format!("{head}cone:{}", named.join(","))
+}
+
 /// Closed genus ≥ 1 with `--seamless`: the flow's result with the least change of log lengths
 /// that makes the holonomy of the homology loops quarter turns too (`seamless`, CSZZ 2019).
 fn seamless_result(
@@ -472,7 +491,7 @@ pub(super) fn chart_uv(
         vertices: piece.surface.mesh.n_vertices(),
         genus: comp.genus,
         boundary_loops: comp.boundary_loops,
-        target: r.target_description.clone(),
+        target: input_target_description(&r.target_description, &cones),
         seams: if disk.is_some() { "free" } else { "rigid" }.into(),
         cones,
         cone_source: plan.source,

@@ -242,6 +242,8 @@ pub struct Chart {
     pub vertices: usize,
     pub genus: i64,
     pub boundary_loops: usize,
+    /// The flow's target (`uniform`, `cone:v=K,…`, `free-boundary+cone:v=K,…`, …), its cones
+    /// named by their input vertices as in [`Chart::cones`] and `--cones V=K,…`.
     pub target: String,
     /// `"free"` when this chart's homology seams are free (closed, genus ≥ 1, `--seams
     /// free`), else `"rigid"` (also charts with no homology seams).
