@@ -20,7 +20,7 @@ use super::basis::cubic;
 use super::bezier::{interpolate_patch, BezierPatch};
 use super::fit::bbox_scale;
 use super::genus_domain::{CylinderChart, GenusDomain};
-use super::glue::{gluing, CylinderLayout, Gluing};
+use super::glue::{gluing, Gluing, RigidLayout};
 use crate::error::{Error, Result};
 use crate::numeric::sparse::Cholesky;
 use faer::sparse::{SparseColMat, Triplet};
@@ -28,7 +28,7 @@ use faer::Mat;
 use serde::Serialize;
 
 /// A tensor-product cubic spline on one cylinder, in the sheared coordinate
-/// `u' = (u − shift − shear · v / H) mod L` of [`super::glue::CylinderLayout`]:
+/// `u' = (u − shift − shear · v / H) mod L` of [`super::glue::RigidLayout`]:
 /// `control[j * ncu + i]`, `j < nv + 3` (clamped uniform knots in `v`). In `u'`: without knot
 /// lines, periodic uniform knots (`nu` spans, `ncu = nu`); with knot lines, every strip
 /// between two lines carries clamped uniform knots (`spans[s]` spans, triple knots on the
@@ -50,12 +50,7 @@ pub struct CylinderSpline {
 }
 
 impl CylinderSpline {
-    fn new(
-        c: &CylinderChart,
-        layout: Option<&CylinderLayout>,
-        spans: Vec<usize>,
-        nv: usize,
-    ) -> Self {
+    fn new(c: &CylinderChart, layout: Option<&RigidLayout>, spans: Vec<usize>, nv: usize) -> Self {
         let (shift, shear, lines) = layout.map_or((0.0, 0.0, Vec::new()), |y| {
             (y.shift, y.shear, y.lines.clone())
         });
@@ -626,12 +621,19 @@ pub fn fit_cylinders(
     let tol = opts.tolerance * scale;
     let nc = domain.cylinders.len();
     let gluing = if opts.share {
-        gluing(domain)
+        gluing(domain).and_then(|g| match g.rigid(domain) {
+            Some(_) => Ok(g),
+            None => Err(
+                "the strips are not a shear of every cylinder (their lines are not parallel)"
+                    .to_string(),
+            ),
+        })
     } else {
         Err("sharing the boundary rows was switched off".to_string())
     };
     let glued = gluing.as_ref().ok();
-    let layout = |c: usize| glued.map(|g| &g.layouts[c]);
+    let rigid: Option<Vec<RigidLayout>> = glued.and_then(|g| g.rigid(domain));
+    let layout = |c: usize| rigid.as_ref().map(|r| &r[c]);
     let nstrips: Vec<usize> = (0..nc)
         .map(|c| layout(c).map_or(1, |y| y.lines.len()))
         .collect();

@@ -1,7 +1,7 @@
 //! Genus ≥ 2: least squares on the spline of the domain manifold's quad mesh
 //! ([`super::domain_mesh`]), the default of `ricci tspline` for genus ≥ 2 (the per-cylinder
 //! fit of [`super::cylinder_fit`] is the `--per-cylinder` option). The data points are
-//! located in the cells from their cylinder coordinates and the gluing's sheared coordinate;
+//! located in the cells from their cylinder coordinates and the gluing's strips ([`super::glue::CylinderLayout::locate`]);
 //! the fairness term is the squared second differences of the control net along the mesh
 //! lines through every regular vertex (as the per-cylinder fit's), the umbrella operator at
 //! the zeros. Refinement is local where it can be: while a point of a cell next to a zero
@@ -132,14 +132,13 @@ pub fn locate(
 ) -> Option<(u32, f64, f64)> {
     let lay = gluing.layouts.get(c)?;
     let ch = &domain.cylinders[c];
-    let up = (u - lay.shift - lay.shear * v / ch.height).rem_euclid(ch.circumference);
-    let s = lay.strip(up);
+    let (s, x) = lay.locate(u, v, ch.height, ch.circumference);
     let r = mesh
         .rects
         .iter()
         .position(|r| r.cylinder == c && r.strip == s)?;
     let rc = &mesh.rects[r];
-    let (i, x) = rc.column(up - lay.lines[s]);
+    let (i, x) = rc.column(x);
     let (j, y) = rc.row(v);
     let cell = (rc.first_cell + j * rc.m + i) as u32;
     Some((cell, x, y))

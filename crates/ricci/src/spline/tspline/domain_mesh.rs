@@ -427,12 +427,12 @@ impl DomainMesh {
         for (c, lay) in gluing.layouts.iter().enumerate() {
             let ch = &domain.cylinders[c];
             let n = ((ch.height / spacing).ceil() as usize).max(MIN_CELLS) + 2 * levels;
-            for s in 0..lay.lines.len() {
+            for s in 0..lay.strips() {
                 index.insert((c, s), rects.len());
                 rects.push(Rect {
                     cylinder: c,
                     strip: s,
-                    length: lay.strip_length(s, ch.circumference),
+                    length: lay.strip_length(s),
                     height: ch.height,
                     m: 0,
                     n,
@@ -471,7 +471,7 @@ impl DomainMesh {
         let cells = blocks::split_knots(&mut rects, &top, blocks)?;
         let right_rect = |r: usize| {
             let (c, s) = (rects[r].cylinder, rects[r].strip);
-            let k = gluing.layouts[c].lines.len();
+            let k = gluing.layouts[c].strips();
             index[&(c, (s + 1) % k)]
         };
         let cell = |r: usize, i: usize, j: usize| (rects[r].first_cell + j * rects[r].m + i) as u32;

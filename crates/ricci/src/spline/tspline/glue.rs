@@ -1,58 +1,146 @@
 //! Genus ≥ 2, step 3a: how the cylinders of [`super::genus_domain`] are glued along the
-//! critical trajectories, in a form that lets the cylinders' splines share their boundary
-//! control points (C⁰ across the critical trajectories by construction, issue 18).
+//! critical trajectories, cut into **strips** whose sides are glued whole, so that one mesh of
+//! knot intervals covers the closed surface ([`super::domain_mesh`], issue 18).
 //!
-//! Every cylinder's circles are cut by the copies of the zeros into **segments**; a top
-//! segment of one cylinder is a bottom segment of the next, up to a translation in `u`. Each
-//! cylinder gets a **sheared** coordinate `u' = u − shift − shear · v / H` (an affine change
-//! of its parameters, the surface is unchanged) such that the zero copies on its top and
-//! bottom circles lie on the same vertical lines `u' = lines[s]` (the **knot lines**, triple
-//! knots in the fit). The cylinder is then a cycle of vertical **strips** `[lines[s],
-//! lines[s + 1]]`; the top of strip `s` of cylinder `c` is glued, point for point with the
-//! same offset from the strip's left line, to the bottom of strip `s'` of another cylinder
-//! (a [`Glue`]). Both are read off the data: the copies from
-//! [`GenusDomain::zero_copies`], the glues from the mesh edges' [`GenusDomain::crossings`].
+//! **Interfaces.** The copies of the zeros cut every cylinder's top circle into intervals; each
+//! is a horizontal saddle connection (or a whole circle where a cylinder meets the next band
+//! without a zero on it), and its other side is an interval between consecutive zero copies on
+//! the bottom circle of one cylinder above, glued by a translation in `u`. Which one, and the
+//! translation, are read off the mesh edges' [`GenusDomain::crossings`] (the cylinder, interval
+//! and offset most crossings agree on; the others, next to a zero where the piecewise-linear
+//! development is not that of the flat surface, are counted as outliers).
 //!
-//! This needs, per cylinder, as many zero copies on top as on the bottom with the same cyclic
-//! gaps (true for the pants decompositions of genus 2 with one zero per critical level, e.g.
-//! eight.off); otherwise [`gluing`] says why not and the fit falls back to the penalty.
+//! **Lines.** A cylinder is cut into strips by segments from a point of its bottom circle to a
+//! point of its top circle (straight in `(u, v)`), one per zero copy. A cylinder has as many
+//! copies on top as on the bottom only in special cases (eight.off; in general a cylinder of
+//! genus ≥ 3 can have one copy below and two above, or none on a circle that is a regular level
+//! of another band's critical value), so **points are added** in the middle of interfaces: an
+//! added point lies on the top of one cylinder and the bottom of the next, so it balances one
+//! cylinder and unbalances the next; the points are routed along the directed graph
+//! "cylinder → cylinder above" from cylinders with more points below to cylinders with more
+//! above (shortest paths, preferring the longest intervals: a flow, which exists because the
+//! circumferences are a positive circulation on that graph), and every whole-circle interface
+//! gets at least one. Every cylinder then has `k` points on each circle; line `i` joins bottom
+//! point `i` to top point `i + r`, the rotation `r` (and the number of turns) chosen to make the
+//! lines as vertical as possible (least `Σ (u_top − u_bottom)²`). Added points are regular
+//! vertices of the mesh (valence 4); only the zero copies are its extraordinary points.
+//!
+//! **Strips and glues.** Strip `s` of a cylinder lies between lines `s` and `s + 1`; its top is
+//! glued whole to the bottom of one strip of the cylinder above (a [`Glue`]): the same two
+//! points seen from both sides. Following the glues upward, the strips form closed **chains**;
+//! every strip of a chain gets one knot length, the mean width of the chain's strips (a strip
+//! whose bottom and top widths differ is parametrized affinely on every level `v`), so glued
+//! sides carry the same knot intervals. When every cylinder's lines are parallel and the knot
+//! lengths are the widths (genus 2 with one zero per critical level, e.g. eight.off), the
+//! layout is a shear of the cylinder ([`CylinderLayout::rigid`], what the per-cylinder fit of
+//! [`super::cylinder_fit`] needs to share its boundary rows).
 
 use super::genus_domain::GenusDomain;
 use serde::Serialize;
+use std::collections::VecDeque;
 
-/// The sheared coordinate and the knot lines of one cylinder.
+/// How one cylinder is cut into strips.
 #[derive(Debug, Clone, Serialize)]
 pub struct CylinderLayout {
-    /// `u' = (u − shift − shear · v / H) mod L`.
+    /// `u` of line `i` on the bottom circle (`v = 0`): increasing, within one circumference.
+    pub bottom: Vec<f64>,
+    /// `u` of line `i` on the top circle (`v = H`), unwrapped so that line `i` is the segment
+    /// from `(bottom[i], 0)` to `(top[i], H)`: increasing, `top[k − 1] < top[0] + L`.
+    pub top: Vec<f64>,
+    /// Knot length of strip `s` (between lines `s` and `s + 1`, the last one wraps around).
+    pub lengths: Vec<f64>,
+    /// Whether line `i` ends at a zero copy on the bottom and on the top circle (else at an
+    /// added point).
+    pub zero_ends: Vec<[bool; 2]>,
+}
+
+/// A cylinder layout that is a shear: `u' = (u − shift − shear · v / H) mod L`, knot lines
+/// `u' = lines[s]` (`lines[0] = 0`), knot lengths equal to the widths.
+#[derive(Debug, Clone, Serialize)]
+pub struct RigidLayout {
     pub shift: f64,
     pub shear: f64,
-    /// Knot lines `u'` (sorted, `lines[0] = 0`): strip `s` is `[lines[s], lines[s + 1]]`,
-    /// the last one ends at `L`.
     pub lines: Vec<f64>,
 }
 
-impl CylinderLayout {
+impl RigidLayout {
     /// Length of strip `s` in a cylinder of circumference `l`.
     pub fn strip_length(&self, s: usize, l: f64) -> f64 {
         self.lines.get(s + 1).copied().unwrap_or(l) - self.lines[s]
     }
+}
 
-    /// The strip holding `u' ∈ [0, L)`.
-    pub fn strip(&self, u: f64) -> usize {
-        self.lines.partition_point(|&x| x <= u).saturating_sub(1)
+impl CylinderLayout {
+    /// Number of strips (= lines).
+    pub fn strips(&self) -> usize {
+        self.bottom.len()
+    }
+
+    /// Knot length of strip `s`.
+    pub fn strip_length(&self, s: usize) -> f64 {
+        self.lengths[s]
+    }
+
+    /// `u` of line `i` (`i ≤ k`; line `k` is line 0 one turn on) at height fraction `t = v / H`.
+    fn line_at(&self, i: usize, t: f64, l: f64) -> f64 {
+        let k = self.bottom.len();
+        let (j, turn) = if i >= k { (i - k, l) } else { (i, 0.0) };
+        turn + self.bottom[j] + (self.top[j] - self.bottom[j]) * t
+    }
+
+    /// The strip holding the point `(u, v)` of a cylinder of height `h` and circumference `l`,
+    /// and the knot coordinate in it (`0 ≤ x ≤` [`Self::strip_length`]).
+    pub fn locate(&self, u: f64, v: f64, h: f64, l: f64) -> (usize, f64) {
+        let t = (v / h).clamp(0.0, 1.0);
+        let k = self.bottom.len();
+        let x0 = self.line_at(0, t, l);
+        let u = x0 + (u - x0).rem_euclid(l);
+        let s = (1..k)
+            .take_while(|&i| self.line_at(i, t, l) <= u)
+            .last()
+            .unwrap_or(0);
+        let (a, b) = (self.line_at(s, t, l), self.line_at(s + 1, t, l));
+        let x = ((u - a) / (b - a)).clamp(0.0, 1.0) * self.lengths[s];
+        (s, x)
+    }
+
+    /// `u mod l` of the point of strip `s` with knot coordinate `x` at height `v` (the inverse
+    /// of [`Self::locate`]).
+    pub fn u_of(&self, s: usize, x: f64, v: f64, h: f64, l: f64) -> f64 {
+        let t = (v / h).clamp(0.0, 1.0);
+        let (a, b) = (self.line_at(s, t, l), self.line_at(s + 1, t, l));
+        (a + (b - a) * x / self.lengths[s]).rem_euclid(l)
+    }
+
+    /// The layout as a shear of the cylinder, when it is one (all lines parallel, knot
+    /// lengths equal to the widths, within `1e-6 l`).
+    pub fn rigid(&self, l: f64) -> Option<RigidLayout> {
+        let k = self.bottom.len();
+        let shear = self.top[0] - self.bottom[0];
+        let tol = TOL * l;
+        let parallel = (0..k).all(|i| (self.top[i] - self.bottom[i] - shear).abs() <= tol);
+        let widths = (0..k).all(|s| {
+            (self.line_at(s + 1, 0.0, l) - self.line_at(s, 0.0, l) - self.lengths[s]).abs() <= tol
+        });
+        (parallel && widths).then(|| RigidLayout {
+            shift: self.bottom[0],
+            shear,
+            lines: self.bottom.iter().map(|b| b - self.bottom[0]).collect(),
+        })
     }
 }
 
 /// The top of strip `lower_strip` of cylinder `lower` is the bottom of strip `upper_strip` of
-/// cylinder `upper`, offsets from the strips' left lines equal.
+/// cylinder `upper`, knot coordinates equal.
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct Glue {
     pub lower: usize,
     pub lower_strip: usize,
     pub upper: usize,
     pub upper_strip: usize,
+    /// The knot length of both strips.
     pub length: f64,
-    /// Mesh-edge crossings that gave this glue.
+    /// Mesh-edge crossings of the interface this glue lies on.
     pub crossings: usize,
 }
 
@@ -61,30 +149,89 @@ pub struct Glue {
 pub struct Gluing {
     pub layouts: Vec<CylinderLayout>,
     pub glues: Vec<Glue>,
-    /// Largest disagreement (relative to the circumference) between the zero copies on a
-    /// cylinder's top and bottom after the shear, between glued strips' lengths, and between
-    /// the crossings' offsets on the two sides.
+    /// Largest disagreement (relative to the circumference) between the two sides' lengths of
+    /// an interface and of a glued strip side.
     pub mismatch: f64,
-    /// Crossings that disagree with the glue of their strip, and their largest distance to a
-    /// knot line (relative to the circumference).
+    /// Crossings that disagree with the glue of their interface, and their largest distance
+    /// to a zero copy (relative to the circumference).
     pub outliers: usize,
     pub outlier_distance: f64,
+    /// Points added on the interfaces (lines not through a zero), and interfaces.
+    pub added_points: usize,
+    pub interfaces: usize,
+    /// Largest `|u_top − u_bottom| / H` of a line (its slope against the vertical).
+    pub max_slope: f64,
+}
+
+impl Gluing {
+    /// The layouts as shears of the cylinders when every one is ([`CylinderLayout::rigid`]).
+    pub fn rigid(&self, domain: &GenusDomain) -> Option<Vec<RigidLayout>> {
+        self.layouts
+            .iter()
+            .zip(&domain.cylinders)
+            .map(|(y, c)| y.rigid(c.circumference))
+            .collect()
+    }
 }
 
 const TOL: f64 = 1e-6;
-
-/// A crossing seen from a top strip: upper cylinder and strip, the offsets from the strips'
-/// left lines on both sides, the distance to the nearest knot line (relative to `L`).
-type Vote = (usize, usize, f64, f64, f64);
 
 fn wrap_dist(a: f64, b: f64, l: f64) -> f64 {
     let d = (a - b).rem_euclid(l);
     d.min(l - d)
 }
 
-fn layout(domain: &GenusDomain, c: usize) -> Result<(CylinderLayout, f64), String> {
-    let l = domain.cylinders[c].circumference;
-    let copies = |top: bool| {
+/// The intervals of a circle of circumference `l` cut at `copies` (sorted): `(start, length)`;
+/// one closed interval `(0, l)` without copies.
+fn intervals(copies: &[f64], l: f64) -> Vec<(f64, f64)> {
+    let k = copies.len();
+    if k == 0 {
+        return vec![(0.0, l)];
+    }
+    (0..k)
+        .map(|i| {
+            let end = if i + 1 < k {
+                copies[i + 1]
+            } else {
+                copies[0] + l
+            };
+            (copies[i], end - copies[i])
+        })
+        .collect()
+}
+
+/// The interval of `iv` holding `u`, and the offset of `u` from its start.
+fn interval_of(iv: &[(f64, f64)], u: f64, l: f64) -> (usize, f64) {
+    let i = iv
+        .iter()
+        .rposition(|&(s, _)| s <= u)
+        .unwrap_or(iv.len() - 1);
+    (i, (u - iv[i].0).rem_euclid(l))
+}
+
+/// One side of an interface: a top interval of `lower` glued to a bottom interval of `upper`,
+/// `offset_upper = offset_lower − rotation` (`rotation ≠ 0` only on whole circles).
+#[derive(Debug, Clone, Copy)]
+struct Interface {
+    lower: usize,
+    upper: usize,
+    lower_start: f64,
+    upper_start: f64,
+    length: f64,
+    rotation: f64,
+    closed: bool,
+    crossings: usize,
+}
+
+/// A point on a circle: `u`, the interface it lies on and its index there (0: the interval's
+/// start, a zero copy; on a whole circle the added points are numbered from 0).
+type Labelled = (f64, (usize, usize), bool);
+
+/// The layouts and glues of `domain`, or a sentence saying why the strips do not match.
+pub fn gluing(domain: &GenusDomain) -> Result<Gluing, String> {
+    let nc = domain.cylinders.len();
+    let circ: Vec<f64> = domain.cylinders.iter().map(|c| c.circumference).collect();
+    let copies = |c: usize, top: bool| {
         let mut u: Vec<f64> = domain
             .zero_copies
             .iter()
@@ -94,133 +241,98 @@ fn layout(domain: &GenusDomain, c: usize) -> Result<(CylinderLayout, f64), Strin
         u.sort_by(f64::total_cmp);
         u
     };
-    let (bottom, top) = (copies(false), copies(true));
-    if bottom.is_empty() || bottom.len() != top.len() {
-        return Err(format!(
-            "cylinder {c} has {} zero copies on its bottom circle and {} on its top circle",
-            bottom.len(),
-            top.len()
-        ));
-    }
-    let shift = bottom[0];
-    let b: Vec<f64> = bottom.iter().map(|x| x - shift).collect();
-    let mut t: Vec<f64> = top.iter().map(|x| (x - shift).rem_euclid(l)).collect();
-    t.sort_by(f64::total_cmp);
-    let k = b.len();
-    let mut best: Option<(f64, f64)> = None; // (shear, mismatch)
-    for r in 0..k {
-        let mut shear = t[r].rem_euclid(l);
-        if shear > 0.5 * l {
-            shear -= l;
-        }
-        let worst = (0..k)
-            .map(|i| wrap_dist(t[(r + i) % k] - shear, b[i], l))
-            .fold(0.0, f64::max);
-        if worst < TOL * l && best.is_none_or(|(s, _)| shear.abs() < s.abs()) {
-            best = Some((shear, worst / l));
-        }
-    }
-    let Some((shear, mismatch)) = best else {
-        return Err(format!(
-            "the zero copies on the top of cylinder {c} are not a shear of those on its bottom"
-        ));
+    let zb: Vec<Vec<f64>> = (0..nc).map(|c| copies(c, false)).collect();
+    let zt: Vec<Vec<f64>> = (0..nc).map(|c| copies(c, true)).collect();
+    let ib: Vec<Vec<(f64, f64)>> = (0..nc).map(|c| intervals(&zb[c], circ[c])).collect();
+    let it: Vec<Vec<(f64, f64)>> = (0..nc).map(|c| intervals(&zt[c], circ[c])).collect();
+    let first = |iv: &[Vec<(f64, f64)>]| -> Vec<usize> {
+        iv.iter()
+            .scan(0, |at, v| {
+                let f = *at;
+                *at += v.len();
+                Some(f)
+            })
+            .collect()
     };
-    Ok((
-        CylinderLayout {
-            shift,
-            shear,
-            lines: b,
-        },
-        mismatch,
-    ))
-}
-
-/// The layouts and glues of `domain`, or a sentence saying why the strips do not match.
-pub fn gluing(domain: &GenusDomain) -> Result<Gluing, String> {
-    let nc = domain.cylinders.len();
-    let mut layouts = Vec::with_capacity(nc);
-    let mut mismatch = 0.0f64;
-    for c in 0..nc {
-        let (lay, m) = layout(domain, c)?;
-        mismatch = mismatch.max(m);
-        layouts.push(lay);
+    let (ft, fb) = (first(&it), first(&ib));
+    let ntop: usize = it.iter().map(Vec::len).sum();
+    let nbottom: usize = ib.iter().map(Vec::len).sum();
+    if ntop != nbottom {
+        return Err(format!(
+            "the cylinders' top circles have {ntop} intervals between zero copies and their bottom circles {nbottom}"
+        ));
     }
-    // per (cylinder, strip): the glue on its top
-    let first: Vec<usize> = layouts
-        .iter()
-        .scan(0, |at, lay| {
-            let f = *at;
-            *at += lay.lines.len();
-            Some(f)
-        })
-        .collect();
-    let strips = first.last().map_or(0, |f| f + layouts[nc - 1].lines.len());
-    // per crossing: (top strip, upper cylinder, upper strip, offsets, distance to a line / L)
-    let mut votes: Vec<Vec<Vote>> = vec![Vec::new(); strips];
+    // votes per top interval: (upper cylinder, its bottom interval, offset difference, distance
+    // of the crossing to a zero copy / L)
+    let mut votes: Vec<Vec<(usize, usize, f64, f64)>> = vec![Vec::new(); ntop];
+    let near = |z: &[f64], u: f64, l: f64| {
+        z.iter()
+            .map(|&x| wrap_dist(u, x, l) / l)
+            .fold(0.5f64, f64::min)
+    };
     for x in &domain.crossings {
         let (a, b) = (x.lower, x.upper);
-        let (la, lb) = (
-            domain.cylinders[a].circumference,
-            domain.cylinders[b].circumference,
-        );
-        let (ya, yb) = (&layouts[a], &layouts[b]);
-        let ua = (x.u_lower - ya.shift - ya.shear).rem_euclid(la);
-        let ub = (x.u_upper - yb.shift).rem_euclid(lb);
-        let near = |y: &CylinderLayout, u: f64, l: f64| {
-            y.lines
-                .iter()
-                .map(|&z| wrap_dist(u, z, l) / l)
-                .fold(f64::INFINITY, f64::min)
-        };
-        let d = near(ya, ua, la).min(near(yb, ub, lb));
-        let (sa, sb) = (ya.strip(ua), yb.strip(ub));
-        votes[first[a] + sa].push((b, sb, ua - ya.lines[sa], ub - yb.lines[sb], d));
+        let (j, oa) = interval_of(&it[a], x.u_lower.rem_euclid(circ[a]), circ[a]);
+        let (i, ob) = interval_of(&ib[b], x.u_upper.rem_euclid(circ[b]), circ[b]);
+        let d = near(&zt[a], x.u_lower, circ[a]).min(near(&zb[b], x.u_upper, circ[b]));
+        votes[ft[a] + j].push((b, i, oa - ob, d));
     }
-    // the glue of a top strip: the (cylinder, strip) most of its crossings go to with equal
-    // offsets; the others (next to a zero, where the piecewise-linear development of the
-    // edges around the cone point is not that of the flat surface) are outliers
-    let mut top: Vec<Option<Glue>> = vec![None; strips];
-    let (mut outliers, mut outlier_distance) = (0, 0.0f64);
-    for (c, lay) in layouts.iter().enumerate() {
-        let lc = domain.cylinders[c].circumference;
-        for s in 0..lay.lines.len() {
-            let v = &votes[first[c] + s];
-            let good = |t: &Vote| (t.2 - t.3).abs() <= TOL * lc;
-            let mut best: Option<((usize, usize), usize)> = None;
-            for t in v.iter().filter(|t| good(t)) {
-                let n = v
-                    .iter()
-                    .filter(|o| good(o) && (o.0, o.1) == (t.0, t.1))
-                    .count();
+    // the interface of every top interval: the (cylinder, interval, offset) most crossings
+    // agree on; the offset difference must vanish unless both sides are whole circles
+    let mut faces: Vec<Interface> = Vec::with_capacity(ntop);
+    let mut bottom_of = vec![usize::MAX; nbottom];
+    let (mut outliers, mut outlier_distance, mut mismatch) = (0usize, 0.0f64, 0.0f64);
+    for c in 0..nc {
+        let l = circ[c];
+        for (j, &(start, length)) in it[c].iter().enumerate() {
+            let v = &votes[ft[c] + j];
+            let closed = zt[c].is_empty();
+            let agree = |p: &(usize, usize, f64, f64), q: &(usize, usize, f64, f64)| {
+                (p.0, p.1) == (q.0, q.1) && wrap_dist(p.2, q.2, l) <= TOL * l
+            };
+            let admissible = |p: &(usize, usize, f64, f64)| {
+                closed == zb[p.0].is_empty() && (closed || wrap_dist(p.2, 0.0, l) <= TOL * l)
+            };
+            let mut best: Option<(usize, usize)> = None; // (index of a vote, count)
+            for (k, p) in v.iter().enumerate().filter(|(_, p)| admissible(p)) {
+                let n = v.iter().filter(|q| agree(p, q)).count();
                 if best.is_none_or(|(_, m)| n > m) {
-                    best = Some(((t.0, t.1), n));
+                    best = Some((k, n));
                 }
             }
-            let Some(((b, sb), n)) = best else {
+            let Some((k, n)) = best else {
                 return Err(format!(
-                    "no mesh edge crosses the top of strip {s} of cylinder {c} consistently"
+                    "no mesh edge crosses the top of cylinder {c} consistently (interval {j} of {})",
+                    it[c].len()
                 ));
             };
-            for t in v.iter().filter(|t| !(good(t) && (t.0, t.1) == (b, sb))) {
+            let p = v[k];
+            for q in v.iter().filter(|q| !agree(&p, q)) {
                 outliers += 1;
-                outlier_distance = outlier_distance.max(t.4);
+                outlier_distance = outlier_distance.max(q.3);
             }
-            let (length, lenb) = (
-                lay.strip_length(s, lc),
-                layouts[b].strip_length(sb, domain.cylinders[b].circumference),
-            );
-            mismatch = mismatch.max((length - lenb).abs() / lc);
-            if (length - lenb).abs() > TOL * lc {
+            let (b, i) = (p.0, p.1);
+            let (ustart, ulen) = ib[b][i];
+            mismatch = mismatch.max((length - ulen).abs() / l);
+            if (length - ulen).abs() > TOL * l.max(circ[b]) {
                 return Err(format!(
-                    "strip {s} of cylinder {c} (length {length}) is glued to strip {sb} of cylinder {b} (length {lenb})"
+                    "interval {j} on the top of cylinder {c} (length {length}) is glued to interval {i} on the bottom of cylinder {b} (length {ulen})"
                 ));
             }
-            top[first[c] + s] = Some(Glue {
+            if bottom_of[fb[b] + i] != usize::MAX {
+                return Err(format!(
+                    "interval {i} on the bottom of cylinder {b} is glued twice"
+                ));
+            }
+            bottom_of[fb[b] + i] = faces.len();
+            faces.push(Interface {
                 lower: c,
-                lower_strip: s,
                 upper: b,
-                upper_strip: sb,
+                lower_start: start,
+                upper_start: ustart,
                 length,
+                rotation: if closed { p.2.rem_euclid(l) } else { 0.0 },
+                closed,
                 crossings: n,
             });
         }
@@ -228,28 +340,161 @@ pub fn gluing(domain: &GenusDomain) -> Result<Gluing, String> {
     let total = domain.crossings.len();
     if 20 * outliers > total || outlier_distance > 0.05 {
         return Err(format!(
-            "{outliers} of {total} crossings of the critical levels disagree with the glues of their strips (up to {outlier_distance:.2e} of the circumference from a zero)"
+            "{outliers} of {total} crossings of the critical levels disagree with the glues of their intervals (up to {outlier_distance:.2e} of the circumference from a zero)"
         ));
     }
+    let added = balance(&faces, nc)?;
+    // the labelled points on every circle
+    let mut pts_bottom: Vec<Vec<Labelled>> = vec![Vec::new(); nc];
+    let mut pts_top: Vec<Vec<Labelled>> = vec![Vec::new(); nc];
+    for (e, f) in faces.iter().enumerate() {
+        let x = added[e];
+        let (lo, up) = (circ[f.lower], circ[f.upper]);
+        let offsets: Vec<(usize, f64)> = if f.closed {
+            (0..x)
+                .map(|k| (k, f.length * k as f64 / x as f64))
+                .collect()
+        } else {
+            (0..=x)
+                .map(|k| (k, f.length * k as f64 / (x + 1) as f64))
+                .collect()
+        };
+        for (k, o) in offsets {
+            let zero = !f.closed && k == 0;
+            pts_top[f.lower].push(((f.lower_start + o).rem_euclid(lo), (e, k), zero));
+            pts_bottom[f.upper].push((
+                (f.upper_start + o - f.rotation).rem_euclid(up),
+                (e, k),
+                zero,
+            ));
+        }
+    }
+    let mut layouts = Vec::with_capacity(nc);
+    let mut labels_bottom = Vec::with_capacity(nc);
+    let mut labels_top = Vec::with_capacity(nc);
+    let mut max_slope = 0.0f64;
+    for c in 0..nc {
+        let (bp, tp) = (&mut pts_bottom[c], &mut pts_top[c]);
+        bp.sort_by(|p, q| p.0.total_cmp(&q.0));
+        tp.sort_by(|p, q| p.0.total_cmp(&q.0));
+        let k = bp.len();
+        if k == 0 || k != tp.len() {
+            return Err(format!(
+                "cylinder {c} has {k} points on its bottom circle and {} on its top after balancing",
+                tp.len()
+            ));
+        }
+        let l = circ[c];
+        let unwrapped = |j: isize| {
+            let (q, r) = (j.div_euclid(k as isize), j.rem_euclid(k as isize) as usize);
+            tp[r].0 + q as f64 * l
+        };
+        let cost = |r: isize| -> f64 {
+            (0..k)
+                .map(|i| (unwrapped(i as isize + r) - bp[i].0).powi(2))
+                .sum()
+        };
+        let r = (-(k as isize)..2 * k as isize)
+            .min_by(|&a, &b| cost(a).total_cmp(&cost(b)))
+            .unwrap_or(0);
+        let bottom: Vec<f64> = bp.iter().map(|p| p.0).collect();
+        let top: Vec<f64> = (0..k).map(|i| unwrapped(i as isize + r)).collect();
+        let tl: Vec<Labelled> = (0..k)
+            .map(|i| tp[(i as isize + r).rem_euclid(k as isize) as usize])
+            .collect();
+        let h = domain.cylinders[c].height;
+        for i in 0..k {
+            max_slope = max_slope.max((top[i] - bottom[i]).abs() / h);
+        }
+        layouts.push(CylinderLayout {
+            zero_ends: (0..k).map(|i| [bp[i].2, tl[i].2]).collect(),
+            bottom,
+            top,
+            lengths: vec![0.0; k],
+        });
+        labels_bottom.push(bp.iter().map(|p| p.1).collect::<Vec<_>>());
+        labels_top.push(tl.iter().map(|p| p.1).collect::<Vec<_>>());
+    }
+    // glues: the top of strip s starts at the label of line s's top end; the strip above
+    // starts at the same label on its bottom
+    let firsts: Vec<usize> = layouts
+        .iter()
+        .scan(0, |at, y| {
+            let f = *at;
+            *at += y.strips();
+            Some(f)
+        })
+        .collect();
+    let strips: usize = layouts.iter().map(|y| y.strips()).sum();
+    let mut up_of = vec![usize::MAX; strips];
     let mut glues = Vec::with_capacity(strips);
-    let mut bottom_seen = vec![false; strips];
-    for (c, lay) in layouts.iter().enumerate() {
-        for s in 0..lay.lines.len() {
-            let Some(g) = top[first[c] + s] else {
+    let width =
+        |y: &CylinderLayout, s: usize, t: f64, l: f64| y.line_at(s + 1, t, l) - y.line_at(s, t, l);
+    for c in 0..nc {
+        for s in 0..layouts[c].strips() {
+            let label = labels_top[c][s];
+            let b = faces[label.0].upper;
+            let Some(m) = labels_bottom[b].iter().position(|&x| x == label) else {
                 return Err(format!(
-                    "no mesh edge crosses the top of strip {s} of cylinder {c}"
+                    "the top of strip {s} of cylinder {c} starts at a point missing on the bottom of cylinder {b}"
                 ));
             };
-            let seen = &mut bottom_seen[first[g.upper] + g.upper_strip];
-            if *seen {
+            let (wt, wb) = (
+                width(&layouts[c], s, 1.0, circ[c]),
+                width(&layouts[b], m, 0.0, circ[b]),
+            );
+            mismatch = mismatch.max((wt - wb).abs() / circ[c]);
+            if (wt - wb).abs() > TOL * circ[c].max(circ[b]) {
                 return Err(format!(
-                    "the bottom of strip {} of cylinder {} is glued twice",
-                    g.upper_strip, g.upper
+                    "the top of strip {s} of cylinder {c} (width {wt}) is glued to the bottom of strip {m} of cylinder {b} (width {wb})"
                 ));
             }
-            *seen = true;
-            glues.push(g);
+            up_of[firsts[c] + s] = firsts[b] + m;
+            glues.push(Glue {
+                lower: c,
+                lower_strip: s,
+                upper: b,
+                upper_strip: m,
+                length: 0.0,
+                crossings: faces[label.0].crossings,
+            });
         }
+    }
+    // one knot length per chain of strips glued top to bottom: the mean width
+    let owner: Vec<(usize, usize)> = (0..nc)
+        .flat_map(|c| (0..layouts[c].strips()).map(move |s| (c, s)))
+        .collect();
+    let mut done = vec![false; strips];
+    for r0 in 0..strips {
+        if done[r0] {
+            continue;
+        }
+        let mut chain = vec![r0];
+        let mut r = up_of[r0];
+        while r != r0 {
+            if chain.len() > strips || done[r] {
+                return Err("the glues of the strips' tops are not a permutation".into());
+            }
+            chain.push(r);
+            r = up_of[r];
+        }
+        let mean = chain
+            .iter()
+            .map(|&r| {
+                let (c, s) = owner[r];
+                let y = &layouts[c];
+                0.5 * (width(y, s, 0.0, circ[c]) + width(y, s, 1.0, circ[c]))
+            })
+            .sum::<f64>()
+            / chain.len() as f64;
+        for &r in &chain {
+            let (c, s) = owner[r];
+            layouts[c].lengths[s] = mean;
+            done[r] = true;
+        }
+    }
+    for g in &mut glues {
+        g.length = layouts[g.lower].lengths[g.lower_strip];
     }
     Ok(Gluing {
         layouts,
@@ -257,5 +502,69 @@ pub fn gluing(domain: &GenusDomain) -> Result<Gluing, String> {
         mismatch,
         outliers,
         outlier_distance,
+        added_points: added.iter().sum(),
+        interfaces: faces.len(),
+        max_slope,
     })
+}
+
+/// Points to add per interface so that every cylinder has as many points on its bottom circle
+/// as on its top (the module doc): at least one on a whole circle, then units of flow from
+/// cylinders with more points below to cylinders with more above along shortest directed
+/// paths, each step over the interface with the longest gaps.
+fn balance(faces: &[Interface], nc: usize) -> Result<Vec<usize>, String> {
+    let mut x: Vec<usize> = faces.iter().map(|f| usize::from(f.closed)).collect();
+    // points below minus points above, per cylinder
+    let mut excess = vec![0isize; nc];
+    for (f, &n) in faces.iter().zip(&x) {
+        let pts = n as isize + isize::from(!f.closed);
+        excess[f.upper] += pts;
+        excess[f.lower] -= pts;
+    }
+    let mut out: Vec<Vec<usize>> = vec![Vec::new(); nc];
+    for (e, f) in faces.iter().enumerate() {
+        out[f.lower].push(e);
+    }
+    let budget = faces.len() * nc + nc;
+    for _ in 0..budget {
+        let Some(src) = excess.iter().position(|&d| d > 0) else {
+            return Ok(x);
+        };
+        // breadth-first search upward to a cylinder with more points above
+        let mut via = vec![usize::MAX; nc];
+        let mut seen = vec![false; nc];
+        seen[src] = true;
+        let mut queue = VecDeque::from([src]);
+        let mut sink = None;
+        while let Some(c) = queue.pop_front() {
+            if excess[c] < 0 {
+                sink = Some(c);
+                break;
+            }
+            let mut edges = out[c].clone();
+            let gap = |e: usize| faces[e].length / (x[e] + 2) as f64;
+            edges.sort_by(|&a, &b| gap(b).total_cmp(&gap(a)));
+            for e in edges {
+                let u = faces[e].upper;
+                if !seen[u] {
+                    seen[u] = true;
+                    via[u] = e;
+                    queue.push_back(u);
+                }
+            }
+        }
+        let Some(mut c) = sink else {
+            return Err(format!(
+                "cylinder {src} has more zero copies on its bottom circle than on its top and no cylinder above it has fewer"
+            ));
+        };
+        excess[c] += 1;
+        excess[src] -= 1;
+        while c != src {
+            let e = via[c];
+            x[e] += 1;
+            c = faces[e].lower;
+        }
+    }
+    Err("balancing the points on the cylinders' circles did not finish".into())
 }
