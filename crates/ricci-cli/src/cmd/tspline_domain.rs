@@ -214,6 +214,13 @@ pub fn domain_spline(
         "bezier_elements": merge,
         "continuity": continuity,
         "gluing_mismatch": gluing.mismatch,
+        "gluing": {
+            "interfaces": gluing.interfaces,
+            "added_points": gluing.added_points,
+            "max_line_slope": gluing.max_slope,
+            "sheared_cylinders": gluing.rigid(domain).is_some(),
+            "what": "interfaces: intervals of the critical trajectories between zero copies (or whole circles); added_points: points added on them so every cylinder has as many on its top circle as on its bottom (regular vertices of the mesh); lines join them across each cylinder, max_line_slope = largest |u_top - u_bottom| / H; sheared_cylinders: every cylinder's lines parallel and its knot lengths its widths",
+        },
         "max_deviation_between_vertices_percent": between_max,
         "rms_deviation_between_vertices_percent": between_rms,
         "between_vertices_data": if on { "points on the input triangles (centroid, edge midpoints) in the least squares too, weight 0.1 per point times area over mean area; kept because nearer the triangles between the vertices than the fit of the vertices only" } else { "the input vertices only (the fit with points on the input triangles too was not nearer the triangles between the vertices)" },

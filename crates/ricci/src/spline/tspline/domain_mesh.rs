@@ -2,10 +2,13 @@
 //! mesh of knot intervals over all the cylinders' strips, glued by the translations of
 //! [`super::glue`], instead of one spline per cylinder.
 //!
-//! The strips of [`super::glue::Gluing`] are rectangles `[0, length] × [0, H]` whose sides are
-//! glued **whole** by translations: the right side of strip `s` to the left side of strip
+//! The strips of [`super::glue::Gluing`] are rectangles `[0, length] × [0, H]` in knot space
+//! whose sides are glued **whole**: the right side of strip `s` to the left side of strip
 //! `s + 1` of the same cylinder, the top to the bottom of one strip of the next band (equal
-//! lengths). Every rectangle corner is a zero of the form. Cutting every strip into `m × n`
+//! knot lengths along every chain of strips glued top to bottom). Every rectangle corner is a
+//! zero of the form or a point the gluing added on a critical trajectory (genus ≥ 3, where a
+//! cylinder's circles carry different zero copies; a regular vertex: four cells meet there).
+//! Cutting every strip into `m × n`
 //! cells, with `m` the same along every chain of strips glued top to bottom and `n` the same
 //! in every cylinder (at least 5 each), gives a conforming quad mesh of the closed surface (no T-junctions) whose
 //! only vertices of valence ≠ 4 are the zeros (valence `4 (k + 1)` at a zero of order `k`).
