@@ -4,9 +4,9 @@
 //! defects). [`render_net_and_zebra`] is shared by the genus-1 T-mesh
 //! (`crate::cmd::tspline::pictures`) and the genus ≥ 2 domain mesh ([`domain_pictures`]):
 //! the cells' sides mapped through the spline, the strips' sides (critical horizontal
-//! trajectories and the vertical sides through the zeros) drawn darker, and a ring around
-//! every zero (the extraordinary points). The domain mesh is conforming: it has no
-//! T-junctions.
+//! trajectories and the sides across the cylinders from the zeros and the gluing's added
+//! points) drawn darker, and a ring around every zero (the extraordinary points). T-junctions
+//! (graded lines, blocks) are ringed in red.
 
 use ricci::spline::tspline::domain_fit::DomainFit;
 use ricci_render::{render, Camera, Image, Paint, Polyline, RenderOptions, Style};
@@ -297,7 +297,7 @@ pub fn domain_caption(info: &DomainPictures, cells: usize) -> String {
         format!("the sides of all {cells} cells")
     };
     format!(
-        "The domain mesh on the surface: {lines} mapped through the spline in dark grey, the strips' sides (critical horizontal trajectories of the 1-form and the vertical sides through its zeros) in blue, and the {} zeros of the form — the extraordinary points, where the spline is G¹ — ringed in orange; lines on the far side of the surface are not drawn. {}",
+        "The domain mesh on the surface: {lines} mapped through the spline in dark grey, the strips' sides (critical horizontal trajectories of the 1-form and the sides across its cylinders from its zeros, and from the points the gluing added where a cylinder's two circles carry different zero copies) in blue, and the {} zeros of the form — the extraordinary points, where the spline is G¹ — ringed in orange; lines on the far side of the surface are not drawn. {}",
         info.zeros,
         if info.t_junctions > 0 {
             format!("The graded lines at the zeros and the lines of any blocks (cells split 2×2 where the error was beyond the tolerance, nested where it stayed) end in the {} T-junctions ringed in red (the T-mesh; its sides only are drawn).", info.t_junctions)
