@@ -42,7 +42,8 @@ def generated(tmp_path_factory):
     """Procedural surfaces made by `ricci generate` (no shared meshes needed)."""
     d = tmp_path_factory.mktemp("generated")
     out = {}
-    for kind, extra in [("torus", []), ("genus", ["--genus", "2"]), ("disk", []), ("sphere", [])]:
+    kinds = [("torus", []), ("genus", ["--genus", "2"]), ("disk", []), ("sphere", [])]
+    for kind, extra in kinds + [("genus3", ["-n", "30"])]:
         path = d / f"{kind}.off"
         cli("generate", kind, *extra, "--out", path)
         out[kind] = path

@@ -2,7 +2,7 @@
 B_SPLINE_SURFACE_WITH_KNOTS faces) and IGES (entity 128) files open without errors, have one
 face per Bézier patch, every face passes BRepCheck, and the surfaces Open CASCADE builds agree
 with our own T-spline evaluation (samples.json, written by the CLI) to 1e-9. Genus 1 (torus,
-kitten) and genus 2 (generated, eight: the default spline on the quad mesh of the glued strips
+kitten), genus 2 (generated, eight) and genus 3 (generated: the default spline on the quad mesh of the glued strips
 of a holomorphic 1-form's cylinders, one Bézier patch per Bézier element: the cells merged
 where the spline is one polynomial).
 
@@ -91,16 +91,16 @@ def test_kitten_step_and_iges_open_in_open_cascade(tmp_path):
         check_file(tmp_path / name, samples)
 
 
-def check_genus_two(rep, samples, tol_percent):
+def check_genus_two(rep, samples, tol_percent, zeros=2):
     """Genus >= 2, the default: one spline on the quad mesh over the glued strips of the
     cylinders; continuity measured per class of cell sides (C2 on every side not at a zero,
     C1 in the translation chart, hence G1, at the zeros), the same surface point from both
-    patches of every side."""
+    patches of every side. `zeros`: 2g - 2 simple zeros."""
     assert rep["spline"] == "domain_mesh"
     assert rep["converged"] and rep["max_error_percent"] <= tol_percent
     assert rep["control_points"] <= 20000
     cont = rep["continuity"]
-    assert cont["extraordinary_points"] == 2
+    assert cont["extraordinary_points"] == zeros
     assert cont["at_zeros"]["class"] == "C1" and cont["at_zeros"]["sides"] > 0
     assert cont["elsewhere"]["class"] in ("C2", "C3") and cont["elsewhere"]["sides"] > 0
     assert cont["one_interval_from_zeros"]["class"] in ("C2", "C3")
@@ -116,6 +116,14 @@ def check_genus_two(rep, samples, tol_percent):
 def test_generated_genus_two_step_and_iges_open_in_open_cascade(generated, tmp_path):
     rep, samples = run_tspline(generated["genus"], tmp_path, "--tolerance", "1%")
     check_genus_two(rep, samples, 1.0)
+    for name in ("tspline.step", "tspline.igs"):
+        check_file(tmp_path / name, samples)
+
+
+def test_generated_genus_three_step_and_iges_open_in_open_cascade(generated, tmp_path):
+    # genus 3 (session 18): the strips of the cylinders glue into one quad mesh there too
+    rep, samples = run_tspline(generated["genus3"], tmp_path, "--tolerance", "1%")
+    check_genus_two(rep, samples, 1.0, zeros=4)
     for name in ("tspline.step", "tspline.igs"):
         check_file(tmp_path / name, samples)
 
