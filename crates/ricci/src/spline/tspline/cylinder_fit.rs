@@ -605,6 +605,18 @@ fn refine(
     (next_spans, next_nv)
 }
 
+/// The gluing of `domain` when every cylinder's layout is a shear (what sharing the boundary
+/// rows of tensor-product splines in sheared coordinates needs), or why not.
+fn sheared_gluing(domain: &GenusDomain) -> std::result::Result<Gluing, String> {
+    gluing(domain).and_then(|g| match g.rigid(domain) {
+        Some(_) => Ok(g),
+        None => Err(
+            "the strips are not a shear of every cylinder (their lines are not parallel)"
+                .to_string(),
+        ),
+    })
+}
+
 /// Fit every cylinder of `domain` to `positions` (indexed by the points' `vertex`).
 pub fn fit_cylinders(
     domain: &GenusDomain,
@@ -621,13 +633,7 @@ pub fn fit_cylinders(
     let tol = opts.tolerance * scale;
     let nc = domain.cylinders.len();
     let gluing = if opts.share {
-        gluing(domain).and_then(|g| match g.rigid(domain) {
-            Some(_) => Ok(g),
-            None => Err(
-                "the strips are not a shear of every cylinder (their lines are not parallel)"
-                    .to_string(),
-            ),
-        })
+        sheared_gluing(domain)
     } else {
         Err("sharing the boundary rows was switched off".to_string())
     };

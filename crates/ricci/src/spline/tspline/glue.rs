@@ -227,104 +227,143 @@ struct Interface {
 /// start, a zero copy; on a whole circle the added points are numbered from 0).
 type Labelled = (f64, (usize, usize), bool);
 
-/// The layouts and glues of `domain`, or a sentence saying why the strips do not match.
-pub fn gluing(domain: &GenusDomain) -> Result<Gluing, String> {
-    let nc = domain.cylinders.len();
-    let circ: Vec<f64> = domain.cylinders.iter().map(|c| c.circumference).collect();
-    let copies = |c: usize, top: bool| {
-        let mut u: Vec<f64> = domain
-            .zero_copies
-            .iter()
-            .filter(|z| z.cylinder == c && z.top == top)
-            .map(|z| z.u)
-            .collect();
-        u.sort_by(f64::total_cmp);
-        u
-    };
-    let zb: Vec<Vec<f64>> = (0..nc).map(|c| copies(c, false)).collect();
-    let zt: Vec<Vec<f64>> = (0..nc).map(|c| copies(c, true)).collect();
-    let ib: Vec<Vec<(f64, f64)>> = (0..nc).map(|c| intervals(&zb[c], circ[c])).collect();
-    let it: Vec<Vec<(f64, f64)>> = (0..nc).map(|c| intervals(&zt[c], circ[c])).collect();
-    let first = |iv: &[Vec<(f64, f64)>]| -> Vec<usize> {
-        iv.iter()
-            .scan(0, |at, v| {
-                let f = *at;
-                *at += v.len();
-                Some(f)
-            })
-            .collect()
-    };
-    let (ft, fb) = (first(&it), first(&ib));
-    let ntop: usize = it.iter().map(Vec::len).sum();
-    let nbottom: usize = ib.iter().map(Vec::len).sum();
+/// The zero copies of every cylinder's circles and the intervals they cut them into.
+struct Circles {
+    circ: Vec<f64>,
+    /// Zero copies (sorted `u`) on the bottom and top circles.
+    zb: Vec<Vec<f64>>,
+    zt: Vec<Vec<f64>>,
+    /// Intervals `(start, length)` of the bottom and top circles, and the first index of each
+    /// cylinder's in the concatenation.
+    ib: Vec<Vec<(f64, f64)>>,
+    it: Vec<Vec<(f64, f64)>>,
+    fb: Vec<usize>,
+    ft: Vec<usize>,
+}
+
+fn firsts<T>(per: &[Vec<T>]) -> Vec<usize> {
+    per.iter()
+        .scan(0, |at, v| {
+            let f = *at;
+            *at += v.len();
+            Some(f)
+        })
+        .collect()
+}
+
+impl Circles {
+    fn new(domain: &GenusDomain) -> Self {
+        let nc = domain.cylinders.len();
+        let circ: Vec<f64> = domain.cylinders.iter().map(|c| c.circumference).collect();
+        let copies = |c: usize, top: bool| {
+            let mut u: Vec<f64> = domain
+                .zero_copies
+                .iter()
+                .filter(|z| z.cylinder == c && z.top == top)
+                .map(|z| z.u)
+                .collect();
+            u.sort_by(f64::total_cmp);
+            u
+        };
+        let zb: Vec<Vec<f64>> = (0..nc).map(|c| copies(c, false)).collect();
+        let zt: Vec<Vec<f64>> = (0..nc).map(|c| copies(c, true)).collect();
+        let ib: Vec<Vec<(f64, f64)>> = (0..nc).map(|c| intervals(&zb[c], circ[c])).collect();
+        let it: Vec<Vec<(f64, f64)>> = (0..nc).map(|c| intervals(&zt[c], circ[c])).collect();
+        let (fb, ft) = (firsts(&ib), firsts(&it));
+        Circles {
+            circ,
+            zb,
+            zt,
+            ib,
+            it,
+            fb,
+            ft,
+        }
+    }
+}
+
+/// A crossing seen from a top interval: the upper cylinder, its bottom interval, the
+/// difference of the offsets from the two intervals' starts, the distance to a zero copy / L.
+type Vote = (usize, usize, f64, f64);
+
+/// The interfaces (one per top interval, in the order of the cylinders and their intervals)
+/// from the crossings' votes, and the crossings that disagree: `(interfaces, outliers, their
+/// largest distance to a zero copy, largest length mismatch)`.
+fn interfaces(
+    domain: &GenusDomain,
+    k: &Circles,
+) -> Result<(Vec<Interface>, usize, f64, f64), String> {
+    let ntop: usize = k.it.iter().map(Vec::len).sum();
+    let nbottom: usize = k.ib.iter().map(Vec::len).sum();
     if ntop != nbottom {
         return Err(format!(
             "the cylinders' top circles have {ntop} intervals between zero copies and their bottom circles {nbottom}"
         ));
     }
-    // votes per top interval: (upper cylinder, its bottom interval, offset difference, distance
-    // of the crossing to a zero copy / L)
-    let mut votes: Vec<Vec<(usize, usize, f64, f64)>> = vec![Vec::new(); ntop];
     let near = |z: &[f64], u: f64, l: f64| {
         z.iter()
             .map(|&x| wrap_dist(u, x, l) / l)
             .fold(0.5f64, f64::min)
     };
+    let mut votes: Vec<Vec<Vote>> = vec![Vec::new(); ntop];
     for x in &domain.crossings {
         let (a, b) = (x.lower, x.upper);
-        let (j, oa) = interval_of(&it[a], x.u_lower.rem_euclid(circ[a]), circ[a]);
-        let (i, ob) = interval_of(&ib[b], x.u_upper.rem_euclid(circ[b]), circ[b]);
-        let d = near(&zt[a], x.u_lower, circ[a]).min(near(&zb[b], x.u_upper, circ[b]));
-        votes[ft[a] + j].push((b, i, oa - ob, d));
+        let (ua, ub) = (
+            x.u_lower.rem_euclid(k.circ[a]),
+            x.u_upper.rem_euclid(k.circ[b]),
+        );
+        let (j, oa) = interval_of(&k.it[a], ua, k.circ[a]);
+        let (i, ob) = interval_of(&k.ib[b], ub, k.circ[b]);
+        let d = near(&k.zt[a], ua, k.circ[a]).min(near(&k.zb[b], ub, k.circ[b]));
+        votes[k.ft[a] + j].push((b, i, oa - ob, d));
     }
-    // the interface of every top interval: the (cylinder, interval, offset) most crossings
-    // agree on; the offset difference must vanish unless both sides are whole circles
+    // per top interval: the (cylinder, interval, offset) most crossings agree on; the offset
+    // difference must vanish unless both sides are whole circles
     let mut faces: Vec<Interface> = Vec::with_capacity(ntop);
     let mut bottom_of = vec![usize::MAX; nbottom];
     let (mut outliers, mut outlier_distance, mut mismatch) = (0usize, 0.0f64, 0.0f64);
-    for c in 0..nc {
-        let l = circ[c];
-        for (j, &(start, length)) in it[c].iter().enumerate() {
-            let v = &votes[ft[c] + j];
-            let closed = zt[c].is_empty();
-            let agree = |p: &(usize, usize, f64, f64), q: &(usize, usize, f64, f64)| {
-                (p.0, p.1) == (q.0, q.1) && wrap_dist(p.2, q.2, l) <= TOL * l
-            };
-            let admissible = |p: &(usize, usize, f64, f64)| {
-                closed == zb[p.0].is_empty() && (closed || wrap_dist(p.2, 0.0, l) <= TOL * l)
-            };
-            let mut best: Option<(usize, usize)> = None; // (index of a vote, count)
-            for (k, p) in v.iter().enumerate().filter(|(_, p)| admissible(p)) {
-                let n = v.iter().filter(|q| agree(p, q)).count();
-                if best.is_none_or(|(_, m)| n > m) {
-                    best = Some((k, n));
-                }
-            }
-            let Some((k, n)) = best else {
+    for c in 0..k.circ.len() {
+        let l = k.circ[c];
+        let closed = k.zt[c].is_empty();
+        let agree =
+            |p: &Vote, q: &Vote| (p.0, p.1) == (q.0, q.1) && wrap_dist(p.2, q.2, l) <= TOL * l;
+        let admissible = |p: &Vote| {
+            closed == k.zb[p.0].is_empty() && (closed || wrap_dist(p.2, 0.0, l) <= TOL * l)
+        };
+        for (j, &(start, length)) in k.it[c].iter().enumerate() {
+            let v = &votes[k.ft[c] + j];
+            let best = v
+                .iter()
+                .filter(|p| admissible(p))
+                .map(|p| (p, v.iter().filter(|q| agree(p, q)).count()))
+                .fold(None, |best: Option<(&Vote, usize)>, (p, n)| match best {
+                    Some((_, m)) if m >= n => best,
+                    _ => Some((p, n)),
+                });
+            let Some((&p, n)) = best else {
                 return Err(format!(
                     "no mesh edge crosses the top of cylinder {c} consistently (interval {j} of {})",
-                    it[c].len()
+                    k.it[c].len()
                 ));
             };
-            let p = v[k];
             for q in v.iter().filter(|q| !agree(&p, q)) {
                 outliers += 1;
                 outlier_distance = outlier_distance.max(q.3);
             }
             let (b, i) = (p.0, p.1);
-            let (ustart, ulen) = ib[b][i];
+            let (ustart, ulen) = k.ib[b][i];
             mismatch = mismatch.max((length - ulen).abs() / l);
-            if (length - ulen).abs() > TOL * l.max(circ[b]) {
+            if (length - ulen).abs() > TOL * l.max(k.circ[b]) {
                 return Err(format!(
                     "interval {j} on the top of cylinder {c} (length {length}) is glued to interval {i} on the bottom of cylinder {b} (length {ulen})"
                 ));
             }
-            if bottom_of[fb[b] + i] != usize::MAX {
+            if bottom_of[k.fb[b] + i] != usize::MAX {
                 return Err(format!(
                     "interval {i} on the bottom of cylinder {b} is glued twice"
                 ));
             }
-            bottom_of[fb[b] + i] = faces.len();
+            bottom_of[k.fb[b] + i] = faces.len();
             faces.push(Interface {
                 lower: c,
                 upper: b,
@@ -337,133 +376,100 @@ pub fn gluing(domain: &GenusDomain) -> Result<Gluing, String> {
             });
         }
     }
-    let total = domain.crossings.len();
-    if 20 * outliers > total || outlier_distance > 0.05 {
-        return Err(format!(
-            "{outliers} of {total} crossings of the critical levels disagree with the glues of their intervals (up to {outlier_distance:.2e} of the circumference from a zero)"
-        ));
-    }
-    let added = balance(&faces, nc)?;
-    // the labelled points on every circle
-    let mut pts_bottom: Vec<Vec<Labelled>> = vec![Vec::new(); nc];
-    let mut pts_top: Vec<Vec<Labelled>> = vec![Vec::new(); nc];
+    Ok((faces, outliers, outlier_distance, mismatch))
+}
+
+/// The labelled points on every cylinder's bottom and top circles: the zero copies that start
+/// the interfaces and `added[e]` points evenly spaced inside interface `e`.
+#[allow(clippy::type_complexity)]
+fn labelled_points(
+    faces: &[Interface],
+    added: &[usize],
+    circ: &[f64],
+) -> (Vec<Vec<Labelled>>, Vec<Vec<Labelled>>) {
+    let nc = circ.len();
+    let mut bottom: Vec<Vec<Labelled>> = vec![Vec::new(); nc];
+    let mut top: Vec<Vec<Labelled>> = vec![Vec::new(); nc];
     for (e, f) in faces.iter().enumerate() {
         let x = added[e];
         let (lo, up) = (circ[f.lower], circ[f.upper]);
-        let offsets: Vec<(usize, f64)> = if f.closed {
-            (0..x)
-                .map(|k| (k, f.length * k as f64 / x as f64))
-                .collect()
+        // on a whole circle `x ≥ 1` points from offset 0; else the zero copy and `x` inside
+        let offsets: Vec<f64> = if f.closed {
+            (0..x).map(|k| f.length * k as f64 / x as f64).collect()
         } else {
             (0..=x)
-                .map(|k| (k, f.length * k as f64 / (x + 1) as f64))
+                .map(|k| f.length * k as f64 / (x + 1) as f64)
                 .collect()
         };
-        for (k, o) in offsets {
+        for (k, o) in offsets.into_iter().enumerate() {
             let zero = !f.closed && k == 0;
-            pts_top[f.lower].push(((f.lower_start + o).rem_euclid(lo), (e, k), zero));
-            pts_bottom[f.upper].push((
-                (f.upper_start + o - f.rotation).rem_euclid(up),
-                (e, k),
-                zero,
-            ));
+            top[f.lower].push(((f.lower_start + o).rem_euclid(lo), (e, k), zero));
+            let u = (f.upper_start + o - f.rotation).rem_euclid(up);
+            bottom[f.upper].push((u, (e, k), zero));
         }
     }
-    let mut layouts = Vec::with_capacity(nc);
-    let mut labels_bottom = Vec::with_capacity(nc);
-    let mut labels_top = Vec::with_capacity(nc);
-    let mut max_slope = 0.0f64;
-    for c in 0..nc {
-        let (bp, tp) = (&mut pts_bottom[c], &mut pts_top[c]);
-        bp.sort_by(|p, q| p.0.total_cmp(&q.0));
-        tp.sort_by(|p, q| p.0.total_cmp(&q.0));
-        let k = bp.len();
-        if k == 0 || k != tp.len() {
-            return Err(format!(
-                "cylinder {c} has {k} points on its bottom circle and {} on its top after balancing",
-                tp.len()
-            ));
-        }
-        let l = circ[c];
-        let unwrapped = |j: isize| {
-            let (q, r) = (j.div_euclid(k as isize), j.rem_euclid(k as isize) as usize);
-            tp[r].0 + q as f64 * l
-        };
-        let cost = |r: isize| -> f64 {
-            (0..k)
-                .map(|i| (unwrapped(i as isize + r) - bp[i].0).powi(2))
-                .sum()
-        };
-        let r = (-(k as isize)..2 * k as isize)
-            .min_by(|&a, &b| cost(a).total_cmp(&cost(b)))
-            .unwrap_or(0);
-        let bottom: Vec<f64> = bp.iter().map(|p| p.0).collect();
-        let top: Vec<f64> = (0..k).map(|i| unwrapped(i as isize + r)).collect();
-        let tl: Vec<Labelled> = (0..k)
-            .map(|i| tp[(i as isize + r).rem_euclid(k as isize) as usize])
-            .collect();
-        let h = domain.cylinders[c].height;
-        for i in 0..k {
-            max_slope = max_slope.max((top[i] - bottom[i]).abs() / h);
-        }
-        layouts.push(CylinderLayout {
-            zero_ends: (0..k).map(|i| [bp[i].2, tl[i].2]).collect(),
-            bottom,
-            top,
-            lengths: vec![0.0; k],
-        });
-        labels_bottom.push(bp.iter().map(|p| p.1).collect::<Vec<_>>());
-        labels_top.push(tl.iter().map(|p| p.1).collect::<Vec<_>>());
+    for p in bottom.iter_mut().chain(top.iter_mut()) {
+        p.sort_by(|a, b| a.0.total_cmp(&b.0));
     }
-    // glues: the top of strip s starts at the label of line s's top end; the strip above
-    // starts at the same label on its bottom
-    let firsts: Vec<usize> = layouts
-        .iter()
-        .scan(0, |at, y| {
-            let f = *at;
-            *at += y.strips();
-            Some(f)
-        })
+    (bottom, top)
+}
+
+/// The lines of cylinder `c` (circumference `l`, height `h`) from its sorted bottom and top
+/// points: bottom point `i` to top point `i + r`, `r` (with the number of turns) minimizing
+/// `Σ (u_top − u_bottom)²`; the layout (knot lengths still 0) and the top labels of its lines.
+fn cylinder_lines(
+    c: usize,
+    bp: &[Labelled],
+    tp: &[Labelled],
+    l: f64,
+) -> Result<(CylinderLayout, Vec<(usize, usize)>), String> {
+    let k = bp.len();
+    if k == 0 || k != tp.len() {
+        return Err(format!(
+            "cylinder {c} has {k} points on its bottom circle and {} on its top after balancing",
+            tp.len()
+        ));
+    }
+    let unwrapped = |j: isize| {
+        let (q, r) = (j.div_euclid(k as isize), j.rem_euclid(k as isize) as usize);
+        tp[r].0 + q as f64 * l
+    };
+    let cost = |r: isize| -> f64 {
+        (0..k)
+            .map(|i| (unwrapped(i as isize + r) - bp[i].0).powi(2))
+            .sum()
+    };
+    let r = (-(k as isize)..2 * k as isize)
+        .min_by(|&a, &b| cost(a).total_cmp(&cost(b)))
+        .unwrap_or(0);
+    let tl: Vec<Labelled> = (0..k)
+        .map(|i| tp[(i as isize + r).rem_euclid(k as isize) as usize])
         .collect();
-    let strips: usize = layouts.iter().map(|y| y.strips()).sum();
-    let mut up_of = vec![usize::MAX; strips];
-    let mut glues = Vec::with_capacity(strips);
-    let width =
-        |y: &CylinderLayout, s: usize, t: f64, l: f64| y.line_at(s + 1, t, l) - y.line_at(s, t, l);
-    for c in 0..nc {
-        for s in 0..layouts[c].strips() {
-            let label = labels_top[c][s];
-            let b = faces[label.0].upper;
-            let Some(m) = labels_bottom[b].iter().position(|&x| x == label) else {
-                return Err(format!(
-                    "the top of strip {s} of cylinder {c} starts at a point missing on the bottom of cylinder {b}"
-                ));
-            };
-            let (wt, wb) = (
-                width(&layouts[c], s, 1.0, circ[c]),
-                width(&layouts[b], m, 0.0, circ[b]),
-            );
-            mismatch = mismatch.max((wt - wb).abs() / circ[c]);
-            if (wt - wb).abs() > TOL * circ[c].max(circ[b]) {
-                return Err(format!(
-                    "the top of strip {s} of cylinder {c} (width {wt}) is glued to the bottom of strip {m} of cylinder {b} (width {wb})"
-                ));
-            }
-            up_of[firsts[c] + s] = firsts[b] + m;
-            glues.push(Glue {
-                lower: c,
-                lower_strip: s,
-                upper: b,
-                upper_strip: m,
-                length: 0.0,
-                crossings: faces[label.0].crossings,
-            });
-        }
-    }
-    // one knot length per chain of strips glued top to bottom: the mean width
-    let owner: Vec<(usize, usize)> = (0..nc)
+    let layout = CylinderLayout {
+        bottom: bp.iter().map(|p| p.0).collect(),
+        top: (0..k).map(|i| unwrapped(i as isize + r)).collect(),
+        lengths: vec![0.0; k],
+        zero_ends: (0..k).map(|i| [bp[i].2, tl[i].2]).collect(),
+    };
+    Ok((layout, tl.iter().map(|p| p.1).collect()))
+}
+
+/// Width of strip `s` of `y` at height fraction `t`.
+fn width(y: &CylinderLayout, s: usize, t: f64, l: f64) -> f64 {
+    y.line_at(s + 1, t, l) - y.line_at(s, t, l)
+}
+
+/// Sets one knot length per chain of strips glued top to bottom (`up_of`, over the strips
+/// numbered cylinder by cylinder): the mean width of the chain's strips.
+fn chain_lengths(
+    layouts: &mut [CylinderLayout],
+    circ: &[f64],
+    up_of: &[usize],
+) -> Result<(), String> {
+    let owner: Vec<(usize, usize)> = (0..layouts.len())
         .flat_map(|c| (0..layouts[c].strips()).map(move |s| (c, s)))
         .collect();
+    let strips = owner.len();
     let mut done = vec![false; strips];
     for r0 in 0..strips {
         if done[r0] {
@@ -478,21 +484,80 @@ pub fn gluing(domain: &GenusDomain) -> Result<Gluing, String> {
             chain.push(r);
             r = up_of[r];
         }
-        let mean = chain
-            .iter()
-            .map(|&r| {
-                let (c, s) = owner[r];
-                let y = &layouts[c];
-                0.5 * (width(y, s, 0.0, circ[c]) + width(y, s, 1.0, circ[c]))
-            })
-            .sum::<f64>()
-            / chain.len() as f64;
+        let widths = chain.iter().map(|&r| {
+            let (c, s) = owner[r];
+            0.5 * (width(&layouts[c], s, 0.0, circ[c]) + width(&layouts[c], s, 1.0, circ[c]))
+        });
+        let mean = widths.sum::<f64>() / chain.len() as f64;
         for &r in &chain {
             let (c, s) = owner[r];
             layouts[c].lengths[s] = mean;
             done[r] = true;
         }
     }
+    Ok(())
+}
+
+/// The layouts and glues of `domain`, or a sentence saying why the strips do not match.
+pub fn gluing(domain: &GenusDomain) -> Result<Gluing, String> {
+    let nc = domain.cylinders.len();
+    let k = Circles::new(domain);
+    let (faces, outliers, outlier_distance, mut mismatch) = interfaces(domain, &k)?;
+    let total = domain.crossings.len();
+    if 20 * outliers > total || outlier_distance > 0.05 {
+        return Err(format!(
+            "{outliers} of {total} crossings of the critical levels disagree with the glues of their intervals (up to {outlier_distance:.2e} of the circumference from a zero)"
+        ));
+    }
+    let added = balance(&faces, nc)?;
+    let (pts_bottom, pts_top) = labelled_points(&faces, &added, &k.circ);
+    let mut layouts = Vec::with_capacity(nc);
+    let mut labels_top = Vec::with_capacity(nc);
+    let mut max_slope = 0.0f64;
+    for c in 0..nc {
+        let (y, tl) = cylinder_lines(c, &pts_bottom[c], &pts_top[c], k.circ[c])?;
+        let h = domain.cylinders[c].height;
+        for (b, t) in y.bottom.iter().zip(&y.top) {
+            max_slope = max_slope.max((t - b).abs() / h);
+        }
+        layouts.push(y);
+        labels_top.push(tl);
+    }
+    // glues: the top of strip s starts at the label of line s's top end; the strip above
+    // starts at the same label on its bottom
+    let first = firsts(&labels_top);
+    let mut up_of = Vec::with_capacity(first.last().map_or(0, |f| f + labels_top[nc - 1].len()));
+    let mut glues = Vec::with_capacity(up_of.capacity());
+    for c in 0..nc {
+        for (s, label) in labels_top[c].iter().enumerate() {
+            let b = faces[label.0].upper;
+            let Some(m) = pts_bottom[b].iter().position(|p| p.1 == *label) else {
+                return Err(format!(
+                    "the top of strip {s} of cylinder {c} starts at a point missing on the bottom of cylinder {b}"
+                ));
+            };
+            let (wt, wb) = (
+                width(&layouts[c], s, 1.0, k.circ[c]),
+                width(&layouts[b], m, 0.0, k.circ[b]),
+            );
+            mismatch = mismatch.max((wt - wb).abs() / k.circ[c]);
+            if (wt - wb).abs() > TOL * k.circ[c].max(k.circ[b]) {
+                return Err(format!(
+                    "the top of strip {s} of cylinder {c} (width {wt}) is glued to the bottom of strip {m} of cylinder {b} (width {wb})"
+                ));
+            }
+            up_of.push(first[b] + m);
+            glues.push(Glue {
+                lower: c,
+                lower_strip: s,
+                upper: b,
+                upper_strip: m,
+                length: 0.0,
+                crossings: faces[label.0].crossings,
+            });
+        }
+    }
+    chain_lengths(&mut layouts, &k.circ, &up_of)?;
     for g in &mut glues {
         g.length = layouts[g.lower].lengths[g.lower_strip];
     }
