@@ -25,7 +25,7 @@
 
 use super::cylinder_fit::GenusStep;
 use super::domain_mesh::blocks::place_blocks;
-use super::domain_mesh::{Block, DomainMesh};
+use super::domain_mesh::{Block, Combination, DomainMesh};
 use super::fit::bbox_scale;
 use super::genus_domain::GenusDomain;
 use super::glue::Gluing;
@@ -144,10 +144,85 @@ pub fn locate(
     Some((cell, x, y))
 }
 
+/// The data term of [`solve`]'s normal equations: the lower triangle of `Σ w rowᵀ row` over
+/// the data points `located` as triplets (`trip`), and `Σ w row p` (`b`); `unknowns` maps a
+/// row of control points to the solve's unknowns. The points are summed cell by cell in a
+/// dense block over the unknowns of their rows — one triplet per pair of unknowns and cell, not
+/// per pair and point (genus3's 60 k points made 14 M triplets, most of its 0.9 GB).
+fn data_term(
+    mesh: &DomainMesh,
+    (located, targets, weights): (&[(u32, f64, f64)], &[[f64; 3]], &[f64]),
+    unknowns: &dyn Fn(Combination) -> Combination,
+    trip: &mut Vec<Triplet<usize, usize, f64>>,
+    b: &mut Mat<f64>,
+) {
+    // the points by cell, in their order within a cell (a counting sort)
+    let nc = mesh.n_cells();
+    let mut start = vec![0usize; nc + 1];
+    for &(c, _, _) in located {
+        start[c as usize + 1] += 1;
+    }
+    for c in 0..nc {
+        start[c + 1] += start[c];
+    }
+    let mut order = vec![0usize; located.len()];
+    let mut next = start.clone();
+    for (k, &(c, _, _)) in located.iter().enumerate() {
+        order[next[c as usize]] = k;
+        next[c as usize] += 1;
+    }
+    // per unknown its index in the current cell's block (u32::MAX: not in it)
+    let mut slot = vec![u32::MAX; b.nrows()];
+    let (mut ids, mut rows, mut block) = (Vec::<u32>::new(), Vec::new(), Vec::<f64>::new());
+    for c in 0..nc {
+        let points = &order[start[c]..start[c + 1]];
+        if points.is_empty() {
+            continue;
+        }
+        ids.clear();
+        rows.clear();
+        for &k in points {
+            let (c, s, t) = located[k];
+            let row = unknowns(mesh.blending(c, s, t));
+            for &(r, _) in &row {
+                if slot[r as usize] == u32::MAX {
+                    slot[r as usize] = ids.len() as u32;
+                    ids.push(r);
+                }
+            }
+            rows.push((k, row));
+        }
+        let m = ids.len();
+        block.clear();
+        block.resize(m * m, 0.0);
+        for (k, row) in &rows {
+            let (wk, p) = (weights.get(*k).copied().unwrap_or(1.0), targets[*k]);
+            for &(r, x) in row {
+                let a = slot[r as usize] as usize;
+                for &(q, y) in row {
+                    block[a * m + slot[q as usize] as usize] += wk * x * y;
+                }
+                for d in 0..3 {
+                    b[(r as usize, d)] += wk * x * p[d];
+                }
+            }
+        }
+        for (a, &r) in ids.iter().enumerate() {
+            for (e, &q) in ids.iter().enumerate() {
+                if r >= q {
+                    trip.push(Triplet::new(r as usize, q as usize, block[a * m + e]));
+                }
+            }
+        }
+        ids.iter().for_each(|&r| slot[r as usize] = u32::MAX);
+    }
+}
+
 /// One least-squares solve on `mesh`; with `g1`, for the free values of the mesh's reduction
 /// (the net is G¹ at the zeros).
 /// `weights` per data point (empty: all 1); the fairness weight grows with `vertices`, the
-/// number of input vertices among the data.
+/// number of input vertices among the data. The normal equations are assembled as their lower
+/// triangle (all the Cholesky factorization reads).
 fn solve(
     mesh: &DomainMesh,
     located: &[(u32, f64, f64)],
@@ -157,7 +232,7 @@ fn solve(
     smoothing: f64,
     g1: bool,
 ) -> Result<Vec<[f64; 3]>> {
-    let unknowns = |row: Vec<(u32, f64)>| if g1 { mesh.reduce(&row) } else { row };
+    let unknowns = |row: Combination| if g1 { mesh.reduce(&row) } else { row };
     let n = if g1 {
         mesh.reduction.free
     } else {
@@ -165,23 +240,18 @@ fn solve(
     };
     let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::new();
     let mut b = Mat::<f64>::zeros(n, 3);
-    for (k, (&(c, s, t), p)) in located.iter().zip(targets).enumerate() {
-        let wk = weights.get(k).copied().unwrap_or(1.0);
-        let row = unknowns(mesh.blending(c, s, t));
-        for &(r, x) in &row {
-            for &(q, y) in &row {
-                trip.push(Triplet::new(r as usize, q as usize, wk * x * y));
-            }
-            for d in 0..3 {
-                b[(r as usize, d)] += wk * x * p[d];
-            }
-        }
-    }
+    data_term(
+        mesh,
+        (located, targets, weights),
+        &unknowns,
+        &mut trip,
+        &mut b,
+    );
     let w = smoothing * (vertices as f64 / mesh.n_vertices() as f64).max(1.0);
     let mut push = |row: &[(u32, f64)]| {
         let row = unknowns(row.to_vec());
         for &(r, x) in &row {
-            for &(q, y) in &row {
+            for &(q, y) in row.iter().filter(|&&(q, _)| r >= q) {
                 trip.push(Triplet::new(r as usize, q as usize, w * x * y));
             }
         }
@@ -228,6 +298,7 @@ fn solve(
             "domain mesh fit: the normal equations ({n} unknowns) cannot be assembled: {e:?}"
         ))
     })?;
+    drop(trip);
     let chol = Cholesky::factor(a.as_ref()).map_err(|e| {
         Error::numerical(format!(
             "domain mesh fit: the normal equations ({n} unknowns, {} points) are not positive definite: {e:?}",
