@@ -25,7 +25,7 @@
 
 use super::cylinder_fit::GenusStep;
 use super::domain_mesh::blocks::place_blocks;
-use super::domain_mesh::{Block, Combination, DomainMesh};
+use super::domain_mesh::{bernstein, Block, Combination, DomainMesh};
 use super::fit::bbox_scale;
 use super::genus_domain::GenusDomain;
 use super::glue::Gluing;
@@ -145,14 +145,15 @@ pub fn locate(
 }
 
 /// The data term of [`solve`]'s normal equations: the lower triangle of `Σ w rowᵀ row` over
-/// the data points `located` as triplets (`trip`), and `Σ w row p` (`b`); `unknowns` maps a
-/// row of control points to the solve's unknowns. The points are summed cell by cell in a
-/// dense block over the unknowns of their rows — one triplet per pair of unknowns and cell, not
-/// per pair and point (genus3's 60 k points made 14 M triplets, most of its 0.9 GB).
+/// the data points `located` as triplets (`trip`), and `Σ w row p` (`b`); with `g1` the rows
+/// are in the free values of the mesh's reduction. The points are summed cell by cell in a
+/// dense block over the cell's unknowns — one triplet per pair of unknowns and cell, not per
+/// pair and point (genus3's 60 k points made 14 M triplets, most of its 0.9 GB) — and a point's
+/// row is the Bernstein sum of the cell's 16 Bézier points, each reduced once per cell.
 fn data_term(
     mesh: &DomainMesh,
     (located, targets, weights): (&[(u32, f64, f64)], &[[f64; 3]], &[f64]),
-    unknowns: &dyn Fn(Combination) -> Combination,
+    g1: bool,
     trip: &mut Vec<Triplet<usize, usize, f64>>,
     b: &mut Mat<f64>,
 ) {
@@ -173,37 +174,56 @@ fn data_term(
     }
     // per unknown its index in the current cell's block (u32::MAX: not in it)
     let mut slot = vec![u32::MAX; b.nrows()];
-    let (mut ids, mut rows, mut block) = (Vec::<u32>::new(), Vec::new(), Vec::<f64>::new());
+    let mut ids = Vec::<u32>::new();
+    // per Bézier point of the cell (`4 i + j`): its combination of the block's unknowns
+    let mut local: Vec<Vec<(usize, f64)>> = vec![Vec::new(); 16];
+    let (mut row, mut block) = (Vec::<f64>::new(), Vec::<f64>::new());
     for c in 0..nc {
         let points = &order[start[c]..start[c + 1]];
         if points.is_empty() {
             continue;
         }
         ids.clear();
-        rows.clear();
-        for &k in points {
-            let (c, s, t) = located[k];
-            let row = unknowns(mesh.blending(c, s, t));
-            for &(r, _) in &row {
+        for (ij, l) in local.iter_mut().enumerate() {
+            l.clear();
+            let comb = &mesh.bezier[c][ij / 4][ij % 4];
+            let reduced;
+            let comb = if g1 {
+                reduced = mesh.reduce(comb);
+                &reduced
+            } else {
+                comb
+            };
+            for &(r, w) in comb {
                 if slot[r as usize] == u32::MAX {
                     slot[r as usize] = ids.len() as u32;
                     ids.push(r);
                 }
+                l.push((slot[r as usize] as usize, w));
             }
-            rows.push((k, row));
         }
         let m = ids.len();
         block.clear();
         block.resize(m * m, 0.0);
-        for (k, row) in &rows {
-            let (wk, p) = (weights.get(*k).copied().unwrap_or(1.0), targets[*k]);
-            for &(r, x) in row {
-                let a = slot[r as usize] as usize;
-                for &(q, y) in row {
-                    block[a * m + slot[q as usize] as usize] += wk * x * y;
+        for &k in points {
+            let (_, s, t) = located[k];
+            let (bu, bv) = (bernstein(s), bernstein(t));
+            row.clear();
+            row.resize(m, 0.0);
+            for (ij, l) in local.iter().enumerate() {
+                let f = bu[ij / 4] * bv[ij % 4];
+                for &(a, w) in l {
+                    row[a] += f * w;
+                }
+            }
+            let (wk, p) = (weights.get(k).copied().unwrap_or(1.0), targets[k]);
+            for (a, &x) in row.iter().enumerate() {
+                let wx = wk * x;
+                for (e, &y) in row.iter().enumerate() {
+                    block[a * m + e] += wx * y;
                 }
                 for d in 0..3 {
-                    b[(r as usize, d)] += wk * x * p[d];
+                    b[(ids[a] as usize, d)] += wx * p[d];
                 }
             }
         }
@@ -240,13 +260,7 @@ fn solve(
     };
     let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::new();
     let mut b = Mat::<f64>::zeros(n, 3);
-    data_term(
-        mesh,
-        (located, targets, weights),
-        &unknowns,
-        &mut trip,
-        &mut b,
-    );
+    data_term(mesh, (located, targets, weights), g1, &mut trip, &mut b);
     let w = smoothing * (vertices as f64 / mesh.n_vertices() as f64).max(1.0);
     let mut push = |row: &[(u32, f64)]| {
         let row = unknowns(row.to_vec());
