@@ -144,6 +144,9 @@ pub fn locate(
     Some((cell, x, y))
 }
 
+/// Data points of a least-squares solve: cell and local `(s, t)`, target, weight.
+type DataPoints<'a> = (&'a [(u32, f64, f64)], &'a [[f64; 3]], &'a [f64]);
+
 /// The data term of [`solve`]'s normal equations: the lower triangle of `Σ w rowᵀ row` over
 /// the data points `located` as triplets (`trip`), and `Σ w row p` (`b`); with `g1` the rows
 /// are in the free values of the mesh's reduction. The points are summed cell by cell in a
@@ -152,7 +155,7 @@ pub fn locate(
 /// row is the Bernstein sum of the cell's 16 Bézier points, each reduced once per cell.
 fn data_term(
     mesh: &DomainMesh,
-    (located, targets, weights): (&[(u32, f64, f64)], &[[f64; 3]], &[f64]),
+    (located, targets, weights): DataPoints<'_>,
     g1: bool,
     trip: &mut Vec<Triplet<usize, usize, f64>>,
     b: &mut Mat<f64>,
@@ -490,12 +493,14 @@ pub fn deviation_between_vertices(
         .into_par_iter()
         .flat_map_iter(|c| {
             let dist = &dist;
+            // the cell's Bézier patch once, then its points
+            let p = fit.mesh.patch(c, &fit.control, 0.0, 0.0);
             (0..k * k).map(move |ij| {
                 let (s, t) = (
                     ((ij % k) as f64 + 0.5) / k as f64,
                     ((ij / k) as f64 + 0.5) / k as f64,
                 );
-                dist.distance(fit.mesh.point(c, s, t, &fit.control))
+                dist.distance(p.point(p.u0 + s * (p.u1 - p.u0), p.v0 + t * (p.v1 - p.v0)))
             })
         })
         .collect();
