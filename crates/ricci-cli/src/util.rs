@@ -483,6 +483,26 @@ pub fn ring_marker(
     fraction: f64,
     color: ricci_render::color::Rgb,
 ) -> ricci_render::Polyline {
+    let normals = ricci_render::render::vertex_normals(pos, tris);
+    ring_around(pos, &normals, v, fraction * bbox_diagonal(pos), color)
+}
+
+/// [`ring_marker`] for every mark `(v, fraction, color)`, the vertex normals computed once (a
+/// T-spline's picture rings hundreds of T-junctions).
+pub fn ring_markers(
+    pos: &[[f64; 3]],
+    tris: &[[u32; 3]],
+    marks: &[(u32, f64, ricci_render::color::Rgb)],
+) -> Vec<ricci_render::Polyline> {
+    let diag = bbox_diagonal(pos);
+    let normals = ricci_render::render::vertex_normals(pos, tris);
+    marks
+        .iter()
+        .map(|&(v, fraction, color)| ring_around(pos, &normals, v, fraction * diag, color))
+        .collect()
+}
+
+fn bbox_diagonal(pos: &[[f64; 3]]) -> f64 {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for p in pos {
         for k in 0..3 {
@@ -490,12 +510,18 @@ pub fn ring_marker(
             hi[k] = hi[k].max(p[k]);
         }
     }
-    let diag = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
-    let r = fraction * diag;
-    let n = ricci_render::render::vertex_normals(pos, tris)
-        .get(v as usize)
-        .copied()
-        .unwrap_or([0.0, 0.0, 1.0]);
+    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// The ring of radius `r` around vertex `v` orthogonal to its normal (`normals[v]`).
+fn ring_around(
+    pos: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    v: u32,
+    r: f64,
+    color: ricci_render::color::Rgb,
+) -> ricci_render::Polyline {
+    let n = normals.get(v as usize).copied().unwrap_or([0.0, 0.0, 1.0]);
     let a = if n[0].abs() < 0.9 {
         [1.0, 0.0, 0.0]
     } else {

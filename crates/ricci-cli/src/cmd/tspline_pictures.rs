@@ -265,14 +265,13 @@ pub fn domain_pictures(
         [0.0, 0.0, opts.width as f64, opts.height as f64],
     )?;
     let mut polylines = cell_sides(fit, &t, stride, |p| camera.to_viewer(p));
-    for &z in &t.zeros {
-        let mut ring = crate::util::ring_marker(&t.positions, &t.triangles, z, 0.02, ZERO);
-        ring.width = 3.0;
-        polylines.push(ring);
-    }
-    for &v in &t.t_junctions {
-        let mut ring = crate::util::ring_marker(&t.positions, &t.triangles, v, 0.012, T_JUNCTION);
-        ring.width = 2.5;
+    // the zeros' rings 3 wide, the T-junctions' 2.5 (normals computed once for all)
+    let marks: Vec<_> = (t.zeros.iter().map(|&z| (z, 0.02, ZERO)))
+        .chain(t.t_junctions.iter().map(|&v| (v, 0.012, T_JUNCTION)))
+        .collect();
+    let rings = crate::util::ring_markers(&t.positions, &t.triangles, &marks);
+    for (k, mut ring) in rings.into_iter().enumerate() {
+        ring.width = if k < t.zeros.len() { 3.0 } else { 2.5 };
         polylines.push(ring);
     }
     let (net, zebra) = render_net_and_zebra(&t.positions, &t.triangles, polylines, opts)?;

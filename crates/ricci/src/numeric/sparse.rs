@@ -420,6 +420,75 @@ impl<T: faer::traits::ComplexField> Cholesky<T> {
     }
 }
 
+/// The lower triangle of a symmetric `n × n` matrix summed from dense blocks on sets of indices
+/// (finite-element assembly): the pattern — every pair of one set, and the diagonal — is built
+/// once from the sets, then every block's values are added at their places. Memory stays the
+/// size of the pattern (a triplet per pair and block held genus3's T-spline fit at 25 MB per
+/// solve, a triplet per pair and data point at 0.9 GB).
+pub struct BlockAssembly {
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    vals: Vec<f64>,
+    /// Values added outside the pattern (a caller's error; [`Self::matrix`] refuses them).
+    outside: usize,
+}
+
+impl BlockAssembly {
+    /// The pattern of the sets `sets` (indices `< n`; one set's pairs are its block's entries).
+    pub fn new<'a>(n: usize, sets: impl IntoIterator<Item = &'a [u32]>) -> BlockAssembly {
+        let mut cols: Vec<Vec<u32>> = (0..n as u32).map(|j| vec![j]).collect();
+        for set in sets {
+            for &r in set {
+                for &q in set.iter().filter(|&&q| q < r) {
+                    if let Some(c) = cols.get_mut(q as usize) {
+                        c.push(r);
+                    }
+                }
+            }
+        }
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut row_idx = Vec::new();
+        col_ptr.push(0);
+        for mut c in cols {
+            c.sort_unstable();
+            c.dedup();
+            row_idx.extend(c.iter().map(|&r| r as usize));
+            col_ptr.push(row_idx.len());
+        }
+        let vals = vec![0.0; row_idx.len()];
+        BlockAssembly {
+            col_ptr,
+            row_idx,
+            vals,
+            outside: 0,
+        }
+    }
+
+    /// Adds `v` to entry `(r, q)` (and so to `(q, r)`: only the lower triangle is stored).
+    pub fn add(&mut self, r: u32, q: u32, v: f64) {
+        let (r, q) = (r.max(q) as usize, r.min(q) as usize);
+        let Some(&[a, b]) = self.col_ptr.get(q..q + 2) else {
+            self.outside += 1;
+            return;
+        };
+        match self.row_idx[a..b].binary_search(&r) {
+            Ok(k) => self.vals[a + k] += v,
+            Err(_) => self.outside += 1,
+        }
+    }
+
+    /// The lower triangle in compressed columns, or the number of values added outside the
+    /// pattern.
+    pub fn matrix(&self) -> std::result::Result<SparseColMatRef<'_, usize, f64>, usize> {
+        if self.outside > 0 {
+            return Err(self.outside);
+        }
+        let n = self.col_ptr.len() - 1;
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
+        Ok(SparseColMatRef::new(sym, &self.vals))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -593,5 +662,50 @@ mod tests {
                 assert!((rhs[(i, c)] - x[i]).abs() < 1e-12);
             }
         }
+    }
+
+    /// Blocks on overlapping index sets: the assembled lower triangle equals faer's triplet
+    /// assembly of the same blocks (independently summed), and a value outside is refused.
+    #[test]
+    fn block_assembly_sums_blocks_like_triplets() {
+        let sets: [&[u32]; 4] = [&[0, 3, 5], &[5, 1, 3], &[2], &[4, 0, 1, 3]];
+        let value = |k: usize, a: u32, b: u32| {
+            1.0 + k as f64 + 0.1 * (a * b) as f64 + 0.01 * (a + b) as f64
+        };
+        let mut asm = BlockAssembly::new(6, sets.iter().copied());
+        let mut t = Vec::new();
+        for (k, set) in sets.iter().enumerate() {
+            for &a in set.iter() {
+                for &b in set.iter() {
+                    t.push(Triplet::new(a as usize, b as usize, value(k, a, b)));
+                    if a >= b {
+                        asm.add(a, b, value(k, a, b));
+                    }
+                }
+            }
+        }
+        let full =
+            faer::sparse::SparseColMat::<usize, f64>::try_new_from_triplets(6, 6, &t).unwrap();
+        let m = asm.matrix().unwrap();
+        let dense = |i: usize, j: usize| {
+            let (i, j) = (i.max(j), i.min(j));
+            let (a, b) = (m.symbolic().col_ptr()[j], m.symbolic().col_ptr()[j + 1]);
+            (a..b)
+                .find(|&k| m.symbolic().row_idx()[k] == i)
+                .map_or(0.0, |k| m.val()[k])
+        };
+        for i in 0..6 {
+            for j in 0..6 {
+                let want = full.as_ref().get(i, j).copied().unwrap_or(0.0);
+                assert!(
+                    (dense(i, j) - want).abs() < 1e-14,
+                    "({i}, {j}): {} vs {want}",
+                    dense(i, j)
+                );
+            }
+        }
+        // rows 2 and 4 share no set: outside the pattern
+        asm.add(4, 2, 1.0);
+        assert_eq!(asm.matrix().err(), Some(1));
     }
 }

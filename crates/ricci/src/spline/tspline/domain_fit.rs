@@ -25,15 +25,14 @@
 
 use super::cylinder_fit::GenusStep;
 use super::domain_mesh::blocks::place_blocks;
-use super::domain_mesh::{Block, DomainMesh};
+use super::domain_mesh::{bernstein, Block, Combination, DomainMesh};
 use super::fit::bbox_scale;
 use super::genus_domain::GenusDomain;
 use super::glue::Gluing;
 use crate::error::{Error, Result};
-use crate::numeric::sparse::Cholesky;
+use crate::numeric::sparse::{BlockAssembly, Cholesky};
 use crate::numeric::vec3::{cross, norm, sub};
 use crate::spline::surface::MeshDistance;
-use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
 
 /// The fitted spline on the domain mesh.
@@ -144,48 +143,135 @@ pub fn locate(
     Some((cell, x, y))
 }
 
-/// One least-squares solve on `mesh`; with `g1`, for the free values of the mesh's reduction
-/// (the net is G¹ at the zeros).
-/// `weights` per data point (empty: all 1); the fairness weight grows with `vertices`, the
-/// number of input vertices among the data.
-fn solve(
-    mesh: &DomainMesh,
-    located: &[(u32, f64, f64)],
-    targets: &[[f64; 3]],
-    weights: &[f64],
-    vertices: usize,
-    smoothing: f64,
-    g1: bool,
-) -> Result<Vec<[f64; 3]>> {
-    let unknowns = |row: Vec<(u32, f64)>| if g1 { mesh.reduce(&row) } else { row };
-    let n = if g1 {
-        mesh.reduction.free
-    } else {
-        mesh.n_vertices()
-    };
-    let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::new();
-    let mut b = Mat::<f64>::zeros(n, 3);
-    for (k, (&(c, s, t), p)) in located.iter().zip(targets).enumerate() {
-        let wk = weights.get(k).copied().unwrap_or(1.0);
-        let row = unknowns(mesh.blending(c, s, t));
-        for &(r, x) in &row {
-            for &(q, y) in &row {
-                trip.push(Triplet::new(r as usize, q as usize, wk * x * y));
-            }
-            for d in 0..3 {
-                b[(r as usize, d)] += wk * x * p[d];
+/// Data points of a least-squares solve: cell and local `(s, t)`, target, weight.
+type DataPoints<'a> = (&'a [(u32, f64, f64)], &'a [[f64; 3]], &'a [f64]);
+
+/// The data points by cell (a counting sort, their order kept within a cell): the points of
+/// cell `c` are `order[start[c]..start[c + 1]]`.
+fn by_cell(located: &[(u32, f64, f64)], cells: usize) -> (Vec<usize>, Vec<usize>) {
+    let mut start = vec![0usize; cells + 1];
+    for &(c, _, _) in located {
+        start[c as usize + 1] += 1;
+    }
+    for c in 0..cells {
+        start[c + 1] += start[c];
+    }
+    let mut order = vec![0usize; located.len()];
+    let mut next = start.clone();
+    for (k, &(c, _, _)) in located.iter().enumerate() {
+        order[next[c as usize]] = k;
+        next[c as usize] += 1;
+    }
+    (start, order)
+}
+
+/// The unknowns a row of cell `c` can involve, appended to `out`: the vertices of its Bézier
+/// points, with `g1` the free values they expand to (`mark`, per unknown, is left all false).
+fn cell_set(mesh: &DomainMesh, c: usize, g1: bool, mark: &mut [bool], out: &mut Vec<u32>) {
+    let from = out.len();
+    for comb in mesh.bezier[c].iter().flatten() {
+        for &(v, _) in comb {
+            let itself = [(v, 1.0)];
+            let free: &[(u32, f64)] = if g1 {
+                &mesh.reduction.expand[v as usize]
+            } else {
+                &itself
+            };
+            for &(f, _) in free {
+                if !mark[f as usize] {
+                    mark[f as usize] = true;
+                    out.push(f);
+                }
             }
         }
     }
-    let w = smoothing * (vertices as f64 / mesh.n_vertices() as f64).max(1.0);
-    let mut push = |row: &[(u32, f64)]| {
-        let row = unknowns(row.to_vec());
-        for &(r, x) in &row {
-            for &(q, y) in &row {
-                trip.push(Triplet::new(r as usize, q as usize, w * x * y));
+    out[from..].iter().for_each(|&f| mark[f as usize] = false);
+}
+
+/// The data term of [`solve`]'s normal equations: `Σ w rowᵀ row` over the data points (grouped
+/// by cell: [`by_cell`]) added to `asm`, and `Σ w row p` to `b`; with `g1` the rows are in the
+/// free values of the mesh's reduction. The points are summed cell by cell in a dense block
+/// over the cell's unknowns, added once per cell — not a triplet per pair and point, which held
+/// genus3's fit at 0.9 GB — and a point's row is the Bernstein sum of the cell's 16 Bézier
+/// points, each reduced once per cell.
+fn data_term(
+    mesh: &DomainMesh,
+    (start, order): (&[usize], &[usize]),
+    (located, targets, weights): DataPoints<'_>,
+    g1: bool,
+    asm: &mut BlockAssembly,
+    b: &mut Mat<f64>,
+) {
+    // per unknown its index in the current cell's block (u32::MAX: not in it)
+    let mut slot = vec![u32::MAX; b.nrows()];
+    let mut ids = Vec::<u32>::new();
+    // per Bézier point of the cell (`4 i + j`): its combination of the block's unknowns
+    let mut local: Vec<Vec<(usize, f64)>> = vec![Vec::new(); 16];
+    let (mut row, mut block) = (Vec::<f64>::new(), Vec::<f64>::new());
+    for c in 0..mesh.n_cells() {
+        let points = &order[start[c]..start[c + 1]];
+        if points.is_empty() {
+            continue;
+        }
+        ids.clear();
+        for (ij, l) in local.iter_mut().enumerate() {
+            l.clear();
+            let comb = &mesh.bezier[c][ij / 4][ij % 4];
+            let reduced;
+            let comb = if g1 {
+                reduced = mesh.reduce(comb);
+                &reduced
+            } else {
+                comb
+            };
+            for &(r, w) in comb {
+                if slot[r as usize] == u32::MAX {
+                    slot[r as usize] = ids.len() as u32;
+                    ids.push(r);
+                }
+                l.push((slot[r as usize] as usize, w));
             }
         }
-    };
+        let m = ids.len();
+        block.clear();
+        block.resize(m * m, 0.0);
+        for &k in points {
+            let (_, s, t) = located[k];
+            let (bu, bv) = (bernstein(s), bernstein(t));
+            row.clear();
+            row.resize(m, 0.0);
+            for (ij, l) in local.iter().enumerate() {
+                let f = bu[ij / 4] * bv[ij % 4];
+                for &(a, w) in l {
+                    row[a] += f * w;
+                }
+            }
+            let (wk, p) = (weights.get(k).copied().unwrap_or(1.0), targets[k]);
+            for (a, &x) in row.iter().enumerate() {
+                let wx = wk * x;
+                for (e, &y) in row.iter().enumerate() {
+                    block[a * m + e] += wx * y;
+                }
+                for d in 0..3 {
+                    b[(ids[a] as usize, d)] += wx * p[d];
+                }
+            }
+        }
+        for (a, &r) in ids.iter().enumerate() {
+            for (e, &q) in ids.iter().enumerate() {
+                if r >= q {
+                    asm.add(r, q, block[a * m + e]);
+                }
+            }
+        }
+        ids.iter().for_each(|&r| slot[r as usize] = u32::MAX);
+    }
+}
+
+/// The rows of the fairness term of [`solve`] (before its weight): the second differences
+/// along the mesh lines through every regular vertex, the umbrella operator at the zeros.
+fn fairness_rows(mesh: &DomainMesh) -> Vec<Combination> {
+    let mut rows = Vec::with_capacity(2 * mesh.n_cells());
     for c in 0..mesh.n_cells() as u32 {
         let a = mesh.corners[c as usize][0];
         let (l, bt) = (mesh.across(c, 2), mesh.across(c, 3));
@@ -198,8 +284,16 @@ fn solve(
         let (hl, hb, (hu, hv)) = (mesh.size(l).0, mesh.size(bt).1, mesh.size(c));
         let (ul, ur) = (2.0 * hu / (hl + hu), 2.0 * hl / (hl + hu));
         let (vb, vt) = (2.0 * hv / (hb + hv), 2.0 * hb / (hb + hv));
-        push(&[(mesh.corners[l as usize][0], ul), (a, -2.0), (q[1], ur)]);
-        push(&[(mesh.corners[bt as usize][0], vb), (a, -2.0), (q[3], vt)]);
+        rows.push(vec![
+            (mesh.corners[l as usize][0], ul),
+            (a, -2.0),
+            (q[1], ur),
+        ]);
+        rows.push(vec![
+            (mesh.corners[bt as usize][0], vb),
+            (a, -2.0),
+            (q[3], vt),
+        ]);
     }
     for z in (0..mesh.n_vertices() as u32).filter(|&z| mesh.is_zero(z)) {
         let mut nb: Vec<u32> = Vec::new();
@@ -217,18 +311,70 @@ fn solve(
         let k = nb.len() as f64;
         let mut row: Vec<(u32, f64)> = nb.iter().map(|&x| (x, 1.0 / k)).collect();
         row.push((z, -1.0));
-        push(&row);
+        rows.push(row);
+    }
+    rows
+}
+
+/// One least-squares solve on `mesh`; with `g1`, for the free values of the mesh's reduction
+/// (the net is G¹ at the zeros).
+/// `weights` per data point (empty: all 1); the fairness weight grows with `vertices`, the
+/// number of input vertices among the data. The normal equations are assembled as their lower
+/// triangle (all the Cholesky factorization reads) on the pattern of the cells' and the
+/// fairness rows' unknowns ([`BlockAssembly`]).
+fn solve(
+    mesh: &DomainMesh,
+    located: &[(u32, f64, f64)],
+    targets: &[[f64; 3]],
+    weights: &[f64],
+    vertices: usize,
+    smoothing: f64,
+    g1: bool,
+) -> Result<Vec<[f64; 3]>> {
+    let n = if g1 {
+        mesh.reduction.free
+    } else {
+        mesh.n_vertices()
+    };
+    let fair: Vec<Combination> = fairness_rows(mesh)
+        .into_iter()
+        .map(|row| if g1 { mesh.reduce(&row) } else { row })
+        .collect();
+    let (start, order) = by_cell(located, mesh.n_cells());
+    // the pattern: the unknowns of every cell with data, of every fairness row
+    let (mut flat, mut at) = (Vec::<u32>::new(), vec![0usize]);
+    let mut mark = vec![false; n];
+    for c in (0..mesh.n_cells()).filter(|&c| start[c + 1] > start[c]) {
+        cell_set(mesh, c, g1, &mut mark, &mut flat);
+        at.push(flat.len());
+    }
+    for row in &fair {
+        flat.extend(row.iter().map(|x| x.0));
+        at.push(flat.len());
+    }
+    let mut asm = BlockAssembly::new(n, at.windows(2).map(|w| &flat[w[0]..w[1]]));
+    drop(flat);
+    let mut b = Mat::<f64>::zeros(n, 3);
+    let points = (located, targets, weights);
+    data_term(mesh, (&start, &order), points, g1, &mut asm, &mut b);
+    let w = smoothing * (vertices as f64 / mesh.n_vertices() as f64).max(1.0);
+    for row in &fair {
+        for &(r, x) in row {
+            for &(q, y) in row.iter().filter(|&&(q, _)| r >= q) {
+                asm.add(r, q, w * x * y);
+            }
+        }
     }
     // a tiny ridge keeps vertices without data determined by the fairness alone
-    for i in 0..n {
-        trip.push(Triplet::new(i, i, 1e-12));
+    for i in 0..n as u32 {
+        asm.add(i, i, 1e-12);
     }
-    let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip).map_err(|e| {
+    let a = asm.matrix().map_err(|k| {
         Error::numerical(format!(
-            "domain mesh fit: the normal equations ({n} unknowns) cannot be assembled: {e:?}"
+            "domain mesh fit: {k} values of the normal equations ({n} unknowns) fall outside their pattern"
         ))
     })?;
-    let chol = Cholesky::factor(a.as_ref()).map_err(|e| {
+    let chol = Cholesky::factor(a).map_err(|e| {
         Error::numerical(format!(
             "domain mesh fit: the normal equations ({n} unknowns, {} points) are not positive definite: {e:?}",
             located.len()
@@ -405,12 +551,14 @@ pub fn deviation_between_vertices(
         .into_par_iter()
         .flat_map_iter(|c| {
             let dist = &dist;
+            // the cell's Bézier patch once, then its points
+            let p = fit.mesh.patch(c, &fit.control, 0.0, 0.0);
             (0..k * k).map(move |ij| {
                 let (s, t) = (
                     ((ij % k) as f64 + 0.5) / k as f64,
                     ((ij / k) as f64 + 0.5) / k as f64,
                 );
-                dist.distance(fit.mesh.point(c, s, t, &fit.control))
+                dist.distance(p.point(p.u0 + s * (p.u1 - p.u0), p.v0 + t * (p.v1 - p.v0)))
             })
         })
         .collect();

@@ -312,6 +312,12 @@ pub fn inner_weights(d: [f64; 3]) -> [[f64; 2]; 2] {
     [[1.0 - t1, t1], [1.0 - t2, t2]]
 }
 
+/// The four cubic Bernstein polynomials at `x ∈ [0, 1]`.
+pub fn bernstein(x: f64) -> [f64; 4] {
+    let y = 1.0 - x;
+    [y * y * y, 3.0 * x * y * y, 3.0 * x * x * y, x * x * x]
+}
+
 fn add(out: &mut Combination, v: u32, w: f64) {
     if w == 0.0 {
         return;
@@ -805,11 +811,7 @@ impl DomainMesh {
     /// The blending functions non-zero at `(s, t) ∈ [0, 1]²` of cell `c`: vertex and value
     /// (summed over the Bézier points; a vertex may appear once).
     pub fn blending(&self, c: u32, s: f64, t: f64) -> Combination {
-        let bern = |x: f64| {
-            let y = 1.0 - x;
-            [y * y * y, 3.0 * x * y * y, 3.0 * x * x * y, x * x * x]
-        };
-        let (bu, bv) = (bern(s), bern(t));
+        let (bu, bv) = (bernstein(s), bernstein(t));
         let mut out = Combination::new();
         for i in 0..4 {
             for j in 0..4 {
