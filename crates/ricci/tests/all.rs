@@ -152,6 +152,8 @@ mod tspline_domain_nested;
 mod tspline_genus;
 #[path = "tspline_genus0.rs"]
 mod tspline_genus0;
+#[path = "tspline_thin_cylinders.rs"]
+mod tspline_thin_cylinders;
 #[path = "uv_match.rs"]
 mod uv_match;
 
