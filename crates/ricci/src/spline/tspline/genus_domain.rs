@@ -174,11 +174,13 @@ fn candidates(m: usize) -> Vec<Vec<i32>> {
 
 /// Over the candidate combinations ([`genus_domain`]), the domain whose cylinders cover the
 /// surface (`Σ L·H` over the cylinders = the net's area, [`GenusDomain::covers`]) and whose
-/// poorest cylinder holds the most data points; when every covering domain has thin cylinders
-/// (which may hold no data), the one whose poorest other cylinder holds the most (ties: the
-/// earlier candidate).
+/// poorest cylinder holds the most data points (ties: the earlier candidate). When every
+/// covering domain has thin cylinders (which may hold no data, so "poorest" says nothing),
+/// the one whose strips glue with the least sheared layout (the smallest largest slope
+/// `|u_top − u_bottom| / H` of [`super::glue::gluing`]'s lines; botijo: 8.97 against 112 for the
+/// most data, L∞ 4.2 % against 22 % at the budget).
 pub fn best_genus_domain(h: &HolomorphicForms, data: usize) -> Result<GenusDomain> {
-    let mut best: Option<((usize, usize), GenusDomain)> = None;
+    let mut best: Option<((usize, f64), GenusDomain)> = None;
     let mut last_err = None;
     for n in candidates(2 * h.genus) {
         match genus_domain(h, &n, data) {
@@ -193,9 +195,12 @@ pub fn best_genus_domain(h: &HolomorphicForms, data: usize) -> Result<GenusDomai
                     .min()
                     .unwrap_or(0);
                 let score = match (covered, thin) {
-                    (true, false) => (poorest, 0),
-                    (true, true) => (0, 1 + poorest),
-                    _ => (0, 0),
+                    (true, false) => (poorest, 0.0),
+                    (true, true) => match super::glue::gluing(&d) {
+                        Ok(g) => (0, 1.0 / (1.0 + g.max_slope)),
+                        Err(_) => (0, 0.0),
+                    },
+                    _ => (0, 0.0),
                 };
                 if best.as_ref().is_none_or(|(s, _)| score > *s) {
                     best = Some((score, d));
