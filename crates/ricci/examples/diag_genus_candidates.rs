@@ -46,6 +46,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let area: f64 = d.cylinders.iter().map(|c| c.circumference * c.height).sum();
                 let net = d.decomposition.area;
                 let poorest = d.cylinders.iter().map(|c| c.data_points).min().unwrap_or(0);
+                let thin = d.cylinders.iter().filter(|c| c.thin).count();
                 let thinnest = d
                     .cylinders
                     .iter()
@@ -59,7 +60,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     Err(e) => e,
                 };
                 println!(
-                    "{n:?}: {} cylinders, area defect {:.2e}, poorest {poorest}, thinnest {thinnest:.4}; {glue}",
+                    "{n:?}: {} cylinders ({thin} thin), area defect {:.2e}, poorest {poorest}, thinnest {thinnest:.4}; {glue}",
                     d.cylinders.len(),
                     (area - net).abs() / net.abs()
                 );

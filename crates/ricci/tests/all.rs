@@ -154,6 +154,8 @@ mod tspline_genus;
 mod tspline_genus0;
 #[path = "tspline_genus_three.rs"]
 mod tspline_genus_three;
+#[path = "tspline_thin_cylinders.rs"]
+mod tspline_thin_cylinders;
 #[path = "uv_match.rs"]
 mod uv_match;
 

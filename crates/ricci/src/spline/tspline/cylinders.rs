@@ -18,6 +18,12 @@
 //! counts negatively). Checks that do not come from the decomposition: the coarea formula
 //! `Σ_cylinders L·H = ∫ du∧dv` (the signed uv area of the net), and the circumferences at a
 //! second level of each band (homologous curves: the same `∮ du`).
+//!
+//! A level curve is also **developed** ([`LevelCurve::crossings`]): walking it face by face,
+//! `u` at each crossed edge is the sum of the face segments' `Δu` before it (on a face the form
+//! is affine, so `Δu` is the flat length; the net's jumps across the cut do not enter), and
+//! the walk's total is `±∮ du`. [`super::genus_domain`] gives a thin band's cylinders (no
+//! vertex inside) their `u` this way.
 
 use crate::analysis::forms::cochain::period;
 use crate::analysis::forms::small::solve;
@@ -152,8 +158,13 @@ pub fn cylinders(
     for (band, &(bottom, height)) in bands.iter().enumerate() {
         let mid = level_curves(h, uv, (bottom + 0.5 * height).rem_euclid(1.0))?;
         let third = level_curves(h, uv, (bottom + height / 3.0).rem_euclid(1.0))?;
-        let mut check: Vec<f64> = third.iter().map(|c| c.0).collect();
-        for (length, faces) in mid {
+        let mut check: Vec<f64> = third.iter().map(|c| c.circumference).collect();
+        for LevelCurve {
+            circumference: length,
+            faces,
+            ..
+        } in mid
+        {
             // the homologous curve at the other level: the closest circumference
             let j = check
                 .iter()
@@ -183,16 +194,39 @@ pub fn cylinders(
     })
 }
 
-/// The components of the level set `v ≡ t (mod 1)` on the net: per closed curve, its signed
-/// `∮ du` and the number of faces it crosses. Every crossed edge must be crossed once and meet
-/// two crossed faces (a closed 1-manifold), else an error naming the edge.
-fn level_curves(h: &HolomorphicForms, uv: &[[f64; 2]], t: f64) -> Result<Vec<(f64, usize)>> {
+/// One closed component of a level set `v ≡ t (mod 1)`, developed along itself.
+#[derive(Debug, Clone)]
+pub struct LevelCurve {
+    /// Signed `∮ du` (a face whose uv image is reversed counts negatively).
+    pub circumference: f64,
+    /// Faces of the cut mesh it crosses.
+    pub faces: usize,
+    /// The refined-mesh edges it crosses: the half-edge along which `v` increases, the
+    /// parameter `s ∈ (0, 1)` of the crossing point from that half-edge's origin, and its `u`
+    /// developed along the curve (the sum of the face segments `Δu` from the first crossing;
+    /// defined mod `|circumference|`).
+    pub crossings: Vec<(u32, f64, f64)>,
+}
+
+/// Where the level enters or leaves a face of the net: the half-edge of that side along which
+/// `v` increases, the parameter from its origin, and the crossing's `u` in the face's uv image.
+type FaceCrossing = (u32, f64, f64);
+
+/// The components of the level set `v ≡ t (mod 1)` on the net (`uv`: the net's coordinates),
+/// each developed ([`LevelCurve`]). Every crossed edge must be crossed once and meet two
+/// crossed faces (a closed 1-manifold), else an error naming the edge.
+pub(crate) fn level_curves(
+    h: &HolomorphicForms,
+    uv: &[[f64; 2]],
+    t: f64,
+) -> Result<Vec<LevelCurve>> {
     let cm = &h.cut.cut_mesh;
     let refined = h.mesh();
     let ne = refined.n_edges();
     // per refined edge, the faces whose level segment ends on it
     let mut ends: Vec<Vec<u32>> = vec![Vec::new(); ne];
     let mut segment = vec![0.0f64; cm.n_faces()];
+    let mut at: Vec<[FaceCrossing; 2]> = vec![[(0, 0.0, 0.0); 2]; cm.n_faces()];
     let mut crossed = vec![false; cm.n_faces()];
     for f in 0..cm.n_faces() as u32 {
         let corners = cm.face(f).map(|v| uv[v as usize]);
@@ -216,7 +250,16 @@ fn level_curves(h: &HolomorphicForms, uv: &[[f64; 2]], t: f64) -> Result<Vec<(f6
             let (p, q) = (corners[i], corners[(i + 1) % 3]);
             if (p[1] - level) * (q[1] - level) < 0.0 {
                 let s = (level - p[1]) / (q[1] - p[1]);
-                us.push(p[0] + s * (q[0] - p[0]));
+                let u = p[0] + s * (q[0] - p[0]);
+                let hh = 3 * f + i as u32;
+                if us.len() < 2 {
+                    at[f as usize][us.len()] = if q[1] > p[1] {
+                        (hh, s, u)
+                    } else {
+                        (refined.he_twin(hh), 1.0 - s, u)
+                    };
+                }
+                us.push(u);
                 ends[refined.he_edge(3 * f + i as u32) as usize].push(f);
             }
         }
@@ -230,38 +273,48 @@ fn level_curves(h: &HolomorphicForms, uv: &[[f64; 2]], t: f64) -> Result<Vec<(f6
         segment[f as usize] = det.signum() * (us[1] - us[0]).abs();
         crossed[f as usize] = true;
     }
-    // union of the faces meeting at a crossed edge
-    let mut parent: Vec<u32> = (0..cm.n_faces() as u32).collect();
-    fn root(p: &mut [u32], mut x: u32) -> u32 {
-        while p[x as usize] != x {
-            p[x as usize] = p[p[x as usize] as usize];
-            x = p[x as usize];
-        }
-        x
-    }
     for (e, fs) in ends.iter().enumerate() {
-        match fs.as_slice() {
-            [] => {}
-            [a, b] => {
-                let (ra, rb) = (root(&mut parent, *a), root(&mut parent, *b));
-                parent[ra as usize] = rb;
-            }
-            _ => {
-                return Err(Error::numerical(format!(
-                    "the level {t:.6} crosses edge {e} {} time(s) from its faces (not a closed curve there)",
-                    fs.len()
-                )))
-            }
+        if !(fs.is_empty() || fs.len() == 2) {
+            return Err(Error::numerical(format!(
+                "the level {t:.6} crosses edge {e} {} time(s) from its faces (not a closed curve there)",
+                fs.len()
+            )));
         }
     }
-    let mut curves: std::collections::BTreeMap<u32, (f64, usize)> = Default::default();
-    for f in 0..cm.n_faces() as u32 {
-        if crossed[f as usize] {
-            let r = root(&mut parent, f);
-            let c = curves.entry(r).or_insert((0.0, 0));
-            c.0 += segment[f as usize];
-            c.1 += 1;
+    // walk every curve face by face: the face across the exit edge is the next one
+    let mut seen = vec![false; cm.n_faces()];
+    let mut curves = Vec::new();
+    for f0 in 0..cm.n_faces() {
+        if !crossed[f0] || seen[f0] {
+            continue;
         }
+        let mut curve = LevelCurve {
+            circumference: 0.0,
+            faces: 0,
+            crossings: Vec::new(),
+        };
+        let (mut f, mut entry, mut u) = (f0, 0usize, 0.0);
+        while !seen[f] {
+            seen[f] = true;
+            curve.circumference += segment[f];
+            curve.faces += 1;
+            let (hh, s, u_in) = at[f][entry];
+            let (exit, s_out, u_out) = at[f][1 - entry];
+            if f == f0 {
+                curve.crossings.push((hh, s, u));
+            }
+            u += u_out - u_in;
+            let e = refined.he_edge(exit) as usize;
+            let next = ends[e].iter().copied().find(|&g| g as usize != f);
+            let Some(g) = next else { break };
+            let g = g as usize;
+            if g != f0 {
+                curve.crossings.push((exit, s_out, u));
+            }
+            entry = usize::from(refined.he_edge(at[g][0].0) as usize != e);
+            f = g;
+        }
+        curves.push(curve);
     }
-    Ok(curves.into_values().collect())
+    Ok(curves)
 }
