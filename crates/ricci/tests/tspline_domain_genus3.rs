@@ -10,9 +10,8 @@ mod ricci_meshes;
 mod tspline_cases;
 
 use crate::tspline_domain_mesh::{check_t_spline, Rng};
-use ricci::spline::tspline::domain_fit::{fit_domain_mesh, DomainFitOptions};
 use ricci::spline::tspline::fit::bbox_scale;
-use tspline_cases::{glued_domain, max_vertex_error};
+use tspline_cases::{fit_at, glued_domain, max_vertex_error};
 
 #[test]
 fn genus3_blocks_meet_the_tolerance_with_fewer_control_points_than_the_spacing() {
@@ -26,14 +25,7 @@ fn genus3_blocks_meet_the_tolerance_with_fewer_control_points_than_the_spacing()
     let (d, g, _) = glued_domain(&s);
     let side = bbox_scale(&s.positions);
     let tolerance = 0.005;
-    let fit = |blocks: bool| {
-        let opts = DomainFitOptions {
-            tolerance,
-            blocks,
-            ..DomainFitOptions::default()
-        };
-        fit_domain_mesh(&d, &g, &s.positions, &opts).unwrap()
-    };
+    let fit = |blocks: bool| fit_at(&d, &g, &s.positions, tolerance, blocks);
     let (local, global) = (fit(true), fit(false));
     let (max_local, max_global) = (
         max_vertex_error(&d, &local, &s.positions) / side,
