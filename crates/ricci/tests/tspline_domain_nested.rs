@@ -11,11 +11,10 @@ mod ricci_meshes;
 mod tspline_cases;
 
 use crate::tspline_domain_mesh::{check_t_spline, local_knots, Rng, StripLines};
-use ricci::spline::tspline::domain_fit::{fit_domain_mesh, DomainFitOptions};
 use ricci::spline::tspline::domain_mesh::blocks::{place_blocks, Block, CLEAR, FINE};
 use ricci::spline::tspline::domain_mesh::DomainMesh;
 use ricci::spline::tspline::fit::bbox_scale;
-use tspline_cases::{genus_two_cases, glued_domain, max_vertex_error};
+use tspline_cases::{fit_at, genus_two_cases, glued_domain, max_vertex_error};
 
 /// Anchors a block of `a × b` cells (of its level) inside a uniform part of the T-mesh adds: `a`
 /// lines along `v` over the box's `b` rows and one row beyond each end (`b + 3` crossings of
@@ -222,14 +221,7 @@ fn a_fit_that_needs_two_levels_of_blocks_nests_them() {
     let (d, g, _) = glued_domain(&s);
     let side = bbox_scale(&s.positions);
     let tolerance = 0.005;
-    let fit = |blocks: bool| {
-        let opts = DomainFitOptions {
-            tolerance,
-            blocks,
-            ..DomainFitOptions::default()
-        };
-        fit_domain_mesh(&d, &g, &s.positions, &opts).unwrap()
-    };
+    let fit = |blocks: bool| fit_at(&d, &g, &s.positions, tolerance, blocks);
     let (f, global) = (fit(true), fit(false));
     let max = max_vertex_error(&d, &f, &s.positions);
     let deepest = f.mesh.blocks.iter().map(|b| b.level).max().unwrap_or(0);

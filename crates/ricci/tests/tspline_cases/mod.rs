@@ -72,3 +72,20 @@ pub fn max_vertex_error(
     }
     max
 }
+
+/// The domain-mesh fit of the vertices `positions` of `d` glued by `g` at `tolerance`, with the
+/// default refinement (`blocks`) or the spacing refined everywhere instead of blocks.
+pub fn fit_at(
+    d: &ricci::spline::tspline::genus_domain::GenusDomain,
+    g: &ricci::spline::tspline::glue::Gluing,
+    positions: &[[f64; 3]],
+    tolerance: f64,
+    blocks: bool,
+) -> ricci::spline::tspline::domain_fit::DomainFit {
+    let opts = ricci::spline::tspline::domain_fit::DomainFitOptions {
+        tolerance,
+        blocks,
+        ..Default::default()
+    };
+    ricci::spline::tspline::domain_fit::fit_domain_mesh(d, g, positions, &opts).unwrap()
+}

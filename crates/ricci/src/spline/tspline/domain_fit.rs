@@ -22,6 +22,19 @@
 //! [`DomainMesh::with_t_junctions`]): the control points are the T-mesh's anchors. While a
 //! point beside a graded line past its T-junction ([`DomainMesh::past_t_junction`]) is beyond
 //! the tolerance, the lines are extended by two cells (instead of a finer spacing).
+//!
+//! **Where the control points go on genus ≥ 3** (measured with `examples/diag_domain_refinement`;
+//! `docs/notes/wave2-s18-ec20.md`). A level at the zeros is global: it adds a graded column and
+//! row at every zero copy, each kept over `L + 2 + margin` cells, about 900 control points per
+//! level on genus3.off (32 corners), 3 500 of its 6 119 at 0.5 %, asked for by 1–9 points.
+//! Those points lie along the strip sides next to a zero: within `0.06 E_u` of the side
+//! (`E_u`, `E_v` the ungraded edge intervals) and up to `2 E_v` from the zero, where the thin
+//! cylinder (height 0.0117) made `E_v` thirteen times smaller than `E_u` — the corner cells are
+//! anisotropic, and a level refines `u` (needed) and `v` (not). Per-corner levels or levels per
+//! direction would make this local; blocks cannot help (they stay [`super::domain_mesh::blocks::CLEAR`]
+//! intervals from the zeros), and dropping the blocks that break analysis suitability instead of
+//! refining the spacing everywhere leaves their points beyond the tolerance while the levels grow
+//! (3holes 4 623 → 7 221, fertility 6 892 → 9 905).
 
 use super::cylinder_fit::GenusStep;
 use super::domain_mesh::blocks::place_blocks;
