@@ -6,7 +6,7 @@
 use ricci::analysis::forms::{holomorphic_forms, FormsOptions};
 use ricci::metric::IntrinsicMetric;
 use ricci::progress::NoProgress;
-use ricci::spline::tspline::genus_domain::genus_domain;
+use ricci::spline::tspline::genus_domain::{candidates, genus_domain};
 use ricci::spline::tspline::glue::gluing;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -23,24 +23,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &FormsOptions::default(),
         &mut NoProgress,
     )?;
-    let m = 2 * h.genus;
-    let mut candidates = Vec::new();
-    for k in 0..m {
-        let mut n = vec![0; m];
-        n[k] = 1;
-        candidates.push(n);
-    }
-    for i in 0..m {
-        for j in i + 1..m {
-            for sj in [1, -1] {
-                let mut n = vec![0; m];
-                n[i] = 1;
-                n[j] = sj;
-                candidates.push(n);
-            }
-        }
-    }
-    for n in candidates {
+    for n in candidates(2 * h.genus) {
         match genus_domain(&h, &n, s.positions.len()) {
             Ok(d) => {
                 let area: f64 = d.cylinders.iter().map(|c| c.circumference * c.height).sum();

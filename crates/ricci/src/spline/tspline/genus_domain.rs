@@ -151,8 +151,9 @@ pub fn genus_domain(h: &HolomorphicForms, n: &[i32], data: usize) -> Result<Genu
     Ok(d)
 }
 
-/// The candidate combinations `n`: the unit vectors `e_k` and `e_i ± e_j`.
-fn candidates(m: usize) -> Vec<Vec<i32>> {
+/// The candidate combinations `n` of [`best_genus_domain`] for `m = 2g` loops: the unit vectors
+/// `e_k` and `e_i ± e_j`.
+pub fn candidates(m: usize) -> Vec<Vec<i32>> {
     let mut out = Vec::new();
     for k in 0..m {
         let mut n = vec![0; m];
