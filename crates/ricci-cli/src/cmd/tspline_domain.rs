@@ -238,6 +238,10 @@ pub fn domain_spline(
         fit_seconds,
         t0,
     );
+    // the result's errors: the returned fit's (the best step's when not converged)
+    let (rms, max) = fit.errors_percent();
+    report["rms_error_percent"] = json!(rms);
+    report["max_error_percent"] = json!(max);
     // shared_keys says 0 (the per-cylinder fit has none)
     report["t_junctions"] = json!(fit.mesh.n_t_junctions());
     Ok(DomainSpline {
@@ -265,9 +269,7 @@ pub fn run_domain(
         report: mut out,
         max_iterations,
     } = spline;
-    let (rms, max) = fit.steps.last().map_or((f64::NAN, f64::NAN), |s| {
-        (s.rms_error_percent, s.max_error_percent)
-    });
+    let (rms, max) = fit.errors_percent();
     if !fit.converged {
         warn_not_converged(a, max, tolerance, max_iterations);
     }

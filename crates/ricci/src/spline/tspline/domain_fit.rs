@@ -44,9 +44,11 @@ use super::genus_domain::GenusDomain;
 use super::glue::Gluing;
 use crate::error::{Error, Result};
 use crate::numeric::sparse::{BlockAssembly, Cholesky};
-use crate::numeric::vec3::{cross, norm, sub};
-use crate::spline::surface::MeshDistance;
 use faer::Mat;
+
+mod between;
+use between::data;
+pub use between::deviation_between_vertices;
 
 /// The fitted spline on the domain mesh.
 #[derive(Debug, Clone)]
@@ -65,6 +67,18 @@ pub struct DomainFit {
     /// Per refinement (between two steps): what was refined, and why the spacing shrank
     /// everywhere when it did.
     pub refinements: Vec<String>,
+}
+
+impl DomainFit {
+    /// `(rms, L∞)` of this spline's distances to the data vertices, in percent of
+    /// [`Self::scale`]: the last step's, or the best step's when the loop ended above the
+    /// tolerance with an earlier fit nearer (the one returned then).
+    pub fn errors_percent(&self) -> (f64, f64) {
+        let n = self.errors.len().max(1) as f64;
+        let rms = (self.errors.iter().map(|e| e * e).sum::<f64>() / n).sqrt();
+        let s = 100.0 / self.scale.max(1e-300);
+        (rms * s, max_error(self) * s)
+    }
 }
 
 /// Options of [`fit_domain_mesh`].
@@ -453,134 +467,6 @@ fn fill_budget(
     Ok(None)
 }
 
-/// Points on the input triangles whose three vertices are data points of one cylinder: the
-/// centroid and the three edge midpoints, at the mean of the vertices' cylinder coordinates
-/// (`u` unwrapped across the seam; triangles spanning more than a quarter of the circumference
-/// are left out), as `(cylinder, u, v, position, weight)`; weight `w · area / mean area`.
-fn triangle_points(
-    domain: &GenusDomain,
-    positions: &[[f64; 3]],
-    triangles: &[[u32; 3]],
-    w: f64,
-) -> Vec<(usize, f64, f64, [f64; 3], f64)> {
-    if w <= 0.0 || triangles.is_empty() {
-        return Vec::new();
-    }
-    let mut at = vec![usize::MAX; positions.len()];
-    for (k, p) in domain.points.iter().enumerate() {
-        if let Some(x) = at.get_mut(p.vertex as usize) {
-            *x = k;
-        }
-    }
-    let area = |t: &[u32; 3]| {
-        let [a, b, c] = t.map(|v| positions[v as usize]);
-        0.5 * norm(cross(sub(b, a), sub(c, a)))
-    };
-    let mean = triangles.iter().map(area).sum::<f64>() / triangles.len() as f64;
-    let mut out = Vec::new();
-    for t in triangles {
-        let Some(k) = t
-            .iter()
-            .map(|&v| at.get(v as usize).copied().filter(|&k| k != usize::MAX))
-            .collect::<Option<Vec<usize>>>()
-        else {
-            continue;
-        };
-        let q = k.iter().map(|&k| domain.points[k]).collect::<Vec<_>>();
-        let c = q[0].cylinder;
-        if q.iter().any(|p| p.cylinder != c) {
-            continue;
-        }
-        let l = domain.cylinders[c].circumference;
-        let u: Vec<f64> = q
-            .iter()
-            .map(|p| q[0].u + (p.u - q[0].u + 0.5 * l).rem_euclid(l) - 0.5 * l)
-            .collect();
-        // a cylinder glued to itself: a triangle across that trajectory has `v` near 0 and `H`
-        let h = domain.cylinders[c].height;
-        if u.iter().any(|x| (x - u[0]).abs() > 0.25 * l)
-            || q.iter().any(|p| (p.v - q[0].v).abs() > 0.25 * h)
-        {
-            continue;
-        }
-        let x = t.map(|v| positions[v as usize]);
-        // the cylinder coordinates must be close to an affine image of the triangle (not so
-        // around a zero, where the chart is branched): same orientation as the majority, and
-        // the edges' lengths over their lengths in the chart within a factor 1.5 of each other
-        let (du, dv) = (
-            [u[1] - u[0], u[2] - u[0]],
-            [q[1].v - q[0].v, q[2].v - q[0].v],
-        );
-        let signed = du[0] * dv[1] - du[1] * dv[0];
-        let ratios: Vec<f64> = [(0, 1), (1, 2), (2, 0)]
-            .iter()
-            .map(|&(i, j)| norm(sub(x[i], x[j])) / (u[i] - u[j]).hypot(q[i].v - q[j].v).max(1e-300))
-            .collect();
-        let (lo, hi) = ratios
-            .iter()
-            .fold((f64::INFINITY, 0.0f64), |(a, b), &r| (a.min(r), b.max(r)));
-        if hi > 1.5 * lo || !hi.is_finite() {
-            continue;
-        }
-        let wt = w * area(t) / mean.max(1e-300);
-        let all = [
-            [1.0 / 3.0; 3],
-            [0.5, 0.5, 0.0],
-            [0.0, 0.5, 0.5],
-            [0.5, 0.0, 0.5],
-        ];
-        for bary in all.iter() {
-            let ub: f64 = (0..3).map(|i| bary[i] * u[i]).sum();
-            let vb: f64 = (0..3).map(|i| bary[i] * q[i].v).sum();
-            let p = std::array::from_fn(|d| (0..3).map(|i| bary[i] * x[i][d]).sum());
-            out.push((c, ub.rem_euclid(l), vb, p, wt, signed > 0.0));
-        }
-    }
-    // orientation: the charts of a holomorphic form keep it, so the minority is wrong
-    let positive = out.iter().filter(|e| e.5).count();
-    let keep = 2 * positive >= out.len();
-    let out: Vec<_> = out
-        .into_iter()
-        .filter(|e| e.5 == keep)
-        .map(|e| (e.0, e.1, e.2, e.3, e.4))
-        .collect();
-    out
-}
-
-/// Distance of the spline to the input triangles between the vertices: the fitted surface at
-/// `k × k` points of every cell (`((i + ½)/k, (j + ½)/k)`) to the closest point of the
-/// triangles (exact point–triangle distance, [`MeshDistance`]); `(max, rms)` in percent of the
-/// longest bounding-box side ([`DomainFit::scale`]).
-pub fn deviation_between_vertices(
-    fit: &DomainFit,
-    positions: &[[f64; 3]],
-    triangles: &[[u32; 3]],
-    k: usize,
-) -> (f64, f64) {
-    use rayon::prelude::*;
-    let k = k.max(1);
-    let dist = MeshDistance::new(positions, triangles);
-    let d: Vec<f64> = (0..fit.mesh.n_cells() as u32)
-        .into_par_iter()
-        .flat_map_iter(|c| {
-            let dist = &dist;
-            // the cell's Bézier patch once, then its points
-            let p = fit.mesh.patch(c, &fit.control, 0.0, 0.0);
-            (0..k * k).map(move |ij| {
-                let (s, t) = (
-                    ((ij % k) as f64 + 0.5) / k as f64,
-                    ((ij / k) as f64 + 0.5) / k as f64,
-                );
-                dist.distance(p.point(p.u0 + s * (p.u1 - p.u0), p.v0 + t * (p.v1 - p.v0)))
-            })
-        })
-        .collect();
-    let max = d.iter().fold(0.0f64, |a, &b| a.max(b));
-    let rms = (d.iter().map(|x| x * x).sum::<f64>() / d.len().max(1) as f64).sqrt();
-    let s = 100.0 / fit.scale.max(1e-300);
-    (max * s, rms * s)
-}
-
 /// Fit the data points of `domain` (positions by vertex) on the domain mesh, refining (at the
 /// zeros or uniformly, module doc) until `L∞ ≤ tolerance` or the budget is spent. Vertices
 /// only: [`fit_domain_mesh_on_triangles`] with no triangles.
@@ -726,19 +612,11 @@ pub fn fit_domain_mesh_on_triangles(
         .iter()
         .map(|c| c.circumference)
         .fold(0.0, f64::max);
-    let mut targets: Vec<[f64; 3]> = domain
-        .points
-        .iter()
-        .map(|p| positions[p.vertex as usize])
-        .collect();
-    let n_vertices = targets.len();
-    let extra = triangle_points(domain, positions, triangles, opts.between_vertices);
-    let mut weights = vec![1.0; n_vertices];
-    targets.extend(extra.iter().map(|e| e.3));
-    weights.extend(extra.iter().map(|e| e.4));
+    let (targets, weights, n_vertices, extra) = data(domain, positions, triangles, opts);
     let mut spacing = opts.initial * l;
     let mut steps = Vec::new();
     let mut last: Option<DomainFit> = None;
+    let mut best: Option<DomainFit> = None;
     let refine = opts.refine.clamp(0.1, 0.95);
     let mut filled = false;
     let (mut levels, mut previous_spacing, mut margin) = (0, spacing, T_MARGIN);
@@ -821,6 +699,7 @@ pub fn fit_domain_mesh_on_triangles(
             }
         }
         let mesh_levels = mesh.rects.first().map_or(0, |r| r.levels);
+        keep_best(&mut best, last.take());
         last = Some(DomainFit {
             mesh,
             control,
@@ -861,5 +740,39 @@ pub fn fit_domain_mesh_on_triangles(
             what.join(", ")
         ));
     }
-    last.ok_or_else(|| Error::numerical("domain mesh fit: no iteration ran"))
+    let last = last.ok_or_else(|| Error::numerical("domain mesh fit: no iteration ran"))?;
+    Ok(best_of(last, best))
+}
+
+/// The largest distance of `f`'s spline to a data vertex.
+fn max_error(f: &DomainFit) -> f64 {
+    f.errors.iter().fold(0.0f64, |a, &b| a.max(b))
+}
+
+/// Keeps in `best` the one of `best` and `f` with the smaller L∞ (the earlier on a tie).
+fn keep_best(best: &mut Option<DomainFit>, f: Option<DomainFit>) {
+    if let Some(f) = f {
+        if best.as_ref().is_none_or(|b| max_error(&f) < max_error(b)) {
+            *best = Some(f);
+        }
+    }
+}
+
+/// `last`, or when it is above the tolerance and an earlier fit (`best`) had a smaller L∞, that
+/// one, with every step and refinement of the run and a line saying which step it was (its
+/// errors: [`DomainFit::errors_percent`], not the last step's).
+fn best_of(last: DomainFit, best: Option<DomainFit>) -> DomainFit {
+    match best {
+        Some(mut b) if !last.converged && max_error(&b) < max_error(&last) => {
+            let k = b.steps.len();
+            b.steps = last.steps;
+            b.refinements = last.refinements;
+            b.refinements.push(format!(
+                "not converged: the fit of step {k} (the smallest L∞, {:.3} %) is the result, not the last one",
+                100.0 * max_error(&b) / b.scale
+            ));
+            b
+        }
+        _ => last,
+    }
 }
