@@ -144,6 +144,8 @@ mod tspline_bezier_elements;
 mod tspline_cylinders;
 #[path = "tspline_domain_blocks.rs"]
 mod tspline_domain_blocks;
+#[path = "tspline_domain_carry.rs"]
+mod tspline_domain_carry;
 #[path = "tspline_domain_genus3.rs"]
 mod tspline_domain_genus3;
 #[path = "tspline_domain_mesh.rs"]

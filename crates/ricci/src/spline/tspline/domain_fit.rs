@@ -37,7 +37,7 @@
 //! (3holes 4 623 → 7 221, fertility 6 892 → 9 905).
 
 use super::cylinder_fit::GenusStep;
-use super::domain_mesh::blocks::place_blocks;
+use super::domain_mesh::blocks::{carry_blocks, place_blocks};
 use super::domain_mesh::{bernstein, Block, Combination, DomainMesh};
 use super::fit::bbox_scale;
 use super::genus_domain::GenusDomain;
@@ -549,14 +549,14 @@ pub fn graded_cells(blocks: &[Block]) -> usize {
 /// The blocks of the next step of [`fit_domain_mesh_on_triangles`]: the boxes around the
 /// points `far` beyond the tolerance away from the zeros (in the indices of the next graded mesh,
 /// `d` more levels), or — when no block can be placed or they would cover more than
-/// [`BLOCK_SHARE`] of the cells — none, and the spacing times `refine` everywhere; `what` says
-/// which.
+/// [`BLOCK_SHARE`] of the cells — none, and the spacing times `refine` everywhere (`true`; the
+/// caller carries the blocks over: [`carried`]); `what` says which.
 fn next_blocks(
     (use_blocks, far, last, d): (bool, &[u32], Option<&DomainFit>, usize),
     blocks: &mut Vec<Block>,
     (spacing, refine): (&mut f64, f64),
     what: &mut Vec<String>,
-) {
+) -> bool {
     let placed = match (use_blocks, far.is_empty(), last) {
         (_, true, _) => Ok(blocks.clone()),
         (false, _, _) => Err("blocks are off".to_string()),
@@ -570,7 +570,10 @@ fn next_blocks(
         f.mesh.rects.iter().map(|r| r.base_m * r.base_n).sum()
     });
     match shifted {
-        Ok(bs) if far.is_empty() => *blocks = bs,
+        Ok(bs) if far.is_empty() => {
+            *blocks = bs;
+            false
+        }
         Ok(bs) if graded_cells(&bs) as f64 > BLOCK_SHARE * cells as f64 => {
             *spacing *= refine;
             blocks.clear();
@@ -578,6 +581,7 @@ fn next_blocks(
                 "the spacing × 1/√2 everywhere (blocks would cover more than {:.0} % of the cells)",
                 100.0 * BLOCK_SHARE
             ));
+            true
         }
         Ok(bs) => {
             what.push(format!(
@@ -588,13 +592,74 @@ fn next_blocks(
                 far.len()
             ));
             *blocks = bs;
+            false
         }
         Err(why) => {
             *spacing *= refine;
             blocks.clear();
             what.push(format!("the spacing × 1/√2 everywhere (no block: {why})"));
+            true
         }
     }
+}
+
+/// The blocks of `old` carried over to the graded mesh of `spacing` and `levels`
+/// ([`carry_blocks`]: what they split stays split at least as finely).
+fn carried(
+    domain: &GenusDomain,
+    gluing: &Gluing,
+    (spacing, levels): (f64, usize),
+    old: &DomainMesh,
+) -> Result<Vec<Block>> {
+    if old.blocks.is_empty() {
+        return Ok(Vec::new());
+    }
+    let new = DomainMesh::graded(domain, gluing, spacing, levels).map_err(Error::numerical)?;
+    Ok(carry_blocks(old, &new))
+}
+
+/// The mesh of the next step of [`fit_domain_mesh_on_triangles`]: of `spacing` graded `levels`
+/// times, T-junctions `margin` cells past the corner blocks, with `blocks` — or, when their
+/// T-mesh is not analysis-suitable, the spacing times `refine` with the blocks of the `last`
+/// fit carried over ([`carried`]), and none when those are not either (or were the ones just
+/// carried over: `carried`); `refinements` says which.
+fn step_mesh(
+    (domain, gluing, opts): (&GenusDomain, &Gluing, &DomainFitOptions),
+    (spacing, levels, margin): (&mut f64, usize, usize),
+    (blocks, carried_now): (&mut Vec<Block>, bool),
+    (last, refine): (Option<&DomainFit>, f64),
+    refinements: &mut Vec<String>,
+) -> Result<DomainMesh> {
+    let mut mesh = domain_mesh(domain, gluing, (*spacing, levels, margin), blocks, opts)?;
+    if blocks.is_empty() {
+        return Ok(mesh);
+    }
+    let Some(v) = mesh.extensions_meet().map_err(Error::numerical)? else {
+        return Ok(mesh);
+    };
+    let why =
+        format!("the blocks' T-mesh is not analysis-suitable (extensions meet at vertex {v})");
+    if !carried_now {
+        *spacing *= refine;
+        *blocks = match last {
+            Some(f) => carried(domain, gluing, (*spacing, levels), &f.mesh)?,
+            None => Vec::new(),
+        };
+        mesh = domain_mesh(domain, gluing, (*spacing, levels, margin), blocks, opts)?;
+        if blocks.is_empty() || mesh.extensions_meet().map_err(Error::numerical)?.is_none() {
+            refinements.push(format!(
+                "{why}: the spacing × 1/√2 everywhere instead, the last fit's {} blocks carried over",
+                blocks.len()
+            ));
+            return Ok(mesh);
+        }
+    }
+    refinements.push(format!(
+        "{why}: the {} blocks carried over dropped",
+        blocks.len()
+    ));
+    blocks.clear();
+    domain_mesh(domain, gluing, (*spacing, levels, margin), blocks, opts)
 }
 
 /// [`fit_domain_mesh`] with points on the input `triangles` as data too
@@ -623,18 +688,26 @@ pub fn fit_domain_mesh_on_triangles(
     let mut blocks: Vec<Block> = Vec::new();
     let mut refinements = Vec::new();
     let use_blocks = opts.blocks && opts.t_junctions && opts.g1_at_zeros;
+    let mut carried_now = false;
     for _ in 0..opts.max_iterations.max(1) {
-        let mut mesh = domain_mesh(domain, gluing, (spacing, levels, margin), &blocks, opts)?;
-        if !blocks.is_empty() {
-            if let Some(v) = mesh.extensions_meet().map_err(Error::numerical)? {
-                // not analysis-suitable: the spacing instead
-                refinements.push(format!(
-                    "the blocks' T-mesh is not analysis-suitable (extensions meet at vertex {v}): the spacing × 1/√2 everywhere instead"
-                ));
-                blocks.clear();
-                spacing *= refine;
-                mesh = domain_mesh(domain, gluing, (spacing, levels, margin), &blocks, opts)?;
-            }
+        let at = (&mut spacing, levels, margin);
+        let mut mesh = step_mesh(
+            (domain, gluing, opts),
+            at,
+            (&mut blocks, carried_now),
+            (last.as_ref(), refine),
+            &mut refinements,
+        )?;
+        if carried_now && !blocks.is_empty() && mesh.n_control_points() > opts.max_control_points {
+            // the carried blocks over the budget: the largest mesh within it without them
+            refinements.push(format!(
+                "{} control points with the {} blocks carried over: over the budget of {}, without them",
+                mesh.n_control_points(),
+                blocks.len(),
+                opts.max_control_points
+            ));
+            blocks.clear();
+            mesh = domain_mesh(domain, gluing, (spacing, levels, margin), &blocks, opts)?;
         }
         if let Some(prev) = last
             .as_ref()
@@ -726,12 +799,20 @@ pub fn fit_domain_mesh_on_triangles(
                 "graded lines {margin} cells past the corner blocks"
             ));
         }
-        next_blocks(
+        let finer = next_blocks(
             (use_blocks, &far, last.as_ref(), usize::from(near)),
             &mut blocks,
             (&mut spacing, refine),
             &mut what,
         );
+        carried_now = false;
+        if let Some(f) = last.as_ref().filter(|_| finer && use_blocks) {
+            blocks = carried(domain, gluing, (spacing, levels), &f.mesh)?;
+            if !blocks.is_empty() {
+                carried_now = true;
+                what.push(format!("{} blocks carried over", blocks.len()));
+            }
+        }
         refinements.push(format!(
             "step {}: {} control points, L∞ {:.3} %; next: {}",
             steps.len(),

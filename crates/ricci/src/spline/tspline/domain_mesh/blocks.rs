@@ -297,6 +297,11 @@ impl DomainMesh {
     /// splits — its index in [`DomainMesh::blocks`], and whether it lies in split columns and in
     /// split rows; if any.
     pub fn block_of_cell(&self, c: u32) -> Option<(usize, (bool, bool))> {
+        self.block_of_cell_below(c, usize::MAX)
+    }
+
+    /// [`Self::block_of_cell`] among the blocks of level below `below`.
+    pub fn block_of_cell_below(&self, c: u32, below: usize) -> Option<(usize, (bool, bool))> {
         let (r, i, j) = self.cell_at[c as usize];
         let rc = &self.rects[r as usize];
         let (i, j) = (i as usize, j as usize);
@@ -309,7 +314,7 @@ impl DomainMesh {
         self.blocks
             .iter()
             .enumerate()
-            .filter(|(_, b)| b.rect == r as usize)
+            .filter(|(_, b)| b.rect == r as usize && b.level < below)
             .map(|(k, b)| (k, b.splits(cell, rc.base_m, rc.base_n)))
             .filter(|(_, (u, v))| *u || *v)
             .max_by_key(|(k, _)| self.blocks[*k].level)
@@ -328,16 +333,51 @@ fn close(a: [usize; 4], b: [usize; 4]) -> bool {
 /// the directions they split.
 type Group = (usize, usize, Option<usize>, [bool; 2]);
 
-/// The box a marked cell asks for: the cell of the level-`ℓ − 1` mesh that contains it and its
-/// neighbours, inside the strip (level 1) or inside the split part of the parent block, one
-/// cell in from its sides (module doc), and its group; `None` when the cell is in the first or
-/// last row or column of its block (a nested box there would end its lines where the T-mesh
-/// has none, or meet the extensions of the parent's T-junctions), or why no box can be placed.
-fn box_around(mesh: &DomainMesh, c: u32) -> Result<Option<(Group, [usize; 4])>, String> {
+/// Why a marked cell takes no block.
+enum Refusal {
+    /// Within [`CLEAR`] cells of two sides of its strip: only a finer spacing (or a level at
+    /// the zeros) refines it, and [`place_blocks`] places no block.
+    Corner(String),
+    /// Split [`MAX_BLOCK_LEVEL`] times: the other cells' blocks are placed.
+    Capped(String),
+}
+
+/// The box a marked cell asks for: the box of [`box_in`] in the deepest block that splits it, or
+/// — when the cell is in the first or last row or column of that block's split part, where no
+/// block can nest — a box of that block's level around it in the block's parent, which the
+/// closure of [`place_blocks`] merges into the block: the block **grows** (and the cell, inside
+/// it then, can nest at the next step); up the chain of parents while the cell is at an edge of
+/// each. `None`: no box (the cell is at an edge of the strip's split part); or why the cell can
+/// take no block.
+fn box_around(mesh: &DomainMesh, c: u32) -> Result<Option<(Group, [usize; 4])>, Refusal> {
+    let mut below = usize::MAX;
+    loop {
+        let found = mesh.block_of_cell_below(c, below);
+        if let Some(x) = box_in(mesh, c, found)? {
+            return Ok(Some(x));
+        }
+        match found {
+            Some((p, _)) => below = mesh.blocks[p].level,
+            None => return Ok(None),
+        }
+    }
+}
+
+/// The box a marked cell asks for inside the block `found` (its index and whether the cell lies
+/// in its split columns and rows; `None`: the strip): the cell of the level-`ℓ − 1` mesh that
+/// contains it and its neighbours, inside the strip (level 1) or inside the split part of the
+/// parent block, one cell in from its sides (module doc), and its group; `None` when the cell
+/// is in the first or last row or column of its block (a nested box there would end its lines
+/// where the T-mesh has none, or meet the extensions of the parent's T-junctions), or why no
+/// box can be placed.
+fn box_in(
+    mesh: &DomainMesh,
+    c: u32,
+    found: Option<(usize, (bool, bool))>,
+) -> Result<Option<(Group, [usize; 4])>, Refusal> {
     let (r, bi, bj) = mesh.base_cell(c);
     let rc = &mesh.rects[r];
     let (m, n) = (rc.base_m, rc.base_n);
-    let found = mesh.block_of_cell(c);
     let parent = found.map(|f| f.0);
     let level = parent.map_or(0, |p| mesh.blocks[p].level) + 1;
     let at = || {
@@ -347,7 +387,10 @@ fn box_around(mesh: &DomainMesh, c: u32) -> Result<Option<(Group, [usize; 4])>, 
         )
     };
     if level > MAX_BLOCK_LEVEL {
-        return Err(format!("{} is split {MAX_BLOCK_LEVEL} times already", at()));
+        return Err(Refusal::Capped(format!(
+            "{} is split {MAX_BLOCK_LEVEL} times already",
+            at()
+        )));
     }
     let (_, i, j) = mesh.cell_at[c as usize];
     let s = FINE >> (level - 1);
@@ -358,7 +401,10 @@ fn box_around(mesh: &DomainMesh, c: u32) -> Result<Option<(Group, [usize; 4])>, 
         None => {
             let clear = |k: usize, len: usize| k >= CLEAR && k + CLEAR < len;
             if !clear(bi, m) && !clear(bj, n) {
-                return Err(format!("{} is within {CLEAR} cells of two sides", at()));
+                return Err(Refusal::Corner(format!(
+                    "{} is within {CLEAR} cells of two sides",
+                    at()
+                )));
             }
             ((0, m, false), (0, n, false))
         }
@@ -402,43 +448,37 @@ fn box_around(mesh: &DomainMesh, c: u32) -> Result<Option<(Group, [usize; 4])>, 
     Ok(Some(((r, level, parent, split), bx)))
 }
 
-/// The blocks that split the cells `marked` of `mesh` (and their neighbours) with those it
-/// has, closed (module doc), in the indices of `mesh`'s graded mesh: a marked cell split
-/// already asks for a block nested in the deepest block that split it; or why a block cannot
-/// be placed: a marked cell is within [`CLEAR`] cells of two sides of its strip or split
-/// [`MAX_BLOCK_LEVEL`] times, or no cell would be split that is not already (a marked cell
-/// in the first or last row of its block places no nested box).
-pub fn place_blocks(mesh: &DomainMesh, marked: &[u32]) -> Result<Vec<Block>, String> {
-    use std::collections::BTreeMap;
-    let mut groups: BTreeMap<Group, Vec<[usize; 4]>> = BTreeMap::new();
-    for b in &mesh.blocks {
-        // its parent: the block one level up whose box (halved) holds its box
-        let parent = (b.level > 1)
-            .then(|| {
-                mesh.blocks.iter().position(|p| {
-                    p.rect == b.rect
-                        && p.level + 1 == b.level
-                        && 2 * p.i0 <= b.i0
-                        && b.i1 <= 2 * p.i1
-                        && 2 * p.j0 <= b.j0
-                        && b.j1 <= 2 * p.j1
-                })
+/// The parent of `b` among `blocks`: the block one level up whose box (halved) holds its box.
+fn parent_of(blocks: &[Block], b: &Block) -> Option<usize> {
+    (b.level > 1)
+        .then(|| {
+            blocks.iter().position(|p| {
+                p.rect == b.rect
+                    && p.level + 1 == b.level
+                    && 2 * p.i0 <= b.i0
+                    && b.i1 <= 2 * p.i1
+                    && 2 * p.j0 <= b.j0
+                    && b.j1 <= 2 * p.j1
             })
-            .flatten();
+        })
+        .flatten()
+}
+
+/// The boxes of `blocks` by group ([`parent_of`]).
+fn groups_of(blocks: &[Block]) -> std::collections::BTreeMap<Group, Vec<[usize; 4]>> {
+    let mut groups: std::collections::BTreeMap<Group, Vec<[usize; 4]>> = Default::default();
+    for b in blocks {
         groups
-            .entry((b.rect, b.level, parent, b.split))
+            .entry((b.rect, b.level, parent_of(blocks, b), b.split))
             .or_default()
             .push([b.i0, b.i1, b.j0, b.j1]);
     }
-    let mut seen = std::collections::HashSet::new();
-    for &c in marked {
-        if !seen.insert(c) {
-            continue;
-        }
-        if let Some((g, bx)) = box_around(mesh, c)? {
-            groups.entry(g).or_default().push(bx);
-        }
-    }
+    groups
+}
+
+/// The blocks of `groups`, the boxes of a group closer than [`GAP`] merged into their bounding
+/// box, repeatedly (module doc).
+fn closure(groups: std::collections::BTreeMap<Group, Vec<[usize; 4]>>) -> Vec<Block> {
     let mut out = Vec::new();
     for ((r, level, _, split), mut bs) in groups {
         // every merge removes a box: at most `bs.len()` rounds
@@ -468,15 +508,128 @@ pub fn place_blocks(mesh: &DomainMesh, marked: &[u32]) -> Result<Vec<Block>, Str
             split,
         }));
     }
+    out
+}
+
+/// The blocks that split the cells `marked` of `mesh` (and their neighbours) with those it
+/// has, closed (module doc), in the indices of `mesh`'s graded mesh: a marked cell split
+/// already asks for a block nested in the deepest block that split it, or grows that block when
+/// it is at its edge ([`box_around`]). A marked cell split [`MAX_BLOCK_LEVEL`] times asks for
+/// nothing (the other cells' blocks are placed). An error says why when a marked cell is within
+/// [`CLEAR`] cells of two sides of its strip, or no cell would be split that is not already.
+pub fn place_blocks(mesh: &DomainMesh, marked: &[u32]) -> Result<Vec<Block>, String> {
+    let mut groups = groups_of(&mesh.blocks);
+    let mut seen = std::collections::HashSet::new();
+    let mut refused: Option<String> = None;
+    for &c in marked {
+        if !seen.insert(c) {
+            continue;
+        }
+        match box_around(mesh, c) {
+            Ok(Some((g, bx))) => groups.entry(g).or_default().push(bx),
+            Ok(None) => {}
+            Err(Refusal::Corner(why)) => return Err(why),
+            Err(Refusal::Capped(why)) => {
+                refused.get_or_insert(why);
+            }
+        }
+    }
+    let out = closure(groups);
     let mut old = mesh.blocks.clone();
     let mut new = out.clone();
     old.sort();
     new.sort();
     if old == new {
-        return Err(format!(
-            "the {} cells beyond the tolerance are in their blocks already",
-            seen.len()
-        ));
+        return Err(refused.unwrap_or_else(|| {
+            format!(
+                "the {} cells beyond the tolerance are in their blocks already",
+                seen.len()
+            )
+        }));
     }
     Ok(out)
+}
+
+/// The levels a block loses when it is carried to a finer spacing ([`carry_blocks`]).
+pub const CARRY_DOWN: usize = 0;
+
+/// The range `[lo, hi]` (coordinates along a strip side) in the intervals of the mesh whose
+/// knots are `knots` halved `level − 1` times: the least range of them that covers it.
+fn covering(knots: &[f64], level: usize, (lo, hi): (f64, f64)) -> (usize, usize) {
+    let s = FINE >> (level - 1);
+    let count = (knots.len() - 1) << (level - 1);
+    let at = knots_at(knots, &(0..=count).map(|a| a * s).collect::<Vec<_>>());
+    let eps = 1e-9 * (knots[knots.len() - 1] - knots[0]).abs();
+    // the last knot at or before `lo`, the first at or after `hi`
+    let i0 = at.partition_point(|&x| x <= lo + eps).saturating_sub(1);
+    let i1 = at.partition_point(|&x| x < hi - eps).min(count);
+    (i0, i1.max(i0 + 1).min(count))
+}
+
+/// The blocks of `old` carried to `new`, the graded mesh (no blocks) of a finer spacing and as
+/// many levels at the zeros or more, over the same strips: what the blocks had split stays split
+/// **at least as finely**. Block by block, parents first, the box of the same level
+/// ([`CARRY_DOWN`] fewer) of `new` that covers the region of its box, inside the split part of
+/// its carried parent one cell in from its sides (as [`box_in`] places a nested box), closed
+/// (module doc). A level-`ℓ` cell on the spacing `h` is `h / 2^ℓ` wide; carried on `h / √2` it
+/// is `√2` finer (the spacing's step doubles the blocks' control points, as everywhere else).
+pub fn carry_blocks(old: &DomainMesh, new: &DomainMesh) -> Vec<Block> {
+    if old.rects.len() != new.rects.len() || old.blocks.is_empty() {
+        return Vec::new();
+    }
+    let mut order: Vec<usize> = (0..old.blocks.len()).collect();
+    order.sort_by_key(|&k| old.blocks[k].level);
+    let mut carried: Vec<Option<Block>> = vec![None; old.blocks.len()];
+    for k in order {
+        let b = &old.blocks[k];
+        let Some(level) = b.level.checked_sub(CARRY_DOWN).filter(|&l| l >= 1) else {
+            continue;
+        };
+        let (orc, nrc) = (&old.rects[b.rect], &new.rects[b.rect]);
+        let s = b.cell_fine();
+        let ((bu, bv), (nu, nv)) = (orc.base_knots(), nrc.base_knots());
+        let u = knots_at(&bu, &[b.i0 * s, b.i1 * s]);
+        let v = knots_at(&bv, &[b.j0 * s, b.j1 * s]);
+        let (mut i0, mut i1) = covering(&nu, level, (u[0], u[1]));
+        let (mut j0, mut j1) = covering(&nv, level, (v[0], v[1]));
+        if level > 1 {
+            // inside its carried parent's split part, one cell in, along a direction it splits;
+            // the parent's whole box along one it does not (as `box_in` nests a box)
+            let Some(p) = parent_of(&old.blocks, b).and_then(|p| carried[p]) else {
+                continue;
+            };
+            if p.level + 1 != level {
+                continue;
+            }
+            let inner = |(a, z): (usize, usize), r: std::ops::Range<usize>, lo, hi, split| {
+                if split {
+                    (a.max(2 * r.start + 1), z.min((2 * r.end).saturating_sub(1)))
+                } else {
+                    (2 * lo, 2 * hi)
+                }
+            };
+            (i0, i1) = inner((i0, i1), p.split_u(nrc.base_m), p.i0, p.i1, b.split[0]);
+            (j0, j1) = inner((j0, j1), p.split_v(nrc.base_n), p.j0, p.j1, b.split[1]);
+        }
+        if i0 < i1 && j0 < j1 {
+            carried[k] = Some(Block {
+                i0,
+                i1,
+                j0,
+                j1,
+                level,
+                ..*b
+            });
+        }
+    }
+    let mut out: Vec<Block> = carried.into_iter().flatten().collect();
+    // merging parents can bring their children within the gap: close again until it holds
+    for _ in 0..=MAX_BLOCK_LEVEL {
+        let next = closure(groups_of(&out));
+        if next.len() == out.len() {
+            return next;
+        }
+        out = next;
+    }
+    out
 }
