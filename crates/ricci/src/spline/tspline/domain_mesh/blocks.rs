@@ -38,6 +38,16 @@
 //! closure of [`place_blocks`]), so the extensions of two blocks stay apart too. Near the strip
 //! sides, the graded lines and a parent's sides the fit checks the whole T-mesh
 //! ([`DomainMesh::extensions_meet`]) and refines the spacing instead if it is not.
+//!
+//! **Monotone refinement** (session 19). A marked cell in the first or last row or column of the
+//! split part of its deepest block — where no block can nest — asks for a box of that block's
+//! level around it in the block's parent, which the closure merges into the block: the block
+//! **grows**, and the cell nests at the next step (before, no block was placed there and the
+//! spacing shrank everywhere, every block dropped). When the spacing does shrink, the blocks are
+//! **carried over** ([`carry_blocks`]): each becomes the box of its level on the new graded mesh
+//! that covers its region, nested in its carried parent as [`place_blocks`] nests a box, so every
+//! region stays split at least as finely. The nesting goes [`MAX_BLOCK_LEVEL`] = 8 deep (6
+//! before: on fertility at 0.5 % a cell nested 6 times made the spacing shrink).
 
 use super::*;
 
@@ -65,8 +75,9 @@ pub const GAP: isize = 3;
 /// The graded intervals at each end of a strip side that no block splits (module doc).
 pub const CLEAR: usize = 4;
 
-/// The most levels of blocks (each halves the intervals of the cells it splits).
-pub const MAX_BLOCK_LEVEL: usize = 6;
+/// The most levels of blocks (each halves the intervals of the cells it splits); 8: a cell of
+/// the graded mesh split into at most `256 × 256` (measured against 6: `docs/notes/wave2-s19-kb21.md`).
+pub const MAX_BLOCK_LEVEL: usize = 8;
 
 /// A graded interval in units of the finest blocks' knots: `Rect::u_fine` and `Rect::v_fine`
 /// count in `1 / FINE` of it.
@@ -333,15 +344,6 @@ fn close(a: [usize; 4], b: [usize; 4]) -> bool {
 /// the directions they split.
 type Group = (usize, usize, Option<usize>, [bool; 2]);
 
-/// Why a marked cell takes no block.
-enum Refusal {
-    /// Within [`CLEAR`] cells of two sides of its strip: only a finer spacing (or a level at
-    /// the zeros) refines it, and [`place_blocks`] places no block.
-    Corner(String),
-    /// Split [`MAX_BLOCK_LEVEL`] times: the other cells' blocks are placed.
-    Capped(String),
-}
-
 /// The box a marked cell asks for: the box of [`box_in`] in the deepest block that splits it, or
 /// — when the cell is in the first or last row or column of that block's split part, where no
 /// block can nest — a box of that block's level around it in the block's parent, which the
@@ -349,7 +351,7 @@ enum Refusal {
 /// it then, can nest at the next step); up the chain of parents while the cell is at an edge of
 /// each. `None`: no box (the cell is at an edge of the strip's split part); or why the cell can
 /// take no block.
-fn box_around(mesh: &DomainMesh, c: u32) -> Result<Option<(Group, [usize; 4])>, Refusal> {
+fn box_around(mesh: &DomainMesh, c: u32) -> Result<Option<(Group, [usize; 4])>, String> {
     let mut below = usize::MAX;
     loop {
         let found = mesh.block_of_cell_below(c, below);
@@ -374,7 +376,7 @@ fn box_in(
     mesh: &DomainMesh,
     c: u32,
     found: Option<(usize, (bool, bool))>,
-) -> Result<Option<(Group, [usize; 4])>, Refusal> {
+) -> Result<Option<(Group, [usize; 4])>, String> {
     let (r, bi, bj) = mesh.base_cell(c);
     let rc = &mesh.rects[r];
     let (m, n) = (rc.base_m, rc.base_n);
@@ -387,10 +389,7 @@ fn box_in(
         )
     };
     if level > MAX_BLOCK_LEVEL {
-        return Err(Refusal::Capped(format!(
-            "{} is split {MAX_BLOCK_LEVEL} times already",
-            at()
-        )));
+        return Err(format!("{} is split {MAX_BLOCK_LEVEL} times already", at()));
     }
     let (_, i, j) = mesh.cell_at[c as usize];
     let s = FINE >> (level - 1);
@@ -401,10 +400,7 @@ fn box_in(
         None => {
             let clear = |k: usize, len: usize| k >= CLEAR && k + CLEAR < len;
             if !clear(bi, m) && !clear(bj, n) {
-                return Err(Refusal::Corner(format!(
-                    "{} is within {CLEAR} cells of two sides",
-                    at()
-                )));
+                return Err(format!("{} is within {CLEAR} cells of two sides", at()));
             }
             ((0, m, false), (0, n, false))
         }
@@ -514,24 +510,18 @@ fn closure(groups: std::collections::BTreeMap<Group, Vec<[usize; 4]>>) -> Vec<Bl
 /// The blocks that split the cells `marked` of `mesh` (and their neighbours) with those it
 /// has, closed (module doc), in the indices of `mesh`'s graded mesh: a marked cell split
 /// already asks for a block nested in the deepest block that split it, or grows that block when
-/// it is at its edge ([`box_around`]). A marked cell split [`MAX_BLOCK_LEVEL`] times asks for
-/// nothing (the other cells' blocks are placed). An error says why when a marked cell is within
-/// [`CLEAR`] cells of two sides of its strip, or no cell would be split that is not already.
+/// it is at its edge ([`box_around`]); or why a block cannot be placed: a marked cell is within
+/// [`CLEAR`] cells of two sides of its strip or split [`MAX_BLOCK_LEVEL`] times, or no cell
+/// would be split that is not already.
 pub fn place_blocks(mesh: &DomainMesh, marked: &[u32]) -> Result<Vec<Block>, String> {
     let mut groups = groups_of(&mesh.blocks);
     let mut seen = std::collections::HashSet::new();
-    let mut refused: Option<String> = None;
     for &c in marked {
         if !seen.insert(c) {
             continue;
         }
-        match box_around(mesh, c) {
-            Ok(Some((g, bx))) => groups.entry(g).or_default().push(bx),
-            Ok(None) => {}
-            Err(Refusal::Corner(why)) => return Err(why),
-            Err(Refusal::Capped(why)) => {
-                refused.get_or_insert(why);
-            }
+        if let Some((g, bx)) = box_around(mesh, c)? {
+            groups.entry(g).or_default().push(bx);
         }
     }
     let out = closure(groups);
@@ -540,12 +530,10 @@ pub fn place_blocks(mesh: &DomainMesh, marked: &[u32]) -> Result<Vec<Block>, Str
     old.sort();
     new.sort();
     if old == new {
-        return Err(refused.unwrap_or_else(|| {
-            format!(
-                "the {} cells beyond the tolerance are in their blocks already",
-                seen.len()
-            )
-        }));
+        return Err(format!(
+            "the {} cells beyond the tolerance are in their blocks already",
+            seen.len()
+        ));
     }
     Ok(out)
 }
