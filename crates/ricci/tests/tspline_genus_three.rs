@@ -157,11 +157,14 @@ fn strips_glue_on_genus_three_and_four_and_their_mesh_is_the_closed_surface() {
 
 /// A fit that cannot reach its tolerance within the budget returns its best step: the spline's
 /// L∞ at the vertices (evaluated here from its Bézier patches) is the smallest over the steps
-/// it reports, not the last one's. Fertility at 1 % with 6 000 control points: a refinement of
-/// the spacing everywhere (blocks dropped) makes its error grow again before the budget ends.
+/// it reports, not the last one's. Fertility at 0.5 % with 8 000 control points (points on the
+/// input triangles too, as `ricci tspline` fits): a refinement of
+/// the spacing everywhere (blocks not analysis-suitable, carried over in part) makes its error
+/// grow again before the budget ends. (At 1 % with 6 000 before session 19; that fit converges
+/// now at 4 220: blocks grow where an error sits at their edge.)
 #[test]
 fn a_fit_above_the_tolerance_returns_its_smallest_error() {
-    use ricci::spline::tspline::domain_fit::{fit_domain_mesh, DomainFitOptions};
+    use ricci::spline::tspline::domain_fit::{fit_domain_mesh_on_triangles, DomainFitOptions};
     let Some(dir) = ricci_meshes::ricci_meshes() else {
         eprintln!("RICCI_MESHES is not set: skipping fertility.off");
         return;
@@ -171,17 +174,17 @@ fn a_fit_above_the_tolerance_returns_its_smallest_error() {
         .0;
     let (_, d, g) = glued(&s);
     let opts = DomainFitOptions {
-        tolerance: 0.01,
-        max_control_points: 6000,
+        tolerance: 0.005,
+        max_control_points: 8000,
         ..DomainFitOptions::default()
     };
-    let f = fit_domain_mesh(&d, &g, &s.positions, &opts).unwrap();
+    let f = fit_domain_mesh_on_triangles(&d, &g, &s.positions, s.mesh.faces(), &opts).unwrap();
     let scale = ricci::spline::tspline::fit::bbox_scale(&s.positions);
     let e = 100.0 * tspline_cases::max_vertex_error(&d, &f, &s.positions) / scale;
     let per_step: Vec<f64> = f.steps.iter().map(|t| t.max_error_percent).collect();
     let smallest = per_step.iter().copied().fold(f64::INFINITY, f64::min);
     eprintln!(
-        "fertility at 1 %, 6 000 control points: L∞ per step {per_step:?}, result {e:.4} % with {} control points",
+        "fertility at 0.5 %, 8 000 control points: L∞ per step {per_step:?}, result {e:.4} % with {} control points",
         f.mesh.n_control_points()
     );
     assert!(!f.converged);

@@ -50,7 +50,6 @@
 //! (3holes 4 623 → 7 221, fertility 6 892 → 9 905).
 
 use super::cylinder_fit::GenusStep;
-use super::domain_mesh::blocks::{carry_blocks, place_blocks};
 use super::domain_mesh::{bernstein, Block, Combination, DomainMesh};
 use super::fit::bbox_scale;
 use super::genus_domain::GenusDomain;
@@ -62,6 +61,8 @@ use faer::Mat;
 mod between;
 use between::data;
 pub use between::deviation_between_vertices;
+mod refine;
+use refine::{carry_over, next_blocks, step_mesh, within_budget};
 
 /// The fitted spline on the domain mesh.
 #[derive(Debug, Clone)]
@@ -559,143 +560,6 @@ pub fn graded_cells(blocks: &[Block]) -> usize {
         .sum()
 }
 
-/// The blocks of the next step of [`fit_domain_mesh_on_triangles`]: the boxes around the
-/// points `far` beyond the tolerance away from the zeros (in the indices of the next graded mesh,
-/// `d` more levels), or — when no block can be placed or they would cover more than
-/// [`BLOCK_SHARE`] of the cells — none, and the spacing times `refine` everywhere (`true`; the
-/// caller carries the blocks over: [`carried`]); `what` says which.
-fn next_blocks(
-    (use_blocks, far, last, d): (bool, &[u32], Option<&DomainFit>, usize),
-    blocks: &mut Vec<Block>,
-    (spacing, refine): (&mut f64, f64),
-    what: &mut Vec<String>,
-) -> bool {
-    let placed = match (use_blocks, far.is_empty(), last) {
-        (_, true, _) => Ok(blocks.clone()),
-        (false, _, _) => Err("blocks are off".to_string()),
-        (true, false, Some(fit)) => place_blocks(&fit.mesh, far),
-        (true, false, None) => Err("no mesh".to_string()),
-    };
-    // in the indices of the next graded mesh (one more level: one more column and row
-    // at each end)
-    let shifted = placed.map(|bs| bs.iter().map(|b| b.shifted(d)).collect::<Vec<_>>());
-    let cells: usize = last.map_or(0, |f| {
-        f.mesh.rects.iter().map(|r| r.base_m * r.base_n).sum()
-    });
-    match shifted {
-        Ok(bs) if far.is_empty() => {
-            *blocks = bs;
-            false
-        }
-        Ok(bs) if graded_cells(&bs) as f64 > BLOCK_SHARE * cells as f64 => {
-            *spacing *= refine;
-            blocks.clear();
-            what.push(format!(
-                "the spacing × 1/√2 everywhere (blocks would cover more than {:.0} % of the cells)",
-                100.0 * BLOCK_SHARE
-            ));
-            true
-        }
-        Ok(bs) => {
-            what.push(format!(
-                "{} blocks split 2×2, or across one direction where the other is near a strip's end ({} levels, {} graded cells in their boxes; {} points beyond the tolerance away from the zeros)",
-                bs.len(),
-                bs.iter().map(|b| b.level).max().unwrap_or(0),
-                graded_cells(&bs),
-                far.len()
-            ));
-            *blocks = bs;
-            false
-        }
-        Err(why) => {
-            *spacing *= refine;
-            blocks.clear();
-            what.push(format!("the spacing × 1/√2 everywhere (no block: {why})"));
-            true
-        }
-    }
-}
-
-/// The blocks of `old` carried over to the graded mesh of `spacing` and `levels`
-/// ([`carry_blocks`]: what they split stays split at least as finely).
-fn carried(
-    domain: &GenusDomain,
-    gluing: &Gluing,
-    (spacing, levels): (f64, usize),
-    old: &DomainMesh,
-) -> Result<Vec<Block>> {
-    if old.blocks.is_empty() {
-        return Ok(Vec::new());
-    }
-    let new = DomainMesh::graded(domain, gluing, spacing, levels).map_err(Error::numerical)?;
-    Ok(carry_blocks(old, &new))
-}
-
-/// The mesh of the next step of [`fit_domain_mesh_on_triangles`]: of `spacing` graded `levels`
-/// times, T-junctions `margin` cells past the corner blocks, with `blocks` — or, when their
-/// T-mesh is not analysis-suitable, the spacing times `refine` with the blocks of the `last`
-/// fit carried over ([`carried`]). Carried blocks (those, or the ones just carried over:
-/// `carried_now`) whose T-mesh is not analysis-suitable are dropped strip by strip where the
-/// extensions meet ([`drop_where_extensions_meet`]); `refinements` says which.
-fn step_mesh(
-    (domain, gluing, opts): (&GenusDomain, &Gluing, &DomainFitOptions),
-    (spacing, levels, margin): (&mut f64, usize, usize),
-    (blocks, carried_now): (&mut Vec<Block>, bool),
-    (last, refine): (Option<&DomainFit>, f64),
-    refinements: &mut Vec<String>,
-) -> Result<DomainMesh> {
-    let mesh = domain_mesh(domain, gluing, (*spacing, levels, margin), blocks, opts)?;
-    if blocks.is_empty() {
-        return Ok(mesh);
-    }
-    let Some(v) = mesh.extensions_meet().map_err(Error::numerical)? else {
-        return Ok(mesh);
-    };
-    let mut why =
-        format!("the blocks' T-mesh is not analysis-suitable (extensions meet at vertex {v})");
-    if !carried_now {
-        *spacing *= refine;
-        *blocks = match last {
-            Some(f) => carried(domain, gluing, (*spacing, levels), &f.mesh)?,
-            None => Vec::new(),
-        };
-        why.push_str(": the spacing × 1/√2 everywhere instead, the last fit's blocks carried over");
-    }
-    let kept = blocks.len();
-    let at = (*spacing, levels, margin);
-    let mesh = drop_where_extensions_meet((domain, gluing, opts), at, blocks)?;
-    refinements.push(format!(
-        "{why}; {} of {kept} carried blocks kept (the others in strips where extensions meet)",
-        blocks.len()
-    ));
-    Ok(mesh)
-}
-
-/// The mesh of `spacing`, `levels` and `margin` with `blocks`, after dropping the blocks of the
-/// strips around a vertex where the extensions of T-junctions meet, until none do (all of them
-/// when that vertex's strips have none).
-fn drop_where_extensions_meet(
-    (domain, gluing, opts): (&GenusDomain, &Gluing, &DomainFitOptions),
-    at: (f64, usize, usize),
-    blocks: &mut Vec<Block>,
-) -> Result<DomainMesh> {
-    loop {
-        let mesh = domain_mesh(domain, gluing, at, blocks, opts)?;
-        let Some(v) = mesh.extensions_meet().map_err(Error::numerical)? else {
-            return Ok(mesh);
-        };
-        let strips: Vec<usize> = (0..mesh.n_cells())
-            .filter(|&c| mesh.corners[c].contains(&v))
-            .map(|c| mesh.cell_at[c].0 as usize)
-            .collect();
-        let before = blocks.len();
-        blocks.retain(|b| !strips.contains(&b.rect));
-        if blocks.len() == before {
-            blocks.clear();
-        }
-    }
-}
-
 /// [`fit_domain_mesh`] with points on the input `triangles` as data too
 /// ([`DomainFitOptions::between_vertices`]); the tolerance is still checked at the vertices.
 pub fn fit_domain_mesh_on_triangles(
@@ -713,16 +577,13 @@ pub fn fit_domain_mesh_on_triangles(
         .fold(0.0, f64::max);
     let (targets, weights, n_vertices, extra) = data(domain, positions, triangles, opts);
     let mut spacing = opts.initial * l;
-    let mut steps = Vec::new();
-    let mut last: Option<DomainFit> = None;
-    let mut best: Option<DomainFit> = None;
+    let (mut steps, mut refinements) = (Vec::new(), Vec::new());
+    let (mut last, mut best): (Option<DomainFit>, Option<DomainFit>) = (None, None);
     let refine = opts.refine.clamp(0.1, 0.95);
-    let mut filled = false;
+    let (mut filled, mut carried_now) = (false, false);
     let (mut levels, mut previous_spacing, mut margin) = (0, spacing, T_MARGIN);
     let mut blocks: Vec<Block> = Vec::new();
-    let mut refinements = Vec::new();
     let use_blocks = opts.blocks && opts.t_junctions && opts.g1_at_zeros;
-    let mut carried_now = false;
     for _ in 0..opts.max_iterations.max(1) {
         let at = (&mut spacing, levels, margin);
         let mut mesh = step_mesh(
@@ -732,16 +593,9 @@ pub fn fit_domain_mesh_on_triangles(
             (last.as_ref(), refine),
             &mut refinements,
         )?;
-        if carried_now && !blocks.is_empty() && mesh.n_control_points() > opts.max_control_points {
-            // the carried blocks over the budget: the largest mesh within it without them
-            refinements.push(format!(
-                "{} control points with the {} blocks carried over: over the budget of {}, without them",
-                mesh.n_control_points(),
-                blocks.len(),
-                opts.max_control_points
-            ));
-            blocks.clear();
-            mesh = domain_mesh(domain, gluing, (spacing, levels, margin), &blocks, opts)?;
+        if carried_now {
+            let (at, r) = ((spacing, levels, margin), &mut refinements);
+            mesh = within_budget(mesh, (domain, gluing, opts), at, &mut blocks, r)?;
         }
         if let Some(prev) = last
             .as_ref()
@@ -839,14 +693,9 @@ pub fn fit_domain_mesh_on_triangles(
             (&mut spacing, refine),
             &mut what,
         );
-        carried_now = false;
-        if let Some(f) = last.as_ref().filter(|_| finer && use_blocks) {
-            blocks = carried(domain, gluing, (spacing, levels), &f.mesh)?;
-            if !blocks.is_empty() {
-                carried_now = true;
-                what.push(format!("{} blocks carried over", blocks.len()));
-            }
-        }
+        let from = last.as_ref().filter(|_| finer && use_blocks);
+        let (dg, at) = ((domain, gluing), (spacing, levels));
+        carried_now = carry_over(dg, at, from, &mut blocks, &mut what)?;
         refinements.push(format!(
             "step {}: {} control points, L∞ {:.3} %; next: {}",
             steps.len(),
