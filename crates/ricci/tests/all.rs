@@ -152,6 +152,8 @@ mod tspline_domain_genus3;
 mod tspline_domain_mesh;
 #[path = "tspline_domain_nested.rs"]
 mod tspline_domain_nested;
+#[path = "tspline_domain_thin_plate.rs"]
+mod tspline_domain_thin_plate;
 #[path = "tspline_genus.rs"]
 mod tspline_genus;
 #[path = "tspline_genus0.rs"]

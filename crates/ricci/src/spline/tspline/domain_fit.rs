@@ -4,7 +4,8 @@
 //! located in the cells from their cylinder coordinates and the gluing's strips ([`super::glue::CylinderLayout::locate`]);
 //! the fairness term is the squared second differences of the control net along the mesh
 //! lines through every regular vertex (as the per-cylinder fit's), the umbrella operator at
-//! the zeros. Refinement is local where it can be: while a point of a cell next to a zero
+//! the zeros, and optionally the exact thin-plate energy ([`DomainFitOptions::thin_plate`]).
+//! Refinement is local where it can be: while a point of a cell next to a zero
 //! ([`DomainMesh::near_zero`]) is beyond the tolerance, the mesh is refined once more at the
 //! zeros ([`DomainMesh::graded`]: two columns and rows per strip); while a point elsewhere is,
 //! the cells around it are split 2×2 in blocks whose lines end in T-junctions
@@ -48,6 +49,20 @@
 //! intervals from the zeros), and dropping the blocks that break analysis suitability instead of
 //! refining the spacing everywhere leaves their points beyond the tolerance while the levels grow
 //! (3holes 4 623 → 7 221, fertility 6 892 → 9 905).
+//!
+//! **The fairness and the spline between the vertices** (`docs/notes/wave2-s19-bv21.md`). The
+//! second differences are in index space: a cell `b` high costs `b²` times its thin-plate energy
+//! per unit area, so the graded rows along the critical trajectories (down to `E_v / 2⁷` high)
+//! are nearly free across, and the twist `S_uv` is free everywhere. The spline's largest
+//! distances to the input triangles sit there, in cells without data next to a zero (genus3.off:
+//! 6.4 % of the bounding box in rows `10⁻⁵` high of the thin cylinder, 1.3 `E_u` from a zero), and
+//! those ripples are what fits the vertices next to the trajectories within the tolerance: any
+//! thin-plate weight (even `10⁻³`) on the final mesh lifts L∞ from 0.50 to 0.69 %.
+//! [`DomainFitOptions::thin_plate`] adds the exact thin-plate energy of every cell
+//! (`thin_plate.rs`; times `min(1, r²/E²)` near the zeros, where the surface goes as `√w`): at
+//! 0.3, genus3 6.40 → 0.57 % between the vertices at 8 075 control points (6 119), eight 2.72 →
+//! 1.01 %, fertility 2.45 → 1.03 % (14 407); 3holes does not converge within the budget. Off by
+//! default.
 
 use super::cylinder_fit::GenusStep;
 use super::domain_mesh::{bernstein, Block, Combination, DomainMesh};
@@ -59,8 +74,9 @@ use crate::numeric::sparse::{BlockAssembly, Cholesky};
 use faer::Mat;
 
 mod between;
+mod thin_plate;
 use between::data;
-pub use between::deviation_between_vertices;
+pub use between::{deviation_between_vertices, deviation_per_cell, triangle_points};
 mod refine;
 use refine::{carry_over, next_blocks, step_mesh, within_budget};
 
@@ -127,6 +143,14 @@ pub struct DomainFitOptions {
     /// ([`super::domain_mesh::blocks`]; only with [`Self::t_junctions`]) rather than by a finer
     /// spacing everywhere (which stays the fallback when a block cannot be placed).
     pub blocks: bool,
+    /// Weight of the thin-plate energy `∫∫ S_uu² + 2 S_uv² + S_vv²` over the domain
+    /// (module `domain_fit::thin_plate`: exact per cell, in the strips' parameters, times
+    /// `min(1, r²/E²)` near the zeros), added to the second differences in units of them on the
+    /// ungraded cells. `0` (the default): the second differences only, which weigh the thin
+    /// graded rows along the critical trajectories next to nothing and leave the twist free —
+    /// the spline ripples there, between the vertices (genus3.off: 6.4 % of the bounding box);
+    /// `0.3` brings that to 0.6 % at about 30 % more control points (BENCHMARKS "Session 19 (bv21)").
+    pub thin_plate: f64,
 }
 
 /// Blocks splitting more than this share of the graded mesh's cells: a finer spacing
@@ -157,6 +181,7 @@ impl Default for DomainFitOptions {
             between_vertices: 0.1,
             t_junctions: true,
             blocks: true,
+            thin_plate: 0.0,
         }
     }
 }
@@ -229,6 +254,38 @@ fn cell_set(mesh: &DomainMesh, c: usize, g1: bool, mark: &mut [bool], out: &mut 
     out[from..].iter().for_each(|&f| mark[f as usize] = false);
 }
 
+/// The unknowns of cell `c` (`ids`, with `slot` their index there: reset it from `ids` after
+/// use) and its 16 Bézier points (`local[4 i + j]`) as combinations of them; with `g1` the
+/// unknowns are the free values of the mesh's reduction.
+fn cell_local(
+    mesh: &DomainMesh,
+    c: usize,
+    g1: bool,
+    slot: &mut [u32],
+    ids: &mut Vec<u32>,
+    local: &mut [Vec<(usize, f64)>],
+) {
+    ids.clear();
+    for (ij, l) in local.iter_mut().enumerate() {
+        l.clear();
+        let comb = &mesh.bezier[c][ij / 4][ij % 4];
+        let reduced;
+        let comb = if g1 {
+            reduced = mesh.reduce(comb);
+            &reduced
+        } else {
+            comb
+        };
+        for &(r, w) in comb {
+            if slot[r as usize] == u32::MAX {
+                slot[r as usize] = ids.len() as u32;
+                ids.push(r);
+            }
+            l.push((slot[r as usize] as usize, w));
+        }
+    }
+}
+
 /// The data term of [`solve`]'s normal equations: `Σ w rowᵀ row` over the data points (grouped
 /// by cell: [`by_cell`]) added to `asm`, and `Σ w row p` to `b`; with `g1` the rows are in the
 /// free values of the mesh's reduction. The points are summed cell by cell in a dense block
@@ -254,25 +311,7 @@ fn data_term(
         if points.is_empty() {
             continue;
         }
-        ids.clear();
-        for (ij, l) in local.iter_mut().enumerate() {
-            l.clear();
-            let comb = &mesh.bezier[c][ij / 4][ij % 4];
-            let reduced;
-            let comb = if g1 {
-                reduced = mesh.reduce(comb);
-                &reduced
-            } else {
-                comb
-            };
-            for &(r, w) in comb {
-                if slot[r as usize] == u32::MAX {
-                    slot[r as usize] = ids.len() as u32;
-                    ids.push(r);
-                }
-                l.push((slot[r as usize] as usize, w));
-            }
-        }
+        cell_local(mesh, c, g1, &mut slot, &mut ids, &mut local);
         let m = ids.len();
         block.clear();
         block.resize(m * m, 0.0);
@@ -360,7 +399,8 @@ fn fairness_rows(mesh: &DomainMesh) -> Vec<Combination> {
 /// One least-squares solve on `mesh`; with `g1`, for the free values of the mesh's reduction
 /// (the net is G¹ at the zeros).
 /// `weights` per data point (empty: all 1); the fairness weight grows with `vertices`, the
-/// number of input vertices among the data. The normal equations are assembled as their lower
+/// number of input vertices among the data; `thin_plate` > 0 adds the thin-plate energy
+/// ([`DomainFitOptions::thin_plate`]) on every cell. The normal equations are assembled as their lower
 /// triangle (all the Cholesky factorization reads) on the pattern of the cells' and the
 /// fairness rows' unknowns ([`BlockAssembly`]).
 fn solve(
@@ -369,7 +409,7 @@ fn solve(
     targets: &[[f64; 3]],
     weights: &[f64],
     vertices: usize,
-    smoothing: f64,
+    (smoothing, thin_plate): (f64, f64),
     g1: bool,
 ) -> Result<Vec<[f64; 3]>> {
     let n = if g1 {
@@ -385,7 +425,7 @@ fn solve(
     // the pattern: the unknowns of every cell with data, of every fairness row
     let (mut flat, mut at) = (Vec::<u32>::new(), vec![0usize]);
     let mut mark = vec![false; n];
-    for c in (0..mesh.n_cells()).filter(|&c| start[c + 1] > start[c]) {
+    for c in (0..mesh.n_cells()).filter(|&c| thin_plate > 0.0 || start[c + 1] > start[c]) {
         cell_set(mesh, c, g1, &mut mark, &mut flat);
         at.push(flat.len());
     }
@@ -405,6 +445,18 @@ fn solve(
                 asm.add(r, q, w * x * y);
             }
         }
+    }
+    if thin_plate > 0.0 {
+        // in the units of the second differences on the ungraded cells: `h²` times the
+        // thin-plate energy, `h²` the domain's area over its ungraded cells
+        let area: f64 = mesh.rects.iter().map(|r| r.length * r.height).sum();
+        let uniform: usize = mesh
+            .rects
+            .iter()
+            .map(|r| r.base_m.saturating_sub(2 * r.levels) * r.base_n.saturating_sub(2 * r.levels))
+            .sum();
+        let h2 = area / uniform.max(1) as f64;
+        thin_plate::thin_plate_term(mesh, g1, thin_plate * w * h2, &mut asm, n);
     }
     // a tiny ridge keeps vertices without data determined by the fairness alone
     for i in 0..n as u32 {
@@ -534,7 +586,7 @@ fn fit_on_mesh(
         &data_targets,
         &data_weights,
         n_vertices,
-        opts.smoothing,
+        (opts.smoothing, opts.thin_plate),
         opts.g1_at_zeros,
     )?;
     let errors: Vec<f64> = located

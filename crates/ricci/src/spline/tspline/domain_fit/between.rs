@@ -38,7 +38,7 @@ pub(super) fn data(
 /// centroid and the three edge midpoints, at the mean of the vertices' cylinder coordinates
 /// (`u` unwrapped across the seam; triangles spanning more than a quarter of the circumference
 /// are left out), as `(cylinder, u, v, position, weight)`; weight `w · area / mean area`.
-pub(super) fn triangle_points(
+pub fn triangle_points(
     domain: &GenusDomain,
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
@@ -128,20 +128,36 @@ pub(super) fn triangle_points(
     out
 }
 
-/// Distance of the spline to the input triangles between the vertices: the fitted surface at
-/// `k × k` points of every cell (`((i + ½)/k, (j + ½)/k)`) to the closest point of the
-/// triangles (exact point–triangle distance, [`MeshDistance`]); `(max, rms)` in percent of the
-/// longest bounding-box side ([`DomainFit::scale`]).
-pub fn deviation_between_vertices(
+/// Per cell, the largest distance of the spline to the input triangles at `k × k` points of
+/// the cell (`((i + ½)/k, (j + ½)/k)`), and where: `(distance, s, t)` (distance in the
+/// positions' units, `(s, t) ∈ [0, 1]²` the cell's local coordinates).
+pub fn deviation_per_cell(
     fit: &DomainFit,
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
     k: usize,
-) -> (f64, f64) {
+) -> Vec<(f64, f64, f64)> {
+    deviation_samples(fit, positions, triangles, k)
+        .chunks(k.max(1) * k.max(1))
+        .map(|d| {
+            d.iter()
+                .fold((0.0f64, 0.0, 0.0), |a, &b| if b.0 > a.0 { b } else { a })
+        })
+        .collect()
+}
+
+/// The distance of the spline to the triangles at the `k × k` points of every cell (cell
+/// order, then the points), with the points' local coordinates.
+fn deviation_samples(
+    fit: &DomainFit,
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    k: usize,
+) -> Vec<(f64, f64, f64)> {
     use rayon::prelude::*;
     let k = k.max(1);
     let dist = MeshDistance::new(positions, triangles);
-    let d: Vec<f64> = (0..fit.mesh.n_cells() as u32)
+    (0..fit.mesh.n_cells() as u32)
         .into_par_iter()
         .flat_map_iter(|c| {
             let dist = &dist;
@@ -152,12 +168,26 @@ pub fn deviation_between_vertices(
                     ((ij % k) as f64 + 0.5) / k as f64,
                     ((ij / k) as f64 + 0.5) / k as f64,
                 );
-                dist.distance(p.point(p.u0 + s * (p.u1 - p.u0), p.v0 + t * (p.v1 - p.v0)))
+                let x = p.point(p.u0 + s * (p.u1 - p.u0), p.v0 + t * (p.v1 - p.v0));
+                (dist.distance(x), s, t)
             })
         })
-        .collect();
-    let max = d.iter().fold(0.0f64, |a, &b| a.max(b));
-    let rms = (d.iter().map(|x| x * x).sum::<f64>() / d.len().max(1) as f64).sqrt();
+        .collect()
+}
+
+/// Distance of the spline to the input triangles between the vertices: the fitted surface at
+/// `k × k` points of every cell (`((i + ½)/k, (j + ½)/k)`) to the closest point of the
+/// triangles (exact point–triangle distance, [`MeshDistance`]); `(max, rms)` in percent of the
+/// longest bounding-box side ([`DomainFit::scale`]).
+pub fn deviation_between_vertices(
+    fit: &DomainFit,
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    k: usize,
+) -> (f64, f64) {
+    let d = deviation_samples(fit, positions, triangles, k);
+    let max = d.iter().fold(0.0f64, |a, b| a.max(b.0));
+    let rms = (d.iter().map(|x| x.0 * x.0).sum::<f64>() / d.len().max(1) as f64).sqrt();
     let s = 100.0 / fit.scale.max(1e-300);
     (max * s, rms * s)
 }
