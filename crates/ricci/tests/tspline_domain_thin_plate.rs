@@ -128,7 +128,7 @@ fn genus3_with_the_thin_plate_stays_near_the_triangles_between_the_vertices() {
     let (d, g, _) = glued_domain(&s);
     let side = bbox_scale(&s.positions);
     let opts = DomainFitOptions {
-        thin_plate: 0.3,
+        thin_plate: 0.1,
         ..DomainFitOptions::default()
     };
     let tris = s.mesh.faces();
@@ -152,7 +152,7 @@ fn genus3_with_the_thin_plate_stays_near_the_triangles_between_the_vertices() {
     }
     let rms = (sum / count as f64).sqrt();
     eprintln!(
-        "genus3 0.5 %, thin plate 0.3: {} control points, L∞ {:.4} % at the vertices, between them {:.3} / {:.4} % (max / rms, {count} points); {:#?}",
+        "genus3 0.5 %, thin plate 0.1: {} control points, L∞ {:.4} % at the vertices, between them {:.3} / {:.4} % (max / rms, {count} points); {:#?}",
         f.mesh.n_control_points(),
         100.0 * vertex,
         100.0 * max,
