@@ -169,6 +169,9 @@ pub fn continuity<A: FlatCharts + Sync + ?Sized>(
 pub struct MeshDistance {
     tris: Vec<[[f64; 3]; 3]>,
     lo: [f64; 3],
+    /// Upper corner of the triangles' bounding box (the grid may end before it: at most 512
+    /// cells per axis, the last one holding the rest).
+    hi: [f64; 3],
     cell: f64,
     dims: [usize; 3],
     start: Vec<u32>,
@@ -305,6 +308,7 @@ impl MeshDistance {
         MeshDistance {
             tris,
             lo,
+            hi,
             cell,
             dims,
             start: count,
@@ -358,22 +362,32 @@ impl MeshDistance {
             if best <= (r as f64 - 1.0).max(0.0) * self.cell {
                 break;
             }
-            // Every cell seen.
-            if (0..3).all(|k| c[k] - r <= 0 && c[k] + r >= self.dims[k] as i64 - 1) {
-                break;
-            }
-            // Sharper, for points inside the grid: a triangle not yet seen has its bounding
-            // box outside the block of cells within r of `c`, so it is farther from `p` than
-            // the block's nearest face (less a margin for the rounding of cell indices). Most
-            // points stop after one cell instead of 5³.
+            // Sharper: a triangle not yet seen lies in cells outside the block of cells within
+            // r of `c`, so in some axis k beyond one of the block's faces that still has cells
+            // behind it, and inside the bounding box in the other axes: it is at least
+            // sqrt(gap_k² + Σ_{j≠k} out_j²) from `p` (`out_j`: how far `p` lies outside the box
+            // in axis j), less a margin for the rounding of cell indices. Most points inside
+            // stop after one cell instead of 5³, far points once the shells reach the
+            // surface's near side; every cell seen: no face left, the search ends.
+            let out: [f64; 3] =
+                std::array::from_fn(|k| (self.lo[k] - p[k]).max(p[k] - self.hi[k]).max(0.0));
             let gap = (0..3)
                 .map(|k| {
                     let below = self.lo[k] + (c[k] - r) as f64 * self.cell;
                     let above = self.lo[k] + (c[k] + r + 1) as f64 * self.cell;
-                    (p[k] - below).min(above - p[k])
+                    let mut g = f64::INFINITY;
+                    if c[k] - r > 0 {
+                        g = g.min(p[k] - below);
+                    }
+                    if c[k] + r < self.dims[k] as i64 - 1 {
+                        g = g.min(above - p[k]);
+                    }
+                    let g = g.max(0.0);
+                    let o: f64 = (0..3).filter(|&j| j != k).map(|j| out[j] * out[j]).sum();
+                    (g * g + o).sqrt()
                 })
                 .fold(f64::INFINITY, f64::min);
-            if best <= gap - 1e-9 * (self.cell + self.diagonal) {
+            if best <= gap - 1e-9 * (self.cell + self.diagonal) || gap == f64::INFINITY {
                 break;
             }
         }
