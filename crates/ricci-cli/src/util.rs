@@ -232,7 +232,47 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
         let _ = std::fs::remove_file(&tmp);
         anyhow::bail!("{}: {e}", path.display());
     }
+    WRITTEN.with(|w| {
+        if let Some(w) = w.borrow_mut().as_mut() {
+            w.push(path.to_path_buf());
+        }
+    });
     Ok(())
+}
+
+thread_local! {
+    /// The files [`write_atomic`] wrote on this thread inside [`all_or_nothing`].
+    static WRITTEN: RefCell<Option<Vec<PathBuf>>> = const { RefCell::new(None) };
+}
+
+/// Runs `f`; when it fails, removes the files [`write_atomic`] wrote on this thread meanwhile,
+/// and `dir` if it did not exist before and is left empty: a command that fails after writing
+/// part of its output leaves none of it (nor a mix of old and new files) behind.
+pub fn all_or_nothing<T>(
+    dir: Option<&Path>,
+    f: impl FnOnce() -> anyhow::Result<T>,
+) -> anyhow::Result<T> {
+    let existed = dir.map(|d| d.exists());
+    let outer = WRITTEN.with(|w| w.borrow_mut().replace(Vec::new()));
+    let r = f();
+    let written = WRITTEN.with(|w| std::mem::replace(&mut *w.borrow_mut(), outer));
+    let written = written.unwrap_or_default();
+    if r.is_err() {
+        for p in &written {
+            let _ = std::fs::remove_file(p);
+        }
+        if let (Some(d), Some(false)) = (dir, existed) {
+            // only when empty: the directory may hold files written outside `f`
+            let _ = std::fs::remove_dir(d);
+        }
+    } else {
+        WRITTEN.with(|w| {
+            if let Some(w) = w.borrow_mut().as_mut() {
+                w.extend(written);
+            }
+        });
+    }
+    r
 }
 
 /// Set once a command has printed its JSON object, so that a failure after it (e.g. the demo

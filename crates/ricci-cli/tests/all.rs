@@ -60,6 +60,8 @@ mod cli_tspline;
 mod readme;
 #[path = "sweep_meshes.rs"]
 mod sweep_meshes;
+#[path = "sweep_tspline.rs"]
+mod sweep_tspline;
 
 #[path = "../../ricci/tests/test_files/mod.rs"]
 mod test_files;

@@ -364,7 +364,14 @@ fn flat_domain(
     })
 }
 
+/// `ricci tspline`: when it fails after writing part of `--out DIR`, those files are removed
+/// again (`all_or_nothing`): a failed run leaves no half-written directory.
 pub fn run_cmd(a: Args) -> anyhow::Result<()> {
+    let dir = a.out.clone();
+    crate::util::all_or_nothing(dir.as_deref(), || run_tspline(a))
+}
+
+fn run_tspline(a: Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let tolerance = parse_tolerance(&a.tolerance)?;
     let rms_tolerance = parse_fraction("--rms-tolerance", &a.rms_tolerance, true)?;
@@ -381,7 +388,7 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
     let genus0 = comps == 1 && genus == 0;
     if comps != 1 {
         anyhow::bail!(
-            "{}: ricci tspline supports closed surfaces of genus ≥ 1 and connected surfaces of any genus with boundary loops (filled for the domain); this mesh has {comps} components: fit each component on its own (one file per component)",
+            "{}: ricci tspline fits one connected surface (closed or with boundary loops, of any genus); this mesh has {comps} components: save each component to its own file and fit them one by one",
             a.mesh.display()
         );
     }
@@ -455,6 +462,7 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         "max_error_percent": max,
         "tolerance_percent": 100.0 * tolerance,
         "converged": r.converged,
+        "refinement_stalled": r.stalled,
         "iterations": r.steps.len(),
         "steps": r.steps,
         "continuity": continuity_json(&class, &jumps, &charts),
@@ -470,16 +478,7 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         "seconds_fit": fit_seconds,
         "seconds": t0.elapsed().as_secs_f64(),
     });
-    if !r.converged {
-        eprintln!(
-            "warning: {}: the fit stopped at L∞ {:.3} % above the tolerance {:.3} % (budget: {} iterations, {} control points)",
-            a.mesh.display(),
-            max,
-            100.0 * tolerance,
-            opts.max_iterations,
-            opts.max_control_points
-        );
-    }
+    warn_stopped(&a, &r, max, tolerance, &opts);
     if let Some(dir) = &a.out {
         write_outputs(dir, &a, &r, &patches, half)?;
         out["out"] = json!(dir.display().to_string());
@@ -510,6 +509,22 @@ pub fn run_cmd(a: Args) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The warning when the genus-0 / genus-1 fit stopped above the tolerance (L∞ `max` in
+/// percent): at the budget, or because the worst faces cannot be split (`FitResult::stalled`).
+fn warn_stopped(a: &Args, r: &FitResult, max: f64, tolerance: f64, opts: &FitOptions) {
+    let (file, tol) = (a.mesh.display(), 100.0 * tolerance);
+    if r.stalled {
+        eprintln!(
+            "warning: {file}: the fit stopped at L∞ {max:.3} % above the tolerance {tol:.3} %: the T-mesh faces holding the worst points cannot be split further (the conformal domain crowds those points within 1e-10 of its size, as on long thin protrusions); the result is the last fit"
+        );
+    } else if !r.converged {
+        eprintln!(
+            "warning: {file}: the fit stopped at L∞ {max:.3} % above the tolerance {tol:.3} % (budget: {} iterations, {} control points)",
+            opts.max_iterations, opts.max_control_points
+        );
+    }
 }
 
 /// The files of `--out DIR` but the report (see the module docs).

@@ -169,6 +169,9 @@ pub fn continuity<A: FlatCharts + Sync + ?Sized>(
 pub struct MeshDistance {
     tris: Vec<[[f64; 3]; 3]>,
     lo: [f64; 3],
+    /// Upper corner of the triangles' bounding box (the grid may end before it: at most 512
+    /// cells per axis, the last one holding the rest).
+    hi: [f64; 3],
     cell: f64,
     dims: [usize; 3],
     start: Vec<u32>,
@@ -305,6 +308,7 @@ impl MeshDistance {
         MeshDistance {
             tris,
             lo,
+            hi,
             cell,
             dims,
             start: count,
@@ -313,8 +317,13 @@ impl MeshDistance {
         }
     }
 
-    /// Distance from `p` to the mesh (searches growing shells of grid cells).
+    /// Distance from `p` to the mesh (searches growing shells of grid cells); NaN for a point
+    /// that is not finite.
     pub fn distance(&self, p: [f64; 3]) -> f64 {
+        if p.iter().any(|x| !x.is_finite()) {
+            // (no cell is near it: the search below would visit every shell of the grid)
+            return f64::NAN;
+        }
         // Start from the nearest cell of the grid (points outside the box are clamped in; the
         // shell bound below then loses one cell, hence `r − 1`).
         let c: [i64; 3] = std::array::from_fn(|k| {
@@ -323,30 +332,29 @@ impl MeshDistance {
         let mut best = f64::INFINITY;
         let maxr = self.dims.iter().copied().max().unwrap_or(1) as i64 + 1;
         for r in 0..=maxr {
-            // Points outside the box: distance to the box bounds the search from below.
-            for z in c[2] - r..=c[2] + r {
-                for y in c[1] - r..=c[1] + r {
-                    for x in c[0] - r..=c[0] + r {
-                        let shell = (x - c[0]).abs().max((y - c[1]).abs()).max((z - c[2]).abs());
-                        if shell != r {
-                            continue;
+            // The cells of the shell inside the grid: whole rows where y or z is on the shell,
+            // else the row's two ends in x (O(r²) cells per shell, not the (2r + 1)³ of the
+            // block: a point far outside the box visited ~r⁴ cells).
+            let dx = self.dims[0] as i64;
+            let within = |k: usize| (c[k] - r).max(0)..=(c[k] + r).min(self.dims[k] as i64 - 1);
+            for z in within(2) {
+                for y in within(1) {
+                    let face = (z - c[2]).abs() == r || (y - c[1]).abs() == r;
+                    let (step, mut x, end) = if face {
+                        (1, (c[0] - r).max(0), (c[0] + r).min(dx - 1))
+                    } else {
+                        (2 * r, c[0] - r, c[0] + r)
+                    };
+                    while x <= end {
+                        if (0..dx).contains(&x) {
+                            let cell = (z as usize * self.dims[1] + y as usize) * self.dims[0]
+                                + x as usize;
+                            let (a, b) = (self.start[cell] as usize, self.start[cell + 1] as usize);
+                            for &t in &self.items[a..b] {
+                                best = best.min(point_triangle_distance(p, &self.tris[t as usize]));
+                            }
                         }
-                        if x < 0
-                            || y < 0
-                            || z < 0
-                            || x as usize >= self.dims[0]
-                            || y as usize >= self.dims[1]
-                            || z as usize >= self.dims[2]
-                        {
-                            continue;
-                        }
-                        let cell =
-                            (z as usize * self.dims[1] + y as usize) * self.dims[0] + x as usize;
-                        for &t in
-                            &self.items[self.start[cell] as usize..self.start[cell + 1] as usize]
-                        {
-                            best = best.min(point_triangle_distance(p, &self.tris[t as usize]));
-                        }
+                        x += step;
                     }
                 }
             }
@@ -354,18 +362,32 @@ impl MeshDistance {
             if best <= (r as f64 - 1.0).max(0.0) * self.cell {
                 break;
             }
-            // Sharper, for points inside the grid: a triangle not yet seen has its bounding
-            // box outside the block of cells within r of `c`, so it is farther from `p` than
-            // the block's nearest face (less a margin for the rounding of cell indices). Most
-            // points stop after one cell instead of 5³.
+            // Sharper: a triangle not yet seen lies in cells outside the block of cells within
+            // r of `c`, so in some axis k beyond one of the block's faces that still has cells
+            // behind it, and inside the bounding box in the other axes: it is at least
+            // sqrt(gap_k² + Σ_{j≠k} out_j²) from `p` (`out_j`: how far `p` lies outside the box
+            // in axis j), less a margin for the rounding of cell indices. Most points inside
+            // stop after one cell instead of 5³, far points once the shells reach the
+            // surface's near side; every cell seen: no face left, the search ends.
+            let out: [f64; 3] =
+                std::array::from_fn(|k| (self.lo[k] - p[k]).max(p[k] - self.hi[k]).max(0.0));
             let gap = (0..3)
                 .map(|k| {
                     let below = self.lo[k] + (c[k] - r) as f64 * self.cell;
                     let above = self.lo[k] + (c[k] + r + 1) as f64 * self.cell;
-                    (p[k] - below).min(above - p[k])
+                    let mut g = f64::INFINITY;
+                    if c[k] - r > 0 {
+                        g = g.min(p[k] - below);
+                    }
+                    if c[k] + r < self.dims[k] as i64 - 1 {
+                        g = g.min(above - p[k]);
+                    }
+                    let g = g.max(0.0);
+                    let o: f64 = (0..3).filter(|&j| j != k).map(|j| out[j] * out[j]).sum();
+                    (g * g + o).sqrt()
                 })
                 .fold(f64::INFINITY, f64::min);
-            if best <= gap - 1e-9 * (self.cell + self.diagonal) {
+            if best <= gap - 1e-9 * (self.cell + self.diagonal) || gap == f64::INFINITY {
                 break;
             }
         }

@@ -121,7 +121,11 @@ pub struct FitStep {
     /// The rms of the errors, weighted by [`FitOptions::weights`] when they are given.
     pub rms_error_percent: f64,
     pub max_error_percent: f64,
+    /// Conjugate-gradient iterations; `FitOptions::cg_max_iterations` when they did not reach
+    /// the tolerance and the system was solved by sparse Cholesky instead, 0 when it was
+    /// solved by sparse Cholesky at once (the gradients failed on an earlier step).
     pub cg_iterations: usize,
+    /// Relative residual of the solution (of the Cholesky solve, measured, in that case).
     pub cg_relative_residual: f64,
 }
 
@@ -138,6 +142,10 @@ pub struct FitResult {
     /// [`FitOptions::parameter_correction`] > 0).
     pub params: Vec<[f64; 2]>,
     pub converged: bool,
+    /// The fit stopped above the tolerance because the faces marked for refinement could not
+    /// be split (narrower than the T-mesh's tolerance, 1e-10 of the lattice: the conformal
+    /// parameters of their points are that crowded), not at the budget.
+    pub stalled: bool,
 }
 
 /// Least squares with thin-plate fairness over a fixed T-mesh (one step of §3.3).
@@ -265,25 +273,7 @@ pub fn fit(
             "data point {k} or its parameter is not finite"
         )));
     }
-    if !(0.0..1.0).contains(&opts.mark_fraction) {
-        return Err(Error::input(format!(
-            "the marking fraction {} of the T-spline fit must be in [0, 1)",
-            opts.mark_fraction
-        )));
-    }
-    if !(opts.rms_tolerance >= 0.0 && opts.rms_tolerance < 1.0) {
-        return Err(Error::input(format!(
-            "the rms tolerance {} of the T-spline fit must be in [0, 1)",
-            opts.rms_tolerance
-        )));
-    }
-    let decay_ok = opts.smoothing_decay > 0.0 && opts.smoothing_decay <= 1.0;
-    if !(decay_ok && (0.0..1.0).contains(&opts.correction_gain)) {
-        return Err(Error::input(format!(
-            "the smoothing decay {} and the correction gain {} of the T-spline fit must be in (0, 1] and [0, 1)",
-            opts.smoothing_decay, opts.correction_gain
-        )));
-    }
+    check_options(opts)?;
     check_weights(&opts.weights, points.len())?;
     let scale = bbox_scale(points);
     if !(scale > 0.0) {
@@ -329,6 +319,8 @@ pub fn fit(
     let mut iteration = 0;
     let rms_target = opts.rms_tolerance.max(0.0) * scale;
     let mut smoothing = opts.smoothing;
+    // once the conjugate gradients fail on one T-mesh, the later (larger) ones go direct
+    let mut direct = false;
     loop {
         iteration += 1;
         progress.report("tspline", None, &format!("T-spline fit {iteration}"));
@@ -338,8 +330,15 @@ pub fn fit(
         let guess: Option<Vec<[f64; 3]>> = prev
             .as_ref()
             .map(|p| basis.anchors.iter().map(|a| p.point(a.u, a.v)).collect());
-        let (ts, cg_it, cg_res) =
-            fit_corrected(basis, points, &mut params, opts, smoothing, guess)?;
+        let (ts, cg_it, cg_res) = fit_corrected(
+            basis,
+            points,
+            &mut params,
+            opts,
+            smoothing,
+            guess,
+            &mut direct,
+        )?;
         let errors = errors_of(&ts, points, &params);
         let max = errors.iter().cloned().fold(0.0, f64::max);
         let rms = weighted_rms(&errors, &opts.weights);
@@ -368,12 +367,14 @@ pub fn fit(
             };
             refinement_marks(&mesh, &params, &errors, &m)
         };
-        let refined = if marks.is_empty() {
-            None
-        } else {
-            refine_within_budget(&mesh, &marks, opts.max_control_points, opts.budget_half)?
-        };
-        let Some(refined) = refined else {
+        let refined =
+            refine_within_budget(&mesh, &marks, opts.max_control_points, opts.budget_half)?;
+        // marked faces narrower than the T-mesh's tolerance are not split: the same T-mesh
+        // again would give the same fit (camel's legs: 15 identical steps to the budget)
+        let stalled = refined
+            .as_ref()
+            .is_some_and(|r| r.faces().len() == mesh.faces().len());
+        let Some(refined) = refined.filter(|_| !stalled) else {
             return Ok(FitResult {
                 spline: ts,
                 steps,
@@ -381,12 +382,37 @@ pub fn fit(
                 errors,
                 params,
                 converged,
+                stalled,
             });
         };
         mesh = refined;
         smoothing *= opts.smoothing_decay;
         prev = Some(ts);
     }
+}
+
+/// The ranges of the marking fraction, rms tolerance, smoothing decay and correction gain.
+fn check_options(opts: &FitOptions) -> Result<()> {
+    if !(0.0..1.0).contains(&opts.mark_fraction) {
+        return Err(Error::input(format!(
+            "the marking fraction {} of the T-spline fit must be in [0, 1)",
+            opts.mark_fraction
+        )));
+    }
+    if !(opts.rms_tolerance >= 0.0 && opts.rms_tolerance < 1.0) {
+        return Err(Error::input(format!(
+            "the rms tolerance {} of the T-spline fit must be in [0, 1)",
+            opts.rms_tolerance
+        )));
+    }
+    let decay_ok = opts.smoothing_decay > 0.0 && opts.smoothing_decay <= 1.0;
+    if !(decay_ok && (0.0..1.0).contains(&opts.correction_gain)) {
+        return Err(Error::input(format!(
+            "the smoothing decay {} and the correction gain {} of the T-spline fit must be in (0, 1] and [0, 1)",
+            opts.smoothing_decay, opts.correction_gain
+        )));
+    }
+    Ok(())
 }
 
 /// `weights` empty, or one finite non-negative weight per point with a positive sum.
@@ -511,9 +537,11 @@ fn fit_corrected(
     opts: &FitOptions,
     smoothing: f64,
     guess: Option<Vec<[f64; 3]>>,
+    direct: &mut bool,
 ) -> Result<(TSpline, usize, f64)> {
     // the fairness matrix and the pattern once per T-mesh; the rounds refill the data term
     let mut system = FitSystem::new(basis)?;
+    system.direct = *direct;
     let solve = |system: &mut FitSystem, params: &[[f64; 2]], guess: Option<&[[f64; 3]]>| {
         system.solve(
             points,
@@ -555,11 +583,12 @@ fn fit_corrected(
             rms = now;
         }
     }
+    *direct = system.direct;
     Ok((ts, cg_it, cg_res))
 }
 
-/// The genus-1 domain: flat metric (default conformal flow), cut along a canonical basis, flat
-/// layout; the deck translations span the lattice, reduced (Gauss) and rotated so that
+/// The genus-1 domain: flat metric (default conformal flow to max |K| ≤ 1e-11, accepted up to
+/// 1e-10 when rounding stalls it there), cut along a canonical basis, flat layout; the deck translations span the lattice, reduced (Gauss) and rotated so that
 /// `ω₁ = (W, 0)`, `ω₂ = (s, H)`. Returns one parameter per input vertex and the lattice.
 pub fn flat_torus_domain(
     surface: &Surface,
@@ -593,9 +622,12 @@ pub fn flat_torus_domain(
         progress,
     )?
     .result;
-    if !r.converged {
+    // Newton can stall a little above 1e-11 by rounding (camel, with angles down to 0.003°:
+    // 3.9e-11 after 50 iterations): accepted up to the tolerance of the layout's flat flow.
+    let accept = crate::flow::uniformize::layout_tolerance(Geometry::Euclidean);
+    if !(r.converged || r.max_curvature_error <= accept) {
         return Err(Error::numerical(format!(
-            "the flat-metric flow did not converge (max curvature error {:.3e} after {} iterations)",
+            "the flat-metric flow did not converge (max curvature error {:.3e} after {} iterations, above {accept:.0e})",
             r.max_curvature_error, r.iterations
         )));
     }

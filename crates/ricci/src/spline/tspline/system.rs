@@ -7,7 +7,8 @@
 //! stores it in compressed columns; every refit of a parameter-correction round only refills the
 //! values of `AᵀA` on that pattern (in parallel over fixed chunks of data points, summed in
 //! chunk order: the result does not depend on the number of threads) and runs the conjugate
-//! gradients, warm-started from the previous control points. A data pair outside the pattern
+//! gradients, warm-started from the previous control points (or, when they do not converge in
+//! their budget on an ill-conditioned domain, a sparse Cholesky solve). A data pair outside the pattern
 //! (possible only through rounding at element sides) widens the pattern once; nothing is lost.
 
 use super::bezier::elements;
@@ -38,6 +39,10 @@ pub(crate) struct FitSystem {
     pub basis: TBasis,
     fair: SparseColMat<usize, f64>,
     tr_f: f64,
+    /// Solve by sparse Cholesky without trying the conjugate gradients first: set by the
+    /// caller once they failed on an earlier system of the same fit, and by [`Self::solve`]
+    /// when they fail.
+    pub direct: bool,
 }
 
 /// What one solve returns: the control points, CG iterations and relative residual.
@@ -68,7 +73,12 @@ impl FitSystem {
             .concat();
         let fair = assemble(n, &fair)?;
         let tr_f = diagonal(fair.as_ref()).iter().sum();
-        Ok(FitSystem { basis, fair, tr_f })
+        Ok(FitSystem {
+            basis,
+            fair,
+            tr_f,
+            direct: false,
+        })
     }
 
     /// Position of entry `(i, j)` in the values, if it is in the pattern.
@@ -142,7 +152,9 @@ impl FitSystem {
 
     /// Least squares with thin-plate fairness at the parameters `params`: `λ = smoothing ·
     /// tr(AᵀA)/tr(F)`, symmetric Jacobi scaling, conjugate gradients from `guess` to the
-    /// relative residual `cg_tolerance`.
+    /// relative residual `cg_tolerance`; when they do not reach it in `cg_max_iterations`,
+    /// sparse Cholesky of the same system (iterations reported as `cg_max_iterations`, the
+    /// residual measured), and with [`Self::direct`] sparse Cholesky only (0 iterations).
     #[allow(clippy::too_many_arguments)]
     pub fn solve(
         &mut self,
@@ -199,6 +211,11 @@ impl FitSystem {
                 }
             }
         }
+        if self.direct {
+            x = direct_solve(k, &rhs, cg_tolerance, cg_max_iterations)?;
+            let resid = relative_residual(k, &x, &rhs);
+            return Ok((unscale(&x, &s)?, 0, resid));
+        }
         let precond = IdentityPrecond { dim: n };
         let params_cg = CgParams {
             rel_tolerance: cg_tolerance,
@@ -218,21 +235,60 @@ impl FitSystem {
         );
         let (iters, resid) = match info {
             Ok(i) => (i.iter_count, i.rel_residual),
-            Err(e) => {
-                return Err(Error::numerical(format!(
-                    "the conjugate gradients of the T-spline fit broke down: {e:?}"
-                )))
+            // Ill-conditioned (e.g. the decimated knight's genus-0 domain, whose limbs the
+            // conformal map shrinks by orders of magnitude): the sparse Cholesky factorization
+            // of the same scaled system, its residual measured.
+            Err(_) => {
+                self.direct = true;
+                x = direct_solve(k, &rhs, cg_tolerance, cg_max_iterations)?;
+                (cg_max_iterations, relative_residual(k, &x, &rhs))
             }
         };
-        let control: Vec<[f64; 3]> = (0..n)
-            .map(|i| [x[(i, 0)] * s[i], x[(i, 1)] * s[i], x[(i, 2)] * s[i]])
-            .collect();
-        if control.iter().any(|c| c.iter().any(|x| !x.is_finite())) {
-            return Err(Error::numerical(
-                "the T-spline fit produced non-finite control points",
-            ));
-        }
-        Ok((control, iters, resid))
+        Ok((unscale(&x, &s)?, iters, resid))
+    }
+}
+
+/// The control points `x_i · s_i` of the scaled unknowns; an error if one is not finite.
+fn unscale(x: &Mat<f64>, s: &[f64]) -> Result<Vec<[f64; 3]>> {
+    let control: Vec<[f64; 3]> = (0..s.len())
+        .map(|i| [x[(i, 0)] * s[i], x[(i, 1)] * s[i], x[(i, 2)] * s[i]])
+        .collect();
+    if control.iter().any(|c| c.iter().any(|x| !x.is_finite())) {
+        return Err(Error::numerical(
+            "the T-spline fit produced non-finite control points",
+        ));
+    }
+    Ok(control)
+}
+
+/// The solution of `k x = rhs` by sparse Cholesky (`k` symmetric positive definite, both
+/// triangles stored), when the conjugate gradients did not reach `cg_tolerance` in
+/// `cg_max_iterations`; one sentence when `k` is not numerically positive definite either.
+fn direct_solve(
+    k: SparseColMatRef<'_, usize, f64>,
+    rhs: &Mat<f64>,
+    cg_tolerance: f64,
+    cg_max_iterations: usize,
+) -> Result<Mat<f64>> {
+    let chol = crate::numeric::sparse::Cholesky::factor(k).map_err(|_| {
+        Error::numerical(format!(
+            "the T-spline fitting system ({} control points) could not be solved: the conjugate gradients did not reach the relative residual {cg_tolerance:.0e} in {cg_max_iterations} iterations and its matrix is not numerically positive definite (sparse Cholesky failed)",
+            k.nrows()
+        ))
+    })?;
+    let mut x = rhs.clone();
+    chol.solve_in_place(x.as_mut());
+    Ok(x)
+}
+
+/// `‖k x − rhs‖ / ‖rhs‖` (Frobenius norms over the three coordinates).
+fn relative_residual(k: SparseColMatRef<'_, usize, f64>, x: &Mat<f64>, rhs: &Mat<f64>) -> f64 {
+    let r = k * x - rhs;
+    let b = rhs.norm_l2();
+    if b > 0.0 {
+        r.norm_l2() / b
+    } else {
+        r.norm_l2()
     }
 }
 
