@@ -127,11 +127,27 @@ fn carried_blocks_split_their_region_at_least_as_finely() {
 /// 0.5 %.
 #[test]
 fn fertility_at_one_percent_keeps_what_it_has_and_needs_fewer_points_than_at_half() {
+    one_percent_keeps_what_it_has_and_needs_no_more_points_than_half("fertility", 1.0);
+}
+
+/// 3holes.off at 1 %: one point next to a zero stalled at 1.009 → 1.008 % while three more
+/// levels at the zeros were added (6 078 points against 4 623 at 0.5 %); a level that does not
+/// help a point that close to the tolerance now stops the levels (`LEVEL_STALL`). The two fits
+/// refine along different paths, so 1 % may take a few more points than 0.5 % (4 606 against
+/// 4 396 for the vertices-only fit): at most 10 % more here, against 38 % before.
+#[test]
+fn three_holes_at_one_percent_needs_about_the_points_of_half() {
+    one_percent_keeps_what_it_has_and_needs_no_more_points_than_half("3holes", 1.1);
+}
+
+/// `name`.off at 1 %: no step's L∞ above 1.5 times the smallest before it, and at most
+/// `factor` times the control points of the fit at 0.5 %.
+fn one_percent_keeps_what_it_has_and_needs_no_more_points_than_half(name: &str, factor: f64) {
     let Some(dir) = ricci_meshes::ricci_meshes() else {
-        eprintln!("RICCI_MESHES is not set: fertility.off skipped");
+        eprintln!("RICCI_MESHES is not set: {name}.off skipped");
         return;
     };
-    let s = ricci::mesh::io::read_surface(&dir.join("fertility.off"))
+    let s = ricci::mesh::io::read_surface(&dir.join(format!("{name}.off")))
         .unwrap()
         .0;
     let h = forms(&s);
@@ -145,7 +161,7 @@ fn fertility_at_one_percent_keeps_what_it_has_and_needs_fewer_points_than_at_hal
     for (f, tolerance) in [(&one, 0.01), (&half, 0.005)] {
         let max = max_vertex_error(&d, f, &s.positions) / side;
         eprintln!(
-            "fertility at {} %: {} control points, L∞ {:.4} %, steps {:?}",
+            "{name} at {} %: {} control points, L∞ {:.4} %, steps {:?}",
             100.0 * tolerance,
             f.mesh.n_control_points(),
             100.0 * max,
@@ -168,7 +184,7 @@ fn fertility_at_one_percent_keeps_what_it_has_and_needs_fewer_points_than_at_hal
         least = least.min(st.max_error_percent);
     }
     assert!(
-        one.mesh.n_control_points() <= half.mesh.n_control_points(),
+        one.mesh.n_control_points() as f64 <= factor * half.mesh.n_control_points() as f64,
         "{} control points at 1 %, {} at 0.5 %",
         one.mesh.n_control_points(),
         half.mesh.n_control_points()

@@ -7,7 +7,9 @@
 //! the zeros, and optionally the exact thin-plate energy ([`DomainFitOptions::thin_plate`]).
 //! Refinement is local where it can be: while a point of a cell next to a zero
 //! ([`DomainMesh::near_zero`]) is beyond the tolerance, the mesh is refined once more at the
-//! zeros ([`DomainMesh::graded`]: two columns and rows per strip); while a point elsewhere is,
+//! zeros ([`DomainMesh::graded`]: two columns and rows per strip; no more once a level left
+//! the largest error there within [`STALL_NEAR`] × the tolerance and not [`LEVEL_STALL`] lower,
+//! those points then go to the blocks); while a point elsewhere is,
 //! the cells around it are split 2×2 in blocks whose lines end in T-junctions
 //! ([`super::domain_mesh::blocks`], [`DomainFitOptions::blocks`]; a cell split already by
 //! blocks nested in the deepest block that split it; a cell in the first or last row or column
@@ -169,6 +171,16 @@ pub const T_MARGIN: usize = 2;
 
 /// The most levels of refinement at the zeros; beyond, errors there refine uniformly.
 pub const MAX_LEVELS: usize = 8;
+
+/// A level at the zeros that leaves the largest error next to them above this fraction of what
+/// it was, when that error is within [`STALL_NEAR`] times the tolerance, stops the levels: the
+/// points there go to the blocks (or the spacing) instead. (3holes.off at 1 %: three levels,
+/// ≈ 750 control points each, moved one point from 1.009 to 1.008 % of the box.) Farther from
+/// the tolerance a level that does not help yet is kept: the spacing may be what is missing.
+pub const LEVEL_STALL: f64 = 0.98;
+
+/// See [`LEVEL_STALL`].
+pub const STALL_NEAR: f64 = 1.5;
 
 impl Default for DomainFitOptions {
     fn default() -> Self {
@@ -637,6 +649,7 @@ pub fn fit_domain_mesh_on_triangles(
     let refine = opts.refine.clamp(0.1, 0.95);
     let (mut filled, mut carried_now) = (false, false);
     let (mut levels, mut previous_spacing, mut margin) = (0, spacing, T_MARGIN);
+    let (mut max_levels, mut worst_before) = (MAX_LEVELS, None);
     let mut blocks: Vec<Block> = Vec::new();
     let use_blocks = opts.blocks && opts.t_junctions && opts.g1_at_zeros;
     for _ in 0..opts.max_iterations.max(1) {
@@ -700,20 +713,18 @@ pub fn fit_domain_mesh_on_triangles(
             max_error_percent: 100.0 * max / scale,
         });
         let converged = max <= opts.tolerance * scale;
-        // where the tolerance is exceeded: next to a zero, elsewhere
-        let (mut near, mut extend) = (false, false);
-        let mut far = Vec::new();
-        for (&(c, _, _), &e) in located.iter().zip(&errors) {
-            if e > opts.tolerance * scale {
-                if opts.local_refinement && levels < MAX_LEVELS && mesh.near_zero(c) {
-                    near = true;
-                } else if mesh.past_t_junction(c) {
-                    extend = true;
-                } else {
-                    far.push(c);
-                }
+        // where the tolerance is exceeded: next to a zero, elsewhere; a level at the zeros that
+        // did not lower the error next to them by LEVEL_STALL, when it is within STALL_NEAR of
+        // the tolerance, stops the levels
+        let worst = near_worst(&mesh, &located, &errors, opts.tolerance * scale);
+        if let (Some(before), Some(now)) = (worst_before, worst) {
+            if now > LEVEL_STALL * before && now <= STALL_NEAR * opts.tolerance * scale {
+                max_levels = levels;
             }
         }
+        let allow = opts.local_refinement && levels < max_levels;
+        let (near, extend, far) = classify(&mesh, &located, &errors, opts.tolerance * scale, allow);
+        worst_before = worst.filter(|_| near);
         let mesh_levels = mesh.rects.first().map_or(0, |r| r.levels);
         keep_best(&mut best, last.take());
         last = Some(DomainFit {
@@ -761,6 +772,46 @@ pub fn fit_domain_mesh_on_triangles(
     }
     let last = last.ok_or_else(|| Error::numerical("domain mesh fit: no iteration ran"))?;
     Ok(best_of(last, best))
+}
+
+/// The largest error beyond `tolerance` of a point in a cell next to a zero, if any.
+fn near_worst(
+    mesh: &DomainMesh,
+    located: &[(u32, f64, f64)],
+    errors: &[f64],
+    tolerance: f64,
+) -> Option<f64> {
+    located
+        .iter()
+        .zip(errors)
+        .filter(|&(&(c, _, _), &e)| e > tolerance && mesh.near_zero(c))
+        .map(|(_, &e)| e)
+        .reduce(f64::max)
+}
+
+/// Where the points beyond `tolerance` lie: next to a zero (when `levels` may grow), beside a
+/// graded line past its T-junction, or elsewhere (their cells).
+fn classify(
+    mesh: &DomainMesh,
+    located: &[(u32, f64, f64)],
+    errors: &[f64],
+    tolerance: f64,
+    levels: bool,
+) -> (bool, bool, Vec<u32>) {
+    let (mut near, mut extend) = (false, false);
+    let mut far = Vec::new();
+    for (&(c, _, _), &e) in located.iter().zip(errors) {
+        if e > tolerance {
+            if levels && mesh.near_zero(c) {
+                near = true;
+            } else if mesh.past_t_junction(c) {
+                extend = true;
+            } else {
+                far.push(c);
+            }
+        }
+    }
+    (near, extend, far)
 }
 
 /// The largest distance of `f`'s spline to a data vertex.
