@@ -11,7 +11,7 @@ mod tspline_cases;
 use crate::tspline_domain_mesh::{check_t_spline, Rng};
 use ricci::spline::tspline::domain_mesh::blocks::{carry_blocks, place_blocks, CLEAR};
 use ricci::spline::tspline::domain_mesh::DomainMesh;
-use tspline_cases::{fit_at, forms, genus_two_cases, glued_domain, max_vertex_error};
+use tspline_cases::{fit_at, genus_two_cases, glued_domain, max_vertex_error};
 
 /// The width and height of the cell of `m` at `(x, y)` of strip `r`.
 fn cell_size(m: &DomainMesh, r: usize, x: f64, y: f64) -> (f64, f64) {
@@ -150,9 +150,7 @@ fn one_percent_keeps_what_it_has_and_needs_no_more_points_than_half(name: &str, 
     let s = ricci::mesh::io::read_surface(&dir.join(format!("{name}.off")))
         .unwrap()
         .0;
-    let h = forms(&s);
-    let d = ricci::spline::tspline::genus_domain::best_genus_domain(&h, s.positions.len()).unwrap();
-    let g = ricci::spline::tspline::glue::gluing(&d).unwrap();
+    let (d, g, _) = glued_domain(&s);
     let side = ricci::spline::tspline::fit::bbox_scale(&s.positions);
     let (one, half) = (
         fit_at(&d, &g, &s.positions, 0.01, true),

@@ -162,7 +162,8 @@ pub(super) fn within_budget(
 
 /// The mesh of `spacing`, `levels` and `margin` with `blocks`, after dropping the blocks of the
 /// strips around a vertex where the extensions of T-junctions meet, until none do (all of them
-/// when that vertex's strips have none).
+/// when that vertex's strips have none). Every round drops a block, so it ends; the mesh
+/// without blocks is taken as it is (as [`step_mesh`] takes it).
 pub(super) fn drop_where_extensions_meet(
     (domain, gluing, opts): (&GenusDomain, &Gluing, &DomainFitOptions),
     at: (f64, usize, usize),
@@ -170,6 +171,9 @@ pub(super) fn drop_where_extensions_meet(
 ) -> Result<DomainMesh> {
     loop {
         let mesh = domain_mesh(domain, gluing, at, blocks, opts)?;
+        if blocks.is_empty() {
+            return Ok(mesh);
+        }
         let Some(v) = mesh.extensions_meet().map_err(Error::numerical)? else {
             return Ok(mesh);
         };

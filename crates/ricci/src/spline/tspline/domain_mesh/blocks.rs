@@ -538,9 +538,6 @@ pub fn place_blocks(mesh: &DomainMesh, marked: &[u32]) -> Result<Vec<Block>, Str
     Ok(out)
 }
 
-/// The levels a block loses when it is carried to a finer spacing ([`carry_blocks`]).
-pub const CARRY_DOWN: usize = 0;
-
 /// The range `[lo, hi]` (coordinates along a strip side) in the intervals of the mesh whose
 /// knots are `knots` halved `level − 1` times: the least range of them that covers it.
 fn covering(knots: &[f64], level: usize, (lo, hi): (f64, f64)) -> (usize, usize) {
@@ -556,8 +553,8 @@ fn covering(knots: &[f64], level: usize, (lo, hi): (f64, f64)) -> (usize, usize)
 
 /// The blocks of `old` carried to `new`, the graded mesh (no blocks) of a finer spacing and as
 /// many levels at the zeros or more, over the same strips: what the blocks had split stays split
-/// **at least as finely**. Block by block, parents first, the box of the same level
-/// ([`CARRY_DOWN`] fewer) of `new` that covers the region of its box, inside the split part of
+/// **at least as finely**. Block by block, parents first, the box of the same level of `new`
+/// that covers the region of its box, inside the split part of
 /// its carried parent one cell in from its sides (as [`box_in`] places a nested box), closed
 /// (module doc). A level-`ℓ` cell on the spacing `h` is `h / 2^ℓ` wide; carried on `h / √2` it
 /// is `√2` finer (the spacing's step doubles the blocks' control points, as everywhere else).
@@ -570,9 +567,7 @@ pub fn carry_blocks(old: &DomainMesh, new: &DomainMesh) -> Vec<Block> {
     let mut carried: Vec<Option<Block>> = vec![None; old.blocks.len()];
     for k in order {
         let b = &old.blocks[k];
-        let Some(level) = b.level.checked_sub(CARRY_DOWN).filter(|&l| l >= 1) else {
-            continue;
-        };
+        let level = b.level;
         let (orc, nrc) = (&old.rects[b.rect], &new.rects[b.rect]);
         let s = b.cell_fine();
         let ((bu, bv), (nu, nv)) = (orc.base_knots(), nrc.base_knots());
@@ -586,9 +581,6 @@ pub fn carry_blocks(old: &DomainMesh, new: &DomainMesh) -> Vec<Block> {
             let Some(p) = parent_of(&old.blocks, b).and_then(|p| carried[p]) else {
                 continue;
             };
-            if p.level + 1 != level {
-                continue;
-            }
             let inner = |(a, z): (usize, usize), r: std::ops::Range<usize>, lo, hi, split| {
                 if split {
                     (a.max(2 * r.start + 1), z.min((2 * r.end).saturating_sub(1)))
